@@ -1,0 +1,62 @@
+/*
+ * tase/common.h - error codes and small definitions shared by every module.
+ *
+ * Conventions used throughout the library:
+ *  - Functions that can fail return int: 0 (or a length/count) on success,
+ *    a negative TASE_E* code on failure. A failing call leaves its outputs
+ *    and the instance it was given unchanged unless its contract says
+ *    otherwise.
+ *  - Errors that come from the wire (bad checksums, noise, wrong lengths)
+ *    are not return codes: they are counted in statistics and may be
+ *    reported to an error hook.
+ *  - All state is owned by the caller; the library keeps no globals and
+ *    never allocates.
+ */
+#ifndef TASE_COMMON_H
+#define TASE_COMMON_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TASE_VERSION_MAJOR 0
+#define TASE_VERSION_MINOR 1
+#define TASE_VERSION_PATCH 0
+
+/* Error codes. Stable: values never change meaning once released. */
+#define TASE_OK 0
+#define TASE_EARG (-1)        /* NULL pointer or out-of-range argument */
+#define TASE_ENOSPC (-2)      /* caller's buffer too small */
+#define TASE_ETOOLONG (-3)    /* data longer than the protocol allows */
+#define TASE_ELENGTH (-4)     /* wrong data length for this packet type */
+#define TASE_EUNKNOWN (-5)    /* group/type (or name, tag) not known */
+#define TASE_ECHECKSUM (-6)   /* checksum mismatch */
+#define TASE_EFORMAT (-7)     /* malformed input (bad key, tag, layout) */
+#define TASE_ERANGE (-8)      /* value outside its representable range */
+#define TASE_EAGAIN (-9)      /* nothing to do now / would block; retry */
+#define TASE_ETIMEOUT (-10)   /* no answer within the time allowed */
+#define TASE_EIO (-11)        /* operating-system I/O error */
+#define TASE_ENODEV (-12)     /* device or interface does not exist */
+#define TASE_EDOWN (-13)      /* interface exists but is down */
+#define TASE_EACCES (-14)     /* permission denied */
+#define TASE_EBUSY (-15)      /* a request is already in progress */
+#define TASE_ENOBUFS (-16)    /* transmit queue full; nothing was sent */
+#define TASE_ETRUNC (-17)     /* input ends before the item is complete */
+#define TASE_EUNSUPPORTED (-18) /* valid request this build/port cannot do */
+#define TASE_ESTATE (-19)     /* call not valid in the current state */
+
+/* Returns a short constant English description of a TASE_E* code (or of
+ * TASE_OK). Unknown codes give "unknown error". Never returns NULL.
+ * Lives in its own translation unit so firmware that never calls it does
+ * not link the strings. Reentrant, ISR-safe. */
+const char *tase_strerror(int err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TASE_COMMON_H */

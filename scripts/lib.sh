@@ -1,0 +1,35 @@
+# Shared by the scripts in this folder; source it, do not run it.
+# shellcheck shell=bash
+
+TASE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+# tase_need LIST...: install the Debian packages named in
+# scripts/packages.d/LIST.txt (one per line, # comments) that are missing.
+# Runs apt-get update once, only when something is missing.
+tase_need() {
+    local list pkgs=() missing=() p
+    for list in "$@"; do
+        while read -r p; do
+            p=${p%%#*}; p=${p//[[:space:]]/}
+            [ -n "$p" ] && pkgs+=("$p")
+        done < "$TASE_ROOT/scripts/packages.d/$list.txt"
+    done
+    for p in "${pkgs[@]}"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || missing+=("$p")
+    done
+    [ ${#missing[@]} -eq 0 ] && return 0
+    echo "== installing: ${missing[*]}"
+    local sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo=sudo
+    export DEBIAN_FRONTEND=noninteractive
+    $sudo apt-get update -qq
+    $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# tase_all_lists: every package list, for the full test suite.
+tase_all_lists() {
+    local f
+    for f in "$TASE_ROOT"/scripts/packages.d/*.txt; do
+        basename "$f" .txt
+    done
+}
