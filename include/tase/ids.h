@@ -1,0 +1,52 @@
+/*
+ * tase/ids.h - group and packet-type numbers of the spec (section 4).
+ *
+ * A packet is identified by its (group, type) pair; TASE_ID() packs the
+ * pair into one 16-bit value, group in the high byte, for switch
+ * statements and tables.
+ */
+#ifndef TASE_IDS_H
+#define TASE_IDS_H
+
+#include "tase/common.h"
+
+#define TASE_ID(group, type) ((uint16_t)(((unsigned)(group) << 8) | (unsigned)(type)))
+#define TASE_ID_GROUP(id) ((uint8_t)((unsigned)(id) >> 8))
+#define TASE_ID_TYPE(id) ((uint8_t)((unsigned)(id) & 0xFFu))
+
+/* Groups (spec table 3) */
+#define TASE_GROUP_COMMAND 0x00u  /* command and control input */
+#define TASE_GROUP_DYNAMICS 0x08u /* rate and attitude information */
+#define TASE_GROUP_POSITION 0x10u /* GPS and sensor point of interest */
+#define TASE_GROUP_STATUS 0x28u   /* status; no packets defined in v1.0.0 */
+#define TASE_GROUP_SETUP 0x48u    /* gimbal setup (echoed, queryable) */
+
+/* Group 0x00 (table 4) */
+#define TASE_ID_GIMBAL_CMD TASE_ID(0x00u, 0x80u)
+#define TASE_ID_GYRO_ZERO_CMD TASE_ID(0x00u, 0x40u)
+#define TASE_ID_CAMERA_CMD TASE_ID(0x00u, 0x41u)
+#define TASE_ID_LEGACY_CAMERA_CMD TASE_ID(0x00u, 0x81u)
+#define TASE_ID_CAMERA_PASS TASE_ID(0x00u, 0x42u)
+#define TASE_ID_RETRACT_DEPLOY_CMD TASE_ID(0x00u, 0x43u)
+/* Group 0x08 (table 10) */
+#define TASE_ID_GIMBAL_ANGLE TASE_ID(0x08u, 0x10u)
+#define TASE_ID_GIMBAL_RATE TASE_ID(0x08u, 0x40u) /* "GIMBAL_TELEMETRY" in table 10 */
+#define TASE_ID_HOST_SENSOR TASE_ID(0x08u, 0x41u)
+#define TASE_ID_HOST_ATTITUDE TASE_ID(0x08u, 0x42u)
+/* Group 0x10 (table 15) */
+#define TASE_ID_HOST_GPS_DATA TASE_ID(0x10u, 0x10u)
+#define TASE_ID_SPOI_CMD TASE_ID(0x10u, 0x40u)
+#define TASE_ID_GEOREFERENCE_DATA TASE_ID(0x10u, 0x41u)
+/* Group 0x48 (table 19) */
+#define TASE_ID_PACKET_RATE TASE_ID(0x48u, 0x00u)
+#define TASE_ID_SENSOR_FILTER TASE_ID(0x48u, 0x01u)
+#define TASE_ID_AXIS_SETTING TASE_ID(0x48u, 0x02u)
+#define TASE_ID_SYSTEM_VERSION TASE_ID(0x48u, 0x03u)
+#define TASE_ID_NAV_SOURCE TASE_ID(0x48u, 0x04u)
+#define TASE_ID_CAMERA_TYPE TASE_ID(0x48u, 0x05u)
+#define TASE_ID_GPS_LEVER_ARM TASE_ID(0x48u, 0x06u)
+#define TASE_ID_CAMERA_ALIGN TASE_ID(0x48u, 0x07u)
+
+#define TASE_PACKET_COUNT 21u
+
+#endif /* TASE_IDS_H */
