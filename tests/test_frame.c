@@ -541,6 +541,49 @@ static void bit_errors_cost_untouched_frames_no_latency(void **state)
     free(r);
 }
 
+static void any_split_gives_identical_frames_and_counters(void **state)
+{
+    static uint8_t buf[1 << 20];
+    static size_t starts[3000], ends[3000];
+    tase_rx_t a, b;
+    recorder_t *ra = new_recorder(&a);
+    recorder_t *rb = new_recorder(&b);
+    size_t n, pos, k, trial;
+    (void)state;
+    for (trial = 0; trial < 6; trial++) {
+        rng_state = (uint32_t)(0xC0FFEEu + trial);
+        n = build_noisy_stream(buf, sizeof(buf), 3000, starts, ends);
+        assert_int_equal(tase_rx_init(&a), TASE_OK);
+        assert_int_equal(tase_rx_init(&b), TASE_OK);
+        ra->n = 0;
+        rb->n = 0;
+        feed_bytes_one_by_one(&a, buf, n, ra);
+        if (trial == 0) {
+            assert_true(tase_rx_feed(&b, buf, n, record, rb) >= 0); /* one call */
+        } else {
+            for (pos = 0; pos < n;) {
+                size_t chunk = 1 + rnd() % (trial * 100);
+                if (chunk > n - pos) {
+                    chunk = n - pos;
+                }
+                assert_true(tase_rx_feed(&b, buf + pos, chunk, record, rb) >= 0);
+                pos += chunk;
+            }
+        }
+        assert_true(tase_rx_flush(&a, record, ra) >= 0);
+        assert_true(tase_rx_flush(&b, record, rb) >= 0);
+        assert_int_equal(ra->n, rb->n);
+        for (k = 0; k < ra->n; k++) {
+            assert_int_equal(ra->f[k].offset, rb->f[k].offset);
+            assert_int_equal(ra->f[k].len, rb->f[k].len);
+            assert_memory_equal(ra->f[k].data, rb->f[k].data, ra->f[k].len);
+        }
+        assert_memory_equal(&a.stats, &b.stats, sizeof(a.stats));
+    }
+    free(ra);
+    free(rb);
+}
+
 static void more_overlapping_candidates_than_slots_still_loses_nothing(void **state)
 {
     tase_rx_t rx;
@@ -720,6 +763,7 @@ int main(void)
         cmocka_unit_test(failed_frame_is_rescanned_from_the_byte_after_its_first_sync),
         cmocka_unit_test(noisy_stream_delivers_every_clean_packet_once_in_order),
         cmocka_unit_test(bit_errors_cost_untouched_frames_no_latency),
+        cmocka_unit_test(any_split_gives_identical_frames_and_counters),
         cmocka_unit_test(more_overlapping_candidates_than_slots_still_loses_nothing),
         cmocka_unit_test(flush_finds_clean_packets_held_at_end_of_input),
         cmocka_unit_test(flush_of_clean_stream_changes_nothing),
