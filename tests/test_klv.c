@@ -616,6 +616,25 @@ static void packet_is_delivered_by_the_call_that_feeds_its_last_byte(void **stat
     assert_int_equal(seen.n, 1);
 }
 
+static void packet_behind_a_cut_packet_comes_out_with_its_last_byte(void **state)
+{
+    tase_klv_rx_t rx;
+    seen_t seen;
+    size_t cut, i;
+    (void)state;
+    for (cut = 1; cut < 87; cut++) {
+        memset(&seen, 0, sizeof(seen));
+        assert_int_equal(tase_klv_rx_init(&rx), TASE_OK);
+        assert_int_equal(tase_klv_rx_feed(&rx, hand_packet, cut, on_packet, NULL, &seen), 0);
+        for (i = 0; i < 86; i++) {
+            assert_int_equal(tase_klv_rx_feed(&rx, hand_packet + i, 1, on_packet, NULL, &seen),
+                             0);
+        }
+        assert_int_equal(tase_klv_rx_feed(&rx, hand_packet + 86, 1, on_packet, NULL, &seen), 1);
+        assert_int_equal(seen.offset[0], cut);
+    }
+}
+
 static void scanner_rejects_bad_arguments_and_resets_counters(void **state)
 {
     tase_klv_rx_t rx;
@@ -791,6 +810,7 @@ int main(void)
         cmocka_unit_test(errors_are_reported_with_offset_and_code),
         cmocka_unit_test(flush_reports_only_candidates_with_a_whole_key),
         cmocka_unit_test(packet_is_delivered_by_the_call_that_feeds_its_last_byte),
+        cmocka_unit_test(packet_behind_a_cut_packet_comes_out_with_its_last_byte),
         cmocka_unit_test(scanner_rejects_bad_arguments_and_resets_counters),
         cmocka_unit_test(raw_to_units_match_hand_computed_values),
         cmocka_unit_test(units_to_raw_round_to_nearest),
