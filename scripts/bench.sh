@@ -24,7 +24,7 @@ if [ -f "$TASE_ROOT/include/tase/dispatch.h" ]; then
     cflags+=(-DBENCH_DISPATCH)
     variants+=(dispatch)
 fi
-build_cmd="gcc ${cflags[*]} -Iinclude src/*.c bench/bench_rx.c -o $bdir/bench_rx"
+build_cmd="gcc ${cflags[*]} -Iinclude src/*.c bench/bench_rx.c -o ${bdir#$TASE_ROOT/}/bench_rx"
 (cd "$TASE_ROOT" && gcc "${cflags[@]}" -Iinclude src/*.c bench/bench_rx.c -o "$bdir/bench_rx")
 bin="$bdir/bench_rx"
 
@@ -63,6 +63,10 @@ for stream in telemetry badsize sync4 syncrand noise zeros; do
         fi
         if [ "$stream" = telemetry ] && [ "$variant" = framing ]; then
             tele=${cols[0]}
+            ir --toggle-collect='tase_rx_feed' "$bin" telemetry 4096 once >/dev/null
+            profile=$(callgrind_annotate --inclusive=no --auto=no "$bdir/callgrind.out" 2>/dev/null |
+                      grep -E '^ *[0-9,]+ +\(' | grep -v 'PROGRAM TOTALS' | head -8 |
+                      sed -E "s#$TASE_ROOT/##; s# \[[^]]*\]##; s#^ *#    #")
         fi
     done
 done
@@ -108,6 +112,14 @@ status=$(awk -v a="$tele" 'BEGIN {print (a <= 10) ? "met" : "**missed**"}')
     echo "- Framing only, telemetry stream, x86-64 gcc -O2: $tele instructions per byte"
     echo "  (chunk 4096) against a target of <= 10: $status. MAVLink's parser costs about 41"
     echo "  per byte on the same kind of measurement (figure as issue 8 states it)."
+    echo "- Where the telemetry stream's instructions go (chunk 4096, exclusive cost per"
+    echo "  function; static functions of src/frame.c that gcc inlined are counted in their"
+    echo "  caller; per-line detail: \`callgrind_annotate --auto=yes callgrind.out\` after"
+    echo "  \`valgrind --tool=callgrind --toggle-collect=tase_rx_feed"
+    echo "  --callgrind-out-file=callgrind.out bench_rx telemetry 4096 once\`):"
+    echo
+    echo "$profile"
+    echo
     echo "- Worst case measured for adversarial input (chunk 1): $worst instructions per byte"
     echo "  ($worst_name). The receiver's bound is O(n * TASE_FRAME_MAX) (include/tase/frame.h)."
 } > "$out"

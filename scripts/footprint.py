@@ -145,6 +145,22 @@ def worst_stack(fn, own, edges, names, memo):
     return memo[fn]
 
 
+def to_callback(fn, own, edges, names, memo):
+    """Deepest stack at a call through a function pointer below fn
+    (fn's frame included), or (-1, []) when there is none."""
+    if fn in memo:
+        return memo[fn]
+    if fn not in own:
+        return (-1, [])
+    best = (0, []) if "__indirect_call" in edges.get(fn, ()) else (-1, [])
+    for callee in sorted(edges.get(fn, ())):
+        d, c = to_callback(callee, own, edges, names, memo)
+        if d >= 0 and d > best[0]:
+            best = (d, c)
+    memo[fn] = (own[fn] + best[0], [names.get(fn, fn)] + best[1]) if best[0] >= 0 else (-1, [])
+    return memo[fn]
+
+
 def met(value, target):
     return "met" if value <= target else "**missed** (+%d)" % (value - target)
 
@@ -232,16 +248,19 @@ def main():
         memo = {}
         stacks[c] = (own, edges, names, memo)
     def rx_stack(c):
+        """Deepest of: the receiver's own chains, and the chain down to its
+        frame-callback call site plus the dispatcher's deepest chain."""
         own, edges, names, memo = stacks[c]
         best = max((worst_stack(r, own, edges, names, memo) for r in
                     ("tase_rx_feed", "tase_rx_flush") if r in own), key=lambda x: x[0])
-        extra = (0, [], set())
-        if res[c]["dispatch"]:
-            for s in globals_of(res[c]["objs"]["dispatch"]):
-                d = worst_stack(s, own, edges, names, memo)
-                if d[0] > extra[0]:
-                    extra = d
-        return best[0] + extra[0], best[1] + extra[1], best[2] | extra[2]
+        if not res[c]["dispatch"]:
+            return best
+        disp = max((worst_stack(s, own, edges, names, memo)
+                    for s in globals_of(res[c]["objs"]["dispatch"])), key=lambda x: x[0])
+        site = max((to_callback(r, own, edges, names, {}) for r in
+                    ("tase_rx_feed", "tase_rx_flush") if r in own), key=lambda x: x[0])
+        via = (site[0] + disp[0], site[1] + ["(callback)"] + disp[1], disp[2])
+        return via if via[0] > best[0] else best
     p("| receive path stack (worst chain%s) | %s | 128 | %s |" % (
         ", + the dispatcher as the frame callback" if dispatch else "",
         " | ".join(str(rx_stack(c)[0]) for c in CPUS), met(rx_stack("cortex-m4")[0], TARGET_RX_STACK)))
