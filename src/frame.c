@@ -313,9 +313,38 @@ static void make_room(tase_rx_t *rx)
     release(rx, rx->cand[0].start, rx->cand[0].credit);
 }
 
+/* No candidate alive: the window holds only a partial sync (len 0..2,
+ * floor 0, no credit), so matching the next sync byte is all there is. */
+static void hunt_byte(tase_rx_t *rx, uint8_t b)
+{
+    static const uint8_t sync[3] = {TASE_SYNC1, TASE_SYNC2, TASE_SYNC3};
+    uint16_t len = rx->len;
+    rx->stats.bytes_in++;
+    if (b == sync[len]) {
+        rx->buf[len] = b;
+        len++;
+        if (len == 3u) {
+            add_cand(rx, 0u);
+            rx->next = 3u;
+        }
+    } else if (b == TASE_SYNC1) {
+        rx->stats.bytes_discarded += len; /* 00 or 00 FF, then 00 again */
+        len = 1u;
+    } else {
+        rx->stats.bytes_discarded += (uint32_t)len + 1u;
+        len = 0u;
+    }
+    rx->len = len;
+    rx->scan = len;
+}
+
 static void push_byte(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
     uint16_t q;
+    if (rx->ncand == 0u) {
+        hunt_byte(rx, b);
+        return;
+    }
     if (rx->len == RX_CAP) {
         make_room(rx);
     }
@@ -354,8 +383,9 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
     }
     before = rx->stats.frames_ok;
     while (i < n) {
-        if (rx->len == 0u) {
-            /* Idle: everything up to the next 00 is noise. */
+        if (rx->len == 0u && n - i >= 16u) {
+            /* Idle: everything up to the next 00 is noise. (For a few
+             * bytes a library call costs more than hunt_byte.) */
             const uint8_t *z = memchr(&data[i], TASE_SYNC1, n - i);
             size_t skip = (z != NULL) ? (size_t)(z - &data[i]) : (n - i);
             rx->stats.bytes_in += (uint32_t)skip;
@@ -411,7 +441,24 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
             if (run > n - i) {
                 run = n - i;
             }
-            if (run > 0u) {
+            if (run > 0u && run < 8u) {
+                /* Short runs (byte-at-a-time feeding): no library calls. */
+                size_t k = 0u;
+                bool scanning = rx->scan == rx->len;
+                while (k < run && !(scanning && data[i + k] == TASE_SYNC3)) {
+                    rx->buf[rx->len + k] = data[i + k];
+                    k++;
+                }
+                rx->len = (uint16_t)(rx->len + k);
+                if (scanning) {
+                    rx->scan = rx->len;
+                }
+                rx->stats.bytes_in += (uint32_t)k;
+                i += k;
+                if (i == n) {
+                    break;
+                }
+            } else if (run > 0u) {
                 if (rx->scan == rx->len) {
                     const uint8_t *s = memchr(&data[i], TASE_SYNC3, run);
                     if (s != NULL) {
