@@ -68,6 +68,16 @@ static const tase_packet_handler_t all_typed[TASE_PKT_COUNT] = {
     [TASE_PKT_CAMERA_ALIGN] = on_typed,
 };
 
+/* A fresh receiver and a dispatcher with every hook logging into l. */
+static void start(tase_rx_t *rx, tase_dispatch_t *d, log_t *l,
+                  const tase_packet_handler_t *handlers)
+{
+    memset(l, 0, sizeof(*l));
+    assert_int_equal(tase_rx_init(rx), TASE_OK);
+    assert_int_equal(tase_dispatch_init(d, handlers, on_default, on_error, l, &rx->stats),
+                     TASE_OK);
+}
+
 /* Frame `len` bytes of `fill` as (g, t) and feed it to rx through d. */
 static void feed(tase_rx_t *rx, tase_dispatch_t *d, uint8_t g, uint8_t t, size_t len,
                  uint8_t fill)
@@ -96,10 +106,7 @@ static void each_packet_reaches_its_typed_handler_decoded(void **state)
     rate.tilt_rate = -1;
     rate.r = INT16_MAX;
     rate.mode = 0x85;
-    memset(&l, 0, sizeof(l));
-    assert_int_equal(tase_rx_init(&rx), TASE_OK);
-    assert_int_equal(tase_dispatch_init(&d, all_typed, on_default, on_error, &l, &rx.stats),
-                     TASE_OK);
+    start(&rx, &d, &l, all_typed);
     for (i = 0; i < TASE_PKT_COUNT; i++) {
         const tase_packet_desc_t *p = tase_schema_at(i);
         feed(&rx, &d, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), p->len, 0x11);
@@ -123,9 +130,7 @@ static void queries_and_short_forms_reach_the_typed_handler(void **state)
     tase_dispatch_t d;
     log_t l;
     (void)state;
-    memset(&l, 0, sizeof(l));
-    tase_rx_init(&rx);
-    tase_dispatch_init(&d, all_typed, on_default, on_error, &l, &rx.stats);
+    start(&rx, &d, &l, all_typed);
     feed(&rx, &d, 0x48, 0x03, 0, 0); /* SYSTEM_VERSION query */
     assert_int_equal(l.typed[TASE_PKT_SYSTEM_VERSION], 1);
     assert_int_equal(l.last_len, 0);
@@ -148,10 +153,8 @@ static void unknown_packets_pass_through_intact_and_are_counted(void **state)
     unsigned t;
     uint8_t want[TASE_DATA_MAX];
     (void)state;
-    memset(&l, 0, sizeof(l));
     memset(want, 0x77, sizeof(want));
-    tase_rx_init(&rx);
-    tase_dispatch_init(&d, all_typed, on_default, on_error, &l, &rx.stats);
+    start(&rx, &d, &l, all_typed);
     /* every type of the STATUS group, which spec v1.0.0 leaves empty */
     for (t = 0; t < 256; t++) {
         size_t len = t % (TASE_DATA_MAX + 1);
@@ -181,9 +184,7 @@ static void every_wrong_length_is_counted_and_reported_never_typed(void **state)
     size_t i, len;
     unsigned expected = 0;
     (void)state;
-    memset(&l, 0, sizeof(l));
-    tase_rx_init(&rx);
-    tase_dispatch_init(&d, all_typed, on_default, on_error, &l, &rx.stats);
+    start(&rx, &d, &l, all_typed);
     for (i = 0; i < TASE_PKT_COUNT; i++) {
         const tase_packet_desc_t *p = tase_schema_at(i);
         for (len = 0; len <= TASE_DATA_MAX; len++) {
@@ -213,9 +214,7 @@ static void packets_without_typed_handler_go_to_default_uncounted(void **state)
     tase_dispatch_t d;
     log_t l;
     (void)state;
-    memset(&l, 0, sizeof(l));
-    tase_rx_init(&rx);
-    tase_dispatch_init(&d, only_angle, on_default, on_error, &l, &rx.stats);
+    start(&rx, &d, &l, only_angle);
     feed(&rx, &d, 0x08, 0x10, 6, 1);
     feed(&rx, &d, 0x00, 0x80, 8, 1);
     assert_int_equal(l.typed[TASE_PKT_GIMBAL_ANGLE], 1);
