@@ -25,38 +25,44 @@
 typedef char tase_rx_size_check[sizeof(tase_rx_t) <= TASE_RX_SIZE_BUDGET ? 1 : -1];
 typedef char tase_rx_cand_check[(TASE_RX_CANDIDATES >= 1 && TASE_RX_CANDIDATES <= 16) ? 1 : -1];
 
+/* The checksum adds a machine word of bytes per step: the word is split
+ * into 16-bit lanes (even and odd bytes) that are added and folded at the
+ * end. Byte order does not matter to a sum. A lane gains at most 2 * 255
+ * per word, so folding every 128 words keeps it below 2^16. 32-bit targets
+ * use 32-bit words (64-bit arithmetic costs them code and stack). */
+#if UINTPTR_MAX > 0xFFFFFFFFu
+typedef uint64_t sum_word_t;
+#define SUM_LANES 0x00FF00FF00FF00FFu
+#define FOLD(w) (((w) & 0x0000FFFF0000FFFFu) + (((w) >> 16) & 0x0000FFFF0000FFFFu))
+#define LANE_TOTAL(w) ((uint32_t)((w) & 0xFFFFFFFFu) + (uint32_t)((w) >> 32))
+#else
+typedef uint32_t sum_word_t;
+#define SUM_LANES 0x00FF00FFu
+#define FOLD(w) (w)
+#define LANE_TOTAL(w) (((w) & 0xFFFFu) + ((w) >> 16))
+#endif
+
 uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n)
 {
-    /* Sum eight bytes per step: split each 64-bit word into four 16-bit
-     * lanes (even and odd bytes), add lanes, and fold at the end. A lane
-     * gains at most 2 * 255 per word, so folding every 128 words keeps it
-     * below 2^16. Byte order does not matter to a sum. */
     uint32_t sum = seed;
     size_t i = 0;
     if (p == NULL) {
         return seed;
     }
-    while (n - i >= 8u) {
-        uint64_t lanes = 0u;
-        size_t stop = i + 8u * 128u;
+    while (n - i >= sizeof(sum_word_t)) {
+        sum_word_t lanes = 0u;
+        size_t stop = i + sizeof(sum_word_t) * 128u;
         if (stop > n) {
             stop = n;
         }
-        while (stop - i >= 8u) {
-            uint64_t w;
+        while (stop - i >= sizeof(sum_word_t)) {
+            sum_word_t w;
             memcpy(&w, &p[i], sizeof(w));
-            lanes += (w & 0x00FF00FF00FF00FFu) + ((w >> 8) & 0x00FF00FF00FF00FFu);
-            i += 8u;
+            lanes += (w & SUM_LANES) + ((w >> 8) & SUM_LANES);
+            i += sizeof(sum_word_t);
         }
-        lanes = (lanes & 0x0000FFFF0000FFFFu) + ((lanes >> 16) & 0x0000FFFF0000FFFFu);
-        sum += (uint32_t)(lanes & 0xFFFFFFFFu) + (uint32_t)(lanes >> 32);
-    }
-    if (n - i >= 4u) {
-        uint32_t w;
-        memcpy(&w, &p[i], sizeof(w));
-        w = (w & 0x00FF00FFu) + ((w >> 8) & 0x00FF00FFu);
-        sum += (w & 0xFFFFu) + (w >> 16);
-        i += 4u;
+        lanes = FOLD(lanes);
+        sum += LANE_TOTAL(lanes);
     }
     for (; i < n; i++) {
         sum += p[i];
