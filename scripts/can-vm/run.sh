@@ -35,17 +35,30 @@ if [ -z "$pkg" ]; then
 fi
 [ -n "$pkg" ] || { echo "FAIL: cannot resolve linux-image-amd64"; exit 1; }
 kdir="$cache/kernel-$pkg"
+# An older kernel left by a previous ABI is not needed any more.
+find "$cache" -maxdepth 1 -name 'kernel-*' ! -name "kernel-$pkg" -exec rm -rf {} +
 if [ ! -f "$kdir/.done" ]; then
-    rm -rf "$kdir" && mkdir -p "$kdir/deb"
+    rm -rf "$kdir" && mkdir -p "$kdir/deb" "$kdir/modules"
     (cd "$kdir/deb" && apt-get "${apt_opts[@]}" download "$pkg" -qq) ||
         { apt-get "${apt_opts[@]}" update -qq &&
           (cd "$kdir/deb" && apt-get "${apt_opts[@]}" download "$pkg" -qq); }
     dpkg -x "$kdir"/deb/*.deb "$kdir/x"
-    rm -rf "$kdir/deb" # the 70 MB .deb is not needed once unpacked
+    # Keep only what the VM needs (the unpacked package is ~400 MB).
+    cp "$kdir"/x/boot/vmlinuz-* "$kdir/vmlinuz"
+    mods=$(ls -d "$kdir"/x/lib/modules/* | head -1)
+    for m in net/can/can net/can/can-raw drivers/net/can/dev/can-dev drivers/net/can/vcan; do
+        f="$mods/kernel/$m.ko"
+        if [ -f "$f" ]; then
+            cp "$f" "$kdir/modules/"
+        elif [ -f "$f.xz" ]; then
+            xz -dc "$f.xz" > "$kdir/modules/$(basename "$f")"
+        else
+            echo "FAIL: $pkg has no $m module"; exit 1
+        fi
+    done
+    rm -rf "$kdir/deb" "$kdir/x"
     touch "$kdir/.done"
 fi
-vmlinuz=$(ls "$kdir"/x/boot/vmlinuz-* | head -1)
-mods=$(ls -d "$kdir"/x/lib/modules/* | head -1)
 
 # The initramfs, rebuilt each run (a second; the agent changes often).
 root="$cache/root"
@@ -53,16 +66,7 @@ rm -rf "$root"
 mkdir -p "$root"/{bin,sbin,usr/bin,lib/modules,proc,sys,dev,tmp}
 # busybox-static provides /bin/busybox (it replaces the dynamic busybox).
 cp /bin/busybox "$root/bin/busybox"
-for m in net/can/can net/can/can-raw drivers/net/can/dev/can-dev drivers/net/can/vcan; do
-    f="$mods/kernel/$m.ko"
-    if [ -f "$f" ]; then
-        cp "$f" "$root/lib/modules/"
-    elif [ -f "$f.xz" ]; then
-        xz -dc "$f.xz" > "$root/lib/modules/$(basename "$f")"
-    else
-        echo "FAIL: $pkg has no $m module"; exit 1
-    fi
-done
+cp "$kdir"/modules/*.ko "$root/lib/modules/"
 # Dynamic programs with their libraries and loader (from ldd).
 for prog in "$(command -v ip)" "$(command -v candump)" "$(command -v cansend)"; do
     cp "$prog" "$root/bin/"
@@ -81,7 +85,7 @@ rm -f "$log"
 t_boot=$(date +%s%N)
 set +e
 timeout 110 "$qemu" -accel tcg -m 256 -smp 1 -no-reboot -display none -monitor none \
-    -serial "file:$log" -kernel "$vmlinuz" -initrd "$cache/initramfs.cpio.gz" \
+    -serial "file:$log" -kernel "$kdir/vmlinuz" -initrd "$cache/initramfs.cpio.gz" \
     -append "console=ttyS0 quiet panic=-1 rdinit=/init" < /dev/null
 qrc=$?
 set -e
