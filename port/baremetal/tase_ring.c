@@ -2,6 +2,12 @@
  * tase_ring.h. */
 #include "tase_ring.h"
 
+/* Optional port configuration header (e.g. -DTASE_RING_CONFIG='"cfg.h"')
+ * that may define TASE_RING_BARRIER(). */
+#ifdef TASE_RING_CONFIG
+#include TASE_RING_CONFIG
+#endif
+
 #ifndef TASE_RING_BARRIER
 #define TASE_RING_BARRIER() ((void)0)
 #endif

@@ -53,15 +53,18 @@
  * write buffers, caches, ARMv8-A weak ordering). Define the port hook
  *     TASE_RING_BARRIER()
  * before compiling tase_ring.c (e.g. -D'TASE_RING_BARRIER()=__DMB()' with
- * CMSIS, or a C11 atomic_thread_fence(memory_order_seq_cst)). The ring
+ * CMSIS, or a C11 atomic_thread_fence(memory_order_seq_cst)), either on
+ * the command line or in a header named by -DTASE_RING_CONFIG='"file.h"'
+ * that tase_ring.c includes first. The ring
  * calls it between writing data and publishing `head`, between reading
  * `head` and reading data, between reading data and publishing `tail`, and
  * between reading `tail` and overwriting a slot. Its default is empty,
  * correct for the single-core case above and free of compiler extensions.
  * With caches and DMA, the ring memory must also be non-cacheable or
  * maintained by the port (not the ring's business). The hosted build in
- * this repository defines the hook as __sync_synchronize() because its
- * test runs the producer on another CPU core (see CMakeLists.txt).
+ * this repository defines the hook as __sync_synchronize() (in
+ * tase_ring_host_config.h) because its test runs the producer on another
+ * CPU core.
  *
  * COST: put is O(1) (a few loads/stores: ISR-friendly); get is O(n).
  */

@@ -272,6 +272,7 @@ static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
 {
     tase_posix_uart_t *u = ctx;
     uint32_t start = tase_posix_now_ms();
+    bool hangup = false;
 
     if (u == NULL || u->fd < 0 || buf == NULL || cap == 0) {
         return TASE_EARG;
@@ -286,12 +287,12 @@ static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
         if (r > 0) {
             return (int)r;
         }
-        /* With VMIN = VTIME = 0 an empty tty reads as 0, not EAGAIN, so a
-         * hang-up is recognised by poll() below, not by read(). */
+        /* With VMIN = VTIME = 0 an empty tty reads as 0, not EAGAIN, and so
+         * does a hung-up one: poll() below tells them apart. */
         if (r < 0 && errno == EINTR) {
             continue;
         }
-        if (r < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
+        if ((r < 0 && errno != EAGAIN && errno != EWOULDBLOCK) || hangup) {
             return TASE_EIO;
         }
         left = time_left(start, timeout_ms);
@@ -308,9 +309,10 @@ static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
         if (pr == 0) {
             return 0;
         }
-        if (pr > 0 && (pfd.revents & POLLIN) == 0 &&
-            (pfd.revents & (POLLHUP | POLLERR | POLLNVAL)) != 0) {
-            return TASE_EIO;
+        /* Hang-up reports POLLIN too (read gives 0): read once more for
+         * bytes still queued, then fail. */
+        if (pr > 0 && (pfd.revents & (POLLHUP | POLLERR | POLLNVAL)) != 0) {
+            hangup = true;
         }
     }
 }
