@@ -20,6 +20,8 @@ typedef struct {
     int write_result;      /* < 0: every write fails with it */
     size_t write_limit;    /* > 0: a write takes at most this many bytes */
     unsigned writes;       /* write() calls that took bytes */
+    int discard;           /* true: count written bytes, keep none */
+    size_t discarded;
     /* Scripted peer: after `reply_after` frames were written, the frame
      * reply[0..nreply) becomes readable (once). 0 disables. */
     unsigned reply_after;
@@ -51,6 +53,11 @@ static inline int fake_write(void *ctx, const uint8_t *data, size_t n)
     }
     if (f->write_limit > 0 && n > f->write_limit) {
         n = f->write_limit;
+    }
+    if (f->discard) {
+        f->discarded += n;
+        f->writes++;
+        return (int)n;
     }
     if (f->nout + n > FAKE_CAP) {
         return TASE_ENOBUFS;
