@@ -9,6 +9,7 @@
 #define SETUP_SYSTEM_VERSION 0x03u
 #define SETUP_PACKET_RATE 0x00u
 #define RATE_BYTES_PER_PORT 5u /* Angle, Rate, Geo-ref, Camera, Reserved */
+#define SETUP_APPLY_MAX 23u /* longest writable setup packet: AXIS_SETTING */
 #define SERVICE_CHUNK 64u
 #define SERVICE_READS 64u
 
@@ -108,20 +109,24 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, size_t nports,
     return TASE_OK;
 }
 
-int tase_gimbal_send(tase_gimbal_t *g, unsigned port, uint8_t group, uint8_t type,
-                     const uint8_t *data, size_t len)
+/* Count the outcome of writing one frame; returns r. */
+static int gimbal_write(tase_gimbal_t *g, int r)
 {
-    int r;
-    if (g == NULL || !port_present(g, port)) {
-        return TASE_EARG;
-    }
-    r = tase_port_send_frame(&g->port[port], group, type, data, len);
     if (r >= 0) {
         g->stats.frames_tx++;
     } else if (r != TASE_EARG && r != TASE_ETOOLONG) {
         g->stats.tx_errors++;
     }
     return r;
+}
+
+int tase_gimbal_send(tase_gimbal_t *g, unsigned port, uint8_t group, uint8_t type,
+                     const uint8_t *data, size_t len)
+{
+    if (g == NULL || !port_present(g, port)) {
+        return TASE_EARG;
+    }
+    return gimbal_write(g, tase_port_send_frame(&g->port[port], group, type, data, len));
 }
 
 int tase_gimbal_setup_len(uint8_t type)
@@ -175,11 +180,11 @@ static void handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f,
                          uint32_t now_ms)
 {
     uint8_t type = f->type;
-    uint8_t tmp[TASE_DATA_MAX];
+    uint8_t tmp[SETUP_APPLY_MAX];
 
     if (f->len == 0 || type == SETUP_SYSTEM_VERSION) {
         g->stats.setup_queries++;
-    } else if (f->len != setup_len[type]) {
+    } else if (f->len != setup_len[type] || f->len > sizeof tmp) {
         g->stats.bad_length++;
         return;
     } else {
@@ -261,20 +266,27 @@ static void sched_catch_up(tase_gimbal_t *g, tase_gimbal_sched_t *s, uint32_t no
 static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_t now_ms)
 {
     tase_gimbal_sched_t *s = &g->sched[port][stream];
-    uint8_t data[TASE_DATA_MAX];
+    /* The application writes the data where the frame will carry it, and
+     * the frame is encoded around it in place: one buffer, not two. */
+    uint8_t frame[TASE_FRAME_MAX];
     uint16_t id = stream_id[stream];
     int n, sent = 0;
 
     if (s->rate == 0 || !reached(now_ms, s->t0 + slot_ms(s->k, s->rate))) {
         return 0;
     }
-    n = g->app.fill_telemetry(g->app.user, port, id, data, sizeof data, now_ms);
+    n = g->app.fill_telemetry(g->app.user, port, id, frame + TASE_FRAME_HEADER,
+                              TASE_DATA_MAX, now_ms);
     if (n < 0 || n > (int)TASE_DATA_MAX) {
         g->stats.telemetry_skipped++;
-    } else if (tase_gimbal_send(g, port, TASE_ID_GROUP(id), TASE_ID_TYPE(id), data,
-                                (size_t)n) >= 0) {
-        g->stats.telemetry_tx++;
-        sent = 1;
+    } else {
+        n = tase_frame_encode(frame, sizeof frame, TASE_ID_GROUP(id), TASE_ID_TYPE(id),
+                              frame + TASE_FRAME_HEADER, (size_t)n);
+        if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >=
+            0) {
+            g->stats.telemetry_tx++;
+            sent = 1;
+        }
     }
     if (++s->k >= s->rate) {
         s->k = 0;
