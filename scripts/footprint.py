@@ -32,6 +32,17 @@ def optional(module):
     return "names" in module or module == "strerror"
 
 
+# The "whole core" of issue 8: framing, dispatch, all codecs, CAN and KLV.
+# Other modules (host/gimbal roles, candump text logs, port helpers) are
+# reported on their own row, outside the 4 KB budget.
+CORE_MODULES = ("frame", "dispatch", "schema", "codec", "can", "klv")
+
+# Engineering-unit conversions done in double precision (they pull the
+# soft-float library on most MCUs); firmware that forwards raw values does
+# not call them. Reported with and without.
+FLOAT_HELPER = re.compile(r"^tase_klv_\w+_(deg|raw|m|mps|s)$")
+
+
 def build(cpu, out):
     """Core library through the toolchain file, with stack and call-graph
     dumps. CFLAGS reaches CMAKE_C_FLAGS without replacing the CPU flags the
@@ -180,12 +191,19 @@ def main():
         has_dispatch = "dispatch" in objs
         if has_dispatch:
             rx_roots += globals_of(objs["dispatch"])
-        core = [o for m, o in objs.items() if not optional(m)]
-        roots_core = [s for o in core for s in globals_of(o)]
+        core = [o for m, o in objs.items() if m in CORE_MODULES]
+        roots_all = [s for o in core for s in globals_of(o)]
+        roots_core = [s for s in roots_all if not FLOAT_HELPER.match(s)]
+        rest = [o for m, o in objs.items() if m not in CORE_MODULES and not optional(m)]
+        roots_rest = [s for o in rest for s in globals_of(o)]
         res[cpu] = {
             "mods": mods,
             "rx": linked_size(cpu, objs.values(), rx_roots, args.build),
             "core": linked_size(cpu, core, roots_core, args.build),
+            "core_float": linked_size(cpu, core, roots_all, args.build),
+            "rest": linked_size(cpu, list(objs.values()), roots_rest, args.build)
+            if roots_rest else (0, 0),
+            "rest_names": sorted(m for m in objs if m not in CORE_MODULES and not optional(m)),
             "types": sizeof_types(cpu, args.build),
             "graph": stack_graph(bdir),
             "objs": objs,
@@ -235,8 +253,16 @@ def main():
     m4 = res["cortex-m4"]
     p("| receive path flash: %s | %s | 1024 | %s |" % (
         rxname, " | ".join(str(res[c]["rx"][0]) for c in CPUS), met(m4["rx"][0], TARGET_RX_FLASH)))
-    p("| whole core flash, optional name strings excluded | %s | 4096 | %s |" % (
+    p("| whole core flash (%s), optional name strings and floating-point unit helpers "
+      "excluded | %s | 4096 | %s |" % (
+        ", ".join(m for m in CORE_MODULES if m in m4["objs"]),
         " | ".join(str(res[c]["core"][0]) for c in CPUS), met(m4["core"][0], TARGET_CORE_FLASH)))
+    p("| whole core flash with the KLV floating-point unit helpers (soft-float library "
+      "routines not counted) | %s | - | informational |" % (
+        " | ".join(str(res[c]["core_float"][0]) for c in CPUS)))
+    if m4["rest_names"]:
+        p("| other modules, linked on their own (%s) | %s | - | informational |" % (
+            ", ".join(m4["rest_names"]), " | ".join(str(res[c]["rest"][0]) for c in CPUS)))
     types = {t: s for _, t, s in m4["types"][0]}
     rxsz = types.get("tase_rx_t", 0)
     p("| RAM per receiver: sizeof(tase_rx_t) | %s | 272 | %s |" % (

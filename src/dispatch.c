@@ -22,7 +22,6 @@ void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
     tase_dispatch_t *d = dispatcher;
     const tase_packet_desc_t *p;
     tase_packet_handler_t h = NULL;
-    tase_packet_msg_t msg;
     if (d == NULL || frame == NULL) {
         return;
     }
@@ -49,6 +48,6 @@ void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
         return;
     }
     /* Cannot fail: the packet is known and its length accepted. */
-    (void)tase_packet_decode(frame, p->size != 0u ? &msg : NULL);
-    h(d->user, frame, p->size != 0u ? &msg : NULL);
+    (void)tase_packet_decode(frame, p->size != 0u ? &d->msg : NULL);
+    h(d->user, frame, p->size != 0u ? &d->msg : NULL);
 }

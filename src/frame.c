@@ -216,32 +216,34 @@ static bool settle(tase_rx_t *rx, uint8_t i, tase_frame_t *out)
     return true;
 }
 
-/* Examine bytes skipped while every candidate slot was busy. A candidate
- * found here may already be complete; it is judged at once. Stops after a
- * valid frame (returns true, frame in *out) so the caller can hand it on
- * before looking further; returns false when the scan is done or the
- * slots are full again. */
-static bool rescan(tase_rx_t *rx, tase_frame_t *out)
+/* Examine bytes skipped while every candidate slot was busy, adding the
+ * candidates found there. Returns the index of one that is already
+ * complete (the caller judges it with settle() and hands the frame on
+ * before calling again), or -1 when the scan is done or the slots are full
+ * again. It does not judge checksums itself, which keeps settle() and the
+ * frame callback off this call chain and the receive-path stack shallow. */
+static int rescan(tase_rx_t *rx)
 {
     while (rx->scan < rx->len && rx->ncand < TASE_RX_CANDIDATES) {
         uint16_t q = rx->scan;
-        bool got = false;
-        if (sync_ends_at(rx, q)) {
-            uint8_t i = rx->ncand;
-            add_cand(rx, (uint16_t)(q - 2u));
-            if ((uint16_t)(q + 1u) < rx->len) {
-                (void)settle(rx, i, out); /* Size */
-                if (rx->ncand > i && rx->cand[i].end < rx->len) {
-                    got = settle(rx, i, out); /* checksum */
-                }
+        rx->scan = (uint16_t)(q + 1u);
+        if (!sync_ends_at(rx, q)) {
+            continue;
+        }
+        if ((uint16_t)(q + 1u) < rx->len && rx->buf[q + 1u] < 2u) {
+            rx->stats.bad_size++;
+            continue;
+        }
+        add_cand(rx, (uint16_t)(q - 2u));
+        if ((uint16_t)(q + 1u) < rx->len) { /* else its Size byte is still to come */
+            tase_rx_cand_t *c = &rx->cand[rx->ncand - 1u];
+            c->end = (uint16_t)(c->start + rx->buf[q + 1u] + 5u);
+            if (c->end < rx->len) {
+                return (int)(rx->ncand - 1u);
             }
         }
-        rx->scan = (uint16_t)(q + 1u);
-        if (got) {
-            return true;
-        }
     }
-    return false;
+    return -1;
 }
 
 /* Judge every candidate whose event is at index q, oldest first. At most
@@ -393,13 +395,15 @@ static void finish_event(tase_rx_t *rx, bool got, tase_frame_t *out, tase_rx_han
                          void *user)
 {
     for (;;) {
+        int k;
         if (got && on_frame != NULL) {
             on_frame(user, out);
         }
-        got = rescan(rx, out);
-        if (!got) {
+        k = rescan(rx);
+        if (k < 0) {
             break;
         }
+        got = settle(rx, (uint8_t)k, out);
     }
     update_next(rx);
     if (rx->ncand == 0u && rx->scan == rx->len) {
@@ -538,8 +542,12 @@ int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
         if (rx->scan >= rx->len) {
             break;
         }
-        while (rescan(rx, &frame)) {
-            if (on_frame != NULL) {
+        for (;;) {
+            int k = rescan(rx);
+            if (k < 0) {
+                break;
+            }
+            if (settle(rx, (uint8_t)k, &frame) && on_frame != NULL) {
                 on_frame(user, &frame);
             }
         }

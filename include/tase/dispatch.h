@@ -17,7 +17,7 @@
  *      stats->bad_length is incremented and the error hook gets the frame
  *      with TASE_ELENGTH. It never reaches a typed handler.
  *   3. Known packet, accepted length, typed handler set: the frame is
- *      decoded (tase_packet_decode()) into a stack buffer and the handler
+ *      decoded (tase_packet_decode()) into the dispatcher's buffer and the handler
  *      gets the frame and the typed struct (tase/codec.h; NULL for
  *      GYRO_ZERO_CMD). A query (tase_schema_is_query()) arrives as a
  *      zeroed struct with frame->len == 0; a 1-byte CAMERA_CMD has
@@ -36,9 +36,11 @@
  *
  * Lookup is O(1): the schema's direct index gives the TASE_PKT_* index.
  *
- * STACK. The decoded struct lives on the stack for the duration of the
- * handler call: sizeof(tase_packet_msg_t) = 64 bytes on Cortex-M. See
- * docs/PROTOCOL-NOTES.md for the measured stack of the receive path.
+ * STACK AND RAM. The decoded struct lives in the dispatcher instance
+ * (`msg`, sizeof(tase_packet_msg_t) = 64 bytes on Cortex-M), not on the
+ * stack, so the receive path stays shallow on small RTOS task stacks. It
+ * is valid only during the handler call (copy what you keep). See
+ * docs/FOOTPRINT.md for the measured stack of the receive path.
  *
  * Handlers run inside tase_rx_feed(): they must not feed the same
  * receiver. The frame and any pointer into it (CAMERA_PASS data) are valid
@@ -68,6 +70,7 @@ typedef struct {
     tase_dispatch_error_t on_error;        /* may be NULL */
     void *user;                            /* first argument of every callback */
     tase_rx_stats_t *stats;                /* bad_length / unknown; may be NULL */
+    tase_packet_msg_t msg;                 /* private: the decoded packet */
 } tase_dispatch_t;
 
 /* Initialise d. Every pointer argument except d may be NULL (`stats` is
