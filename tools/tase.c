@@ -562,7 +562,7 @@ static int cmd_decode(args_t *a)
         while ((n = fread(buf, 1, sizeof(buf), in)) > 0) {
             tase_rx_feed(&rx, buf, n, print_frame, &pr);
         }
-        if (ferror(in)) {
+        if (ferror(in) && errno != EIO) { /* EIO: a pty whose writer went away */
             tk_die("cannot read %s: %s", path, strerror(errno));
         }
         tase_rx_flush(&rx, print_frame, &pr);
@@ -620,7 +620,7 @@ static int cmd_klv(args_t *a)
     while ((n = fread(buf, 1, sizeof(buf), in)) > 0) {
         tase_klv_rx_feed(&rx, buf, n, print_klv, NULL, NULL);
     }
-    if (ferror(in)) {
+    if (ferror(in) && errno != EIO) { /* EIO: a pty whose writer went away */
         tk_die("cannot read %s: %s", path ? path : "standard input", strerror(errno));
     }
     tase_klv_rx_flush(&rx, print_klv, NULL, NULL);
