@@ -1,0 +1,481 @@
+/*
+ * KLV metadata packet: codec, stream scanner, units. The wire format and
+ * the decoder policy are described in include/tase/klv.h; the departures
+ * from the printed spec in docs/PROTOCOL-NOTES.md.
+ */
+#include "tase/klv.h"
+
+#include "tase/frame.h" /* tase_checksum(): the same 16-bit byte sum */
+
+#include <string.h>
+
+/* C99 has no _Static_assert: a negative array size fails the build. */
+typedef char tase_klv_rx_size_check[sizeof(tase_klv_rx_t) <= TASE_KLV_RX_SIZE_BUDGET ? 1 : -1];
+typedef char tase_klv_window_check[TASE_KLV_PACKET_MAX <= 255u ? 1 : -1];
+
+#define KEY_FIRST 0x06u
+#define BER_MAX_OCTETS 4u
+#define SET_START (TASE_KLV_KEY_LEN + 1u) /* with a short-form length */
+
+static const uint8_t klv_key[TASE_KLV_KEY_LEN] = {
+    0x06, 0x0E, 0x2B, 0x34, 0x02, 0x03, 0x01, 0x01,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00
+};
+
+/* Value length of each tag; index 0 is unused. */
+static const uint8_t item_len[TASE_KLV_ITEMS + 1u] = {
+    0, 8, 4, 4, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2
+};
+
+/* Two's complement reinterpretation without implementation-defined
+ * conversions of out-of-range unsigned values. */
+static int32_t as_s32(uint32_t u)
+{
+    return u < 0x80000000u ? (int32_t)u : (int32_t)(u - 0x80000000u) - INT32_MAX - 1;
+}
+
+static int16_t as_s16(uint32_t u)
+{
+    u &= 0xFFFFu;
+    return (int16_t)(u < 0x8000u ? (int32_t)u : (int32_t)u - 65536);
+}
+
+static uint64_t field_get(const tase_klv_t *k, unsigned tag)
+{
+    switch (tag) {
+    case TASE_KLV_TAG_UTC: return k->utc;
+    case TASE_KLV_TAG_LAT: return (uint32_t)k->lat;
+    case TASE_KLV_TAG_LON: return (uint32_t)k->lon;
+    case TASE_KLV_TAG_ALT: return k->alt;
+    case TASE_KLV_TAG_PAN: return k->pan;
+    case TASE_KLV_TAG_TILT: return (uint16_t)k->tilt;
+    case TASE_KLV_TAG_HEADING: return k->heading;
+    case TASE_KLV_TAG_PITCH: return (uint16_t)k->pitch;
+    case TASE_KLV_TAG_ROLL: return (uint16_t)k->roll;
+    case TASE_KLV_TAG_VNORTH: return (uint16_t)k->vnorth;
+    case TASE_KLV_TAG_VEAST: return (uint16_t)k->veast;
+    case TASE_KLV_TAG_HFOV: return k->hfov;
+    case TASE_KLV_TAG_VFOV: return k->vfov;
+    default: return k->gps_status;
+    }
+}
+
+static void field_set(tase_klv_t *k, unsigned tag, uint64_t v)
+{
+    uint16_t w = (uint16_t)(v & 0xFFFFu);
+    switch (tag) {
+    case TASE_KLV_TAG_UTC: k->utc = v; break;
+    case TASE_KLV_TAG_LAT: k->lat = as_s32((uint32_t)v); break;
+    case TASE_KLV_TAG_LON: k->lon = as_s32((uint32_t)v); break;
+    case TASE_KLV_TAG_ALT: k->alt = w; break;
+    case TASE_KLV_TAG_PAN: k->pan = w; break;
+    case TASE_KLV_TAG_TILT: k->tilt = as_s16(w); break;
+    case TASE_KLV_TAG_HEADING: k->heading = w; break;
+    case TASE_KLV_TAG_PITCH: k->pitch = as_s16(w); break;
+    case TASE_KLV_TAG_ROLL: k->roll = as_s16(w); break;
+    case TASE_KLV_TAG_VNORTH: k->vnorth = as_s16(w); break;
+    case TASE_KLV_TAG_VEAST: k->veast = as_s16(w); break;
+    case TASE_KLV_TAG_HFOV: k->hfov = w; break;
+    case TASE_KLV_TAG_VFOV: k->vfov = w; break;
+    default: k->gps_status = w; break;
+    }
+}
+
+static size_t put_item(uint8_t *p, unsigned tag, uint64_t v)
+{
+    unsigned len = item_len[tag];
+    unsigned i;
+    p[0] = (uint8_t)tag;
+    p[1] = (uint8_t)len;
+    for (i = len; i > 0u; i--) {
+        p[1u + i] = (uint8_t)(v & 0xFFu);
+        v >>= 8;
+    }
+    return 2u + len;
+}
+
+int tase_klv_encode(const tase_klv_t *klv, uint8_t *out, size_t cap)
+{
+    size_t pos = SET_START;
+    unsigned tag;
+    if (klv == NULL || out == NULL) {
+        return TASE_EARG;
+    }
+    if (cap < TASE_KLV_PACKET_LEN) {
+        return TASE_ENOSPC;
+    }
+    memcpy(out, klv_key, sizeof(klv_key));
+    out[TASE_KLV_KEY_LEN] = (uint8_t)TASE_KLV_SET_LEN;
+    for (tag = TASE_KLV_TAG_UTC; tag < TASE_KLV_TAG_CHECKSUM; tag++) {
+        pos += put_item(out + pos, tag, field_get(klv, tag));
+    }
+    (void)put_item(out + pos, TASE_KLV_TAG_CHECKSUM,
+                   tase_checksum(0u, out + SET_START, TASE_KLV_SUM_LEN));
+    return (int)TASE_KLV_PACKET_LEN;
+}
+
+/* Reads the BER length at in[TASE_KLV_KEY_LEN]; on success stores the
+ * value and the index of the first local-set byte. */
+static int read_ber(const uint8_t *in, size_t n, uint32_t *value, size_t *set_start)
+{
+    size_t pos = TASE_KLV_KEY_LEN;
+    uint32_t v;
+    unsigned octets, i;
+    if (n <= pos) {
+        return TASE_ETRUNC;
+    }
+    v = in[pos++];
+    if (v >= 0x80u) {
+        octets = v & 0x7Fu;
+        /* 0x80 is BER's indefinite form, meaningless for a fixed set. */
+        if (octets == 0u || octets > BER_MAX_OCTETS) {
+            return TASE_EFORMAT;
+        }
+        v = 0;
+        for (i = 0; i < octets; i++) {
+            if (n <= pos) {
+                return TASE_ETRUNC;
+            }
+            v = (v << 8) | in[pos++];
+        }
+    }
+    *value = v;
+    *set_start = pos;
+    return TASE_OK;
+}
+
+int tase_klv_decode(const uint8_t *in, size_t n, tase_klv_t *out)
+{
+    tase_klv_t k;
+    uint32_t declared = 0;
+    size_t set = 0, pos, i;
+    unsigned tag;
+    uint64_t v = 0;
+    int r;
+    if (in == NULL || out == NULL) {
+        return TASE_EARG;
+    }
+    /* Byte by byte so that a mismatch inside a short input is EFORMAT, not
+     * ETRUNC: the scanner must drop such a candidate at once. */
+    for (i = 0; i < TASE_KLV_KEY_LEN; i++) {
+        if (i >= n) {
+            return TASE_ETRUNC;
+        }
+        if (in[i] != klv_key[i]) {
+            return TASE_EFORMAT;
+        }
+    }
+    r = read_ber(in, n, &declared, &set);
+    if (r < 0) {
+        return r;
+    }
+    /* The items always take 70 bytes; 69 is the spec's miscount of them. */
+    if (declared != TASE_KLV_SET_LEN && declared != TASE_KLV_SET_LEN_SPEC) {
+        return TASE_ELENGTH;
+    }
+    memset(&k, 0, sizeof(k));
+    pos = set;
+    for (tag = TASE_KLV_TAG_UTC; tag <= TASE_KLV_TAG_CHECKSUM; tag++) {
+        unsigned len = item_len[tag];
+        if (pos >= n) {
+            return TASE_ETRUNC;
+        }
+        if (in[pos] == 0u || in[pos] > TASE_KLV_ITEMS) {
+            return TASE_EUNKNOWN;
+        }
+        if (in[pos] != tag) {
+            return TASE_EFORMAT; /* repeated, missing or out of order */
+        }
+        if (pos + 1u >= n) {
+            return TASE_ETRUNC;
+        }
+        if (in[pos + 1u] != len) {
+            return TASE_EFORMAT;
+        }
+        pos += 2u;
+        if (n - pos < len) {
+            return TASE_ETRUNC;
+        }
+        for (v = 0, i = 0; i < len; i++) {
+            v = (v << 8) | in[pos + i];
+        }
+        pos += len;
+        if (tag != TASE_KLV_TAG_CHECKSUM) {
+            field_set(&k, tag, v);
+        }
+    }
+    if (v != tase_checksum(0u, in + set, TASE_KLV_SUM_LEN)) {
+        return TASE_ECHECKSUM;
+    }
+    *out = k;
+    return (int)pos;
+}
+
+/* ---- stream scanner --------------------------------------------------- */
+
+int tase_klv_rx_init(tase_klv_rx_t *rx)
+{
+    if (rx == NULL) {
+        return TASE_EARG;
+    }
+    memset(rx, 0, sizeof(*rx));
+    return TASE_OK;
+}
+
+int tase_klv_rx_stats_reset(tase_klv_rx_t *rx)
+{
+    if (rx == NULL) {
+        return TASE_EARG;
+    }
+    memset(&rx->stats, 0, sizeof(rx->stats));
+    return TASE_OK;
+}
+
+static void rx_drop(tase_klv_rx_t *rx, size_t k, int delivered)
+{
+    memmove(rx->buf, rx->buf + k, rx->len - k);
+    rx->len = (uint8_t)(rx->len - k);
+    rx->offset += (uint32_t)k;
+    if (!delivered) {
+        rx->stats.bytes_discarded += (uint32_t)k;
+    }
+}
+
+static void rx_count(tase_klv_rx_stats_t *s, int err)
+{
+    switch (err) {
+    case TASE_ECHECKSUM: s->checksum_errors++; break;
+    case TASE_ELENGTH: s->length_errors++; break;
+    case TASE_EUNKNOWN: s->unknown_tags++; break;
+    case TASE_ETRUNC: s->truncated++; break;
+    default: s->format_errors++; break;
+    }
+}
+
+/* Settle the window as far as its bytes allow. With `final`, a candidate
+ * still waiting for bytes fails as truncated instead. */
+static int rx_scan(tase_klv_rx_t *rx, int final, tase_klv_handler_t on_packet,
+                   tase_klv_error_handler_t on_error, void *user)
+{
+    int delivered = 0;
+    for (;;) {
+        const uint8_t *p = memchr(rx->buf, (int)KEY_FIRST, rx->len);
+        size_t m;
+        tase_klv_t k;
+        int r;
+        rx_drop(rx, p == NULL ? rx->len : (size_t)(p - rx->buf), 0);
+        if (rx->len == 0u) {
+            return delivered;
+        }
+        /* Noise that merely starts with 0x06 is not worth an error. */
+        m = rx->len < TASE_KLV_KEY_LEN ? rx->len : TASE_KLV_KEY_LEN;
+        if (memcmp(rx->buf, klv_key, m) != 0) {
+            rx_drop(rx, 1u, 0);
+            continue;
+        }
+        r = tase_klv_decode(rx->buf, rx->len, &k);
+        if (r > 0) {
+            rx->stats.packets_ok++;
+            delivered++;
+            if (on_packet != NULL) {
+                on_packet(user, rx->offset, &k);
+            }
+            rx_drop(rx, (size_t)r, 1);
+            continue;
+        }
+        if (r == TASE_ETRUNC && !final) {
+            return delivered;
+        }
+        if (m == TASE_KLV_KEY_LEN) {
+            rx_count(&rx->stats, r);
+            if (on_error != NULL) {
+                on_error(user, rx->offset, r);
+            }
+        }
+        /* Re-scan from the byte after the failed candidate's first byte. */
+        rx_drop(rx, 1u, 0);
+    }
+}
+
+int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n,
+                     tase_klv_handler_t on_packet, tase_klv_error_handler_t on_error,
+                     void *user)
+{
+    int delivered = 0;
+    if (rx == NULL || (data == NULL && n > 0u)) {
+        return TASE_EARG;
+    }
+    while (n > 0u) {
+        /* rx_scan leaves the window short of a full packet (a full window
+         * always decides its candidate), so there is always room. */
+        size_t take = TASE_KLV_PACKET_MAX - rx->len;
+        if (take > n) {
+            take = n;
+        }
+        memcpy(rx->buf + rx->len, data, take);
+        rx->len = (uint8_t)(rx->len + take);
+        rx->stats.bytes_in += (uint32_t)take;
+        data += take;
+        n -= take;
+        delivered += rx_scan(rx, 0, on_packet, on_error, user);
+    }
+    return delivered;
+}
+
+int tase_klv_rx_flush(tase_klv_rx_t *rx, tase_klv_handler_t on_packet,
+                      tase_klv_error_handler_t on_error, void *user)
+{
+    if (rx == NULL) {
+        return TASE_EARG;
+    }
+    return rx_scan(rx, 1, on_packet, on_error, user);
+}
+
+/* ---- units ------------------------------------------------------------ */
+
+#define TWO32 4294967296.0
+#define TWO16 65536.0
+#define WRAP_LIMIT_DEG 1e9
+
+double tase_klv_lat_deg(int32_t v)
+{
+    return (double)v * 180.0 / TWO32;
+}
+
+double tase_klv_lon_deg(int32_t v)
+{
+    return (double)v * 360.0 / TWO32;
+}
+
+double tase_klv_alt_m(uint16_t v)
+{
+    return (double)v * 10900.0 / TWO16 - 900.0;
+}
+
+double tase_klv_angle_deg(uint16_t v)
+{
+    return (double)v * 360.0 / TWO16;
+}
+
+double tase_klv_tilt_deg(int16_t v)
+{
+    return (double)v * 360.0 / TWO16;
+}
+
+double tase_klv_pitch_deg(int16_t v)
+{
+    return (double)v * 40.0 / TWO16;
+}
+
+double tase_klv_roll_deg(int16_t v)
+{
+    return (double)v * 100.0 / TWO16;
+}
+
+double tase_klv_speed_mps(int16_t v)
+{
+    return (double)v * 510.0 / TWO16;
+}
+
+double tase_klv_fov_deg(uint16_t v)
+{
+    return (double)v * 180.0 / TWO16;
+}
+
+double tase_klv_utc_s(uint64_t v)
+{
+    return (double)v / 1e6;
+}
+
+/* Nearest integer to x in [lo, hi], halves away from zero; NaN gives 0
+ * (every range here contains 0). */
+static int64_t nearest_sat(double x, int64_t lo, int64_t hi)
+{
+    if (x != x) {
+        return 0;
+    }
+    if (x <= (double)lo) {
+        return lo;
+    }
+    if (x >= (double)hi) {
+        return hi;
+    }
+    return x >= 0.0 ? (int64_t)(x + 0.5) : -(int64_t)(-x + 0.5);
+}
+
+/* Low 32 bits of the nearest integer to deg * scale: binary angles wrap.
+ * Bounding deg keeps deg * scale (scale <= 2^32 / 360) well inside int64. */
+static uint32_t nearest_wrap(double deg, double scale)
+{
+    if (!(deg > -WRAP_LIMIT_DEG && deg < WRAP_LIMIT_DEG)) {
+        return 0u;
+    }
+    return (uint32_t)((uint64_t)nearest_sat(deg * scale, INT64_MIN, INT64_MAX) & 0xFFFFFFFFu);
+}
+
+int32_t tase_klv_lat_raw(double deg)
+{
+    return (int32_t)nearest_sat(deg * TWO32 / 180.0, INT32_MIN, INT32_MAX);
+}
+
+int32_t tase_klv_lon_raw(double deg)
+{
+    return as_s32(nearest_wrap(deg, TWO32 / 360.0));
+}
+
+uint16_t tase_klv_alt_raw(double m)
+{
+    return (uint16_t)nearest_sat((m + 900.0) * TWO16 / 10900.0, 0, UINT16_MAX);
+}
+
+uint16_t tase_klv_angle_raw(double deg)
+{
+    return (uint16_t)(nearest_wrap(deg, TWO16 / 360.0) & 0xFFFFu);
+}
+
+int16_t tase_klv_tilt_raw(double deg)
+{
+    return as_s16(nearest_wrap(deg, TWO16 / 360.0));
+}
+
+int16_t tase_klv_pitch_raw(double deg)
+{
+    return (int16_t)nearest_sat(deg * TWO16 / 40.0, INT16_MIN, INT16_MAX);
+}
+
+int16_t tase_klv_roll_raw(double deg)
+{
+    return (int16_t)nearest_sat(deg * TWO16 / 100.0, INT16_MIN, INT16_MAX);
+}
+
+int16_t tase_klv_speed_raw(double mps)
+{
+    return (int16_t)nearest_sat(mps * TWO16 / 510.0, INT16_MIN, INT16_MAX);
+}
+
+uint16_t tase_klv_fov_raw(double deg)
+{
+    return (uint16_t)nearest_sat(deg * TWO16 / 180.0, 0, UINT16_MAX);
+}
+
+/* ---- GPS status word (spec bit 0 = MSB) ------------------------------- */
+
+#define GPS_FLAGS                                                                          \
+    (TASE_KLV_GPS_DEAD_RECKONED | TASE_KLV_GPS_SBAS | TASE_KLV_GPS_FAST_ACQ |              \
+     TASE_KLV_GPS_RAW | TASE_KLV_GPS_COLD_START | TASE_KLV_GPS_DIFFERENTIAL |              \
+     TASE_KLV_GPS_POSITION_LOCK | TASE_KLV_GPS_AUTO_SURVEY | TASE_KLV_GPS_FEW_SATS)
+
+unsigned tase_klv_gps_fix(uint16_t status)
+{
+    return ((unsigned)status >> 13) & 7u;
+}
+
+unsigned tase_klv_gps_antenna(uint16_t status)
+{
+    return ((unsigned)status >> 1) & 3u;
+}
+
+uint16_t tase_klv_gps_status(unsigned fix, unsigned antenna, uint16_t flags)
+{
+    return (uint16_t)(((fix & 7u) << 13) | ((antenna & 3u) << 1) | (flags & GPS_FLAGS));
+}
