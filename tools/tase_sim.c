@@ -478,7 +478,7 @@ int main(int argc, char **argv)
     uint32_t now, last, next_klv;
     double t_end;
     struct sigaction sa;
-    int i;
+    int i, slave_fd = -1, klv_slave = -1;
     bool have_klv = false;
     uint8_t axis[TASE_DATA_MAX];
     tase_axis_setting_t axs;
@@ -529,11 +529,11 @@ int main(int argc, char **argv)
         tk_link_can(&dl, can, true);
         snprintf(path, sizeof(path), "%s", can);
     } else {
-        tk_link_pty(&dl, tk_pty_open(path, sizeof(path), link));
+        tk_link_pty(&dl, tk_pty_open(path, sizeof(path), link, &slave_fd));
     }
     port = tk_link_port(&dl);
     if (klv_link != NULL) {
-        tk_link_pty(&kl, tk_pty_open(klv_path, sizeof(klv_path), klv_link));
+        tk_link_pty(&kl, tk_pty_open(klv_path, sizeof(klv_path), klv_link, &klv_slave));
         klv_port = tk_link_port(&kl);
         have_klv = true;
     }
@@ -583,8 +583,15 @@ int main(int argc, char **argv)
             send_packet(&s, 0, TASE_ID_RETRACT_DEPLOY_CMD, &rd);
             logf_(&s, now, "RETRACT_DEPLOY_CMD: %s, echoed", rd.deploy ? "deployed" : "retracted");
         }
+        if (slave_fd >= 0 && tk_pty_unread(slave_fd) > 2048) {
+            /* nobody has read the link for a while: keep only fresh data */
+            (void)tk_pty_drop_unread(slave_fd);
+        }
         (void)tase_gimbal_service(&s.g, now);
         if (have_klv && (int32_t)(now - next_klv) >= 0) {
+            /* a packet still unread after 900 ms has no reader: drop it, as a
+             * serial line would, so a reader that opens later gets fresh data */
+            (void)tk_pty_drop_unread(klv_slave);
             send_klv(&s, &klv_port);
             next_klv += KLV_PERIOD_MS;
         }

@@ -10,7 +10,9 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
+#include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -111,6 +113,7 @@ void tk_link_serial(tk_link_t *l, const char *path, long baud)
 
 void tk_link_pty(tk_link_t *l, int fd)
 {
+    struct termios t;
     int rc;
     memset(l, 0, sizeof(*l));
     rc = tase_posix_uart_attach(&l->uart, fd, 115200u);
@@ -119,6 +122,13 @@ void tk_link_pty(tk_link_t *l, int fd)
     }
     /* a simulator must not stall when nobody reads the link: drop instead */
     l->uart.write_timeout_ms = 0;
+    /* The port reads with poll(), but plain readers of the slave (cat, a
+     * capture) need read() to block rather than report end of file. */
+    if (tcgetattr(fd, &t) == 0) {
+        t.c_cc[VMIN] = 1;
+        t.c_cc[VTIME] = 0;
+        (void)tcsetattr(fd, TCSANOW, &t);
+    }
 }
 
 void tk_link_can(tk_link_t *l, const char *iface, bool gimbal)
@@ -167,7 +177,7 @@ int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n)
     return 0;
 }
 
-int tk_pty_open(char *slave, size_t cap, const char *link)
+int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
 {
     int fd = posix_openpt(O_RDWR | O_NOCTTY);
     const char *name;
@@ -189,6 +199,7 @@ int tk_pty_open(char *slave, size_t cap, const char *link)
     if (sfd < 0) {
         tk_die("cannot open %s: %s", slave, strerror(errno));
     }
+    *slave_fd = sfd;
     if (link != NULL) {
         if (lstat(link, &st) == 0) {
             if (!S_ISLNK(st.st_mode)) {
@@ -201,4 +212,20 @@ int tk_pty_open(char *slave, size_t cap, const char *link)
         }
     }
     return fd;
+}
+
+int tk_pty_unread(int slave_fd)
+{
+    int n = 0;
+    return ioctl(slave_fd, FIONREAD, &n) == 0 && n > 0 ? n : 0;
+}
+
+int tk_pty_drop_unread(int slave_fd)
+{
+    int n = tk_pty_unread(slave_fd);
+    if (n == 0) {
+        return 0;
+    }
+    (void)tcflush(slave_fd, TCIFLUSH);
+    return n;
 }

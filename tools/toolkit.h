@@ -69,10 +69,17 @@ void tk_link_close(tk_link_t *l);
  * 0 or a negative TASE_E* code. */
 int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n);
 
-/* Create a pseudo-terminal in raw mode; returns the master descriptor and
- * writes the slave's path (cap bytes). With `link` non-NULL, also makes
- * `link` a symlink to the slave (replacing an old symlink). Dies on error. */
-int tk_pty_open(char *slave, size_t cap, const char *link);
+/* Create a pseudo-terminal; returns the master descriptor, writes the
+ * slave's path (cap bytes) and a descriptor of the slave that this process
+ * keeps open (so the master never sees a hang-up between clients). With
+ * `link` non-NULL, also makes `link` a symlink to the slave (replacing an
+ * old symlink). Dies on error. */
+int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd);
+/* Discard what is waiting unread in a pty slave's input (a serial line
+ * does not keep bytes nobody reads). Returns the bytes discarded. */
+int tk_pty_drop_unread(int slave_fd);
+/* Bytes waiting unread in a pty slave's input. */
+int tk_pty_unread(int slave_fd);
 
 /* ---- packets (the library's schema table, tase/schema.h) ---- */
 
