@@ -25,38 +25,44 @@
 typedef char tase_rx_size_check[sizeof(tase_rx_t) <= TASE_RX_SIZE_BUDGET ? 1 : -1];
 typedef char tase_rx_cand_check[(TASE_RX_CANDIDATES >= 1 && TASE_RX_CANDIDATES <= 16) ? 1 : -1];
 
+/* The checksum adds a machine word of bytes per step: the word is split
+ * into 16-bit lanes (even and odd bytes) that are added and folded at the
+ * end. Byte order does not matter to a sum. A lane gains at most 2 * 255
+ * per word, so folding every 128 words keeps it below 2^16. 32-bit targets
+ * use 32-bit words (64-bit arithmetic costs them code and stack). */
+#if UINTPTR_MAX > 0xFFFFFFFFu
+typedef uint64_t sum_word_t;
+#define SUM_LANES 0x00FF00FF00FF00FFu
+#define FOLD(w) (((w) & 0x0000FFFF0000FFFFu) + (((w) >> 16) & 0x0000FFFF0000FFFFu))
+#define LANE_TOTAL(w) ((uint32_t)((w) & 0xFFFFFFFFu) + (uint32_t)((w) >> 32))
+#else
+typedef uint32_t sum_word_t;
+#define SUM_LANES 0x00FF00FFu
+#define FOLD(w) (w)
+#define LANE_TOTAL(w) (((w) & 0xFFFFu) + ((w) >> 16))
+#endif
+
 uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n)
 {
-    /* Sum eight bytes per step: split each 64-bit word into four 16-bit
-     * lanes (even and odd bytes), add lanes, and fold at the end. A lane
-     * gains at most 2 * 255 per word, so folding every 128 words keeps it
-     * below 2^16. Byte order does not matter to a sum. */
     uint32_t sum = seed;
     size_t i = 0;
     if (p == NULL) {
         return seed;
     }
-    while (n - i >= 8u) {
-        uint64_t lanes = 0u;
-        size_t stop = i + 8u * 128u;
+    while (n - i >= sizeof(sum_word_t)) {
+        sum_word_t lanes = 0u;
+        size_t stop = i + sizeof(sum_word_t) * 128u;
         if (stop > n) {
             stop = n;
         }
-        while (stop - i >= 8u) {
-            uint64_t w;
+        while (stop - i >= sizeof(sum_word_t)) {
+            sum_word_t w;
             memcpy(&w, &p[i], sizeof(w));
-            lanes += (w & 0x00FF00FF00FF00FFu) + ((w >> 8) & 0x00FF00FF00FF00FFu);
-            i += 8u;
+            lanes += (w & SUM_LANES) + ((w >> 8) & SUM_LANES);
+            i += sizeof(sum_word_t);
         }
-        lanes = (lanes & 0x0000FFFF0000FFFFu) + ((lanes >> 16) & 0x0000FFFF0000FFFFu);
-        sum += (uint32_t)(lanes & 0xFFFFFFFFu) + (uint32_t)(lanes >> 32);
-    }
-    if (n - i >= 4u) {
-        uint32_t w;
-        memcpy(&w, &p[i], sizeof(w));
-        w = (w & 0x00FF00FFu) + ((w >> 8) & 0x00FF00FFu);
-        sum += (w & 0xFFFFu) + (w >> 16);
-        i += 4u;
+        lanes = FOLD(lanes);
+        sum += LANE_TOTAL(lanes);
     }
     for (; i < n; i++) {
         sum += p[i];
@@ -313,9 +319,38 @@ static void make_room(tase_rx_t *rx)
     release(rx, rx->cand[0].start, rx->cand[0].credit);
 }
 
+/* No candidate alive: the window holds only a partial sync (len 0..2,
+ * floor 0, no credit), so matching the next sync byte is all there is. */
+static void hunt_byte(tase_rx_t *rx, uint8_t b)
+{
+    static const uint8_t sync[3] = {TASE_SYNC1, TASE_SYNC2, TASE_SYNC3};
+    uint16_t len = rx->len;
+    rx->stats.bytes_in++;
+    if (b == sync[len]) {
+        rx->buf[len] = b;
+        len++;
+        if (len == 3u) {
+            add_cand(rx, 0u);
+            rx->next = 3u;
+        }
+    } else if (b == TASE_SYNC1) {
+        rx->stats.bytes_discarded += len; /* 00 or 00 FF, then 00 again */
+        len = 1u;
+    } else {
+        rx->stats.bytes_discarded += (uint32_t)len + 1u;
+        len = 0u;
+    }
+    rx->len = len;
+    rx->scan = len;
+}
+
 static void push_byte(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
     uint16_t q;
+    if (rx->ncand == 0u) {
+        hunt_byte(rx, b);
+        return;
+    }
     if (rx->len == RX_CAP) {
         make_room(rx);
     }
@@ -354,8 +389,9 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
     }
     before = rx->stats.frames_ok;
     while (i < n) {
-        if (rx->len == 0u) {
-            /* Idle: everything up to the next 00 is noise. */
+        if (rx->len == 0u && n - i >= 16u) {
+            /* Idle: everything up to the next 00 is noise. (For a few
+             * bytes a library call costs more than hunt_byte.) */
             const uint8_t *z = memchr(&data[i], TASE_SYNC1, n - i);
             size_t skip = (z != NULL) ? (size_t)(z - &data[i]) : (n - i);
             rx->stats.bytes_in += (uint32_t)skip;
@@ -411,7 +447,24 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
             if (run > n - i) {
                 run = n - i;
             }
-            if (run > 0u) {
+            if (run > 0u && run < 8u) {
+                /* Short runs (byte-at-a-time feeding): no library calls. */
+                size_t k = 0u;
+                bool scanning = rx->scan == rx->len;
+                while (k < run && !(scanning && data[i + k] == TASE_SYNC3)) {
+                    rx->buf[rx->len + k] = data[i + k];
+                    k++;
+                }
+                rx->len = (uint16_t)(rx->len + k);
+                if (scanning) {
+                    rx->scan = rx->len;
+                }
+                rx->stats.bytes_in += (uint32_t)k;
+                i += k;
+                if (i == n) {
+                    break;
+                }
+            } else if (run > 0u) {
                 if (rx->scan == rx->len) {
                     const uint8_t *s = memchr(&data[i], TASE_SYNC3, run);
                     if (s != NULL) {

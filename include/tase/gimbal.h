@@ -1,0 +1,187 @@
+/*
+ * tase/gimbal.h - the gimbal role: what the gimbal end of the link does
+ * without knowing what the gimbal is (firmware, a simulator, a test).
+ *
+ * A tase_gimbal_t serves up to TASE_GIMBAL_PORTS ports ("external
+ * communications port 1..3" of the PACKET_RATE packet, index 0..2 here),
+ * each a tase_port_t with its own frame receiver. It
+ *
+ *  - SETUP PACKETS (group 0x48, types 0x00..0x07, spec 4.4): stores the
+ *    current data bytes of every setup packet (110 bytes), seeded at init
+ *    with the spec's defaults where it gives them. A zero-length packet is
+ *    a query: the role answers, on the port it came from, with the stored
+ *    bytes. A packet with data of the right length is handed to the
+ *    application's apply_setup() callback, which validates and applies it
+ *    and may change the bytes (e.g. resolve AXIS_SETTING's 0xFF "do not
+ *    change" fields, clamp values); the bytes it leaves are stored and
+ *    echoed. If apply_setup() refuses, the stored bytes are echoed
+ *    unchanged, so the host always learns the settings in force.
+ *    SYSTEM_VERSION is query-only: any SYSTEM_VERSION packet is answered
+ *    with the bytes the application set (tase_gimbal_setup_set()).
+ *    A setup packet with a wrong data length is counted (stats.bad_length)
+ *    and not answered.
+ *
+ *  - TELEMETRY: emits GIMBAL_ANGLE (0x08/0x10), GIMBAL_RATE (0x08/0x40)
+ *    and GEOREFERENCE_DATA (0x10/0x41) on each port at the rates of the
+ *    PACKET_RATE packet (bytes 0,1,2 port 1; 5,6,7 port 2; 10,11,12
+ *    port 3; packets per second, 0 disables; defaults 10, 10, 4). The
+ *    application's fill_telemetry() callback writes each packet's data
+ *    bytes when it is due.
+ *
+ *  - EVERYTHING ELSE (commands, host sensor/attitude/GPS, SPOI, unknown
+ *    setup types) goes to the application's on_frame() callback, which may
+ *    answer with tase_gimbal_send() (e.g. a zero-length SPOI_CMD query).
+ *
+ * SCHEDULE. Each (port, stream) has an anchor time t0 and a slot index k:
+ * slot k is due at t0 + floor(k * 1000 / rate) ms. When k reaches rate,
+ * t0 advances by exactly 1000 ms and k restarts at 0, so after any number
+ * of seconds exactly rate * seconds packets are due: nothing accumulates
+ * a rounded period, there is no drift, and no product overflows. A rate
+ * change on a stream re-anchors it at the moment of the change (t0 = now,
+ * first packet one new period later); streams whose rate did not change
+ * keep their phase. A stream whose slot is due sends one packet per
+ * tase_gimbal_poll(); if the poll came so late that further slots have
+ * passed too, they are skipped (counted in stats.slots_skipped), never
+ * sent as a burst. Poll at least once per shortest period (every few ms)
+ * and every slot is sent, within the poll interval of its due time.
+ *
+ * TIME comes in as `now_ms` (monotonic, wraps modulo 2^32; e.g. a port's
+ * now_ms()). Nothing here reads a clock, allocates or uses globals.
+ *
+ * REENTRANCY. Not reentrant per instance, not ISR-safe: call everything
+ * from one context (the main loop draining the UART rings). Callbacks run
+ * inside tase_gimbal_feed()/_handle_frame()/_poll(); they may call
+ * tase_gimbal_send() and tase_gimbal_setup_get(), nothing else of the
+ * same instance.
+ */
+#ifndef TASE_GIMBAL_H
+#define TASE_GIMBAL_H
+
+#include "tase/frame.h"
+#include "tase/port.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TASE_GIMBAL_PORTS 3u   /* external communications ports 1..3 */
+#define TASE_GIMBAL_STREAMS 3u /* telemetry packets per port */
+#define TASE_GIMBAL_SETUP_TYPES 8u /* setup types 0x00..0x07 */
+#define TASE_GIMBAL_SETUP_BYTES 110u /* sum of their data lengths */
+
+/* Telemetry streams, in PACKET_RATE byte order. */
+#define TASE_STREAM_ANGLE 0u  /* GIMBAL_ANGLE 0x08/0x10 */
+#define TASE_STREAM_RATE 1u   /* GIMBAL_RATE 0x08/0x40 */
+#define TASE_STREAM_GEOREF 2u /* GEOREFERENCE_DATA 0x10/0x41 */
+
+/* Application callbacks; any may be NULL. `user` is passed back. */
+typedef struct {
+    /* A setup packet of `type` (0..7, not SYSTEM_VERSION) with its full
+     * data length arrived on `port`. data[0..len) is a private copy the
+     * callback may modify. Return >= 0 to accept (the bytes are stored,
+     * a PACKET_RATE change reschedules, and the bytes are echoed) or < 0
+     * to refuse (the current settings are echoed). NULL accepts all. */
+    int (*apply_setup)(void *user, unsigned port, uint8_t type, uint8_t *data, size_t len);
+    /* Telemetry packet `id` (TASE_ID_GIMBAL_ANGLE, _GIMBAL_RATE,
+     * _GEOREFERENCE_DATA) is due on `port`: write its data into
+     * data[0..cap) (cap is 253) and return the length, or a negative value
+     * to skip this slot (stats.telemetry_skipped). NULL: nothing is sent. */
+    int (*fill_telemetry)(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
+                          uint32_t now_ms);
+    /* Every other valid frame received on `port`. */
+    void (*on_frame)(void *user, unsigned port, const tase_frame_t *frame);
+    void *user;
+} tase_gimbal_app_t;
+
+/* Statistics; only incremented by the library, wrap modulo 2^32. */
+typedef struct {
+    uint32_t frames_rx;         /* valid frames received on all ports */
+    uint32_t setup_applied;     /* setup packets accepted and stored */
+    uint32_t setup_refused;     /* setup packets apply_setup() refused */
+    uint32_t setup_queries;     /* zero-length setup queries answered */
+    uint32_t bad_length;        /* setup packets with a wrong data length */
+    uint32_t telemetry_tx;      /* telemetry frames written */
+    uint32_t telemetry_skipped; /* due slots fill_telemetry() declined */
+    uint32_t slots_skipped;     /* slots passed over because poll was late */
+    uint32_t frames_tx;         /* all frames written (echoes, telemetry, sends) */
+    uint32_t tx_errors;         /* frames a port did not take completely */
+} tase_gimbal_stats_t;
+
+/* Private: the schedule of one telemetry stream. */
+typedef struct {
+    uint32_t t0;  /* anchor: slot k is due at t0 + k * 1000 / rate */
+    uint16_t k;   /* next slot, 0 <= k < rate */
+    uint8_t rate; /* packets per second, 0 = off */
+} tase_gimbal_sched_t;
+
+/* Gimbal instance (about 1.2 KiB). Treat every field except `stats` and
+ * `rx[i].stats` as private. */
+typedef struct {
+    tase_gimbal_stats_t stats;
+    tase_gimbal_app_t app;
+    tase_port_t port[TASE_GIMBAL_PORTS]; /* ops NULL: port absent */
+    tase_rx_t rx[TASE_GIMBAL_PORTS];
+    tase_gimbal_sched_t sched[TASE_GIMBAL_PORTS][TASE_GIMBAL_STREAMS];
+    uint8_t setup[TASE_GIMBAL_SETUP_BYTES];
+} tase_gimbal_t;
+
+/* Initialise: ports[0..nports) are copied (nports 0..3; an entry whose ops
+ * is NULL leaves that port absent: nothing is sent there), app is copied
+ * (NULL: no callbacks), setup packets take their defaults and every
+ * stream is anchored at now_ms (first packets one period later).
+ * Returns TASE_OK, or TASE_EARG (g NULL, ports NULL with nports > 0,
+ * nports > 3, a present port without write). O(1). */
+int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, size_t nports,
+                     const tase_gimbal_app_t *app, uint32_t now_ms);
+
+/* Feed bytes received on port index `port`. Answers setup packets and
+ * calls on_frame for the rest. Returns frames received (>= 0) or
+ * TASE_EARG (g NULL, port >= 3, bytes NULL with n > 0).
+ * Worst case O(n * TASE_FRAME_MAX). */
+int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
+                     uint32_t now_ms);
+
+/* Hand over one frame received on `port` some other way (e.g. CAN
+ * reassembly). Returns TASE_OK or TASE_EARG. O(len). */
+int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
+                             uint32_t now_ms);
+
+/* Send every telemetry packet that is due at now_ms (at most one per
+ * stream, see SCHEDULE). Returns the number of frames written (>= 0) or
+ * TASE_EARG. O(ports * streams) plus the callbacks and writes. */
+int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
+
+/* Read whatever each present port has ready (timeout 0, ports with a
+ * read function), feed it, then tase_gimbal_poll(). Returns the poll
+ * result or TASE_EARG. A port read error is skipped (the port may
+ * recover), counted nowhere else: check the port. Uses 64 bytes of stack
+ * plus a bounded number of reads (at most 64 per port per call). */
+int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms);
+
+/* Send one frame on port index `port` (e.g. an answer from on_frame).
+ * Returns the frame length, TASE_EARG (g NULL, port >= 3 or absent, data
+ * NULL with len > 0), TASE_ETOOLONG, or a port error. O(len). */
+int tase_gimbal_send(tase_gimbal_t *g, unsigned port, uint8_t group, uint8_t type,
+                     const uint8_t *data, size_t len);
+
+/* Data length of setup packet `type` (0..7), or TASE_EUNKNOWN. O(1). */
+int tase_gimbal_setup_len(uint8_t type);
+
+/* Copy the stored bytes of setup packet `type` into out[0..cap).
+ * Returns the length, TASE_EARG (g/out NULL), TASE_EUNKNOWN (type > 7),
+ * TASE_ENOSPC (cap too small; nothing copied). O(len). */
+int tase_gimbal_setup_get(const tase_gimbal_t *g, uint8_t type, uint8_t *out, size_t cap);
+
+/* Store setup packet `type` directly (no callback, no echo): load saved
+ * settings at start-up, or set SYSTEM_VERSION. A PACKET_RATE change
+ * reschedules as described above, anchored at now_ms. Returns TASE_OK,
+ * TASE_EARG (g NULL, data NULL), TASE_EUNKNOWN (type > 7), TASE_ELENGTH
+ * (len is not the type's length). O(len). */
+int tase_gimbal_setup_set(tase_gimbal_t *g, uint8_t type, const uint8_t *data, size_t len,
+                          uint32_t now_ms);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TASE_GIMBAL_H */

@@ -1,0 +1,183 @@
+/*
+ * tase/host.h - the host role: the side that commands a gimbal and asks it
+ * questions (spec 4.4: "Anytime the gimbal receives one of these packets it
+ * replies by sending the packet back. Hence each of these packets can be
+ * sent as zero length in order to query the current settings.").
+ *
+ * A tase_host_t owns one port (port.h) and one frame receiver. It can
+ *  - send any frame at any time (tase_host_send: commands, host data);
+ *  - run ONE request at a time: send a frame (a zero-length query, or a
+ *    setup packet / SPOI command whose echo confirms it) and wait for the
+ *    gimbal's frame of the same group and type, re-sending the request
+ *    after `timeout_ms` up to `retries` times. The reply's data bytes are
+ *    copied into a caller buffer.
+ *
+ * MATCHING. The pending request completes on the first received frame
+ * with the request's group and type and at least one data byte (a
+ * zero-length frame is a query, never an answer: this keeps a loop-back or
+ * our own query echoed by a half-duplex line from completing it). Any
+ * such frame counts, including a late echo of an earlier attempt that
+ * arrives after a retry was sent: the gimbal's answer always carries its
+ * current settings, so any of them is a valid answer. A frame of another
+ * type never completes it. Frames that do not complete the request
+ * (telemetry, other answers, unsolicited frames) go to the on_frame
+ * callback given at init; the completing reply does not.
+ *
+ * TIME. The core never reads a clock by itself: the poll-driven API takes
+ * `now_ms` (any monotonic millisecond count that wraps modulo 2^32, e.g.
+ * port->ops->now_ms()). Timeouts are measured per attempt from the
+ * moment the attempt was sent.
+ *
+ * TWO WAYS TO USE IT
+ *  - Firmware main loop (never blocks):
+ *        tase_host_query_start(&h, TASE_GROUP_SETUP, 0x00, buf, sizeof buf,
+ *                              200, 3, now);
+ *        for (;;) {                              // main loop
+ *            n = uart_ring_drain(bytes);         // whatever your RX is
+ *            tase_host_feed(&h, bytes, n, now);
+ *            r = tase_host_poll(&h, now);        // re-sends when due
+ *            if (r != TASE_EAGAIN) { ...done: r = length or error... }
+ *        }
+ *  - Tools (blocks, reading the port): tase_host_transact().
+ *
+ * All functions: not reentrant per instance, not ISR-safe (call from one
+ * context); different instances are independent. No allocation, no
+ * globals. sizeof(tase_host_t) is about 650 bytes (a tase_rx_t plus a copy
+ * of the pending request for re-sending).
+ */
+#ifndef TASE_HOST_H
+#define TASE_HOST_H
+
+#include "tase/frame.h"
+#include "tase/port.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Statistics; only incremented by the library, wrap modulo 2^32. */
+typedef struct {
+    uint32_t frames_tx; /* frames written completely (commands, requests,
+                           re-sent requests) */
+    uint32_t tx_errors; /* frames the port did not take completely */
+    uint32_t frames_rx; /* valid frames received */
+    uint32_t requests;  /* requests started */
+    uint32_t retries;   /* requests re-sent after a timeout */
+    uint32_t replies;   /* requests completed by a matching frame */
+    uint32_t timeouts;  /* requests that failed after their last attempt */
+} tase_host_stats_t;
+
+/* Host instance. Treat every field except `stats` and `rx.stats` as
+ * private. */
+typedef struct {
+    tase_host_stats_t stats;
+    tase_rx_t rx;
+    tase_port_t port;
+    tase_rx_handler_t on_frame;
+    void *user;
+    uint8_t *reply;      /* caller's reply buffer of the pending request */
+    size_t reply_cap;
+    uint32_t timeout_ms; /* per attempt */
+    uint32_t sent_at;    /* when the current attempt was sent */
+    int result;          /* reply length or error once complete */
+    uint8_t state;       /* idle / waiting / complete */
+    uint8_t retries_left;
+    uint8_t group, type; /* of the pending request */
+    uint8_t req_len;
+    uint8_t req[TASE_DATA_MAX]; /* the request's data, for re-sending */
+} tase_host_t;
+
+/* Initialise a host on `port` (copied; port->ops must have write, and
+ * read/now_ms for tase_host_service()/tase_host_transact()). on_frame
+ * (may be NULL) receives every valid frame that does not complete the
+ * pending request, with `user`. Returns TASE_OK or TASE_EARG (h or port
+ * or port->ops or port->ops->write NULL). O(1). */
+int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on_frame,
+                   void *user);
+
+/* Send one frame now (a command, host data, anything; a request may be
+ * pending meanwhile). Returns the frame length, or TASE_EARG (h NULL,
+ * data NULL with len > 0), TASE_ETOOLONG (len > 253), or a port error
+ * from tase_port_write_all() (port_io.h). O(len). */
+int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
+                   size_t len);
+
+/* Start a request: send (group, type, data[0..len)) and wait for the
+ * gimbal's frame of the same group and type. len 0 is a query. Up to
+ * 1 + retries attempts, each waiting timeout_ms from its sending. The
+ * reply's data will be copied into reply[0..reply_cap) (reply may be NULL
+ * when reply_cap is 0: only the length is reported). The data is copied;
+ * `reply` must stay valid until the request completes or is cancelled.
+ * Returns TASE_OK (first attempt sent), or
+ *   TASE_EARG     h NULL, data NULL with len > 0, reply NULL with
+ *                 reply_cap > 0, timeout_ms 0 or > 2^31;
+ *   TASE_ETOOLONG len > 253;
+ *   TASE_EBUSY    a request is pending (it is left untouched);
+ *   a port error  the first attempt could not be sent (no request pending).
+ * O(len). */
+int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type,
+                            const uint8_t *data, size_t len, uint8_t *reply,
+                            size_t reply_cap, uint32_t timeout_ms, uint8_t retries,
+                            uint32_t now_ms);
+
+/* tase_host_request_start() with no data: a zero-length query. */
+int tase_host_query_start(tase_host_t *h, uint8_t group, uint8_t type, uint8_t *reply,
+                          size_t reply_cap, uint32_t timeout_ms, uint8_t retries,
+                          uint32_t now_ms);
+
+/* Feed received bytes (from the port, a ring buffer, a capture). Frames
+ * complete the pending request or go to on_frame. now_ms is not used for
+ * matching (a reply fed before the deadline poll always wins) and is
+ * accepted for symmetry with the gimbal role. Returns the number of
+ * frames received (>= 0) or TASE_EARG (h NULL, bytes NULL with n > 0).
+ * Worst case O(n * TASE_FRAME_MAX), see tase_rx_feed(). */
+int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_ms);
+
+/* Hand over one frame received some other way (e.g. reassembled from
+ * CAN). Returns 1 if it completed the pending request, 0 if it went to
+ * on_frame, TASE_EARG if h or frame (or frame->data) is NULL. O(len). */
+int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame);
+
+/* Drive the pending request. Re-sends it when its attempt timed out and
+ * retries remain. Returns
+ *   >= 0          the request completed; the reply's data length (its
+ *                 bytes are in the caller's reply buffer). The host is idle
+ *                 again: each outcome is reported exactly once.
+ *   TASE_EAGAIN   still waiting;
+ *   TASE_ETIMEOUT the last attempt timed out (host idle again);
+ *   TASE_ENOSPC   the reply was longer than reply_cap (nothing copied;
+ *                 host idle again);
+ *   TASE_ESTATE   no request was started (or its outcome was reported);
+ *   TASE_EARG     h NULL.
+ * A re-send the port refuses still uses up the attempt (counted in
+ * stats.tx_errors). O(request length). */
+int tase_host_poll(tase_host_t *h, uint32_t now_ms);
+
+/* Forget the pending request (its outcome will not be reported).
+ * Returns TASE_OK, or TASE_EARG. O(1). */
+int tase_host_cancel(tase_host_t *h);
+
+/* True while a request waits for its reply (false for NULL). O(1). */
+bool tase_host_busy(const tase_host_t *h);
+
+/* Read once from the port, waiting at most wait_ms, and feed what
+ * arrived (time from port->ops->now_ms). Returns bytes read (>= 0), a
+ * port error, TASE_EUNSUPPORTED (port has no read or now_ms) or
+ * TASE_EARG. Uses 64 bytes of stack. */
+int tase_host_service(tase_host_t *h, uint32_t wait_ms);
+
+/* Blocking convenience for tools: start a request, then service the port
+ * and poll until it completes. Same arguments and results as
+ * tase_host_request_start() + tase_host_poll(): returns the reply length
+ * or a negative code (TASE_ETIMEOUT after 1 + retries attempts). Waits at
+ * most about (1 + retries) * timeout_ms. Frames that arrive meanwhile go
+ * to on_frame. */
+int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
+                       size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
+                       uint8_t retries);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TASE_HOST_H */

@@ -1,0 +1,54 @@
+/*
+ * tase/port_io.h - small helpers on top of the port boundary (port.h):
+ * write a whole buffer, and encode + write one frame.
+ *
+ * A port's write() may accept only part of a buffer (it reports how much).
+ * The roles (host.h, gimbal.h) must never leave half a frame on the wire
+ * when it can be avoided, so they send through tase_port_write_all(),
+ * which keeps writing until everything is taken, the port fails, or the
+ * port makes no progress TASE_PORT_WRITE_TRIES times in a row.
+ *
+ * Neither helper blocks by itself: how long a write may wait is the port's
+ * business (the POSIX UART port waits up to its write timeout, the
+ * bare-metal template's TX hook is blocking).
+ */
+#ifndef TASE_PORT_IO_H
+#define TASE_PORT_IO_H
+
+#include "tase/port.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Consecutive calls to write() that took nothing (TASE_EAGAIN,
+ * TASE_ENOBUFS or 0) after which tase_port_write_all() gives up. */
+#ifndef TASE_PORT_WRITE_TRIES
+#define TASE_PORT_WRITE_TRIES 64u
+#endif
+
+/* Write all n bytes of data to the port.
+ * Returns n, or
+ *   TASE_EARG    port/ops/write NULL, or data NULL with n > 0;
+ *   TASE_EAGAIN / TASE_ENOBUFS  the port took nothing at all (retry later;
+ *                nothing was sent);
+ *   TASE_EIO     the port stopped taking bytes part-way (some bytes were
+ *                sent; a receiver will discard the cut frame by its
+ *                checksum);
+ *   any other negative code the port's write() returned.
+ * O(n) plus the port's cost. Reentrant if the port's write is; not
+ * ISR-safe unless the port's write is. */
+int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n);
+
+/* Encode one frame (tase_frame_encode) into a stack buffer of
+ * TASE_FRAME_MAX bytes and write it with tase_port_write_all().
+ * Returns the frame length, an encoder error (TASE_EARG, TASE_ETOOLONG:
+ * nothing sent) or a tase_port_write_all() error. Uses 261 bytes of stack. */
+int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type,
+                         const uint8_t *data, size_t len);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TASE_PORT_IO_H */

@@ -1,0 +1,157 @@
+/*
+ * tase/schema.h - the one description of every packet of the spec
+ * (section 4): identity, direction, accepted data lengths and fields.
+ *
+ * The schema is a `static const` table in ROM. It drives the typed codec
+ * (tase/codec.h), the dispatcher (tase/dispatch.h) and the JSON output of
+ * the tools, so a field is described exactly once.
+ *
+ * A packet descriptor (tase_packet_desc_t) gives:
+ *   - id: TASE_ID(group, type) (tase/ids.h);
+ *   - len: the length of the data table in the spec (the fixed 4-byte
+ *     header for CAMERA_PASS);
+ *   - flags: direction (TASE_DIR_*) and which other lengths are accepted
+ *     (TASE_LEN_*), see tase_schema_length_ok();
+ *   - the fields, in the order of the spec's table. Rows named "Reserved"
+ *     are not fields: they are written as zero and ignored when read.
+ *
+ * A field descriptor (tase_field_t) gives its byte offset in the data,
+ * its width (1, 2, 4 or 8 bytes, big-endian on the wire), its signedness
+ * and the offset of the matching member in the packet's typed struct
+ * (tase/codec.h), so one generic routine encodes and decodes every packet.
+ *
+ * NAMES. Packet names ("GIMBAL_CMD", ...) and field names (the JSON keys
+ * "pan", "impulse_time", ...) live in a separate translation unit
+ * (src/schema_names.c): firmware that never calls the *_name functions
+ * does not link the strings. Field names are a public contract: the
+ * snake_case form of the spec's Name column without byte suffixes, equal
+ * to the member names of the typed structs. See docs/PROTOCOL-NOTES.md.
+ *
+ * LOOKUP by (group, type) is O(1): a 60-byte ROM index (4 groups x 15
+ * type slots), not a scan of the table.
+ *
+ * Every function here is reentrant and ISR-safe: they only read ROM.
+ */
+#ifndef TASE_SCHEMA_H
+#define TASE_SCHEMA_H
+
+#include "tase/ids.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Index of each packet in the schema table (0..TASE_PKT_COUNT-1), in the
+ * order of the spec. Use it to build a dispatch handler table with
+ * designated initialisers: `[TASE_PKT_GIMBAL_CMD] = on_cmd`. */
+enum {
+    TASE_PKT_GIMBAL_CMD,
+    TASE_PKT_GYRO_ZERO_CMD,
+    TASE_PKT_CAMERA_CMD,
+    TASE_PKT_LEGACY_CAMERA_CMD,
+    TASE_PKT_CAMERA_PASS,
+    TASE_PKT_RETRACT_DEPLOY_CMD,
+    TASE_PKT_GIMBAL_ANGLE,
+    TASE_PKT_GIMBAL_RATE,
+    TASE_PKT_HOST_SENSOR,
+    TASE_PKT_HOST_ATTITUDE,
+    TASE_PKT_HOST_GPS_DATA,
+    TASE_PKT_SPOI_CMD,
+    TASE_PKT_GEOREFERENCE_DATA,
+    TASE_PKT_PACKET_RATE,
+    TASE_PKT_SENSOR_FILTER,
+    TASE_PKT_AXIS_SETTING,
+    TASE_PKT_SYSTEM_VERSION,
+    TASE_PKT_NAV_SOURCE,
+    TASE_PKT_CAMERA_TYPE,
+    TASE_PKT_GPS_LEVER_ARM,
+    TASE_PKT_CAMERA_ALIGN,
+    TASE_PKT_COUNT
+};
+
+/* Packet flags: direction as seen from the gimbal ... */
+#define TASE_DIR_IN 0x01u   /* to the gimbal (sent by the host) */
+#define TASE_DIR_OUT 0x02u  /* from the gimbal */
+#define TASE_DIR_BOTH 0x03u /* either way (setup echo, pass-through) */
+/* ... and the data lengths accepted besides `len` itself. */
+#define TASE_LEN_QUERY 0x04u /* 0 bytes: query (the setup echo answers) */
+#define TASE_LEN_SHORT1 0x08u /* 1 byte: CAMERA_CMD "change camera only" */
+#define TASE_LEN_TAIL 0x10u  /* len + 0..(253-len) trailing bytes */
+
+/* Field format byte: width in bytes (1, 2, 4, 8) in bits 0-3 (LSB
+ * numbering here: this is a C value, not a wire byte), signed in bit 4. */
+#define TASE_FIELD_SIGNED 0x10u
+#define TASE_FIELD_WIDTH(f) ((unsigned)(f)->fmt & 0x0Fu)
+#define TASE_FIELD_IS_SIGNED(f) (((unsigned)(f)->fmt & TASE_FIELD_SIGNED) != 0u)
+
+typedef struct {
+    uint8_t offset; /* byte offset in the packet data */
+    uint8_t member; /* offsetof() the member in the packet's typed struct */
+    uint8_t fmt;    /* width | TASE_FIELD_SIGNED */
+} tase_field_t;
+
+typedef struct {
+    uint16_t id;         /* TASE_ID(group, type) */
+    uint8_t len;         /* data length of the spec's table */
+    uint8_t flags;       /* TASE_DIR_* | TASE_LEN_* */
+    uint8_t first_field; /* private: index of the first field */
+    uint8_t nfields;     /* number of fields (Reserved rows excluded) */
+    uint8_t size;        /* sizeof the typed struct (0: none) */
+    uint8_t index;       /* TASE_PKT_* index of this packet */
+} tase_packet_desc_t;
+
+/* The descriptor of packet (group, type), or NULL if the schema does not
+ * know it (group 0x28 STATUS has no packets in spec v1.0.0). O(1). */
+const tase_packet_desc_t *tase_schema_find(uint8_t group, uint8_t type);
+
+/* The descriptor of TASE_PKT_* index i (0..TASE_PKT_COUNT-1), or NULL
+ * when i is out of range. O(1). Iterate over every packet with it. */
+const tase_packet_desc_t *tase_schema_at(size_t i);
+
+/* Field i (0..nfields-1) of packet p, or NULL if p is NULL or i is out of
+ * range. O(1). */
+const tase_field_t *tase_schema_field(const tase_packet_desc_t *p, size_t i);
+
+/* True when `len` data bytes are a valid form of packet p: its table
+ * length, or 0 with TASE_LEN_QUERY, 1 with TASE_LEN_SHORT1, or
+ * len..253 with TASE_LEN_TAIL. False when p is NULL. O(1). */
+bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len);
+
+/* True when a frame of packet p with `len` data bytes is a query (zero
+ * length and p has a query form). GYRO_ZERO_CMD is always zero length and
+ * is a command, not a query. O(1). */
+bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len);
+
+/* Read the integer value of field i of packet p from data[0..len): big-
+ * endian, sign-extended when the field is signed. (A width-8 unsigned
+ * field above INT64_MAX would wrap; the spec has no 8-byte field.)
+ * Returns TASE_OK and sets *value, or
+ *   TASE_EARG  p, data (with len > 0) or value is NULL, or i >= nfields;
+ *   TASE_ETRUNC the field does not lie within len bytes (e.g. a query).
+ * O(width), reentrant, ISR-safe. */
+int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data,
+                   size_t len, int64_t *value);
+
+/* ---- names (src/schema_names.c; not linked unless used) ----------- */
+
+/* The spec name of packet p ("GIMBAL_CMD", "GIMBAL_RATE" for 0x08/0x40,
+ * ...), or NULL if p is NULL. */
+const char *tase_schema_packet_name(const tase_packet_desc_t *p);
+
+/* The JSON name of field i of packet p ("pan", "impulse_time"), or NULL if
+ * p is NULL or i is out of range. */
+const char *tase_schema_field_name(const tase_packet_desc_t *p, size_t i);
+
+/* The packet named `name` (exact, case-sensitive spec name), or NULL.
+ * O(TASE_PKT_COUNT) string compares: for tools, not for receive paths. */
+const tase_packet_desc_t *tase_schema_find_name(const char *name);
+
+/* The index of the field named `name` in packet p, or TASE_EUNKNOWN if it
+ * has none, TASE_EARG if p or name is NULL. O(nfields). */
+int tase_schema_field_index(const tase_packet_desc_t *p, const char *name);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TASE_SCHEMA_H */

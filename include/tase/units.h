@@ -1,0 +1,104 @@
+/*
+ * tase/units.h - conversions between the spec's integer wire units and SI
+ * / degree values, so users never hand-code the scalings.
+ *
+ *   1/100 degree (angles, rates, FOV)   tase_units_cdeg_to_deg / deg_to_cdeg
+ *   milli-arcseconds (lat, lon)         tase_units_mas_to_deg / deg_to_mas
+ *   centimetres (height)                tase_units_cm_to_m / m_to_cm
+ *   cm/s (velocities; TAS)              tase_units_cmps_to_mps / mps_to_cmps
+ *   1/300 m/s^2 (HOST_SENSOR accel)     tase_units_accel_to_mps2 / mps2_to_accel
+ *   0.1 PDOP                            tase_units_pdop_to_raw / raw_to_pdop
+ *
+ * To-wire conversions round to the nearest integer, halves away from zero
+ * (2.5 -> 3, -2.5 -> -3), then SATURATE to the field's range (a value
+ * beyond it gives the nearest representable one); NaN gives 0. Mind
+ * reserved values at the ends of a range: e.g. HFOV -1 and TAS 0xFFFF
+ * mean "no change"/"unavailable", so clamp before converting if a real
+ * value could land there. From-wire conversions are exact within double.
+ *
+ * Header only (static inline, no libm): unused helpers cost nothing.
+ * All functions are pure, reentrant and ISR-safe (when the FPU or soft
+ * float may be used there).
+ */
+#ifndef TASE_UNITS_H
+#define TASE_UNITS_H
+
+#include "tase/common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Round half away from zero and clamp to [lo, hi]; NaN -> 0. Exact for
+ * every |v| < 2^52 except values within one ulp below a .5 boundary. */
+static inline double tase_units_round_clamp(double v, double lo, double hi)
+{
+    if (!(v < 0.0) && !(v >= 0.0)) {
+        return 0.0; /* NaN: every comparison is false */
+    }
+    v = v >= 0.0 ? v + 0.5 : v - 0.5;
+    if (v <= lo) {
+        return lo;
+    }
+    if (v >= hi) {
+        return hi;
+    }
+    return v; /* the caller's cast truncates toward zero */
+}
+
+static inline int16_t tase_units_sat_i16(double v)
+{
+    return (int16_t)tase_units_round_clamp(v, -32768.0, 32767.0);
+}
+static inline uint16_t tase_units_sat_u16(double v)
+{
+    return (uint16_t)tase_units_round_clamp(v, 0.0, 65535.0);
+}
+static inline int32_t tase_units_sat_i32(double v)
+{
+    return (int32_t)tase_units_round_clamp(v, -2147483648.0, 2147483647.0);
+}
+static inline uint8_t tase_units_sat_u8(double v)
+{
+    return (uint8_t)tase_units_round_clamp(v, 0.0, 255.0);
+}
+
+/* 1/100 degree (or deg/s) */
+static inline double tase_units_cdeg_to_deg(int32_t cdeg) { return (double)cdeg / 100.0; }
+static inline int16_t tase_units_deg_to_cdeg(double deg) { return tase_units_sat_i16(deg * 100.0); }
+static inline uint16_t tase_units_deg_to_cdeg_u16(double deg)
+{
+    return tase_units_sat_u16(deg * 100.0); /* HFOV, VFOV, no-go ranges */
+}
+
+/* milli-arcseconds: 1 degree = 3 600 000 mas */
+static inline double tase_units_mas_to_deg(int32_t mas) { return (double)mas / 3600000.0; }
+static inline int32_t tase_units_deg_to_mas(double deg)
+{
+    return tase_units_sat_i32(deg * 3600000.0);
+}
+
+/* centimetres (32-bit heights) */
+static inline double tase_units_cm_to_m(int32_t cm) { return (double)cm / 100.0; }
+static inline int32_t tase_units_m_to_cm(double m) { return tase_units_sat_i32(m * 100.0); }
+
+/* cm/s (16-bit signed velocities; use sat_u16(mps * 100) for TAS) */
+static inline double tase_units_cmps_to_mps(int32_t cmps) { return (double)cmps / 100.0; }
+static inline int16_t tase_units_mps_to_cmps(double mps) { return tase_units_sat_i16(mps * 100.0); }
+
+/* 1/300 m/s^2 */
+static inline double tase_units_accel_to_mps2(int32_t raw) { return (double)raw / 300.0; }
+static inline int16_t tase_units_mps2_to_accel(double mps2)
+{
+    return tase_units_sat_i16(mps2 * 300.0);
+}
+
+/* 0.1 PDOP */
+static inline double tase_units_raw_to_pdop(uint8_t raw) { return (double)raw / 10.0; }
+static inline uint8_t tase_units_pdop_to_raw(double pdop) { return tase_units_sat_u8(pdop * 10.0); }
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TASE_UNITS_H */

@@ -1,0 +1,103 @@
+/* Bare-metal UART port template; see tase_bm_uart.h. */
+#include "tase_bm_uart.h"
+
+#define DRAIN_CHUNK 32u
+
+int tase_bm_uart_init(tase_bm_uart_t *u, uint8_t *rx_buf, size_t cap,
+                      const tase_bm_uart_hooks_t *hooks, void *hw)
+{
+    if (u == NULL || hooks == NULL || hooks->tx == NULL || hooks->millis == NULL) {
+        return TASE_EARG;
+    }
+    if (tase_ring_init(&u->rx, rx_buf, cap) != TASE_OK) {
+        return TASE_EARG;
+    }
+    u->hooks = hooks;
+    u->hw = hw;
+    return TASE_OK;
+}
+
+void tase_bm_uart_rx_isr(tase_bm_uart_t *u, uint8_t byte)
+{
+    (void)tase_ring_put(&u->rx, byte);
+}
+
+int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_frame,
+                      void *user)
+{
+    uint8_t chunk[DRAIN_CHUNK];
+    uint32_t budget;
+    int frames = 0;
+
+    if (u == NULL || rx == NULL) {
+        return TASE_EARG;
+    }
+    budget = tase_ring_capacity(&u->rx);
+    while (budget > 0) {
+        size_t want = budget < DRAIN_CHUNK ? budget : DRAIN_CHUNK;
+        size_t n = tase_ring_get(&u->rx, chunk, want);
+        int r;
+        if (n == 0) {
+            break;
+        }
+        budget -= (uint32_t)n;
+        r = tase_rx_feed(rx, chunk, n, on_frame, user);
+        if (r > 0) {
+            frames += r;
+        }
+    }
+    return frames;
+}
+
+static int bm_write(void *ctx, const uint8_t *data, size_t n)
+{
+    tase_bm_uart_t *u = ctx;
+    int r;
+    if (u == NULL || (data == NULL && n > 0) || n > 0x7FFFFFFFu) {
+        return TASE_EARG;
+    }
+    r = u->hooks->tx(u->hw, data, n);
+    return r < 0 ? r : (int)n;
+}
+
+static int bm_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    tase_bm_uart_t *u = ctx;
+    uint32_t start;
+
+    if (u == NULL || buf == NULL || cap == 0) {
+        return TASE_EARG;
+    }
+    if (cap > 0x7FFFFFFFu) {
+        cap = 0x7FFFFFFFu;
+    }
+    start = u->hooks->millis(u->hw);
+    for (;;) {
+        size_t n = tase_ring_get(&u->rx, buf, cap);
+        if (n > 0) {
+            return (int)n;
+        }
+        if ((uint32_t)(u->hooks->millis(u->hw) - start) >= timeout_ms) {
+            return 0;
+        }
+        if (u->hooks->idle != NULL) {
+            u->hooks->idle(u->hw);
+        }
+    }
+}
+
+static uint32_t bm_now_ms(void *ctx)
+{
+    tase_bm_uart_t *u = ctx;
+    return u->hooks->millis(u->hw);
+}
+
+const tase_port_ops_t tase_bm_uart_ops = {bm_write, bm_read, bm_now_ms};
+
+tase_port_t tase_bm_uart_port(tase_bm_uart_t *u)
+{
+    tase_port_t p;
+    p.ops = &tase_bm_uart_ops;
+    p.ctx = u;
+    return p;
+}

@@ -1,0 +1,93 @@
+/*
+ * tase_bm_uart.h - bare-metal UART port TEMPLATE for microcontrollers:
+ * an RX interrupt fills a tase_ring_t (tase_ring.h), the main loop drains
+ * it, and transmission goes through a blocking TX hook. It implements
+ * tase_port_ops_t (tase/port.h), so the host and gimbal roles run on it
+ * unchanged. Copy it next to your UART driver, or use it as it is and
+ * supply the three hooks.
+ *
+ * WIRING IT UP (e.g. STM32 USART, any Cortex-M):
+ *
+ *     static uint8_t rx_storage[512];                // power of two
+ *     static tase_bm_uart_t com3;
+ *     static const tase_bm_uart_hooks_t com3_hooks = {my_tx, my_millis, my_wfi};
+ *     tase_bm_uart_init(&com3, rx_storage, sizeof rx_storage, &com3_hooks, USART3);
+ *     // then enable the RXNE interrupt:
+ *     void USART3_IRQHandler(void) {
+ *         while (USART3->ISR & USART_ISR_RXNE)
+ *             tase_bm_uart_rx_isr(&com3, (uint8_t)USART3->RDR);
+ *     }
+ *     // main loop: tase_bm_uart_poll(&com3, &rx, on_frame, user);
+ *     //       or: tase_gimbal_service(&g, now) with tase_bm_uart_port(&com3)
+ *
+ * CONTEXTS: tase_bm_uart_rx_isr() is the ring's producer: call it only
+ * from the one RX interrupt of this UART. Everything else (poll, the
+ * port's read/write/now_ms) is the consumer side: call it only from the
+ * main loop (one context). tase_bm_uart_init() runs before the interrupt
+ * is enabled. The ring's memory-ordering rules and the TASE_RING_BARRIER()
+ * hook are explained in tase_ring.h.
+ *
+ * The port functions (tase_bm_uart_ops):
+ *  write   calls hooks->tx(hw, data, n), which must send all bytes
+ *          (blocking on the TX-empty flag, or queue them to a TX ring/DMA)
+ *          and return 0, or a negative TASE_E* code (passed on). Returns n.
+ *  read    takes what the ring holds; if empty, waits until bytes arrive
+ *          or timeout_ms passes on hooks->millis(), calling hooks->idle()
+ *          (e.g. __WFI(): the RX interrupt wakes the core) between checks,
+ *          or spinning if idle is NULL. Returns the count (0: timeout).
+ *  now_ms  hooks->millis(hw) (a SysTick millisecond counter).
+ */
+#ifndef TASE_BM_UART_H
+#define TASE_BM_UART_H
+
+#include "tase/frame.h"
+#include "tase/port.h"
+#include "tase_ring.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+    /* Transmit n bytes (blocking, or queued for an interrupt/DMA). Returns
+     * 0 when all were taken, a negative TASE_E* code otherwise. Required. */
+    int (*tx)(void *hw, const uint8_t *data, size_t n);
+    /* Monotonic milliseconds (modulo 2^32). Required. */
+    uint32_t (*millis)(void *hw);
+    /* Called while read() waits for bytes; NULL: busy-wait. */
+    void (*idle)(void *hw);
+} tase_bm_uart_hooks_t;
+
+typedef struct {
+    tase_ring_t rx;                    /* filled by the ISR */
+    const tase_bm_uart_hooks_t *hooks; /* not copied: keep it alive */
+    void *hw;                          /* passed to the hooks */
+} tase_bm_uart_t;
+
+extern const tase_port_ops_t tase_bm_uart_ops;
+
+/* Set up u with receive storage rx_buf[0..cap) (power of two) and hooks.
+ * Returns TASE_OK or TASE_EARG (NULL argument, hooks without tx or
+ * millis, cap not a power of two). Call before enabling the interrupt. */
+int tase_bm_uart_init(tase_bm_uart_t *u, uint8_t *rx_buf, size_t cap,
+                      const tase_bm_uart_hooks_t *hooks, void *hw);
+
+/* RX INTERRUPT ONLY: one received byte. Drops and counts it when the ring
+ * is full (tase_ring_overflows(&u->rx)). O(1). */
+void tase_bm_uart_rx_isr(tase_bm_uart_t *u, uint8_t byte);
+
+/* MAIN LOOP: drain everything the ring holds into a frame receiver, in
+ * chunks of 32 bytes. Returns the number of frames delivered (>= 0) or
+ * TASE_EARG. Bounded: stops after one ring capacity's worth of bytes even
+ * if the ISR keeps adding, so the main loop cannot be starved. */
+int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_frame,
+                      void *user);
+
+/* The tase_port_t of u: {&tase_bm_uart_ops, u}. */
+tase_port_t tase_bm_uart_port(tase_bm_uart_t *u);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TASE_BM_UART_H */

@@ -1,0 +1,91 @@
+/* SPSC byte ring for ISR -> main loop; the ordering argument is in
+ * tase_ring.h. */
+#include "tase_ring.h"
+
+/* Optional port configuration header (e.g. -DTASE_RING_CONFIG='"cfg.h"')
+ * that may define TASE_RING_BARRIER(). */
+#ifdef TASE_RING_CONFIG
+#include TASE_RING_CONFIG
+#endif
+
+#ifndef TASE_RING_BARRIER
+#define TASE_RING_BARRIER() ((void)0)
+#endif
+
+int tase_ring_init(tase_ring_t *r, uint8_t *buf, size_t cap)
+{
+    if (r == NULL || buf == NULL || cap == 0 || cap > 0x80000000u ||
+        (cap & (cap - 1u)) != 0) {
+        return TASE_EARG;
+    }
+    r->buf = buf;
+    r->mask = (uint32_t)(cap - 1u);
+    r->head = 0;
+    r->tail = 0;
+    r->overflow = 0;
+    return TASE_OK;
+}
+
+bool tase_ring_put(tase_ring_t *r, uint8_t byte)
+{
+    uint32_t head = r->head; /* ours: no one else changes it */
+    uint32_t tail = r->tail;
+
+    if (head - tail > r->mask) {
+        r->overflow = r->overflow + 1u;
+        return false;
+    }
+    /* The slot was freed by the consumer's tail store; its reads of the
+     * slot must be complete before we overwrite it. */
+    TASE_RING_BARRIER();
+    r->buf[head & r->mask] = byte;
+    /* Data before index: the consumer trusts every byte below head. */
+    TASE_RING_BARRIER();
+    r->head = head + 1u;
+    return true;
+}
+
+size_t tase_ring_get(tase_ring_t *r, uint8_t *out, size_t cap)
+{
+    uint32_t tail, avail, i;
+
+    if (r == NULL || out == NULL) {
+        return 0;
+    }
+    tail = r->tail;
+    avail = r->head - tail;
+    TASE_RING_BARRIER(); /* head read before the data it publishes */
+    if (cap < avail) {
+        avail = (uint32_t)cap;
+    }
+    for (i = 0; i < avail; i++) {
+        out[i] = r->buf[(tail + i) & r->mask];
+    }
+    /* Finish reading the slots before handing them back to the ISR. */
+    TASE_RING_BARRIER();
+    r->tail = tail + avail;
+    return avail;
+}
+
+uint32_t tase_ring_count(const tase_ring_t *r)
+{
+    uint32_t tail, n;
+    if (r == NULL) {
+        return 0;
+    }
+    /* tail first: both only grow, so the difference cannot go negative;
+     * clamp because both sides may have moved between the two loads. */
+    tail = r->tail;
+    n = r->head - tail;
+    return n > r->mask ? r->mask + 1u : n;
+}
+
+uint32_t tase_ring_overflows(const tase_ring_t *r)
+{
+    return r == NULL ? 0u : r->overflow;
+}
+
+uint32_t tase_ring_capacity(const tase_ring_t *r)
+{
+    return r == NULL ? 0u : r->mask + 1u;
+}

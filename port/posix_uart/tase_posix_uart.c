@@ -1,0 +1,334 @@
+/* POSIX termios serial port; see tase_posix_uart.h. */
+#define _DEFAULT_SOURCE /* CRTSCTS, rates above B38400 with -std=c99 */
+
+#include "tase_posix_uart.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+typedef struct {
+    uint32_t baud;
+    speed_t code;
+} baud_map_t;
+
+static const baud_map_t baud_map[] = {
+    {50u, B50},         {75u, B75},         {110u, B110},       {134u, B134},
+    {150u, B150},       {200u, B200},       {300u, B300},       {600u, B600},
+    {1200u, B1200},     {1800u, B1800},     {2400u, B2400},     {4800u, B4800},
+    {9600u, B9600},     {19200u, B19200},   {38400u, B38400},
+#ifdef B57600
+    {57600u, B57600},
+#endif
+#ifdef B115200
+    {115200u, B115200},
+#endif
+#ifdef B230400
+    {230400u, B230400},
+#endif
+#ifdef B460800
+    {460800u, B460800},
+#endif
+#ifdef B500000
+    {500000u, B500000},
+#endif
+#ifdef B576000
+    {576000u, B576000},
+#endif
+#ifdef B921600
+    {921600u, B921600},
+#endif
+#ifdef B1000000
+    {1000000u, B1000000},
+#endif
+#ifdef B1152000
+    {1152000u, B1152000},
+#endif
+#ifdef B1500000
+    {1500000u, B1500000},
+#endif
+#ifdef B2000000
+    {2000000u, B2000000},
+#endif
+#ifdef B2500000
+    {2500000u, B2500000},
+#endif
+#ifdef B3000000
+    {3000000u, B3000000},
+#endif
+#ifdef B3500000
+    {3500000u, B3500000},
+#endif
+#ifdef B4000000
+    {4000000u, B4000000},
+#endif
+};
+
+static bool baud_code(uint32_t baud, speed_t *code)
+{
+    size_t i;
+    for (i = 0; i < sizeof baud_map / sizeof baud_map[0]; i++) {
+        if (baud_map[i].baud == baud) {
+            *code = baud_map[i].code;
+            return true;
+        }
+    }
+    return false;
+}
+
+bool tase_posix_uart_baud_supported(uint32_t baud)
+{
+    speed_t code;
+    return baud_code(baud, &code);
+}
+
+uint32_t tase_posix_now_ms(void)
+{
+    struct timespec ts;
+    (void)clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint32_t)((uint64_t)ts.tv_sec * 1000u + (uint64_t)ts.tv_nsec / 1000000u);
+}
+
+static int map_open_errno(int e)
+{
+    switch (e) {
+    case ENOENT:
+    case ENXIO:
+    case ENODEV:
+    case ENOTDIR:
+    case ENOTTY:
+        return TASE_ENODEV;
+    case EACCES:
+    case EPERM:
+    case EROFS:
+        return TASE_EACCES;
+    default:
+        return TASE_EIO;
+    }
+}
+
+/* Raw 8N1, spelled out flag by flag rather than cfmakeraw() (not POSIX)
+ * so the contract in the header is visibly what the code does. */
+static int configure(int fd, speed_t code)
+{
+    struct termios t;
+    struct termios check;
+
+    if (tcgetattr(fd, &t) != 0) {
+        return map_open_errno(errno);
+    }
+    t.c_iflag &= ~(tcflag_t)(IGNBRK | BRKINT | PARMRK | ISTRIP | INLCR | IGNCR | ICRNL |
+                             IXON | IXOFF | IXANY | INPCK);
+    t.c_oflag &= ~(tcflag_t)OPOST;
+    t.c_lflag &= ~(tcflag_t)(ECHO | ECHOE | ECHOK | ECHONL | ICANON | ISIG | IEXTEN);
+    t.c_cflag &= ~(tcflag_t)(CSIZE | PARENB | CSTOPB);
+#ifdef CRTSCTS
+    t.c_cflag &= ~(tcflag_t)CRTSCTS;
+#endif
+    t.c_cflag |= (tcflag_t)(CS8 | CLOCAL | CREAD);
+    /* Reads never block in the kernel: waiting is done with poll(). */
+    t.c_cc[VMIN] = 0;
+    t.c_cc[VTIME] = 0;
+    if (cfsetispeed(&t, code) != 0 || cfsetospeed(&t, code) != 0) {
+        return TASE_EUNSUPPORTED;
+    }
+    if (tcsetattr(fd, TCSANOW, &t) != 0) {
+        return errno == EINVAL ? TASE_EUNSUPPORTED : TASE_EIO;
+    }
+    /* tcsetattr() succeeds if *any* change was applied: read back. */
+    if (tcgetattr(fd, &check) != 0) {
+        return TASE_EIO;
+    }
+    if (cfgetospeed(&check) != code) {
+        return TASE_EUNSUPPORTED;
+    }
+    (void)tcflush(fd, TCIOFLUSH);
+    return TASE_OK;
+}
+
+static int setup_fd(tase_posix_uart_t *u, int fd, uint32_t baud, speed_t code)
+{
+    int flags = fcntl(fd, F_GETFL);
+    int r;
+    if (flags < 0 || fcntl(fd, F_SETFL, flags | O_NONBLOCK) < 0) {
+        return TASE_EIO;
+    }
+    r = configure(fd, code);
+    if (r != TASE_OK) {
+        return r;
+    }
+    u->fd = fd;
+    u->baud = baud;
+    u->write_timeout_ms = TASE_POSIX_UART_WRITE_TIMEOUT_MS;
+    return TASE_OK;
+}
+
+int tase_posix_uart_open(tase_posix_uart_t *u, const char *path, uint32_t baud)
+{
+    speed_t code;
+    int fd, r;
+
+    if (u == NULL || path == NULL) {
+        return TASE_EARG;
+    }
+    u->fd = -1;
+    if (!baud_code(baud, &code)) {
+        return TASE_EUNSUPPORTED;
+    }
+    fd = open(path, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
+        return map_open_errno(errno);
+    }
+    r = setup_fd(u, fd, baud, code);
+    if (r != TASE_OK) {
+        (void)close(fd);
+    }
+    return r;
+}
+
+int tase_posix_uart_attach(tase_posix_uart_t *u, int fd, uint32_t baud)
+{
+    speed_t code;
+
+    if (u == NULL || fd < 0) {
+        return TASE_EARG;
+    }
+    u->fd = -1;
+    if (!baud_code(baud, &code)) {
+        return TASE_EUNSUPPORTED;
+    }
+    if (!isatty(fd)) {
+        return TASE_ENODEV;
+    }
+    return setup_fd(u, fd, baud, code);
+}
+
+int tase_posix_uart_close(tase_posix_uart_t *u)
+{
+    int r;
+    if (u == NULL) {
+        return TASE_EARG;
+    }
+    if (u->fd < 0) {
+        return TASE_OK;
+    }
+    r = close(u->fd);
+    u->fd = -1;
+    return r == 0 ? TASE_OK : TASE_EIO;
+}
+
+/* Milliseconds left of `total` since `start`, 0 when spent. */
+static int time_left(uint32_t start, uint32_t total)
+{
+    uint32_t spent = tase_posix_now_ms() - start;
+    uint32_t left = spent >= total ? 0u : total - spent;
+    return left > 0x7FFFFFFFu ? 0x7FFFFFFF : (int)left;
+}
+
+static int uart_write(void *ctx, const uint8_t *data, size_t n)
+{
+    tase_posix_uart_t *u = ctx;
+    uint32_t start = tase_posix_now_ms();
+    size_t done = 0;
+
+    if (u == NULL || u->fd < 0 || (data == NULL && n > 0) || n > 0x7FFFFFFFu) {
+        return TASE_EARG;
+    }
+    while (done < n) {
+        ssize_t w = write(u->fd, data + done, n - done);
+        if (w > 0) {
+            done += (size_t)w;
+            continue;
+        }
+        if (w < 0 && errno == EINTR) {
+            continue;
+        }
+        if (w < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
+            return TASE_EIO;
+        }
+        {
+            struct pollfd pfd;
+            int left = time_left(start, u->write_timeout_ms);
+            int pr;
+            if (left == 0) {
+                break;
+            }
+            pfd.fd = u->fd;
+            pfd.events = POLLOUT;
+            pfd.revents = 0;
+            pr = poll(&pfd, 1, left);
+            if (pr < 0 && errno != EINTR) {
+                return TASE_EIO;
+            }
+        }
+    }
+    return done > 0 ? (int)done : TASE_EAGAIN;
+}
+
+static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    tase_posix_uart_t *u = ctx;
+    uint32_t start = tase_posix_now_ms();
+    bool hangup = false;
+
+    if (u == NULL || u->fd < 0 || buf == NULL || cap == 0) {
+        return TASE_EARG;
+    }
+    if (cap > 0x7FFFFFFFu) {
+        cap = 0x7FFFFFFFu;
+    }
+    for (;;) {
+        struct pollfd pfd;
+        int pr, left;
+        ssize_t r = read(u->fd, buf, cap);
+        if (r > 0) {
+            return (int)r;
+        }
+        /* With VMIN = VTIME = 0 an empty tty reads as 0, not EAGAIN, and so
+         * does a hung-up one: poll() below tells them apart. */
+        if (r < 0 && errno == EINTR) {
+            continue;
+        }
+        if ((r < 0 && errno != EAGAIN && errno != EWOULDBLOCK) || hangup) {
+            return TASE_EIO;
+        }
+        left = time_left(start, timeout_ms);
+        if (left == 0) {
+            return 0;
+        }
+        pfd.fd = u->fd;
+        pfd.events = POLLIN;
+        pfd.revents = 0;
+        pr = poll(&pfd, 1, left);
+        if (pr < 0 && errno != EINTR) {
+            return TASE_EIO;
+        }
+        if (pr == 0) {
+            return 0;
+        }
+        /* Hang-up reports POLLIN too (read gives 0): read once more for
+         * bytes still queued, then fail. */
+        if (pr > 0 && (pfd.revents & (POLLHUP | POLLERR | POLLNVAL)) != 0) {
+            hangup = true;
+        }
+    }
+}
+
+static uint32_t uart_now_ms(void *ctx)
+{
+    (void)ctx;
+    return tase_posix_now_ms();
+}
+
+const tase_port_ops_t tase_posix_uart_ops = {uart_write, uart_read, uart_now_ms};
+
+tase_port_t tase_posix_uart_port(tase_posix_uart_t *u)
+{
+    tase_port_t p;
+    p.ops = &tase_posix_uart_ops;
+    p.ctx = u;
+    return p;
+}

@@ -1,0 +1,81 @@
+/*
+ * tase_posix_uart.h - the POSIX serial port: a termios device (RS-232
+ * adapter, USB serial, pseudo-terminal) as a tase_port_t (tase/port.h).
+ *
+ * The device is opened in raw 8N1 mode at one of the standard rates
+ * (the TASE links are 9600 baud on Com2 and 57600 on Com3): no echo, no
+ * canonical line editing, no signal characters, no CR/LF translation in
+ * either direction, no software (XON/XOFF) or hardware (RTS/CTS) flow
+ * control, modem lines ignored (CLOCAL), receiver on (CREAD). The file
+ * descriptor is non-blocking; reads wait with poll() for at most the
+ * timeout given.
+ *
+ * CONTRACT OF THE PORT FUNCTIONS (tase_posix_uart_ops)
+ *  write   writes all n bytes, waiting with poll() up to write_timeout_ms
+ *          (default 1000 ms) while the kernel's output queue is full.
+ *          Returns n, the count written when the timeout expired part-way,
+ *          TASE_EAGAIN when nothing could be written in time, TASE_EIO on
+ *          an OS error.
+ *  read    returns what is available now, or waits up to timeout_ms for
+ *          the first bytes (EINTR restarts the wait with the time left).
+ *          Returns the count (0 = nothing within the timeout) or TASE_EIO
+ *          (OS error, or the other end hung up).
+ *  now_ms  CLOCK_MONOTONIC in milliseconds, modulo 2^32.
+ * One instance is used from one thread at a time; separate instances are
+ * independent.
+ */
+#ifndef TASE_POSIX_UART_H
+#define TASE_POSIX_UART_H
+
+#include "tase/port.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TASE_POSIX_UART_WRITE_TIMEOUT_MS 1000u
+
+typedef struct {
+    int fd;                    /* -1 when closed */
+    uint32_t baud;
+    uint32_t write_timeout_ms; /* may be changed after open */
+} tase_posix_uart_t;
+
+extern const tase_port_ops_t tase_posix_uart_ops;
+
+/* Open `path` (e.g. "/dev/ttyUSB0") at `baud` bits per second, raw 8N1.
+ * Any pending input and output is discarded. Returns TASE_OK or
+ *   TASE_EARG         u or path NULL;
+ *   TASE_EUNSUPPORTED baud is not a standard termios rate (checked before
+ *                     the device is touched) or the device refused it;
+ *   TASE_ENODEV       no such device, or it is not a terminal;
+ *   TASE_EACCES       permission denied;
+ *   TASE_EIO          any other OS error.
+ * On error u is left closed (fd -1). */
+int tase_posix_uart_open(tase_posix_uart_t *u, const char *path, uint32_t baud);
+
+/* Take over an already open terminal descriptor (e.g. an openpty()
+ * master) and configure it exactly like tase_posix_uart_open(). The
+ * descriptor is made non-blocking and is closed by tase_posix_uart_close().
+ * Returns as tase_posix_uart_open() (TASE_ENODEV when fd is not a tty;
+ * the fd is then left open and untouched). */
+int tase_posix_uart_attach(tase_posix_uart_t *u, int fd, uint32_t baud);
+
+/* Close the device. Returns TASE_OK (also when already closed), TASE_EARG
+ * if u is NULL, TASE_EIO if close() failed (the fd is gone anyway). */
+int tase_posix_uart_close(tase_posix_uart_t *u);
+
+/* The tase_port_t of an open instance: {&tase_posix_uart_ops, u}. */
+tase_port_t tase_posix_uart_port(tase_posix_uart_t *u);
+
+/* True if `baud` is a rate tase_posix_uart_open() accepts. */
+bool tase_posix_uart_baud_supported(uint32_t baud);
+
+/* CLOCK_MONOTONIC milliseconds modulo 2^32 (the ops' now_ms). */
+uint32_t tase_posix_now_ms(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TASE_POSIX_UART_H */

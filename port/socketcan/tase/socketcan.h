@@ -1,0 +1,135 @@
+/*
+ * tase/socketcan.h - the datalink over Linux SocketCAN (port, Linux only).
+ *
+ * A tase_socketcan_t is a raw CAN socket plus a role (tase/can.h). It is a
+ * tase_port_t byte stream like a UART:
+ *   - write() cuts the bytes into CAN frames of the role's transmit ID
+ *     (host 0x11000000, gimbal 0x10000000), 8 bytes each, the rest last;
+ *   - read() returns the payload bytes of received frames that the role
+ *     accepts (tase_can_accept()), in bus order.
+ * It also sends and receives single frames (the 3AX drive frames).
+ *
+ * RECEIVE FILTERS. tase_socketcan_open() installs CAN_RAW_FILTER entries
+ * for exactly the IDs the role needs, as extended IDs (CAN_EFF_FLAG, mask
+ * CAN_EFF_FLAG | CAN_RTR_FLAG | CAN_EFF_MASK, so standard and remote frames
+ * with the same number do not pass):
+ *     host:   0x10000000
+ *     gimbal: 0x11000000 and 0x12020000 (3AX status)
+ * The port checks every frame again in software, so an adopted descriptor
+ * without kernel filters behaves the same, only with more wake-ups.
+ *
+ * Frames outside the role's ID set (possible on an adopted socket) are
+ * counted in stats.frames_ignored and dropped by both read paths.
+ *
+ * FRAMES THAT ARE NOT DATALINK BYTES. read() keeps the other frames of the
+ * role's set it meets (the gimbal's 3AX status) in a small queue for
+ * tase_socketcan_recv_frame(); when the queue is full the oldest is
+ * dropped and counted in stats.side_dropped. recv_frame() hands out that
+ * queue first, then every frame of the role's set from the socket,
+ * datalink frames included: a program that uses both must feed the
+ * datalink frames recv_frame() returns into its own receiver
+ * (tase_can_rx_feed()).
+ *
+ * TRANSMIT QUEUE FULL. Linux reports a full interface queue as ENOBUFS
+ * (not EAGAIN) and poll() may still say POLLOUT. write() and send_frame()
+ * retry EAGAIN/ENOBUFS, waiting with poll(POLLOUT) and a short sleep, for
+ * at most tx_timeout_ms in total (default TASE_SOCKETCAN_TX_TIMEOUT_MS).
+ * If the time runs out, write() returns how many bytes went out in whole
+ * frames (0 < n < len: the caller sends the rest later), or TASE_ENOBUFS
+ * when none did; nothing is ever dropped silently.
+ *
+ * ERRORS. open(): interface name missing or too long -> TASE_ENODEV or
+ * TASE_EARG; interface not up -> TASE_EDOWN; kernel without CAN
+ * (EAFNOSUPPORT/EPROTONOSUPPORT) -> TASE_EUNSUPPORTED; EPERM/EACCES ->
+ * TASE_EACCES; anything else -> TASE_EIO. A descriptor error while reading
+ * or writing -> TASE_EIO (errno kept in stats.last_errno).
+ *
+ * Threads: one instance is used by one thread at a time. Not ISR code.
+ */
+#ifndef TASE_SOCKETCAN_H
+#define TASE_SOCKETCAN_H
+
+#include "tase/can.h"
+#include "tase/port.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TASE_SOCKETCAN_TX_TIMEOUT_MS 100u
+#define TASE_SOCKETCAN_SIDEQ 8u /* non-datalink frames kept by read() */
+
+/* adopt() flags */
+#define TASE_SOCKETCAN_OWN_FD 0x1u     /* close() closes the descriptor */
+#define TASE_SOCKETCAN_SET_FILTER 0x2u /* install the role's CAN_RAW_FILTER */
+
+typedef struct {
+    uint32_t frames_rx;       /* frames read from the socket */
+    uint32_t frames_tx;       /* frames written */
+    uint32_t bytes_rx;        /* datalink payload bytes returned by read() */
+    uint32_t frames_ignored;  /* outside the role's ID set (dropped) */
+    uint32_t bad_frames;      /* wrong size, remote/error frames, bad dlc */
+    uint32_t side_dropped;    /* side-queue overflow */
+    uint32_t tx_retries;      /* EAGAIN/ENOBUFS retried */
+    uint32_t tx_full;         /* writes that ran out of time (TASE_ENOBUFS or short) */
+    int last_errno;           /* errno of the last TASE_EIO */
+} tase_socketcan_stats_t;
+
+/* Instance; every field but `stats` and `tx_timeout_ms` is private. */
+typedef struct {
+    int fd;
+    unsigned flags;
+    tase_can_role_t role;
+    uint32_t tx_timeout_ms; /* retry budget of one write()/send_frame() */
+    tase_socketcan_stats_t stats;
+    uint8_t pend[8]; /* accepted payload not yet returned by read() */
+    uint8_t pend_pos;
+    uint8_t pend_len;
+    uint8_t side_head;
+    uint8_t side_count;
+    tase_can_frame_t side[TASE_SOCKETCAN_SIDEQ];
+} tase_socketcan_t;
+
+/* Open a raw CAN socket on interface `ifname` for `role`, non-blocking,
+ * with the role's receive filters. Returns TASE_OK or a code listed under
+ * ERRORS above (s untouched, nothing left open). */
+int tase_socketcan_open(tase_socketcan_t *s, const char *ifname, tase_can_role_t role);
+
+/* Use an already-open descriptor that carries struct can_frame records
+ * (a bound CAN_RAW socket, or in tests one end of
+ * socketpair(AF_UNIX, SOCK_SEQPACKET)). Sets O_NONBLOCK. flags:
+ * TASE_SOCKETCAN_OWN_FD, TASE_SOCKETCAN_SET_FILTER. Returns TASE_OK,
+ * TASE_EARG (s NULL, fd < 0, bad role or flags) or TASE_EIO (fcntl or
+ * setsockopt failed; s untouched, fd not closed). */
+int tase_socketcan_adopt(tase_socketcan_t *s, int fd, tase_can_role_t role, unsigned flags);
+
+/* Close the descriptor if owned. Safe to call twice. */
+void tase_socketcan_close(tase_socketcan_t *s);
+
+/* The port view: ops = &tase_socketcan_ops, ctx = s. */
+tase_port_t tase_socketcan_port(tase_socketcan_t *s);
+extern const tase_port_ops_t tase_socketcan_ops;
+
+/* Byte stream (the tase_port_ops_t contract, see tase/port.h). */
+int tase_socketcan_write(tase_socketcan_t *s, const uint8_t *data, size_t n);
+int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t timeout_ms);
+
+/* Send one frame (validated with tase_can_frame_check()). Returns TASE_OK,
+ * TASE_EARG, TASE_ENOBUFS (queue still full after tx_timeout_ms) or
+ * TASE_EIO. */
+int tase_socketcan_send_frame(tase_socketcan_t *s, const tase_can_frame_t *f);
+
+/* Receive one frame, waiting at most timeout_ms. Returns 1 (*f filled),
+ * 0 (none in time), TASE_EARG or TASE_EIO. Frames the filters let through
+ * but that are not data frames (remote, error, wrong size) are counted in
+ * stats.bad_frames and skipped. */
+int tase_socketcan_recv_frame(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_ms);
+
+/* Monotonic milliseconds (CLOCK_MONOTONIC), for the port table. */
+uint32_t tase_socketcan_now_ms(void *ctx);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TASE_SOCKETCAN_H */

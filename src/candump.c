@@ -1,0 +1,297 @@
+/* can-utils log lines <-> tase_can_frame_t. No stdio: the core must build
+ * for targets without printf/sscanf, and sscanf would accept signs and
+ * spaces where the format has none. */
+#include "tase/candump.h"
+
+#include <string.h>
+
+typedef struct {
+    const char *p;
+    size_t len;
+    size_t i;
+} cursor_t;
+
+static int peek(const cursor_t *c)
+{
+    return c->i < c->len ? (unsigned char)c->p[c->i] : -1;
+}
+
+static int hexval(int ch)
+{
+    if (ch >= '0' && ch <= '9') {
+        return ch - '0';
+    }
+    if (ch >= 'A' && ch <= 'F') {
+        return ch - 'A' + 10;
+    }
+    if (ch >= 'a' && ch <= 'f') {
+        return ch - 'a' + 10;
+    }
+    return -1;
+}
+
+static bool is_blank(int ch)
+{
+    return ch == ' ' || ch == '\t';
+}
+
+/* Skips spaces and tabs; returns how many. */
+static size_t skip_blanks(cursor_t *c)
+{
+    size_t start = c->i;
+    while (is_blank(peek(c))) {
+        c->i++;
+    }
+    return c->i - start;
+}
+
+/* Decimal digits into *v; at most max_digits, at least one. */
+static bool read_dec(cursor_t *c, size_t max_digits, uint64_t *v, size_t *ndigits)
+{
+    size_t n = 0;
+    uint64_t acc = 0;
+    while (peek(c) >= '0' && peek(c) <= '9') {
+        if (n == max_digits) {
+            return false;
+        }
+        if (acc > (UINT64_MAX - (uint64_t)(peek(c) - '0')) / 10u) {
+            return false;
+        }
+        acc = acc * 10u + (uint64_t)(peek(c) - '0');
+        c->i++;
+        n++;
+    }
+    *v = acc;
+    *ndigits = n;
+    return n > 0;
+}
+
+static bool read_timestamp(cursor_t *c, uint64_t *sec, uint32_t *usec)
+{
+    uint64_t s;
+    uint64_t u;
+    size_t nd;
+    if (peek(c) != '(') {
+        return false;
+    }
+    c->i++;
+    if (!read_dec(c, 20, &s, &nd) || peek(c) != '.') {
+        return false;
+    }
+    c->i++;
+    if (!read_dec(c, 6, &u, &nd) || nd != 6 || peek(c) != ')') {
+        return false;
+    }
+    c->i++;
+    *sec = s;
+    *usec = (uint32_t)u;
+    return true;
+}
+
+static bool name_char_ok(int ch)
+{
+    return ch > ' ' && ch < 0x7F;
+}
+
+static bool read_ifname(cursor_t *c, char *name)
+{
+    size_t n = 0;
+    while (name_char_ok(peek(c))) {
+        if (n + 1u >= TASE_CANDUMP_IFNAME_MAX) {
+            return false;
+        }
+        name[n++] = (char)peek(c);
+        c->i++;
+    }
+    name[n] = '\0';
+    return n > 0;
+}
+
+/* Identifier up to '#'. Returns TASE_OK, TASE_EFORMAT or TASE_EUNSUPPORTED
+ * (error frame). */
+static int read_id(cursor_t *c, uint32_t *id, bool *extended)
+{
+    uint32_t v = 0;
+    size_t n = 0;
+    int d;
+    while ((d = hexval(peek(c))) >= 0) {
+        if (n == 8u) {
+            return TASE_EFORMAT;
+        }
+        v = (v << 4) | (uint32_t)d;
+        c->i++;
+        n++;
+    }
+    if (peek(c) != '#') {
+        return TASE_EFORMAT;
+    }
+    c->i++;
+    if (n == 3u) {
+        if (v > TASE_CAN_SFF_MASK) {
+            return TASE_EFORMAT;
+        }
+        *extended = false;
+    } else if (n == 8u) {
+        /* can-utils prints error frames with CAN_ERR_FLAG (bit 29) set in
+         * an 8-digit identifier; bits 30/31 never appear in a log. */
+        if (v > TASE_CAN_EFF_MASK) {
+            return v <= 0x3FFFFFFFu ? TASE_EUNSUPPORTED : TASE_EFORMAT;
+        }
+        *extended = true;
+    } else {
+        return TASE_EFORMAT;
+    }
+    *id = v;
+    return TASE_OK;
+}
+
+static int read_data(cursor_t *c, uint8_t *data, uint8_t *dlc)
+{
+    uint8_t n = 0;
+    int hi;
+    int lo;
+    int ch = peek(c);
+    if (ch == '#' || ch == 'R' || ch == 'r') {
+        return TASE_EUNSUPPORTED; /* CAN FD or remote frame */
+    }
+    for (;;) {
+        hi = hexval(peek(c));
+        if (hi < 0) {
+            break;
+        }
+        c->i++;
+        lo = hexval(peek(c));
+        if (lo < 0 || n == TASE_CAN_DLC_MAX) {
+            return TASE_EFORMAT;
+        }
+        c->i++;
+        data[n++] = (uint8_t)((hi << 4) | lo);
+        /* A '.' separates bytes; it may not end the data. */
+        if (peek(c) == '.') {
+            c->i++;
+            if (hexval(peek(c)) < 0) {
+                return TASE_EFORMAT;
+            }
+        }
+    }
+    if (peek(c) == '_') {
+        return TASE_EUNSUPPORTED; /* raw DLC 9..15 of a classic frame */
+    }
+    *dlc = n;
+    return TASE_OK;
+}
+
+/* After the frame: blanks, an optional T/R flag, an optional line end. */
+static bool at_line_end(cursor_t *c)
+{
+    if (skip_blanks(c) > 0 && (peek(c) == 'T' || peek(c) == 'R')) {
+        c->i++;
+        skip_blanks(c);
+    }
+    if (peek(c) == '\r') {
+        c->i++;
+    }
+    if (peek(c) == '\n') {
+        c->i++;
+    }
+    return c->i == c->len;
+}
+
+int tase_candump_parse(const char *line, size_t len, tase_candump_rec_t *rec)
+{
+    cursor_t c;
+    tase_candump_rec_t r;
+    int rc;
+    if (line == NULL || rec == NULL) {
+        return TASE_EARG;
+    }
+    c.p = line;
+    c.len = len;
+    c.i = 0;
+    memset(&r, 0, sizeof(r));
+    skip_blanks(&c);
+    if (!read_timestamp(&c, &r.sec, &r.usec) || skip_blanks(&c) == 0 ||
+        !read_ifname(&c, r.ifname) || skip_blanks(&c) == 0) {
+        return TASE_EFORMAT;
+    }
+    rc = read_id(&c, &r.frame.id, &r.frame.extended);
+    if (rc == TASE_OK) {
+        rc = read_data(&c, r.frame.data, &r.frame.dlc);
+    }
+    if (rc != TASE_OK) {
+        return rc;
+    }
+    if (!at_line_end(&c)) {
+        return TASE_EFORMAT;
+    }
+    *rec = r;
+    return TASE_OK;
+}
+
+static size_t put_hex(char *out, uint32_t v, unsigned digits)
+{
+    static const char hex[] = "0123456789ABCDEF";
+    unsigned k;
+    for (k = 0; k < digits; k++) {
+        out[k] = hex[(v >> (4u * (digits - 1u - k))) & 0xFu];
+    }
+    return digits;
+}
+
+static size_t put_dec(char *out, uint64_t v, unsigned min_digits)
+{
+    char tmp[20];
+    size_t n = 0;
+    size_t k;
+    do {
+        tmp[n++] = (char)('0' + (int)(v % 10u));
+        v /= 10u;
+    } while (v != 0u || n < min_digits);
+    for (k = 0; k < n; k++) {
+        out[k] = tmp[n - 1u - k];
+    }
+    return n;
+}
+
+int tase_candump_format(const tase_candump_rec_t *rec, char *out, size_t cap)
+{
+    char line[TASE_CANDUMP_LINE_MAX];
+    size_t n = 0;
+    size_t k;
+    size_t namelen;
+    if (rec == NULL || out == NULL || rec->usec > 999999u ||
+        tase_can_frame_check(&rec->frame) != TASE_OK) {
+        return TASE_EARG;
+    }
+    namelen = 0;
+    while (namelen < TASE_CANDUMP_IFNAME_MAX && rec->ifname[namelen] != '\0') {
+        if (!name_char_ok((unsigned char)rec->ifname[namelen])) {
+            return TASE_EARG;
+        }
+        namelen++;
+    }
+    if (namelen == 0u || namelen == TASE_CANDUMP_IFNAME_MAX) {
+        return TASE_EARG;
+    }
+    line[n++] = '(';
+    n += put_dec(&line[n], rec->sec, 10);
+    line[n++] = '.';
+    n += put_dec(&line[n], rec->usec, 6);
+    line[n++] = ')';
+    line[n++] = ' ';
+    memcpy(&line[n], rec->ifname, namelen);
+    n += namelen;
+    line[n++] = ' ';
+    n += put_hex(&line[n], rec->frame.id, rec->frame.extended ? 8u : 3u);
+    line[n++] = '#';
+    for (k = 0; k < rec->frame.dlc; k++) {
+        n += put_hex(&line[n], rec->frame.data[k], 2);
+    }
+    line[n++] = '\n';
+    if (n + 1u > cap) {
+        return TASE_ENOSPC;
+    }
+    memcpy(out, line, n);
+    out[n] = '\0';
+    return (int)n;
+}

@@ -1,0 +1,54 @@
+/* Frame dispatch through the schema; the order of the checks is the
+ * contract described in include/tase/dispatch.h. */
+#include "tase/dispatch.h"
+
+int tase_dispatch_init(tase_dispatch_t *d, const tase_packet_handler_t *handlers,
+                       tase_rx_handler_t on_default, tase_dispatch_error_t on_error,
+                       void *user, tase_rx_stats_t *stats)
+{
+    if (d == NULL) {
+        return TASE_EARG;
+    }
+    d->handlers = handlers;
+    d->on_default = on_default;
+    d->on_error = on_error;
+    d->user = user;
+    d->stats = stats;
+    return TASE_OK;
+}
+
+void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
+{
+    tase_dispatch_t *d = dispatcher;
+    const tase_packet_desc_t *p;
+    tase_packet_handler_t h = NULL;
+    tase_packet_msg_t msg;
+    if (d == NULL || frame == NULL) {
+        return;
+    }
+    p = tase_schema_find(frame->group, frame->type);
+    if (p == NULL) {
+        if (d->stats != NULL) {
+            d->stats->unknown++;
+        }
+    } else if (!tase_schema_length_ok(p, frame->len)) {
+        if (d->stats != NULL) {
+            d->stats->bad_length++;
+        }
+        if (d->on_error != NULL) {
+            d->on_error(d->user, frame, TASE_ELENGTH);
+        }
+        return;
+    } else if (d->handlers != NULL) {
+        h = d->handlers[p->index];
+    }
+    if (h == NULL) {
+        if (d->on_default != NULL) {
+            d->on_default(d->user, frame);
+        }
+        return;
+    }
+    /* Cannot fail: the packet is known and its length accepted. */
+    (void)tase_packet_decode(frame, p->size != 0u ? &msg : NULL);
+    h(d->user, frame, p->size != 0u ? &msg : NULL);
+}

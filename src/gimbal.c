@@ -1,0 +1,344 @@
+/* Gimbal role: setup echo/query and telemetry scheduling (see tase/gimbal.h). */
+#include "tase/gimbal.h"
+
+#include <string.h>
+
+#include "tase/ids.h"
+#include "tase/port_io.h"
+
+#define SETUP_SYSTEM_VERSION 0x03u
+#define SETUP_PACKET_RATE 0x00u
+#define RATE_BYTES_PER_PORT 5u /* Angle, Rate, Geo-ref, Camera, Reserved */
+#define SETUP_APPLY_MAX 23u /* longest writable setup packet: AXIS_SETTING */
+#define SERVICE_CHUNK 64u
+#define SERVICE_READS 64u
+
+/* Data length and offset into g->setup of each setup packet (spec 4.4). */
+static const uint8_t setup_len[TASE_GIMBAL_SETUP_TYPES] = {16u, 2u, 23u, 42u, 2u, 3u, 6u, 16u};
+static const uint8_t setup_off[TASE_GIMBAL_SETUP_TYPES] = {0u, 16u, 18u, 41u, 83u, 85u, 88u,
+                                                           94u};
+
+/* Defaults the spec states. PACKET_RATE: 10, 10, 4 per port. SENSOR_FILTER:
+ * 10 Hz cutoff (0.1 Hz units), 0.5 deg/s decimation (0.1 deg/s units).
+ * AXIS_SETTING: tilt no-go centre 90 deg and range 60 deg (0.01 deg units),
+ * pan/tilt max rate 300 deg/s (5 deg/s units), max acceleration
+ * 10000 deg/s^2 (200 units), position gain 4 (0.1 units); byte 13 is
+ * missing from table 22 and stays 0. The rest has no stated default. */
+static const uint8_t setup_defaults[TASE_GIMBAL_SETUP_BYTES] = {
+    /* PACKET_RATE */
+    10u, 10u, 4u, 0u, 0u, 10u, 10u, 4u, 0u, 0u, 10u, 10u, 4u, 0u, 0u, 0u,
+    /* SENSOR_FILTER */
+    100u, 5u,
+    /* AXIS_SETTING */
+    0x00u, 0x00u, 0x00u, 0x00u, 0x23u, 0x28u, 0x17u, 0x70u, 0x00u, 0x00u, 0x00u, 0x00u,
+    60u, 0u, 60u, 0u, 50u, 50u, 0u, 40u, 40u, 0u, 0u,
+    /* SYSTEM_VERSION, NAV_SOURCE, CAMERA_TYPE, GPS_LEVER_ARM, CAMERA_ALIGN: 0 */
+};
+
+static const uint16_t stream_id[TASE_GIMBAL_STREAMS] = {
+    TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE, TASE_ID_GEOREFERENCE_DATA};
+
+/* Slot k's offset from t0. k < rate <= 255 keeps the product small. */
+static uint32_t slot_ms(uint32_t k, uint32_t rate)
+{
+    return k * 1000u / rate;
+}
+
+/* now_ms is at or after t (clock wraps modulo 2^32; times compared must be
+ * less than 2^31 ms apart). */
+static bool reached(uint32_t now_ms, uint32_t t)
+{
+    return (uint32_t)(now_ms - t) < 0x80000000u;
+}
+
+static bool port_present(const tase_gimbal_t *g, unsigned port)
+{
+    return port < TASE_GIMBAL_PORTS && g->port[port].ops != NULL;
+}
+
+/* Anchor a stream at `now`: its first packet one period later. */
+static void sched_start(tase_gimbal_sched_t *s, uint8_t rate, uint32_t now_ms)
+{
+    s->rate = rate;
+    s->t0 = now_ms;
+    s->k = 1;
+    if (rate == 1u) {
+        s->t0 += 1000u;
+        s->k = 0;
+    }
+}
+
+static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
+{
+    unsigned p, s;
+    for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
+        for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
+            uint8_t rate = g->setup[setup_off[SETUP_PACKET_RATE] + p * RATE_BYTES_PER_PORT + s];
+            if (all || rate != g->sched[p][s].rate) {
+                sched_start(&g->sched[p][s], rate, now_ms);
+            }
+        }
+    }
+}
+
+int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, size_t nports,
+                     const tase_gimbal_app_t *app, uint32_t now_ms)
+{
+    size_t i;
+
+    if (g == NULL || (ports == NULL && nports > 0) || nports > TASE_GIMBAL_PORTS) {
+        return TASE_EARG;
+    }
+    for (i = 0; i < nports; i++) {
+        if (ports[i].ops != NULL && ports[i].ops->write == NULL) {
+            return TASE_EARG;
+        }
+    }
+    memset(g, 0, sizeof *g);
+    for (i = 0; i < nports; i++) {
+        g->port[i] = ports[i];
+    }
+    for (i = 0; i < TASE_GIMBAL_PORTS; i++) {
+        (void)tase_rx_init(&g->rx[i]);
+    }
+    if (app != NULL) {
+        g->app = *app;
+    }
+    memcpy(g->setup, setup_defaults, sizeof g->setup);
+    sched_from_rates(g, now_ms, true);
+    return TASE_OK;
+}
+
+/* Count the outcome of writing one frame; returns r. */
+static int gimbal_write(tase_gimbal_t *g, int r)
+{
+    if (r >= 0) {
+        g->stats.frames_tx++;
+    } else if (r != TASE_EARG && r != TASE_ETOOLONG) {
+        g->stats.tx_errors++;
+    }
+    return r;
+}
+
+int tase_gimbal_send(tase_gimbal_t *g, unsigned port, uint8_t group, uint8_t type,
+                     const uint8_t *data, size_t len)
+{
+    if (g == NULL || !port_present(g, port)) {
+        return TASE_EARG;
+    }
+    return gimbal_write(g, tase_port_send_frame(&g->port[port], group, type, data, len));
+}
+
+int tase_gimbal_setup_len(uint8_t type)
+{
+    if (type >= TASE_GIMBAL_SETUP_TYPES) {
+        return TASE_EUNKNOWN;
+    }
+    return setup_len[type];
+}
+
+int tase_gimbal_setup_get(const tase_gimbal_t *g, uint8_t type, uint8_t *out, size_t cap)
+{
+    if (g == NULL || out == NULL) {
+        return TASE_EARG;
+    }
+    if (type >= TASE_GIMBAL_SETUP_TYPES) {
+        return TASE_EUNKNOWN;
+    }
+    if (cap < setup_len[type]) {
+        return TASE_ENOSPC;
+    }
+    memcpy(out, &g->setup[setup_off[type]], setup_len[type]);
+    return setup_len[type];
+}
+
+static void setup_store(tase_gimbal_t *g, uint8_t type, const uint8_t *data, uint32_t now_ms)
+{
+    memcpy(&g->setup[setup_off[type]], data, setup_len[type]);
+    if (type == SETUP_PACKET_RATE) {
+        sched_from_rates(g, now_ms, false);
+    }
+}
+
+int tase_gimbal_setup_set(tase_gimbal_t *g, uint8_t type, const uint8_t *data, size_t len,
+                          uint32_t now_ms)
+{
+    if (g == NULL || data == NULL) {
+        return TASE_EARG;
+    }
+    if (type >= TASE_GIMBAL_SETUP_TYPES) {
+        return TASE_EUNKNOWN;
+    }
+    if (len != setup_len[type]) {
+        return TASE_ELENGTH;
+    }
+    setup_store(g, type, data, now_ms);
+    return TASE_OK;
+}
+
+static void handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f,
+                         uint32_t now_ms)
+{
+    uint8_t type = f->type;
+    uint8_t tmp[SETUP_APPLY_MAX];
+
+    if (f->len == 0 || type == SETUP_SYSTEM_VERSION) {
+        g->stats.setup_queries++;
+    } else if (f->len != setup_len[type] || f->len > sizeof tmp) {
+        g->stats.bad_length++;
+        return;
+    } else {
+        memcpy(tmp, f->data, f->len);
+        if (g->app.apply_setup == NULL ||
+            g->app.apply_setup(g->app.user, port, type, tmp, f->len) >= 0) {
+            setup_store(g, type, tmp, now_ms);
+            g->stats.setup_applied++;
+        } else {
+            g->stats.setup_refused++;
+        }
+    }
+    /* The echo always carries what is in force now. */
+    (void)tase_gimbal_send(g, port, TASE_GROUP_SETUP, type, &g->setup[setup_off[type]],
+                           setup_len[type]);
+}
+
+int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
+                             uint32_t now_ms)
+{
+    if (g == NULL || frame == NULL || frame->data == NULL || port >= TASE_GIMBAL_PORTS) {
+        return TASE_EARG;
+    }
+    g->stats.frames_rx++;
+    if (frame->group == TASE_GROUP_SETUP && frame->type < TASE_GIMBAL_SETUP_TYPES) {
+        if (port_present(g, port)) {
+            handle_setup(g, port, frame, now_ms);
+        }
+    } else if (g->app.on_frame != NULL) {
+        g->app.on_frame(g->app.user, port, frame);
+    }
+    return TASE_OK;
+}
+
+typedef struct {
+    tase_gimbal_t *g;
+    unsigned port;
+    uint32_t now_ms;
+} feed_ctx_t;
+
+static void gimbal_rx(void *user, const tase_frame_t *frame)
+{
+    feed_ctx_t *c = user;
+    (void)tase_gimbal_handle_frame(c->g, c->port, frame, c->now_ms);
+}
+
+int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
+                     uint32_t now_ms)
+{
+    feed_ctx_t c;
+    if (g == NULL || port >= TASE_GIMBAL_PORTS) {
+        return TASE_EARG;
+    }
+    c.g = g;
+    c.port = port;
+    c.now_ms = now_ms;
+    return tase_rx_feed(&g->rx[port], bytes, n, gimbal_rx, &c);
+}
+
+/* Move a stream to the first slot strictly after now_ms (a late poll
+ * passed some). Computed, not looped, so a long stall costs O(1). */
+static void sched_catch_up(tase_gimbal_t *g, tase_gimbal_sched_t *s, uint32_t now_ms)
+{
+    uint32_t elapsed = now_ms - s->t0;
+    uint32_t rem = elapsed % 1000u;
+    uint32_t k = ((rem + 1u) * s->rate + 999u) / 1000u;
+
+    /* Slots passed over, counted from the old anchor: whole seconds plus
+     * the partial one, minus those already sent. */
+    g->stats.slots_skipped += (elapsed / 1000u) * s->rate + k - s->k;
+    s->t0 += elapsed - rem;
+    if (k >= s->rate) {
+        s->t0 += 1000u;
+        k -= s->rate;
+    }
+    s->k = (uint16_t)k;
+}
+
+static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_t now_ms)
+{
+    tase_gimbal_sched_t *s = &g->sched[port][stream];
+    /* The application writes the data where the frame will carry it, and
+     * the frame is encoded around it in place: one buffer, not two. */
+    uint8_t frame[TASE_FRAME_MAX];
+    uint16_t id = stream_id[stream];
+    int n, sent = 0;
+
+    if (s->rate == 0 || !reached(now_ms, s->t0 + slot_ms(s->k, s->rate))) {
+        return 0;
+    }
+    n = g->app.fill_telemetry(g->app.user, port, id, frame + TASE_FRAME_HEADER,
+                              TASE_DATA_MAX, now_ms);
+    if (n < 0 || n > (int)TASE_DATA_MAX) {
+        g->stats.telemetry_skipped++;
+    } else {
+        n = tase_frame_encode(frame, sizeof frame, TASE_ID_GROUP(id), TASE_ID_TYPE(id),
+                              frame + TASE_FRAME_HEADER, (size_t)n);
+        if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >=
+            0) {
+            g->stats.telemetry_tx++;
+            sent = 1;
+        }
+    }
+    if (++s->k >= s->rate) {
+        s->k = 0;
+        s->t0 += 1000u;
+    }
+    if (reached(now_ms, s->t0 + slot_ms(s->k, s->rate))) {
+        sched_catch_up(g, s, now_ms);
+    }
+    return sent;
+}
+
+int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
+{
+    unsigned p, s;
+    int sent = 0;
+
+    if (g == NULL) {
+        return TASE_EARG;
+    }
+    if (g->app.fill_telemetry == NULL) {
+        return 0;
+    }
+    for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
+        if (!port_present(g, p)) {
+            continue;
+        }
+        for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
+            sent += stream_poll(g, p, s, now_ms);
+        }
+    }
+    return sent;
+}
+
+int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
+{
+    uint8_t buf[SERVICE_CHUNK];
+    unsigned p, i;
+
+    if (g == NULL) {
+        return TASE_EARG;
+    }
+    for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
+        if (!port_present(g, p) || g->port[p].ops->read == NULL) {
+            continue;
+        }
+        for (i = 0; i < SERVICE_READS; i++) {
+            int n = g->port[p].ops->read(g->port[p].ctx, buf, sizeof buf, 0);
+            if (n <= 0) {
+                break;
+            }
+            (void)tase_gimbal_feed(g, p, buf, (size_t)n, now_ms);
+        }
+    }
+    return tase_gimbal_poll(g, now_ms);
+}

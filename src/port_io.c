@@ -1,0 +1,56 @@
+/* Helpers over the port boundary: write-all and frame send. */
+#include "tase/port_io.h"
+
+#include "tase/frame.h"
+
+int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n)
+{
+    size_t done = 0;
+    unsigned idle = 0;
+
+    if (port == NULL || port->ops == NULL || port->ops->write == NULL ||
+        (data == NULL && n > 0)) {
+        return TASE_EARG;
+    }
+    if (n > (size_t)0x7FFFFFFF) {
+        return TASE_EARG; /* the result must fit the int return */
+    }
+    while (done < n) {
+        int r = port->ops->write(port->ctx, data + done, n - done);
+        if (r > 0) {
+            if ((size_t)r > n - done) {
+                return TASE_EIO; /* a port claiming more than asked is broken */
+            }
+            done += (size_t)r;
+            idle = 0;
+            continue;
+        }
+        if (r != 0 && r != TASE_EAGAIN && r != TASE_ENOBUFS) {
+            return r;
+        }
+        if (++idle >= TASE_PORT_WRITE_TRIES) {
+            /* Nothing on the wire yet: the caller may simply retry. Once part
+             * of a frame went out, retrying would not repair it. */
+            if (done == 0) {
+                return r == 0 ? TASE_EAGAIN : r;
+            }
+            return TASE_EIO;
+        }
+    }
+    return (int)n;
+}
+
+int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type,
+                         const uint8_t *data, size_t len)
+{
+    uint8_t buf[TASE_FRAME_MAX];
+    int n = tase_frame_encode(buf, sizeof buf, group, type, data, len);
+
+    if (n < 0) {
+        return n;
+    }
+    if (port == NULL) {
+        return TASE_EARG;
+    }
+    return tase_port_write_all(port, buf, (size_t)n);
+}

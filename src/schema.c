@@ -1,0 +1,194 @@
+/*
+ * The schema table. Descriptors are generated from the X-macro list in
+ * schema_def.h so that each field is written once; the names are
+ * generated from the same list in schema_names.c.
+ */
+#include "tase/schema.h"
+
+#include "tase/codec.h"
+
+/* Field index bookkeeping: FIRST_x / END_x are the flat field indices of
+ * packet x. Each marker rewinds the counter so it takes no slot. */
+#define P(N, g, t, fl, l, sz) FIRST_##N, FIRST_##N##_ = FIRST_##N - 1,
+#define F(T, m, o, w, s) FLD_##T##_##m,
+#define E(N) END_##N, END_##N##_ = END_##N - 1,
+enum {
+#include "schema_def.h"
+    FIELD_TOTAL
+};
+#undef P
+#undef F
+#undef E
+
+/* Packet positions in the list, to check the enumeration in schema.h. */
+#define P(N, g, t, fl, l, sz) PKTIDX_##N,
+#define F(T, m, o, w, s)
+#define E(N)
+enum {
+#include "schema_def.h"
+    PKTIDX_COUNT
+};
+#undef P
+#undef F
+
+/* C99 has no _Static_assert: a negative array size fails the build.
+ * Every member must be as wide as its field, and the enumeration in
+ * schema.h must follow the list. */
+#define P(N, g, t, fl, l, sz) \
+    typedef char chk_idx_##N[((int)TASE_PKT_##N == (int)PKTIDX_##N) ? 1 : -1];
+#define F(T, m, o, w, s) \
+    typedef char chk_##T##_##m[(sizeof(((T *)0)->m) == (w) && offsetof(T, m) < 256u) ? 1 : -1];
+#include "schema_def.h"
+#undef P
+#undef F
+#undef E
+typedef char chk_count[((int)PKTIDX_COUNT == (int)TASE_PKT_COUNT && TASE_PKT_COUNT == TASE_PACKET_COUNT)
+                           ? 1 : -1];
+typedef char chk_fields[(FIELD_TOTAL < 256) ? 1 : -1];
+
+#define FMT_U 0u
+#define FMT_S TASE_FIELD_SIGNED
+
+static const tase_field_t fields[FIELD_TOTAL] = {
+#define P(N, g, t, fl, l, sz)
+#define F(T, m, o, w, s) {o, offsetof(T, m), (w) | FMT_##s},
+#define E(N)
+#include "schema_def.h"
+#undef P
+#undef F
+#undef E
+};
+
+static const tase_packet_desc_t packets[TASE_PKT_COUNT] = {
+#define P(N, g, t, fl, l, sz) \
+    {TASE_ID(g, t), l, fl, FIRST_##N, END_##N - FIRST_##N, sz, TASE_PKT_##N},
+#define F(T, m, o, w, s)
+#define E(N)
+#include "schema_def.h"
+#undef P
+#undef F
+#undef E
+};
+
+/* Direct index: the spec uses only 15 distinct type numbers across its
+ * four groups, so (group slot, type slot) -> packet index + 1 fits in 60
+ * bytes of ROM, against 1 KB for full 256-entry rows. */
+#define NSLOTS 15u
+static const uint8_t by_slot[4][NSLOTS] = {
+    /* types: 00..07, 10, 40..43, 80, 81 */
+    {0, 0, 0, 0, 0, 0, 0, 0, 0, TASE_PKT_GYRO_ZERO_CMD + 1, TASE_PKT_CAMERA_CMD + 1,
+     TASE_PKT_CAMERA_PASS + 1, TASE_PKT_RETRACT_DEPLOY_CMD + 1, TASE_PKT_GIMBAL_CMD + 1,
+     TASE_PKT_LEGACY_CAMERA_CMD + 1},
+    {0, 0, 0, 0, 0, 0, 0, 0, TASE_PKT_GIMBAL_ANGLE + 1, TASE_PKT_GIMBAL_RATE + 1,
+     TASE_PKT_HOST_SENSOR + 1, TASE_PKT_HOST_ATTITUDE + 1, 0, 0, 0},
+    {0, 0, 0, 0, 0, 0, 0, 0, TASE_PKT_HOST_GPS_DATA + 1, TASE_PKT_SPOI_CMD + 1,
+     TASE_PKT_GEOREFERENCE_DATA + 1, 0, 0, 0, 0},
+    {TASE_PKT_PACKET_RATE + 1, TASE_PKT_SENSOR_FILTER + 1, TASE_PKT_AXIS_SETTING + 1,
+     TASE_PKT_SYSTEM_VERSION + 1, TASE_PKT_NAV_SOURCE + 1, TASE_PKT_CAMERA_TYPE + 1,
+     TASE_PKT_GPS_LEVER_ARM + 1, TASE_PKT_CAMERA_ALIGN + 1, 0, 0, 0, 0, 0, 0, 0},
+};
+
+static unsigned group_slot(uint8_t group)
+{
+    switch (group) {
+    case TASE_GROUP_COMMAND: return 0u;
+    case TASE_GROUP_DYNAMICS: return 1u;
+    case TASE_GROUP_POSITION: return 2u;
+    case TASE_GROUP_SETUP: return 3u;
+    default: return 4u;
+    }
+}
+
+static unsigned type_slot(uint8_t type)
+{
+    if (type < 0x08u) {
+        return type;
+    }
+    if (type == 0x10u) {
+        return 8u;
+    }
+    if (type >= 0x40u && type <= 0x43u) {
+        return 9u + (type - 0x40u);
+    }
+    if (type == 0x80u || type == 0x81u) {
+        return 13u + (type - 0x80u);
+    }
+    return NSLOTS;
+}
+
+const tase_packet_desc_t *tase_schema_find(uint8_t group, uint8_t type)
+{
+    unsigned g = group_slot(group);
+    unsigned t = type_slot(type);
+    unsigned k;
+    if (g >= 4u || t >= NSLOTS) {
+        return NULL;
+    }
+    k = by_slot[g][t];
+    return k == 0u ? NULL : &packets[k - 1u];
+}
+
+const tase_packet_desc_t *tase_schema_at(size_t i)
+{
+    return i < TASE_PKT_COUNT ? &packets[i] : NULL;
+}
+
+const tase_field_t *tase_schema_field(const tase_packet_desc_t *p, size_t i)
+{
+    if (p == NULL || i >= p->nfields) {
+        return NULL;
+    }
+    return &fields[p->first_field + i];
+}
+
+bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len)
+{
+    if (p == NULL) {
+        return false;
+    }
+    if (len == p->len) {
+        return true;
+    }
+    if (len == 0u) {
+        return (p->flags & TASE_LEN_QUERY) != 0u;
+    }
+    if (len == 1u) {
+        return (p->flags & TASE_LEN_SHORT1) != 0u;
+    }
+    return (p->flags & TASE_LEN_TAIL) != 0u && len > p->len && len <= TASE_DATA_MAX;
+}
+
+bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len)
+{
+    return p != NULL && len == 0u && (p->flags & TASE_LEN_QUERY) != 0u;
+}
+
+int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data,
+                   size_t len, int64_t *value)
+{
+    const tase_field_t *f = tase_schema_field(p, i);
+    unsigned w, k;
+    uint64_t v = 0u;
+    if (f == NULL || value == NULL || (data == NULL && len > 0u)) {
+        return TASE_EARG;
+    }
+    w = TASE_FIELD_WIDTH(f);
+    if ((size_t)f->offset + w > len) {
+        return TASE_ETRUNC;
+    }
+    for (k = 0; k < w; k++) {
+        v = (v << 8) | data[f->offset + k];
+    }
+    if (TASE_FIELD_IS_SIGNED(f) && ((v >> (8u * w - 1u)) & 1u) != 0u) {
+        /* Two's complement by arithmetic, without an implementation-
+         * defined conversion of an out-of-range unsigned value. */
+        uint64_t mag = ~v;
+        if (w < 8u) {
+            mag &= (((uint64_t)1u) << (8u * w)) - 1u;
+        }
+        *value = -(int64_t)mag - 1;
+    } else {
+        *value = (int64_t)v;
+    }
+    return TASE_OK;
+}

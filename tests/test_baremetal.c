@@ -1,0 +1,386 @@
+/* Tests of the bare-metal UART template: the ISR ring buffer (with a
+ * producer thread standing in for the interrupt) and the port functions. */
+#include <pthread.h>
+#include <sched.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "tase/frame.h"
+#include "tase_bm_uart.h"
+#include "tase_ring.h"
+
+/* Byte number i of the test stream: not periodic in 256, so a lost,
+ * repeated or reordered byte changes the sequence. */
+static uint8_t stream_byte(uint32_t i)
+{
+    return (uint8_t)(i ^ (i >> 8) ^ (i >> 16) ^ (i * 37u));
+}
+
+static void init_rejects_sizes_that_are_not_a_power_of_two(void **state)
+{
+    tase_ring_t r;
+    uint8_t buf[64];
+    (void)state;
+    assert_int_equal(tase_ring_init(&r, buf, 0), TASE_EARG);
+    assert_int_equal(tase_ring_init(&r, buf, 48), TASE_EARG);
+    assert_int_equal(tase_ring_init(&r, NULL, 64), TASE_EARG);
+    assert_int_equal(tase_ring_init(NULL, buf, 64), TASE_EARG);
+    assert_int_equal(tase_ring_init(&r, buf, 64), TASE_OK);
+    assert_int_equal(tase_ring_capacity(&r), 64);
+    assert_int_equal(tase_ring_init(&r, buf, 1), TASE_OK);
+    assert_int_equal(tase_ring_capacity(&r), 1);
+    assert_int_equal(tase_ring_count(NULL), 0);
+    assert_int_equal(tase_ring_overflows(NULL), 0);
+    assert_int_equal(tase_ring_get(NULL, buf, 4), 0);
+}
+
+static void a_full_ring_drops_and_counts_every_extra_byte(void **state)
+{
+    tase_ring_t r;
+    uint8_t buf[8], out[16];
+    uint32_t i;
+    (void)state;
+    assert_int_equal(tase_ring_init(&r, buf, sizeof buf), TASE_OK);
+    for (i = 0; i < 8; i++) {
+        assert_true(tase_ring_put(&r, (uint8_t)i));
+    }
+    assert_int_equal(tase_ring_count(&r), 8); /* every slot usable */
+    for (i = 0; i < 5; i++) {
+        assert_false(tase_ring_put(&r, 0xEE));
+    }
+    assert_int_equal(tase_ring_overflows(&r), 5);
+    assert_int_equal(tase_ring_get(&r, out, sizeof out), 8);
+    for (i = 0; i < 8; i++) {
+        assert_int_equal(out[i], i); /* the dropped 0xEE never got in */
+    }
+    assert_int_equal(tase_ring_count(&r), 0);
+    assert_true(tase_ring_put(&r, 42)); /* room again */
+    assert_int_equal(tase_ring_overflows(&r), 5); /* not reset by reading */
+}
+
+static void order_survives_many_wrap_arounds(void **state)
+{
+    tase_ring_t r;
+    uint8_t buf[16], out[16];
+    uint32_t produced = 0, consumed = 0, round;
+    (void)state;
+    assert_int_equal(tase_ring_init(&r, buf, sizeof buf), TASE_OK);
+    for (round = 0; round < 10000; round++) {
+        uint32_t k, put = 1u + round % 16u;
+        size_t n, j;
+        for (k = 0; k < put; k++) {
+            assert_true(tase_ring_put(&r, stream_byte(produced++)));
+        }
+        n = tase_ring_get(&r, out, 1u + (round * 7u) % 16u);
+        for (j = 0; j < n; j++) {
+            assert_int_equal(out[j], stream_byte(consumed++));
+        }
+        n = tase_ring_get(&r, out, sizeof out); /* empty it */
+        for (j = 0; j < n; j++) {
+            assert_int_equal(out[j], stream_byte(consumed++));
+        }
+    }
+    assert_int_equal(consumed, produced);
+    assert_int_equal(tase_ring_overflows(&r), 0);
+}
+
+/* ---- producer thread standing in for the RX interrupt ---------------- */
+
+#define STRESS_BYTES 4000000u
+
+typedef struct {
+    tase_ring_t *ring;
+    uint32_t n;
+    uint8_t *dropped; /* dropped[i] = 1 when byte i did not fit */
+    uint32_t drops;
+    volatile int done;
+} producer_t;
+
+static void *producer(void *arg)
+{
+    producer_t *p = arg;
+    uint32_t i;
+    for (i = 0; i < p->n; i++) {
+        /* Three phases of four wait while the ring is full (a line with
+         * gaps: nothing may be lost); the fourth runs flat out and must
+         * overflow a ring the consumer cannot keep up with. */
+        if (((i >> 16) & 3u) != 3u) {
+            while (tase_ring_count(p->ring) == tase_ring_capacity(p->ring)) {
+                sched_yield();
+            }
+        }
+        if (!tase_ring_put(p->ring, stream_byte(i))) {
+            p->dropped[i] = 1;
+            p->drops++;
+        }
+    }
+    __atomic_store_n(&p->done, 1, __ATOMIC_RELEASE);
+    return NULL;
+}
+
+static void run_stress(uint32_t ring_size, unsigned consumer_pause_every)
+{
+    tase_ring_t ring;
+    uint8_t *storage = malloc(ring_size);
+    uint8_t *got = malloc(STRESS_BYTES);
+    producer_t p;
+    pthread_t th;
+    uint32_t received = 0, j, k, iter = 0;
+    uint8_t chunk[97];
+
+    assert_non_null(storage);
+    assert_non_null(got);
+    memset(&p, 0, sizeof p);
+    p.dropped = calloc(STRESS_BYTES, 1);
+    assert_non_null(p.dropped);
+    assert_int_equal(tase_ring_init(&ring, storage, ring_size), TASE_OK);
+    p.ring = &ring;
+    p.n = STRESS_BYTES;
+    assert_int_equal(pthread_create(&th, NULL, producer, &p), 0);
+    for (;;) {
+        int finished = __atomic_load_n(&p.done, __ATOMIC_ACQUIRE);
+        size_t n = tase_ring_get(&ring, chunk, 1u + iter % sizeof chunk);
+        assert_true(received + n <= STRESS_BYTES);
+        memcpy(got + received, chunk, n);
+        received += (uint32_t)n;
+        iter++;
+        if (consumer_pause_every != 0 && iter % consumer_pause_every == 0) {
+            sched_yield(); /* a slow main loop: forces overflows */
+        }
+        if (finished && n == 0 && tase_ring_count(&ring) == 0) {
+            break;
+        }
+    }
+    pthread_join(th, NULL);
+
+    assert_int_equal(tase_ring_overflows(&ring), p.drops);
+    assert_int_equal((uint64_t)received + tase_ring_overflows(&ring), STRESS_BYTES);
+    /* What arrived is exactly the produced stream minus the dropped bytes,
+     * in order. */
+    for (j = 0, k = 0; j < STRESS_BYTES; j++) {
+        if (p.dropped[j]) {
+            continue;
+        }
+        if (got[k] != stream_byte(j)) {
+            fail_msg("byte %u (received #%u) is %u, expected %u", j, k, got[k],
+                     stream_byte(j));
+        }
+        k++;
+    }
+    assert_int_equal(k, received);
+    assert_true(received >= STRESS_BYTES / 2); /* the paced phases got through */
+    if (consumer_pause_every != 0) {
+        assert_true(tase_ring_overflows(&ring) > 0); /* the slow loop fell behind */
+    }
+    print_message("ring %u B: %u bytes produced, %u received, %u overflowed\n", ring_size,
+                  STRESS_BYTES, received, tase_ring_overflows(&ring));
+    free(p.dropped);
+    free(got);
+    free(storage);
+}
+
+static void millions_of_bytes_from_an_isr_thread_arrive_in_order_or_counted(void **state)
+{
+    (void)state;
+    run_stress(1024, 0);
+}
+
+static void a_slow_consumer_loses_only_counted_bytes(void **state)
+{
+    (void)state;
+    run_stress(64, 3); /* tiny ring and a main loop that keeps yielding */
+}
+
+/* ---- the port template ------------------------------------------------ */
+
+typedef struct {
+    uint32_t now;
+    uint8_t tx[4096];
+    size_t ntx;
+    int tx_result;
+    tase_bm_uart_t *uart; /* idle() "receives" a byte, as an ISR would */
+    int idle_calls;
+    int deliver_after_idles;
+} fake_hw_t;
+
+static int fake_tx(void *hw, const uint8_t *data, size_t n)
+{
+    fake_hw_t *f = hw;
+    if (f->tx_result < 0) {
+        return f->tx_result;
+    }
+    assert_true(f->ntx + n <= sizeof f->tx);
+    memcpy(f->tx + f->ntx, data, n);
+    f->ntx += n;
+    return 0;
+}
+
+static uint32_t fake_millis(void *hw)
+{
+    return ((fake_hw_t *)hw)->now;
+}
+
+static void fake_idle(void *hw)
+{
+    fake_hw_t *f = hw;
+    f->now += 1; /* time passes while the core sleeps */
+    if (++f->idle_calls == f->deliver_after_idles) {
+        tase_bm_uart_rx_isr(f->uart, 0x5A);
+    }
+}
+
+static const tase_bm_uart_hooks_t fake_hooks = {fake_tx, fake_millis, fake_idle};
+
+static void port_read_waits_on_the_millisecond_hook_and_wakes_on_rx(void **state)
+{
+    static fake_hw_t hw;
+    tase_bm_uart_t u;
+    uint8_t storage[32], buf[8];
+    tase_port_t port;
+    (void)state;
+
+    memset(&hw, 0, sizeof hw);
+    hw.now = 0xFFFFFFF0u; /* the wait spans the 2^32 wrap */
+    hw.uart = &u;
+    assert_int_equal(tase_bm_uart_init(&u, storage, 48, &fake_hooks, &hw), TASE_EARG);
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw),
+                     TASE_OK);
+    port = tase_bm_uart_port(&u);
+
+    hw.deliver_after_idles = -1;
+    assert_int_equal(port.ops->read(port.ctx, buf, sizeof buf, 50), 0);
+    assert_int_equal(hw.now, 0xFFFFFFF0u + 50u);
+
+    hw.idle_calls = 0;
+    hw.deliver_after_idles = 7;
+    assert_int_equal(port.ops->read(port.ctx, buf, sizeof buf, 1000), 1);
+    assert_int_equal(buf[0], 0x5A);
+    assert_int_equal(hw.idle_calls, 7);
+    assert_int_equal(port.ops->now_ms(port.ctx), hw.now);
+}
+
+static void port_write_goes_to_the_tx_hook_whole_or_reports_its_error(void **state)
+{
+    static fake_hw_t hw;
+    tase_bm_uart_t u;
+    uint8_t storage[32];
+    tase_port_t port;
+    (void)state;
+
+    memset(&hw, 0, sizeof hw);
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw),
+                     TASE_OK);
+    port = tase_bm_uart_port(&u);
+    assert_int_equal(port.ops->write(port.ctx, (const uint8_t *)"hello", 5), 5);
+    assert_memory_equal(hw.tx, "hello", 5);
+    hw.tx_result = TASE_EIO;
+    assert_int_equal(port.ops->write(port.ctx, (const uint8_t *)"x", 1), TASE_EIO);
+}
+
+typedef struct {
+    uint32_t frames;
+    uint32_t bad;
+    uint32_t next_seq;
+} frame_count_t;
+
+static void count_frame(void *user, const tase_frame_t *f)
+{
+    frame_count_t *c = user;
+    uint32_t seq = ((uint32_t)f->data[0] << 24) | ((uint32_t)f->data[1] << 16) |
+                   ((uint32_t)f->data[2] << 8) | f->data[3];
+    if (f->group != 0x08 || f->type != 0x10 || f->len != 20 || seq != c->next_seq) {
+        c->bad++;
+    }
+    c->next_seq = seq + 1u;
+    c->frames++;
+}
+
+#define ISR_FRAMES 20000u
+
+typedef struct {
+    tase_bm_uart_t *u;
+    volatile int done;
+} isr_sim_t;
+
+/* Sends ISR_FRAMES frames byte by byte like a UART RX interrupt, waiting
+ * (hardware flow control style) whenever the ring is full, so that no
+ * byte may be lost. */
+static void *isr_frames(void *arg)
+{
+    isr_sim_t *s = arg;
+    uint8_t frame[TASE_FRAME_MAX], data[20];
+    uint32_t seq;
+    for (seq = 0; seq < ISR_FRAMES; seq++) {
+        int n, i;
+        memset(data, (int)(seq & 0xFFu), sizeof data);
+        data[0] = (uint8_t)(seq >> 24);
+        data[1] = (uint8_t)(seq >> 16);
+        data[2] = (uint8_t)(seq >> 8);
+        data[3] = (uint8_t)seq;
+        n = tase_frame_encode(frame, sizeof frame, 0x08, 0x10, data, sizeof data);
+        for (i = 0; i < n; i++) {
+            while (tase_ring_count(&s->u->rx) == tase_ring_capacity(&s->u->rx)) {
+                sched_yield();
+            }
+            tase_bm_uart_rx_isr(s->u, frame[i]);
+        }
+    }
+    __atomic_store_n(&s->done, 1, __ATOMIC_RELEASE);
+    return NULL;
+}
+
+static void main_loop_poll_delivers_every_frame_the_isr_received(void **state)
+{
+    static fake_hw_t hw;
+    static tase_rx_t rx;
+    tase_bm_uart_t u;
+    uint8_t storage[256];
+    frame_count_t c = {0, 0, 0};
+    isr_sim_t s;
+    pthread_t th;
+    (void)state;
+
+    memset(&hw, 0, sizeof hw);
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw),
+                     TASE_OK);
+    assert_int_equal(tase_rx_init(&rx), TASE_OK);
+    s.u = &u;
+    s.done = 0;
+    assert_int_equal(pthread_create(&th, NULL, isr_frames, &s), 0);
+    for (;;) {
+        int finished = __atomic_load_n(&s.done, __ATOMIC_ACQUIRE);
+        int r = tase_bm_uart_poll(&u, &rx, count_frame, &c);
+        assert_true(r >= 0);
+        if (finished && tase_ring_count(&u.rx) == 0) {
+            break;
+        }
+    }
+    pthread_join(th, NULL);
+    assert_int_equal(tase_bm_uart_poll(&u, &rx, count_frame, &c), 0);
+    assert_int_equal(c.frames, ISR_FRAMES);
+    assert_int_equal(c.bad, 0);
+    assert_int_equal(rx.stats.checksum_errors, 0);
+    assert_int_equal(tase_ring_overflows(&u.rx), 0);
+    assert_int_equal(tase_bm_uart_poll(NULL, &rx, count_frame, &c), TASE_EARG);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(init_rejects_sizes_that_are_not_a_power_of_two),
+        cmocka_unit_test(a_full_ring_drops_and_counts_every_extra_byte),
+        cmocka_unit_test(order_survives_many_wrap_arounds),
+        cmocka_unit_test(millions_of_bytes_from_an_isr_thread_arrive_in_order_or_counted),
+        cmocka_unit_test(a_slow_consumer_loses_only_counted_bytes),
+        cmocka_unit_test(port_read_waits_on_the_millisecond_hook_and_wakes_on_rx),
+        cmocka_unit_test(port_write_goes_to_the_tx_hook_whole_or_reports_its_error),
+        cmocka_unit_test(main_loop_poll_delivers_every_frame_the_isr_received),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

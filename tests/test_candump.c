@@ -1,0 +1,189 @@
+/* Tests of the can-utils log format reader and writer. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "tase/candump.h"
+
+static int parse(const char *line, tase_candump_rec_t *r)
+{
+    return tase_candump_parse(line, strlen(line), r);
+}
+
+static void extended_line_parses_into_fields(void **state)
+{
+    tase_candump_rec_t r;
+    static const uint8_t want[8] = {0x00, 0xFF, 0x5A, 0x08, 0x08, 0x10, 0x03, 0xE8};
+    (void)state;
+    assert_int_equal(parse("(1700000000.123456) vcan0 11000000#00FF5A08081003E8\n", &r), TASE_OK);
+    assert_true(r.sec == 1700000000u);
+    assert_int_equal(r.usec, 123456);
+    assert_string_equal(r.ifname, "vcan0");
+    assert_true(r.frame.extended);
+    assert_int_equal(r.frame.id, 0x11000000u);
+    assert_int_equal(r.frame.dlc, 8);
+    assert_memory_equal(r.frame.data, want, 8);
+}
+
+static void standard_and_empty_frames_parse(void **state)
+{
+    tase_candump_rec_t r;
+    (void)state;
+    assert_int_equal(parse("(0000000001.000001) can1 7ff#", &r), TASE_OK);
+    assert_false(r.frame.extended);
+    assert_int_equal(r.frame.id, 0x7FF);
+    assert_int_equal(r.frame.dlc, 0);
+    assert_int_equal(r.usec, 1);
+    assert_int_equal(parse("(1.000000) can1 123#de.ad.BE.ef\r\n", &r), TASE_OK);
+    assert_int_equal(r.frame.dlc, 4);
+    assert_int_equal(r.frame.data[2], 0xBE);
+    assert_int_equal(parse("(1.000000)  can1\t12020000#80F6 R\n", &r), TASE_OK);
+    assert_int_equal(r.frame.id, 0x12020000u);
+}
+
+static void malformed_lines_are_rejected_and_leave_output_alone(void **state)
+{
+    static const char *bad[] = {
+        "",
+        "\n",
+        "1700000000.123456 vcan0 123#00",        /* no parentheses */
+        "(1700000000.12345) vcan0 123#00",       /* 5 microsecond digits */
+        "(1700000000.1234567) vcan0 123#00",     /* 7 */
+        "(1700000000.123456)vcan0 123#00",       /* no space */
+        "(1700000000.123456) vcan0 12#00",       /* 2-digit id */
+        "(1700000000.123456) vcan0 1234#00",     /* 4-digit id */
+        "(1700000000.123456) vcan0 800#00",      /* standard id too big */
+        "(1700000000.123456) vcan0 123#0",       /* odd nibble */
+        "(1700000000.123456) vcan0 123#0G",      /* not hex */
+        "(1700000000.123456) vcan0 123#001122334455667788", /* 9 bytes */
+        "(1700000000.123456) vcan0 123#00.",     /* dangling dot */
+        "(1700000000.123456) vcan0 123#00 junk", /* trailing text */
+        "(1700000000.123456) vcan0 C0000000#00", /* flag bits 30/31 */
+        "(1700000000.123456) averyveryverylongname 123#00", /* name > 15 */
+        "(1700000000.123456) vcan0 123",         /* no '#' */
+        "(99999999999999999999.000000) vcan0 123#00", /* > 2^64 seconds */
+        "(-1.000000) vcan0 123#00",
+    };
+    tase_candump_rec_t r;
+    size_t i;
+    (void)state;
+    for (i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+        memset(&r, 0x77, sizeof(r));
+        assert_int_equal(parse(bad[i], &r), TASE_EFORMAT);
+        assert_int_equal(r.usec, 0x77777777u);
+    }
+    /* An embedded NUL is a bad character, not the end of the line. */
+    assert_int_equal(tase_candump_parse("(1.000000) vcan0 123#00\0", 24, &r), TASE_EFORMAT);
+    assert_int_equal(tase_candump_parse(NULL, 3, &r), TASE_EARG);
+    assert_int_equal(tase_candump_parse("x", 1, NULL), TASE_EARG);
+}
+
+static void frames_we_cannot_represent_are_unsupported(void **state)
+{
+    tase_candump_rec_t r;
+    (void)state;
+    assert_int_equal(parse("(1.000000) vcan0 123#R", &r), TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 123##100", &r), TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 20000080#0000000000000000", &r),
+                     TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 123#1122334455667788_E", &r), TASE_EUNSUPPORTED);
+}
+
+static void format_writes_candump_style_lines(void **state)
+{
+    tase_candump_rec_t r;
+    char line[TASE_CANDUMP_LINE_MAX];
+    (void)state;
+    memset(&r, 0, sizeof(r));
+    r.sec = 42;
+    r.usec = 7;
+    strcpy(r.ifname, "vcan0");
+    r.frame.id = 0x10000000u;
+    r.frame.extended = true;
+    r.frame.dlc = 3;
+    r.frame.data[0] = 0x00;
+    r.frame.data[1] = 0xFF;
+    r.frame.data[2] = 0x5a;
+    assert_int_equal(tase_candump_format(&r, line, sizeof(line)),
+                     (int)strlen("(0000000042.000007) vcan0 10000000#00FF5A\n"));
+    assert_string_equal(line, "(0000000042.000007) vcan0 10000000#00FF5A\n");
+    r.frame.extended = false;
+    r.frame.id = 0x12;
+    r.frame.dlc = 0;
+    assert_int_equal(tase_candump_format(&r, line, sizeof(line)),
+                     (int)strlen("(0000000042.000007) vcan0 012#\n"));
+    assert_string_equal(line, "(0000000042.000007) vcan0 012#\n");
+}
+
+static void format_needs_room_and_valid_records(void **state)
+{
+    tase_candump_rec_t r;
+    char line[TASE_CANDUMP_LINE_MAX];
+    (void)state;
+    memset(&r, 0, sizeof(r));
+    strcpy(r.ifname, "vcan0");
+    r.frame.id = 0x123;
+    r.frame.dlc = 1;
+    memset(line, '#', sizeof(line));
+    /* "(0000000000.000000) vcan0 123#00\n" is 33 characters + NUL */
+    assert_int_equal(tase_candump_format(&r, line, 33), TASE_ENOSPC);
+    assert_int_equal(line[0], '#');
+    assert_int_equal(tase_candump_format(&r, line, 34), 33);
+    assert_string_equal(line, "(0000000000.000000) vcan0 123#00\n");
+    r.usec = 1000000;
+    assert_int_equal(tase_candump_format(&r, line, sizeof(line)), TASE_EARG);
+    r.usec = 0;
+    r.frame.id = 0x800;
+    assert_int_equal(tase_candump_format(&r, line, sizeof(line)), TASE_EARG);
+    r.frame.id = 0x123;
+    strcpy(r.ifname, "a b");
+    assert_int_equal(tase_candump_format(&r, line, sizeof(line)), TASE_EARG);
+    r.ifname[0] = '\0';
+    assert_int_equal(tase_candump_format(&r, line, sizeof(line)), TASE_EARG);
+    memset(r.ifname, 'x', sizeof(r.ifname)); /* not terminated */
+    assert_int_equal(tase_candump_format(&r, line, sizeof(line)), TASE_EARG);
+}
+
+static void longest_line_fits_the_documented_maximum_and_round_trips(void **state)
+{
+    tase_candump_rec_t r, back;
+    char line[TASE_CANDUMP_LINE_MAX];
+    int n;
+    (void)state;
+    memset(&r, 0, sizeof(r));
+    r.sec = UINT64_MAX;
+    r.usec = 999999;
+    strcpy(r.ifname, "abcdefghijklmno");
+    r.frame.extended = true;
+    r.frame.id = 0x1FFFFFFFu;
+    r.frame.dlc = 8;
+    memset(r.frame.data, 0xA5, 8);
+    n = tase_candump_format(&r, line, sizeof(line));
+    assert_int_equal(n, (int)TASE_CANDUMP_LINE_MAX - 1);
+    assert_int_equal(tase_candump_parse(line, (size_t)n, &back), TASE_OK);
+    assert_true(back.sec == UINT64_MAX);
+    assert_int_equal(back.usec, 999999);
+    assert_string_equal(back.ifname, r.ifname);
+    assert_int_equal(back.frame.id, r.frame.id);
+    assert_true(back.frame.extended);
+    assert_int_equal(back.frame.dlc, 8);
+    assert_memory_equal(back.frame.data, r.frame.data, 8);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(extended_line_parses_into_fields),
+        cmocka_unit_test(standard_and_empty_frames_parse),
+        cmocka_unit_test(malformed_lines_are_rejected_and_leave_output_alone),
+        cmocka_unit_test(frames_we_cannot_represent_are_unsupported),
+        cmocka_unit_test(format_writes_candump_style_lines),
+        cmocka_unit_test(format_needs_room_and_valid_records),
+        cmocka_unit_test(longest_line_fits_the_documented_maximum_and_round_trips),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,418 @@
+/* Tests of the typed codec: byte-exact frames computed by hand, a
+ * round trip of every packet type with random and extreme values, every
+ * wrong length rejected, and argument errors that write nothing. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "tase/codec.h"
+#include "tase/flags.h"
+
+static uint32_t rng_state = 0x2545F491u;
+static uint32_t rnd(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 17;
+    rng_state ^= rng_state << 5;
+    return rng_state;
+}
+
+static tase_frame_t frame_of(const uint8_t *buf, int n)
+{
+    tase_frame_t f;
+    assert_true(n >= 8);
+    memset(&f, 0, sizeof(f));
+    f.group = buf[4];
+    f.type = buf[5];
+    f.len = (uint8_t)(n - 8);
+    f.data = buf + 6;
+    return f;
+}
+
+/* ---- byte-exact frames, one or more per group ----------------------- */
+
+static void gimbal_cmd_extremes_encode_to_hand_computed_frame(void **state)
+{
+    /* pan INT16_MIN = 80 00, tilt -1 = FF FF, roll INT16_MAX = 7F FF,
+     * flags rate+stab = 0x90, impulse 200 = C8. Size = 8 + 2 = 0x0A.
+     * Sum: 00+FF+5A+0A+00+80 = 483; 80+00+FF+FF+7F+FF+90+C8 = 1364;
+     * 1847 = 0x0737. */
+    static const uint8_t want[] = {0x00, 0xFF, 0x5A, 0x0A, 0x00, 0x80, 0x80, 0x00, 0xFF,
+                                   0xFF, 0x7F, 0xFF, 0x90, 0xC8, 0x07, 0x37};
+    tase_gimbal_cmd_t m = {INT16_MIN, -1, INT16_MAX, TASE_GIMBAL_FLAGS_RATE_STAB, 200};
+    tase_gimbal_cmd_t back;
+    uint8_t out[64];
+    tase_frame_t f;
+    (void)state;
+    assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, &m, out, sizeof(out)), 16);
+    assert_memory_equal(out, want, sizeof(want));
+    f = frame_of(out, 16);
+    memset(&back, 0x55, sizeof(back));
+    assert_int_equal(tase_packet_decode(&f, &back), 8);
+    assert_int_equal(back.pan, INT16_MIN);
+    assert_int_equal(back.tilt, -1);
+    assert_int_equal(back.roll, INT16_MAX);
+    assert_int_equal(back.flags, 0x90);
+    assert_int_equal(back.impulse_time, 200);
+}
+
+static void gyro_zero_and_camera_short_forms_encode_to_hand_computed_frames(void **state)
+{
+    /* GYRO_ZERO_CMD: 00 FF 5A 02 00 40, sum 411 = 0x019B. */
+    static const uint8_t gyro[] = {0x00, 0xFF, 0x5A, 0x02, 0x00, 0x40, 0x01, 0x9B};
+    /* CAMERA_CMD camera-only form, camera B: 00 FF 5A 03 00 41 01,
+     * sum 414 = 0x019E. */
+    static const uint8_t cam1[] = {0x00, 0xFF, 0x5A, 0x03, 0x00, 0x41, 0x01, 0x01, 0x9E};
+    /* CAMERA_PASS camera C, 57600 baud = 48 * 1200 (0x30), bytes 'A' 'B':
+     * 00 FF 5A 08 00 42 02 30 00 00 41 42, sum 600 = 0x0258. */
+    static const uint8_t pass[] = {0x00, 0xFF, 0x5A, 0x08, 0x00, 0x42, 0x02, 0x30,
+                                   0x00, 0x00, 0x41, 0x42, 0x02, 0x58};
+    tase_camera_cmd_t cam = {TASE_CAMERA_B, 1234, 0xFFFF, 1, 2, 3, 0x80};
+    tase_camera_pass_t cp = {TASE_CAMERA_C, 48, 2, (const uint8_t *)"AB"};
+    tase_camera_pass_t cpb;
+    tase_camera_cmd_t camb;
+    uint8_t out[64];
+    tase_frame_t f;
+    (void)state;
+    assert_int_equal(tase_packet_encode(TASE_ID_GYRO_ZERO_CMD, NULL, out, sizeof(out)), 8);
+    assert_memory_equal(out, gyro, sizeof(gyro));
+    assert_int_equal(tase_packet_encode_query(TASE_ID_GYRO_ZERO_CMD, out, sizeof(out)), 8);
+    assert_memory_equal(out, gyro, sizeof(gyro));
+    f = frame_of(out, 8);
+    assert_int_equal(tase_packet_decode(&f, NULL), 0);
+
+    assert_int_equal(tase_packet_encode_len(TASE_ID_CAMERA_CMD, &cam, 1, out, sizeof(out)), 9);
+    assert_memory_equal(out, cam1, sizeof(cam1));
+    f = frame_of(out, 9);
+    memset(&camb, 0x55, sizeof(camb));
+    assert_int_equal(tase_packet_decode(&f, &camb), 1);
+    assert_int_equal(camb.camera, 1);
+    assert_int_equal(camb.hfov, 0); /* not sent: zero */
+    assert_int_equal(camb.flags, 0);
+
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), 14);
+    assert_memory_equal(out, pass, sizeof(pass));
+    f = frame_of(out, 14);
+    assert_int_equal(tase_packet_decode(&f, &cpb), 6);
+    assert_int_equal(cpb.camera, 2);
+    assert_int_equal(cpb.baud, 48);
+    assert_int_equal(cpb.len, 2);
+    assert_ptr_equal(cpb.data, out + 10); /* points into the frame */
+}
+
+static void gimbal_angle_encodes_to_hand_computed_frame(void **state)
+{
+    /* pan 1.00 deg = 100 = 00 64, tilt -45.00 deg = -4500 = EE 6C, roll 0.
+     * Sum: 00+FF+5A+08+08+10 = 377; 64+EE+6C = 446; 823 = 0x0337. */
+    static const uint8_t want[] = {0x00, 0xFF, 0x5A, 0x08, 0x08, 0x10, 0x00, 0x64,
+                                   0xEE, 0x6C, 0x00, 0x00, 0x03, 0x37};
+    tase_gimbal_angle_t m = {100, -4500, 0};
+    uint8_t out[32];
+    (void)state;
+    assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_ANGLE, &m, out, sizeof(out)), 14);
+    assert_memory_equal(out, want, sizeof(want));
+}
+
+static void spoi_full_and_query_forms_encode_to_hand_computed_frames(void **state)
+{
+    /* lat INT32_MIN, lon -1, height 0x12345678, vnorth -2, veast 0x0102,
+     * vdown 0, flags echo. Size 19 + 2 = 0x15. Sum: header
+     * FF+5A+15+10+40 = 446; data 80 + 4*FF + 12+34+56+78 + FF+FE + 01+02
+     * + 80 = 2064; 2510 = 0x09CE. Query: 00 FF 5A 02 10 40, 427 = 0x01AB. */
+    static const uint8_t want[] = {0x00, 0xFF, 0x5A, 0x15, 0x10, 0x40, 0x80, 0x00, 0x00,
+                                   0x00, 0xFF, 0xFF, 0xFF, 0xFF, 0x12, 0x34, 0x56, 0x78,
+                                   0xFF, 0xFE, 0x01, 0x02, 0x00, 0x00, 0x80, 0x09, 0xCE};
+    static const uint8_t query[] = {0x00, 0xFF, 0x5A, 0x02, 0x10, 0x40, 0x01, 0xAB};
+    tase_spoi_cmd_t m = {INT32_MIN, -1, 0x12345678, -2, 0x0102, 0, TASE_SPOI_ECHO};
+    tase_spoi_cmd_t back;
+    uint8_t out[64];
+    tase_frame_t f;
+    (void)state;
+    assert_int_equal(tase_packet_encode(TASE_ID_SPOI_CMD, &m, out, sizeof(out)), 27);
+    assert_memory_equal(out, want, sizeof(want));
+    f = frame_of(out, 27);
+    assert_int_equal(tase_packet_decode(&f, &back), 19);
+    assert_true(back.lat == INT32_MIN);
+    assert_int_equal(back.lon, -1);
+    assert_int_equal(back.vnorth, -2);
+    assert_int_equal(tase_packet_encode_query(TASE_ID_SPOI_CMD, out, sizeof(out)), 8);
+    assert_memory_equal(out, query, sizeof(query));
+    f = frame_of(out, 8);
+    memset(&back, 0x55, sizeof(back));
+    assert_int_equal(tase_packet_decode(&f, &back), 0);
+    assert_int_equal(back.lat, 0); /* a query decodes as a zeroed struct */
+    assert_int_equal(back.flags, 0);
+}
+
+static void axis_setting_leaves_byte_13_reserved_zero(void **state)
+{
+    /* Data: B9B0 (-18000) FFFF 2328 (9000) 1770 (6000) 0000 0000, 3C,
+     * [13] 00, 3C FF 32 32 FF 28 28 FF 01. Size 23 + 2 = 0x19.
+     * Sum: header FF+5A+19+48+02 = 444; data 2147; 2591 = 0x0A1F. */
+    static const uint8_t want[] = {0x00, 0xFF, 0x5A, 0x19, 0x48, 0x02, 0xB9, 0xB0, 0xFF,
+                                   0xFF, 0x23, 0x28, 0x17, 0x70, 0x00, 0x00, 0x00, 0x00,
+                                   0x3C, 0x00, 0x3C, 0xFF, 0x32, 0x32, 0xFF, 0x28, 0x28,
+                                   0xFF, 0x01, 0x0A, 0x1F};
+    tase_axis_setting_t m;
+    uint8_t out[64];
+    (void)state;
+    memset(&m, 0, sizeof(m));
+    m.pan_nogo_center = -18000;
+    m.pan_nogo_range = TASE_AXIS_NO_CHANGE16;
+    m.tilt_nogo_center = 9000;
+    m.tilt_nogo_range = 6000;
+    m.pan_max_rate = 60;
+    m.tilt_max_rate = 60;
+    m.roll_max_rate = TASE_AXIS_NO_CHANGE8;
+    m.pan_max_accel = 50;
+    m.tilt_max_accel = 50;
+    m.roll_max_accel = 0xFF;
+    m.pan_pos_gain = 40;
+    m.tilt_pos_gain = 40;
+    m.roll_pos_gain = 0xFF;
+    m.temporary = TASE_SETUP_TEMPORARY;
+    memset(out, 0xAA, sizeof(out)); /* reserved byte must be cleared */
+    assert_int_equal(tase_packet_encode(TASE_ID_AXIS_SETTING, &m, out, sizeof(out)), 31);
+    assert_memory_equal(out, want, sizeof(want));
+}
+
+/* ---- every packet: round trips -------------------------------------- */
+
+/* The value of a struct member of width w, as unsigned bits. */
+static uint64_t member_bits(const uint8_t *p, unsigned w)
+{
+    uint8_t b;
+    uint16_t h;
+    uint32_t x;
+    uint64_t q;
+    switch (w) {
+    case 1: memcpy(&b, p, 1); return b;
+    case 2: memcpy(&h, p, 2); return h;
+    case 4: memcpy(&x, p, 4); return x;
+    default: memcpy(&q, p, 8); return q;
+    }
+}
+
+/* Fill the data bytes of packet p: fields from `fill`, reserved zero. */
+static void fill_fields(const tase_packet_desc_t *p, uint8_t *data, int mode)
+{
+    size_t k, b;
+    memset(data, 0, p->len);
+    for (k = 0; k < p->nfields; k++) {
+        const tase_field_t *f = tase_schema_field(p, k);
+        unsigned w = TASE_FIELD_WIDTH(f);
+        for (b = 0; b < w; b++) {
+            uint8_t v;
+            switch (mode) {
+            case 0: v = 0xFF; break;                      /* -1, 0xFFFF, 0xFFFFFFFF */
+            case 1: v = b == 0 ? 0x80 : 0x00; break;      /* INT16_MIN, INT32_MIN */
+            case 2: v = b == 0 ? 0x7F : 0xFF; break;      /* INT16_MAX, INT32_MAX */
+            case 3: v = 0x00; break;
+            default: v = (uint8_t)rnd(); break;
+            }
+            data[f->offset + b] = v;
+        }
+    }
+}
+
+static void every_packet_round_trips_random_and_extreme_values(void **state)
+{
+    size_t i, k;
+    int mode, rep;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        for (mode = 0; mode < 5; mode++) {
+            for (rep = 0; rep < (mode == 4 ? 200 : 1); rep++) {
+                uint8_t data[TASE_DATA_MAX], tail[TASE_CAMERA_PASS_MAX];
+                uint8_t wire[TASE_FRAME_MAX], again[TASE_FRAME_MAX];
+                tase_packet_msg_t m1, m2;
+                tase_frame_t f;
+                size_t len = p->len;
+                int n;
+                fill_fields(p, data, mode);
+                if (p->flags & TASE_LEN_TAIL) {
+                    size_t extra = rnd() % (TASE_CAMERA_PASS_MAX + 1);
+                    for (k = 0; k < extra; k++) {
+                        tail[k] = (uint8_t)rnd();
+                    }
+                    memcpy(data + len, tail, extra);
+                    len += extra;
+                }
+                n = tase_frame_encode(wire, sizeof(wire), TASE_ID_GROUP(p->id),
+                                      TASE_ID_TYPE(p->id), data, len);
+                assert_int_equal(n, (int)len + 8);
+                f = frame_of(wire, n);
+                /* wire -> struct: every member equals the raw field value */
+                memset(&m1, 0x55, sizeof(m1));
+                assert_int_equal(tase_packet_decode(&f, p->size ? &m1 : NULL), (int)len);
+                for (k = 0; k < p->nfields; k++) {
+                    const tase_field_t *fd = tase_schema_field(p, k);
+                    int64_t raw;
+                    uint64_t bits = 0, want;
+                    unsigned w = TASE_FIELD_WIDTH(fd);
+                    assert_int_equal(tase_field_get(p, k, f.data, f.len, &raw), TASE_OK);
+                    bits = member_bits((const uint8_t *)&m1 + fd->member, w);
+                    want = w == 8 ? (uint64_t)raw : ((uint64_t)raw & ((1ull << (8 * w)) - 1));
+                    assert_true(bits == want);
+                }
+                /* struct -> wire: byte-identical frame */
+                n = tase_packet_encode(p->id, p->size ? &m1 : NULL, again, sizeof(again));
+                assert_int_equal(n, (int)len + 8);
+                assert_memory_equal(again, wire, (size_t)n);
+                /* and back to an identical struct */
+                f = frame_of(again, n);
+                memset(&m2, 0x33, sizeof(m2));
+                assert_int_equal(tase_packet_decode(&f, p->size ? &m2 : NULL), (int)len);
+                if (p->flags & TASE_LEN_TAIL) {
+                    assert_memory_equal(m2.camera_pass.data, tail, m2.camera_pass.len);
+                    m2.camera_pass.data = m1.camera_pass.data;
+                }
+                assert_memory_equal(&m1, &m2, p->size);
+            }
+        }
+    }
+}
+
+static void every_query_capable_packet_encodes_an_eight_byte_query(void **state)
+{
+    size_t i;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        uint8_t out[16];
+        int n;
+        memset(out, 0xAA, sizeof(out));
+        n = tase_packet_encode_query(p->id, out, sizeof(out));
+        if (tase_schema_length_ok(p, 0)) {
+            uint16_t sum = (uint16_t)(0xFF + 0x5A + 2 + TASE_ID_GROUP(p->id) + TASE_ID_TYPE(p->id));
+            assert_int_equal(n, 8);
+            assert_int_equal(out[3], 2);
+            assert_int_equal(out[6], sum >> 8);
+            assert_int_equal(out[7], sum & 0xFF);
+        } else {
+            assert_int_equal(n, TASE_ELENGTH);
+            assert_int_equal(out[0], 0xAA);
+        }
+    }
+}
+
+static void every_wrong_length_is_rejected_on_decode_and_encode(void **state)
+{
+    size_t i, len;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        for (len = 0; len <= TASE_DATA_MAX; len++) {
+            uint8_t data[TASE_DATA_MAX] = {0};
+            uint8_t out[TASE_FRAME_MAX];
+            tase_packet_msg_t m, before;
+            tase_frame_t f;
+            if (tase_schema_length_ok(p, len)) {
+                continue;
+            }
+            memset(&f, 0, sizeof(f));
+            f.group = TASE_ID_GROUP(p->id);
+            f.type = TASE_ID_TYPE(p->id);
+            f.len = (uint8_t)len;
+            f.data = data;
+            memset(&m, 0x5A, sizeof(m));
+            before = m;
+            assert_int_equal(tase_packet_decode(&f, &m), TASE_ELENGTH);
+            assert_memory_equal(&m, &before, sizeof(m));
+            memset(out, 0xAA, sizeof(out));
+            memset(&m, 0, sizeof(m));
+            /* (CAMERA_PASS: m.camera_pass.len is 0, so only 4 fits) */
+            assert_int_equal(tase_packet_encode_len(p->id, &m, len, out, sizeof(out)),
+                             TASE_ELENGTH);
+            assert_int_equal(out[0], 0xAA);
+        }
+    }
+}
+
+static void argument_errors_are_reported_and_write_nothing(void **state)
+{
+    tase_gimbal_cmd_t m = {1, 2, 3, 4, 5};
+    tase_camera_pass_t cp = {0, 0, 250, (const uint8_t *)"x"};
+    uint8_t out[TASE_FRAME_MAX];
+    uint8_t d[8] = {0};
+    tase_frame_t f = {0, 0x28, 0x00, 8, d};
+    tase_packet_msg_t msg;
+    size_t cap;
+    (void)state;
+    memset(out, 0xAA, sizeof(out));
+    assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, &m, NULL, 64), TASE_EARG);
+    assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, NULL, out, 64), TASE_EARG);
+    assert_int_equal(tase_packet_encode(TASE_ID(0x28, 0x00), &m, out, 64), TASE_EUNKNOWN);
+    assert_int_equal(tase_packet_encode_query(TASE_ID(0x00, 0x99), out, 64), TASE_EUNKNOWN);
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)),
+                     TASE_ETOOLONG);
+    cp.len = 3;
+    cp.data = NULL;
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), TASE_EARG);
+    for (cap = 0; cap < 16; cap++) {
+        assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, &m, out, cap), TASE_ENOSPC);
+    }
+    assert_int_equal(out[0], 0xAA);
+    assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, &m, out, 16), 16);
+
+    assert_int_equal(tase_packet_decode(NULL, &msg), TASE_EARG);
+    assert_int_equal(tase_packet_decode(&f, &msg), TASE_EUNKNOWN);
+    f.group = 0x00;
+    f.type = 0x80;
+    assert_int_equal(tase_packet_decode(&f, NULL), TASE_EARG);
+    f.data = NULL;
+    assert_int_equal(tase_packet_decode(&f, &msg), TASE_EARG);
+}
+
+static void camera_pass_carries_249_bytes_and_may_be_encoded_in_place(void **state)
+{
+    uint8_t out[TASE_FRAME_MAX];
+    uint8_t want[TASE_CAMERA_PASS_MAX];
+    tase_camera_pass_t cp, back;
+    tase_frame_t f;
+    size_t k;
+    (void)state;
+    for (k = 0; k < sizeof(want); k++) {
+        want[k] = (uint8_t)(k * 7u + 1u);
+    }
+    /* the camera bytes already sit where the payload goes */
+    memcpy(out + TASE_FRAME_HEADER + 4, want, sizeof(want));
+    cp.camera = 1;
+    cp.baud = 8;
+    cp.len = TASE_CAMERA_PASS_MAX;
+    cp.data = out + TASE_FRAME_HEADER + 4;
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)),
+                     (int)TASE_FRAME_MAX);
+    assert_int_equal(out[3], 255); /* Size: 253 + 2 */
+    f = frame_of(out, (int)TASE_FRAME_MAX);
+    assert_int_equal(tase_packet_decode(&f, &back), 253);
+    assert_int_equal(back.len, 249);
+    assert_memory_equal(back.data, want, sizeof(want));
+    /* an empty pass-through packet is 4 bytes */
+    cp.len = 0;
+    cp.data = NULL;
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), 12);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(gimbal_cmd_extremes_encode_to_hand_computed_frame),
+        cmocka_unit_test(gyro_zero_and_camera_short_forms_encode_to_hand_computed_frames),
+        cmocka_unit_test(gimbal_angle_encodes_to_hand_computed_frame),
+        cmocka_unit_test(spoi_full_and_query_forms_encode_to_hand_computed_frames),
+        cmocka_unit_test(axis_setting_leaves_byte_13_reserved_zero),
+        cmocka_unit_test(every_packet_round_trips_random_and_extreme_values),
+        cmocka_unit_test(every_query_capable_packet_encodes_an_eight_byte_query),
+        cmocka_unit_test(every_wrong_length_is_rejected_on_decode_and_encode),
+        cmocka_unit_test(argument_errors_are_reported_and_write_nothing),
+        cmocka_unit_test(camera_pass_carries_249_bytes_and_may_be_encoded_in_place),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

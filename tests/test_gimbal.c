@@ -1,0 +1,517 @@
+/* Tests of the gimbal role with fake ports and a fake clock: setup echo
+ * and query, SYSTEM_VERSION, telemetry rates over a simulated hour, rate
+ * changes, rate 0, late polls. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "fake_port.h"
+#include "tase/gimbal.h"
+#include "tase/ids.h"
+
+#define NSTREAM 3
+
+typedef struct {
+    fake_port_t port[3];
+    tase_gimbal_t g;
+    /* apply_setup */
+    unsigned applies;
+    int refuse;
+    uint8_t clamp_to; /* nonzero: PACKET_RATE bytes above it are clamped */
+    /* fill_telemetry */
+    uint32_t count[3][NSTREAM];
+    uint32_t first[3][NSTREAM], last[3][NSTREAM];
+    uint32_t min_gap[3][NSTREAM], max_gap[3][NSTREAM];
+    int decline;
+    /* on_frame */
+    unsigned others;
+    unsigned other_port;
+    uint8_t other_group, other_type;
+} fix_t;
+
+static unsigned stream_of(uint16_t id)
+{
+    if (id == TASE_ID_GIMBAL_ANGLE) {
+        return 0;
+    }
+    if (id == TASE_ID_GIMBAL_RATE) {
+        return 1;
+    }
+    assert_int_equal(id, TASE_ID_GEOREFERENCE_DATA);
+    return 2;
+}
+
+static int app_apply(void *user, unsigned port, uint8_t type, uint8_t *data, size_t len)
+{
+    fix_t *x = user;
+    size_t i;
+    (void)port;
+    x->applies++;
+    if (x->refuse) {
+        return TASE_ERANGE;
+    }
+    if (type == 0x00 && x->clamp_to != 0) {
+        for (i = 0; i < len; i++) {
+            if (data[i] > x->clamp_to) {
+                data[i] = x->clamp_to;
+            }
+        }
+    }
+    return 0;
+}
+
+static int app_fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
+                    uint32_t now)
+{
+    fix_t *x = user;
+    unsigned s = stream_of(id);
+    assert_true(port < 3);
+    assert_int_equal(cap, TASE_DATA_MAX);
+    if (x->count[port][s] == 0) {
+        x->first[port][s] = now;
+        x->min_gap[port][s] = 0xFFFFFFFFu;
+    } else {
+        uint32_t gap = now - x->last[port][s];
+        if (gap < x->min_gap[port][s]) {
+            x->min_gap[port][s] = gap;
+        }
+        if (gap > x->max_gap[port][s]) {
+            x->max_gap[port][s] = gap;
+        }
+    }
+    x->last[port][s] = now;
+    x->count[port][s]++;
+    if (x->decline) {
+        return -1;
+    }
+    data[0] = (uint8_t)(now >> 24);
+    data[1] = (uint8_t)(now >> 16);
+    data[2] = (uint8_t)(now >> 8);
+    data[3] = (uint8_t)now;
+    return 6;
+}
+
+static void app_other(void *user, unsigned port, const tase_frame_t *f)
+{
+    fix_t *x = user;
+    x->others++;
+    x->other_port = port;
+    x->other_group = f->group;
+    x->other_type = f->type;
+}
+
+static fix_t *make(uint32_t now, unsigned nports, bool with_fill)
+{
+    fix_t *x = calloc(1, sizeof *x);
+    tase_port_t ports[3];
+    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL};
+    unsigned i;
+    assert_non_null(x);
+    app.user = x;
+    if (!with_fill) {
+        app.fill_telemetry = NULL;
+    }
+    for (i = 0; i < 3; i++) {
+        ports[i].ops = &fake_ops;
+        ports[i].ctx = &x->port[i];
+    }
+    assert_int_equal(tase_gimbal_init(&x->g, ports, nports, &app, now), TASE_OK);
+    return x;
+}
+
+static void feed(fix_t *x, unsigned port, uint8_t group, uint8_t type, const uint8_t *d,
+                 size_t len, uint32_t now)
+{
+    uint8_t fr[TASE_FRAME_MAX];
+    int n = tase_frame_encode(fr, sizeof fr, group, type, d, len);
+    assert_true(n > 0);
+    assert_int_equal(tase_gimbal_feed(&x->g, port, fr, (size_t)n, now), 1);
+}
+
+/* The only frame written on a fake port so far (fails if not exactly one). */
+static uint8_t only_frame(fake_port_t *f, uint8_t *group, uint8_t *type, uint8_t *data)
+{
+    uint8_t len;
+    assert_int_equal(fake_frames_out(f), 1);
+    len = (uint8_t)(f->out[3] - 2u);
+    *group = f->out[4];
+    *type = f->out[5];
+    memcpy(data, f->out + 6, len);
+    f->nout = 0;
+    return len;
+}
+
+static const uint8_t default_rates[16] = {10, 10, 4, 0, 0, 10, 10, 4, 0, 0, 10, 10, 4, 0, 0, 0};
+
+static void a_zero_length_query_is_answered_with_the_defaults_on_its_port(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX];
+    (void)state;
+
+    feed(x, 1, 0x48, 0x00, NULL, 0, 10);
+    assert_int_equal(fake_frames_out(&x->port[0]), 0);
+    assert_int_equal(fake_frames_out(&x->port[2]), 0);
+    assert_int_equal(only_frame(&x->port[1], &g, &t, d), 16);
+    assert_int_equal(g, 0x48);
+    assert_int_equal(t, 0x00);
+    assert_memory_equal(d, default_rates, 16);
+
+    /* SENSOR_FILTER defaults: 10 Hz in 0.1 Hz, 0.5 deg/s in 0.1 deg/s. */
+    feed(x, 1, 0x48, 0x01, NULL, 0, 10);
+    assert_int_equal(only_frame(&x->port[1], &g, &t, d), 2);
+    assert_int_equal(d[0], 100);
+    assert_int_equal(d[1], 5);
+    /* AXIS_SETTING: tilt no-go centre 90.00 deg, range 60.00 deg. */
+    feed(x, 1, 0x48, 0x02, NULL, 0, 10);
+    assert_int_equal(only_frame(&x->port[1], &g, &t, d), 23);
+    assert_int_equal((d[4] << 8) | d[5], 9000);
+    assert_int_equal((d[6] << 8) | d[7], 6000);
+    assert_int_equal(x->g.stats.setup_queries, 3);
+    assert_int_equal(x->applies, 0);
+    free(x);
+}
+
+static void a_setup_packet_is_applied_and_the_applied_bytes_echoed(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX], want[16], stored[16];
+    uint8_t req[16] = {50, 200, 3, 0, 0, 10, 10, 4, 0, 0, 10, 10, 4, 0, 0, 1};
+    (void)state;
+
+    x->clamp_to = 100; /* the application limits rates to 100/s */
+    feed(x, 0, 0x48, 0x00, req, sizeof req, 10);
+    assert_int_equal(x->applies, 1);
+    memcpy(want, req, sizeof want);
+    want[1] = 100;
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 16);
+    assert_memory_equal(d, want, 16);
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0x00, stored, sizeof stored), 16);
+    assert_memory_equal(stored, want, 16);
+    /* A later query reports the same. */
+    feed(x, 2, 0x48, 0x00, NULL, 0, 20);
+    assert_int_equal(only_frame(&x->port[2], &g, &t, d), 16);
+    assert_memory_equal(d, want, 16);
+    assert_int_equal(x->g.stats.setup_applied, 1);
+    free(x);
+}
+
+static void a_refused_setup_echoes_the_settings_still_in_force(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX];
+    const uint8_t nav[2] = {1, 1};
+    (void)state;
+
+    x->refuse = 1;
+    feed(x, 0, 0x48, 0x04, nav, 2, 10);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 2);
+    assert_int_equal(t, 0x04);
+    assert_int_equal(d[0], 0);
+    assert_int_equal(d[1], 0);
+    assert_int_equal(x->g.stats.setup_refused, 1);
+    x->refuse = 0;
+    feed(x, 0, 0x48, 0x04, nav, 2, 10);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 2);
+    assert_memory_equal(d, nav, 2);
+    free(x);
+}
+
+static void a_setup_packet_of_the_wrong_length_is_counted_not_answered(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    (void)state;
+    feed(x, 0, 0x48, 0x00, default_rates, 15, 10);
+    assert_int_equal(fake_frames_out(&x->port[0]), 0);
+    assert_int_equal(x->g.stats.bad_length, 1);
+    assert_int_equal(x->applies, 0);
+    free(x);
+}
+
+static void system_version_is_query_only_and_answers_the_application_bytes(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX], ver[42], junk[42];
+    size_t i;
+    (void)state;
+
+    for (i = 0; i < sizeof ver; i++) {
+        ver[i] = (uint8_t)(i + 1u);
+        junk[i] = 0xEE;
+    }
+    assert_int_equal(tase_gimbal_setup_set(&x->g, 0x03, ver, 41, 0), TASE_ELENGTH);
+    assert_int_equal(tase_gimbal_setup_set(&x->g, 0x03, ver, 42, 0), TASE_OK);
+    feed(x, 0, 0x48, 0x03, NULL, 0, 10);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 42);
+    assert_memory_equal(d, ver, 42);
+    /* Writing it is not possible: answered, unchanged, no callback. */
+    feed(x, 0, 0x48, 0x03, junk, sizeof junk, 20);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 42);
+    assert_memory_equal(d, ver, 42);
+    assert_int_equal(x->applies, 0);
+    free(x);
+}
+
+static void other_frames_reach_the_application_which_can_answer(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    const uint8_t cmd[8] = {0, 100, 0, 50, 0, 0, 0, 0};
+    (void)state;
+
+    feed(x, 2, 0x00, 0x80, cmd, sizeof cmd, 10);
+    assert_int_equal(x->others, 1);
+    assert_int_equal(x->other_port, 2);
+    assert_int_equal(x->other_type, 0x80);
+    feed(x, 1, 0x48, 0x09, NULL, 0, 10); /* unknown setup type */
+    assert_int_equal(x->others, 2);
+    assert_int_equal(fake_frames_out(&x->port[1]), 0);
+    assert_int_equal(tase_gimbal_send(&x->g, 1, 0x10, 0x40, cmd, 8), 16);
+    assert_int_equal(fake_frames_out(&x->port[1]), 1);
+    free(x);
+}
+
+/* Poll every `step` ms (or with pseudo-random steps 1..max_step when
+ * max_step > 0) from start to start + dur inclusive. */
+static void run(fix_t *x, uint32_t start, uint32_t dur, uint32_t max_step)
+{
+    uint32_t t = 0, seed = 12345u;
+    for (;;) {
+        tase_gimbal_poll(&x->g, start + t);
+        if (t == dur) {
+            break;
+        }
+        if (max_step == 0) {
+            t++;
+        } else {
+            seed = seed * 1103515245u + 12345u;
+            t += 1u + (seed >> 16) % max_step;
+            if (t > dur) {
+                t = dur;
+            }
+        }
+    }
+}
+
+static void set_rates(fix_t *x, const uint8_t r[9], uint32_t now)
+{
+    uint8_t d[16] = {0};
+    unsigned p, s;
+    for (p = 0; p < 3; p++) {
+        for (s = 0; s < 3; s++) {
+            d[p * 5 + s] = r[p * 3 + s];
+        }
+    }
+    assert_int_equal(tase_gimbal_setup_set(&x->g, 0x00, d, 16, now), TASE_OK);
+}
+
+static void an_hour_of_telemetry_has_exactly_rate_times_3600_packets(void **state)
+{
+    /* Start near the top of the 32-bit clock so the hour crosses the wrap. */
+    const uint32_t t0 = 0xFFFF0000u;
+    const uint8_t r[9] = {10, 7, 3, 4, 1, 255, 0, 33, 100};
+    fix_t *x = make(t0, 3, true);
+    unsigned p, s;
+    (void)state;
+
+    for (p = 0; p < 3; p++) {
+        x->port[p].discard = 1;
+    }
+    set_rates(x, r, t0);
+    run(x, t0, 3600000u, 0);
+    for (p = 0; p < 3; p++) {
+        for (s = 0; s < 3; s++) {
+            uint32_t rate = r[p * 3 + s];
+            assert_int_equal(x->count[p][s], rate * 3600u);
+            if (rate > 1) {
+                /* Evenly spaced: every gap is floor or ceil of 1000/rate. */
+                assert_true(x->min_gap[p][s] >= 1000u / rate);
+                assert_true(x->max_gap[p][s] <= (1000u + rate - 1u) / rate);
+            }
+            if (rate > 0) {
+                /* No drift: the last packet is exactly on the hour. */
+                assert_int_equal(x->last[p][s], t0 + 3600000u);
+            }
+        }
+    }
+    assert_int_equal(x->g.stats.slots_skipped, 0);
+    assert_int_equal(x->g.stats.telemetry_tx, (10 + 7 + 3 + 4 + 1 + 255 + 0 + 33 + 100) * 3600u);
+    print_message("one simulated hour: %u packets, angle@10/s port 1: %u\n",
+                  x->g.stats.telemetry_tx, x->count[0][0]);
+    free(x);
+}
+
+static void jittery_polling_still_gives_exact_counts(void **state)
+{
+    const uint8_t r[9] = {10, 7, 3, 4, 25, 0, 0, 0, 0};
+    fix_t *x = make(5, 1, true);
+    unsigned s;
+    (void)state;
+
+    x->port[0].discard = 1;
+    set_rates(x, r, 5);
+    run(x, 5, 3600000u, 37); /* steps of 1..37 ms, all below the 40 ms period */
+    for (s = 0; s < 3; s++) {
+        assert_int_equal(x->count[0][s], r[s] * 3600u);
+    }
+    assert_int_equal(x->g.stats.slots_skipped, 0);
+    free(x);
+}
+
+static void the_defaults_are_10_10_and_4_per_second(void **state)
+{
+    fix_t *x = make(1000, 3, true);
+    unsigned p;
+    (void)state;
+    for (p = 0; p < 3; p++) {
+        x->port[p].discard = 1;
+    }
+    run(x, 1000, 10000, 0);
+    for (p = 0; p < 3; p++) {
+        assert_int_equal(x->count[p][0], 100);
+        assert_int_equal(x->count[p][1], 100);
+        assert_int_equal(x->count[p][2], 40);
+        assert_int_equal(x->first[p][0], 1100); /* one period after init */
+        assert_int_equal(x->first[p][2], 1250);
+    }
+    free(x);
+}
+
+static void a_rate_change_takes_effect_at_once_and_spares_other_streams(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    uint8_t req[16];
+    uint32_t georef_before;
+    (void)state;
+
+    x->port[0].discard = 1;
+    run(x, 0, 5030, 0); /* angle sent at 5000; next would be 5100 */
+    assert_int_equal(x->count[0][0], 50);
+    georef_before = x->count[0][2];
+    /* The host raises GIMBAL_ANGLE to 20/s on port 1 at t = 5030. */
+    memcpy(req, default_rates, sizeof req);
+    req[0] = 20;
+    x->port[0].discard = 0;
+    feed(x, 0, 0x48, 0x00, req, sizeof req, 5030);
+    assert_int_equal(fake_frames_out(&x->port[0]), 1); /* the echo */
+    x->port[0].discard = 1;
+    run(x, 5031, 9999, 0); /* up to 15030 */
+    /* 20/s anchored at the change: first at 5080, exactly 200 in 10 s. */
+    assert_int_equal(x->count[0][0], 50 + 200);
+    assert_int_equal(x->last[0][0], 15030);
+    assert_int_equal(x->min_gap[0][0], 50);
+    /* GIMBAL_RATE and GEOREFERENCE kept their phase and rate. */
+    assert_int_equal(x->count[0][1], 150);
+    assert_int_equal(x->count[0][2] - georef_before, 40);
+    assert_int_equal(x->last[0][2] % 250u, 0);
+    free(x);
+}
+
+static void rate_0_disables_a_stream_and_re_enabling_starts_one_period_later(void **state)
+{
+    fix_t *x = make(0, 2, true);
+    const uint8_t off[9] = {0, 10, 4, 10, 10, 4, 0, 0, 0};
+    const uint8_t on[9] = {5, 10, 4, 10, 10, 4, 0, 0, 0};
+    (void)state;
+
+    x->port[0].discard = 1;
+    x->port[1].discard = 1;
+    set_rates(x, off, 0);
+    run(x, 0, 10000, 0);
+    assert_int_equal(x->count[0][0], 0);
+    assert_int_equal(x->count[0][1], 100);
+    assert_int_equal(x->count[1][0], 100);
+    set_rates(x, on, 10000);
+    run(x, 10001, 9999, 0);
+    assert_int_equal(x->count[0][0], 50);
+    assert_int_equal(x->first[0][0], 10200);
+    free(x);
+}
+
+static void a_late_poll_sends_one_packet_not_a_burst_and_keeps_the_grid(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    (void)state;
+
+    x->port[0].discard = 1;
+    run(x, 0, 1000, 0); /* 10 angle packets, last at 1000 */
+    assert_int_equal(x->count[0][0], 10);
+    tase_gimbal_poll(&x->g, 6050); /* the main loop stalled for 5 s */
+    assert_int_equal(x->count[0][0], 11); /* one packet, not 50 */
+    /* Slots 1100..6000 were due; 6000's went out; 49 angle slots passed,
+     * 49 rate slots, 19 georef slots (1250..5750; 6000 sent). */
+    assert_int_equal(x->g.stats.slots_skipped, 49u + 49u + 19u);
+    run(x, 6051, 949, 0);
+    /* Back on the original 100 ms grid: 6100 .. 7000. */
+    assert_int_equal(x->count[0][0], 21);
+    assert_int_equal(x->last[0][0], 7000);
+    assert_int_equal(x->min_gap[0][0], 50);
+    free(x);
+}
+
+static void a_declined_slot_is_counted_and_the_schedule_moves_on(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    (void)state;
+    x->port[0].discard = 1;
+    x->decline = 1;
+    run(x, 0, 1000, 0);
+    assert_int_equal(x->count[0][0], 10);
+    assert_int_equal(x->g.stats.telemetry_skipped, 10 + 10 + 4);
+    assert_int_equal(x->g.stats.telemetry_tx, 0);
+    assert_int_equal(x->port[0].writes, 0);
+    free(x);
+}
+
+static void absent_ports_get_nothing_and_bad_arguments_are_rejected(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    tase_gimbal_t g;
+    tase_port_t bad = {&fake_ops, NULL};
+    tase_port_ops_t no_write = {NULL, NULL, NULL};
+    tase_port_t nw = {&no_write, NULL};
+    uint8_t d[16];
+    (void)state;
+
+    x->port[0].discard = 1;
+    run(x, 0, 1000, 0);
+    assert_int_equal(x->count[1][0], 0);
+    assert_int_equal(x->port[1].writes + x->port[2].writes, 0);
+    assert_int_equal(tase_gimbal_send(&x->g, 1, 0, 0x80, d, 8), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(&g, &bad, 4, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(&g, &nw, 1, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(NULL, NULL, 0, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(&g, NULL, 0, NULL, 0), TASE_OK);
+    assert_int_equal(tase_gimbal_poll(&g, 100000), 0);
+    assert_int_equal(tase_gimbal_feed(&x->g, 3, d, 1, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 8, d, sizeof d), TASE_EUNKNOWN);
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0, d, 15), TASE_ENOSPC);
+    assert_int_equal(tase_gimbal_setup_len(2), 23);
+    assert_int_equal(tase_gimbal_setup_len(8), TASE_EUNKNOWN);
+    free(x);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(a_zero_length_query_is_answered_with_the_defaults_on_its_port),
+        cmocka_unit_test(a_setup_packet_is_applied_and_the_applied_bytes_echoed),
+        cmocka_unit_test(a_refused_setup_echoes_the_settings_still_in_force),
+        cmocka_unit_test(a_setup_packet_of_the_wrong_length_is_counted_not_answered),
+        cmocka_unit_test(system_version_is_query_only_and_answers_the_application_bytes),
+        cmocka_unit_test(other_frames_reach_the_application_which_can_answer),
+        cmocka_unit_test(an_hour_of_telemetry_has_exactly_rate_times_3600_packets),
+        cmocka_unit_test(jittery_polling_still_gives_exact_counts),
+        cmocka_unit_test(the_defaults_are_10_10_and_4_per_second),
+        cmocka_unit_test(a_rate_change_takes_effect_at_once_and_spares_other_streams),
+        cmocka_unit_test(rate_0_disables_a_stream_and_re_enabling_starts_one_period_later),
+        cmocka_unit_test(a_late_poll_sends_one_packet_not_a_burst_and_keeps_the_grid),
+        cmocka_unit_test(a_declined_slot_is_counted_and_the_schedule_moves_on),
+        cmocka_unit_test(absent_ports_get_nothing_and_bad_arguments_are_rejected),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

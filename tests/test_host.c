@@ -1,0 +1,353 @@
+/* Tests of the host role with a fake port and a fake clock: request/echo
+ * matching, timeouts, retries, late echoes, the blocking convenience. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "fake_port.h"
+#include "tase/host.h"
+#include "tase/ids.h"
+
+typedef struct {
+    fake_port_t port;
+    tase_host_t host;
+    unsigned others;      /* frames handed to on_frame */
+    uint8_t last_group, last_type, last_len;
+} fix_t;
+
+static void on_other(void *user, const tase_frame_t *f)
+{
+    fix_t *x = user;
+    x->others++;
+    x->last_group = f->group;
+    x->last_type = f->type;
+    x->last_len = f->len;
+}
+
+static int setup(void **state)
+{
+    fix_t *x = calloc(1, sizeof *x);
+    tase_port_t p;
+    assert_non_null(x);
+    p.ops = &fake_ops;
+    p.ctx = &x->port;
+    assert_int_equal(tase_host_init(&x->host, &p, on_other, x), TASE_OK);
+    *state = x;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    free(*state);
+    return 0;
+}
+
+/* Decode the n-th frame the host wrote. */
+static tase_frame_t written_frame(fix_t *x, unsigned n, uint8_t *data)
+{
+    tase_frame_t out;
+    memset(&out, 0, sizeof out);
+    /* Frames are contiguous in `out`: walk them by their Size byte. */
+    {
+        size_t pos = 0;
+        unsigned k;
+        for (k = 0; k < n; k++) {
+            pos += (size_t)x->port.out[pos + 3] + 6u;
+        }
+        out.group = x->port.out[pos + 4];
+        out.type = x->port.out[pos + 5];
+        out.len = (uint8_t)(x->port.out[pos + 3] - 2u);
+        memcpy(data, &x->port.out[pos + 6], out.len);
+        out.data = data;
+    }
+    return out;
+}
+
+static void feed_frame(fix_t *x, uint8_t group, uint8_t type, const uint8_t *d, size_t len,
+                       uint32_t now)
+{
+    uint8_t fr[TASE_FRAME_MAX];
+    int n = tase_frame_encode(fr, sizeof fr, group, type, d, len);
+    assert_true(n > 0);
+    assert_int_equal(tase_host_feed(&x->host, fr, (size_t)n, now), 1);
+}
+
+static const uint8_t rates[16] = {10, 10, 4, 0, 0, 20, 5, 1, 0, 0, 0, 0, 0, 0, 0, 1};
+
+static void a_query_is_a_zero_length_frame_completed_by_the_echo(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64], d[TASE_DATA_MAX];
+    tase_frame_t f;
+
+    memset(reply, 0xCC, sizeof reply);
+    assert_int_equal(tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x00, reply,
+                                           sizeof reply, 100, 2, 1000),
+                     TASE_OK);
+    assert_int_equal(fake_frames_out(&x->port), 1);
+    f = written_frame(x, 0, d);
+    assert_int_equal(f.group, 0x48);
+    assert_int_equal(f.type, 0x00);
+    assert_int_equal(f.len, 0);
+    assert_true(tase_host_busy(&x->host));
+    assert_int_equal(tase_host_poll(&x->host, 1050), TASE_EAGAIN);
+
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 1060);
+    assert_int_equal(tase_host_poll(&x->host, 1060), 16);
+    assert_memory_equal(reply, rates, 16);
+    assert_int_equal(reply[16], 0xCC); /* nothing written past the reply */
+    assert_false(tase_host_busy(&x->host));
+    assert_int_equal(tase_host_poll(&x->host, 1061), TASE_ESTATE); /* reported once */
+    assert_int_equal(x->others, 0); /* the reply is not also a stray frame */
+    assert_int_equal(x->host.stats.replies, 1);
+    assert_int_equal(x->host.stats.requests, 1);
+}
+
+static void an_echo_of_another_type_does_not_complete_the_query(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    assert_int_equal(tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x00, reply,
+                                           sizeof reply, 100, 0, 0),
+                     TASE_OK);
+    feed_frame(x, 0x48, 0x01, (const uint8_t *)"\x64\x05", 2, 10); /* SENSOR_FILTER */
+    assert_int_equal(tase_host_poll(&x->host, 10), TASE_EAGAIN);
+    assert_int_equal(x->others, 1);
+    assert_int_equal(x->last_type, 0x01);
+    /* Same type in another group: no match either. */
+    feed_frame(x, 0x08, 0x00, rates, 16, 20);
+    assert_int_equal(tase_host_poll(&x->host, 20), TASE_EAGAIN);
+    /* A zero-length frame of the awaited type is a query, not an answer. */
+    feed_frame(x, 0x48, 0x00, NULL, 0, 30);
+    assert_int_equal(tase_host_poll(&x->host, 30), TASE_EAGAIN);
+    assert_int_equal(x->others, 3);
+    feed_frame(x, 0x48, 0x00, rates, 16, 40);
+    assert_int_equal(tase_host_poll(&x->host, 40), 16);
+}
+
+static void a_silent_gimbal_gets_every_retry_then_a_timeout(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64], d[TASE_DATA_MAX];
+    unsigned i;
+
+    assert_int_equal(tase_host_request_start(&x->host, TASE_GROUP_SETUP, 0x00, rates, 16,
+                                             reply, sizeof reply, 100, 2, 5000),
+                     TASE_OK);
+    assert_int_equal(tase_host_poll(&x->host, 5099), TASE_EAGAIN);
+    assert_int_equal(fake_frames_out(&x->port), 1);
+    assert_int_equal(tase_host_poll(&x->host, 5100), TASE_EAGAIN); /* retry 1 */
+    assert_int_equal(fake_frames_out(&x->port), 2);
+    assert_int_equal(tase_host_poll(&x->host, 5150), TASE_EAGAIN);
+    assert_int_equal(tase_host_poll(&x->host, 5199), TASE_EAGAIN);
+    assert_int_equal(fake_frames_out(&x->port), 2); /* timeout counts from the retry */
+    assert_int_equal(tase_host_poll(&x->host, 5200), TASE_EAGAIN); /* retry 2 */
+    assert_int_equal(fake_frames_out(&x->port), 3);
+    assert_int_equal(tase_host_poll(&x->host, 5299), TASE_EAGAIN);
+    assert_int_equal(tase_host_poll(&x->host, 5300), TASE_ETIMEOUT);
+    assert_int_equal(fake_frames_out(&x->port), 3); /* no fourth attempt */
+    assert_int_equal(tase_host_poll(&x->host, 9999), TASE_ESTATE);
+    /* Every attempt carried the same request. */
+    for (i = 0; i < 3; i++) {
+        tase_frame_t f = written_frame(x, i, d);
+        assert_int_equal(f.group, 0x48);
+        assert_int_equal(f.len, 16);
+        assert_memory_equal(d, rates, 16);
+    }
+    assert_int_equal(x->host.stats.retries, 2);
+    assert_int_equal(x->host.stats.timeouts, 1);
+    /* An echo after the final timeout is just a stray frame. */
+    feed_frame(x, 0x48, 0x00, rates, 16, 9999);
+    assert_int_equal(x->others, 1);
+}
+
+static void a_late_echo_after_a_retry_completes_the_query(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    assert_int_equal(tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x03, reply,
+                                           sizeof reply, 100, 3, 0),
+                     TASE_OK);
+    assert_int_equal(tase_host_poll(&x->host, 130), TASE_EAGAIN); /* re-sent at 130 */
+    assert_int_equal(fake_frames_out(&x->port), 2);
+    /* The answer to the first attempt, 150 ms late. */
+    feed_frame(x, 0x48, 0x03, rates, 16, 150);
+    assert_int_equal(tase_host_poll(&x->host, 231), 16); /* wins over the deadline */
+    assert_int_equal(fake_frames_out(&x->port), 2);
+    /* The echo of the second attempt arrives afterwards: not matched. */
+    feed_frame(x, 0x48, 0x03, rates, 16, 240);
+    assert_int_equal(x->others, 1);
+}
+
+static void one_request_at_a_time_but_commands_still_go_out(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64], d[TASE_DATA_MAX];
+    const uint8_t cmd[8] = {0x01, 0x2C, 0xFF, 0x38, 0, 0, 0x00, 0};
+    tase_frame_t f;
+
+    assert_int_equal(tase_host_query_start(&x->host, 0x10, 0x40, reply, sizeof reply, 50, 0,
+                                           0),
+                     TASE_OK);
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 50, 0,
+                                           0),
+                     TASE_EBUSY);
+    assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, cmd, sizeof cmd), 16);
+    f = written_frame(x, 1, d);
+    assert_int_equal(f.group, 0x00);
+    assert_int_equal(f.type, 0x80);
+    assert_memory_equal(d, cmd, 8);
+    assert_int_equal(tase_host_cancel(&x->host), TASE_OK);
+    assert_int_equal(tase_host_poll(&x->host, 1000), TASE_ESTATE); /* no outcome */
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 50, 0,
+                                           0),
+                     TASE_OK);
+}
+
+static void a_reply_longer_than_the_buffer_is_enospc_and_copies_nothing(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[8];
+
+    memset(reply, 0xAB, sizeof reply);
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 50, 0,
+                                           0),
+                     TASE_OK);
+    feed_frame(x, 0x48, 0x00, rates, 16, 1);
+    assert_int_equal(tase_host_poll(&x->host, 1), TASE_ENOSPC);
+    assert_int_equal(reply[0], 0xAB);
+    /* Length only, no buffer. */
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, NULL, 0, 50, 0, 2), TASE_OK);
+    feed_frame(x, 0x48, 0x00, rates, 16, 3);
+    assert_int_equal(tase_host_poll(&x->host, 3), 16);
+}
+
+static void timeouts_work_across_the_clock_wrap(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    uint32_t t0 = 0xFFFFFFC0u;
+
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1,
+                                           t0),
+                     TASE_OK);
+    assert_int_equal(tase_host_poll(&x->host, t0 + 99u), TASE_EAGAIN);
+    assert_int_equal(fake_frames_out(&x->port), 1);
+    assert_int_equal(tase_host_poll(&x->host, t0 + 100u), TASE_EAGAIN);
+    assert_int_equal(fake_frames_out(&x->port), 2);
+    assert_int_equal(tase_host_poll(&x->host, t0 + 199u), TASE_EAGAIN);
+    assert_int_equal(tase_host_poll(&x->host, t0 + 200u), TASE_ETIMEOUT);
+}
+
+static void a_port_that_refuses_the_request_leaves_the_host_idle(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    x->port.write_result = TASE_EDOWN;
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1,
+                                           0),
+                     TASE_EDOWN);
+    assert_false(tase_host_busy(&x->host));
+    assert_int_equal(x->host.stats.tx_errors, 1);
+    assert_int_equal(tase_host_send(&x->host, 0, 0x80, rates, 8), TASE_EDOWN);
+    /* A refused retry still uses up its attempt. */
+    x->port.write_result = 0;
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1,
+                                           0),
+                     TASE_OK);
+    x->port.write_result = TASE_EDOWN;
+    assert_int_equal(tase_host_poll(&x->host, 100), TASE_EAGAIN);
+    assert_int_equal(tase_host_poll(&x->host, 200), TASE_ETIMEOUT);
+}
+
+static void transact_blocks_until_the_scripted_gimbal_answers(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    int n;
+
+    /* The fake gimbal answers only the third attempt. */
+    x->port.reply_after = 3;
+    x->port.nreply = (size_t)tase_frame_encode(x->port.reply, sizeof x->port.reply, 0x48,
+                                               0x03, rates, 16);
+    x->port.now = 777;
+    n = tase_host_transact(&x->host, 0x48, 0x03, NULL, 0, reply, sizeof reply, 250, 5);
+    assert_int_equal(n, 16);
+    assert_memory_equal(reply, rates, 16);
+    assert_int_equal(fake_frames_out(&x->port), 3);
+    /* Two full timeouts were waited (on the fake clock), then the answer. */
+    assert_true(x->port.now - 777u >= 500u);
+    assert_true(x->port.now - 777u < 520u);
+}
+
+static void transact_times_out_after_all_attempts(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    x->port.now = 0;
+    assert_int_equal(tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply,
+                                        100, 2),
+                     TASE_ETIMEOUT);
+    assert_int_equal(fake_frames_out(&x->port), 3);
+    assert_int_equal(x->port.now, 300);
+}
+
+static void bad_arguments_are_rejected(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[8];
+    tase_port_t p = {NULL, NULL};
+    tase_host_t h;
+    (void)state;
+    assert_int_equal(tase_host_init(NULL, &p, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0, reply, sizeof reply, 0, 0, 0),
+                     TASE_EARG);
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0, NULL, 8, 10, 0, 0), TASE_EARG);
+    assert_int_equal(tase_host_request_start(&x->host, 0x48, 0, NULL, 3, reply, 8, 10, 0, 0),
+                     TASE_EARG);
+    assert_int_equal(tase_host_request_start(&x->host, 0x48, 0, rates, 254, reply, 8, 10, 0,
+                                             0),
+                     TASE_ETOOLONG);
+    assert_int_equal(tase_host_poll(NULL, 0), TASE_EARG);
+    assert_int_equal(tase_host_feed(NULL, rates, 1, 0), TASE_EARG);
+    assert_int_equal(tase_host_handle_frame(&x->host, NULL), TASE_EARG);
+    assert_false(tase_host_busy(NULL));
+    assert_int_equal(x->port.nout, 0); /* nothing was sent by any of these */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(a_query_is_a_zero_length_frame_completed_by_the_echo,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(an_echo_of_another_type_does_not_complete_the_query,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(a_silent_gimbal_gets_every_retry_then_a_timeout, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(a_late_echo_after_a_retry_completes_the_query, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(one_request_at_a_time_but_commands_still_go_out, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(
+            a_reply_longer_than_the_buffer_is_enospc_and_copies_nothing, setup, teardown),
+        cmocka_unit_test_setup_teardown(timeouts_work_across_the_clock_wrap, setup, teardown),
+        cmocka_unit_test_setup_teardown(a_port_that_refuses_the_request_leaves_the_host_idle,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(transact_blocks_until_the_scripted_gimbal_answers,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(transact_times_out_after_all_attempts, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(bad_arguments_are_rejected, setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

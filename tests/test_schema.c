@@ -1,0 +1,313 @@
+/* Tests of the schema table: checked against an independent transcription
+ * of the spec's tables (section 4), structural invariants, O(1) lookup,
+ * accepted lengths, raw field access and names. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "tase/codec.h"
+#include "tase/schema.h"
+
+/* The spec, transcribed by hand from section 4 (not from the code):
+ * "NAME group type dir len forms : field@offset<s|u><width> ...".
+ * dir: I(n), O(ut), B(oth). forms: - none, Q zero-length query, 1 the
+ * one-byte form, T trailing bytes. Reserved rows are not listed. */
+static const char *const spec[] = {
+    "GIMBAL_CMD 00 80 I 8 - : pan@0s2 tilt@2s2 roll@4s2 flags@6u1 impulse_time@7u1",
+    "GYRO_ZERO_CMD 00 40 I 0 - :",
+    "CAMERA_CMD 00 41 I 10 1 : camera@0u1 hfov@2s2 focus@4u2 exposure@6u1 "
+    "shutter_speed@7u1 bright@8u1 flags@9u1",
+    "LEGACY_CAMERA_CMD 00 81 I 8 - : zoom@0u2 focus@2u2 auto_exposure@4u1 "
+    "shutter_speed@5u1 iris@6u1 gain@7u1",
+    "CAMERA_PASS 00 42 B 4 T : camera@0u1 baud@1u1",
+    "RETRACT_DEPLOY_CMD 00 43 B 2 - : deploy@0u1",
+    "GIMBAL_ANGLE 08 10 O 6 - : pan@0s2 tilt@2s2 roll@4s2",
+    "GIMBAL_RATE 08 40 O 18 - : time@0u4 pan_rate@4s2 tilt_rate@6s2 roll_rate@8s2 "
+    "p@10s2 q@12s2 r@14s2 mode@17u1",
+    "HOST_SENSOR 08 41 I 20 - : time@0u4 roll@4s2 pitch@6s2 yaw@8s2 flags@10u1 "
+    "sample_rate@11u1 x_accel@12s2 y_accel@14s2 z_accel@16s2 tas@18u2",
+    "HOST_ATTITUDE 08 42 I 12 - : time@0u4 roll@4s2 pitch@6s2 yaw@8s2 flags@10u1 "
+    "sample_rate@11u1",
+    "HOST_GPS_DATA 10 10 I 32 - : time@0u4 lat@4s4 lon@8s4 height@12s4 vnorth@16s2 "
+    "veast@18s2 vdown@20s2 year@22u2 month@24u1 day@25u1 hour@26u1 minute@27u1 "
+    "second@28u1 frac_second@29u1 valid@30u1 sample_rate@31u1",
+    "SPOI_CMD 10 40 B 19 Q : lat@0s4 lon@4s4 height@8s4 vnorth@12s2 veast@14s2 "
+    "vdown@16s2 flags@18u1",
+    "GEOREFERENCE_DATA 10 41 O 63 - : time@0u4 lat@4s4 lon@8s4 height@12s4 "
+    "vnorth@16s2 veast@18s2 vdown@20s2 year@22u2 month@24u1 day@25u1 hour@26u1 "
+    "minute@27u1 second@28u1 frac_second@29u1 num_sats@30u1 pdop@31u1 status@32u2 "
+    "camera_roll@34s2 camera_pitch@36s2 camera_yaw@38s2 hfov@40u2 vfov@42u2 "
+    "focal@44u2 mode@46u1 sample_rate@47u1 nav_health@48u2 mount_roll@50s2 "
+    "mount_pitch@52s2 mount_yaw@54s2 pan@56s2 tilt@58s2 roll@60s2 camera@62u1",
+    "PACKET_RATE 48 00 B 16 Q : angle_1@0u1 rate_1@1u1 geo_ref_1@2u1 camera_1@3u1 "
+    "angle_2@5u1 rate_2@6u1 geo_ref_2@7u1 camera_2@8u1 angle_3@10u1 rate_3@11u1 "
+    "geo_ref_3@12u1 camera_3@13u1 temporary@15u1",
+    "SENSOR_FILTER 48 01 B 2 Q : cutoff@0u1 decimation@1u1",
+    "AXIS_SETTING 48 02 B 23 Q : pan_nogo_center@0s2 pan_nogo_range@2u2 "
+    "tilt_nogo_center@4s2 tilt_nogo_range@6u2 roll_nogo_center@8s2 "
+    "roll_nogo_range@10u2 pan_max_rate@12u1 tilt_max_rate@14u1 roll_max_rate@15u1 "
+    "pan_max_accel@16u1 tilt_max_accel@17u1 roll_max_accel@18u1 pan_pos_gain@19u1 "
+    "tilt_pos_gain@20u1 roll_pos_gain@21u1 temporary@22u1",
+    "SYSTEM_VERSION 48 03 B 42 Q : major@0u1 minor@1u1 sub@2u1 released@3u1 "
+    "soft_year@4u2 soft_month@6u1 soft_day@7u1 board_sn@8u4 board_rev@12u4 "
+    "board_config@16u4 board_year@20u2 board_month@22u1 board_day@23u1 camera_a@24u1 "
+    "max_hfov_a@26u2 min_hfov_a@28u2 camera_b@30u1 max_hfov_b@32u2 min_hfov_b@34u2 "
+    "camera_c@36u1 max_hfov_c@38u2 min_hfov_c@40u2",
+    "NAV_SOURCE 48 04 B 2 Q : external_attitude@0u1 external_gps@1u1",
+    "CAMERA_TYPE 48 05 B 3 Q : camera_a@0u1 camera_b@1u1 camera_c@2u1",
+    "GPS_LEVER_ARM 48 06 B 6 Q : x@0s2 y@2s2 z@4s2",
+    "CAMERA_ALIGN 48 07 B 16 Q : zoom_1@0u2 pan_err_1@2s2 tilt_err_1@4s2 "
+    "roll_err_1@6s2 zoom_2@8u2 pan_err_2@10s2 tilt_err_2@12s2 roll_err_2@14s2",
+};
+
+/* Reserved bytes per packet in the spec's tables (same order). */
+static const unsigned reserved[] = {0, 0, 1, 0, 2, 1, 0, 1, 0, 0, 0,
+                                    0, 0, 3, 0, 1, 3, 0, 0, 0, 0};
+
+static void schema_matches_spec_transcription(void **state)
+{
+    size_t i;
+    (void)state;
+    assert_int_equal(sizeof(spec) / sizeof(spec[0]), TASE_PKT_COUNT);
+    assert_int_equal(TASE_PKT_COUNT, TASE_PACKET_COUNT);
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        char name[32], dir[4], forms[4];
+        unsigned g, t, len, nf = 0;
+        int used = 0;
+        const char *rest;
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        unsigned want_flags;
+        assert_non_null(p);
+        assert_int_equal(p->index, i);
+        assert_int_equal(sscanf(spec[i], "%31s %x %x %3s %u %3s :%n", name, &g, &t, dir, &len,
+                                forms, &used),
+                         6);
+        assert_string_equal(tase_schema_packet_name(p), name);
+        assert_int_equal(p->id, TASE_ID(g, t));
+        assert_int_equal(p->len, len);
+        want_flags = dir[0] == 'I' ? TASE_DIR_IN : dir[0] == 'O' ? TASE_DIR_OUT : TASE_DIR_BOTH;
+        want_flags |= forms[0] == 'Q' ? TASE_LEN_QUERY : forms[0] == '1' ? TASE_LEN_SHORT1
+                      : forms[0] == 'T' ? TASE_LEN_TAIL : 0u;
+        assert_int_equal(p->flags, want_flags);
+        rest = spec[i] + used;
+        while (*rest != '\0') {
+            char fname[32], sign;
+            unsigned off, width;
+            int n = 0;
+            const tase_field_t *f = tase_schema_field(p, nf);
+            assert_int_equal(sscanf(rest, " %31[a-z0-9_]@%u%c%u%n", fname, &off, &sign, &width, &n),
+                             4);
+            assert_non_null(f);
+            assert_string_equal(tase_schema_field_name(p, nf), fname);
+            assert_int_equal(f->offset, off);
+            assert_int_equal(TASE_FIELD_WIDTH(f), width);
+            assert_int_equal(TASE_FIELD_IS_SIGNED(f), sign == 's');
+            rest += n;
+            nf++;
+        }
+        assert_int_equal(p->nfields, nf);
+        assert_null(tase_schema_field(p, nf));
+    }
+    assert_null(tase_schema_at(TASE_PKT_COUNT));
+}
+
+static void fields_are_in_range_ordered_disjoint_and_cover_all_but_reserved(void **state)
+{
+    size_t i, k;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        unsigned sum = 0, end = 0;
+        for (k = 0; k < p->nfields; k++) {
+            const tase_field_t *f = tase_schema_field(p, k);
+            unsigned w = TASE_FIELD_WIDTH(f);
+            assert_true(w == 1 || w == 2 || w == 4 || w == 8);
+            assert_true(f->offset >= end); /* table order, no overlap */
+            end = f->offset + w;
+            assert_true(end <= p->len);
+            assert_true(f->member + w <= p->size);
+            sum += w;
+        }
+        assert_int_equal(sum + reserved[i], p->len);
+        assert_true(p->len <= TASE_DATA_MAX);
+    }
+}
+
+/* White-box: the member of each field has the field's width, signedness
+ * and offset. Generated from the private list the schema is built from. */
+static void struct_members_match_field_width_sign_and_offset(void **state)
+{
+    (void)state;
+#define P(N, g, t, fl, l, sz) \
+    {                         \
+        const tase_packet_desc_t *p = tase_schema_at(TASE_PKT_##N); \
+        size_t k = 0;
+#define F(T, m, o, w, s)                                                       \
+    {                                                                          \
+        T x;                                                                   \
+        const tase_field_t *f = tase_schema_field(p, k++);                     \
+        memset(&x, 0, sizeof(x));                                              \
+        x.m = 0;                                                               \
+        x.m--; /* -1 if signed, the maximum if unsigned */                     \
+        assert_non_null(f);                                                    \
+        assert_int_equal(sizeof(x.m), w);                                      \
+        assert_int_equal(f->member, offsetof(T, m));                           \
+        assert_int_equal(TASE_FIELD_IS_SIGNED(f), !(x.m > 0));                 \
+        assert_string_equal(tase_schema_field_name(p, k - 1), #m);             \
+    }
+#define E(N)                                \
+        assert_int_equal(k, p->nfields);    \
+    }
+#include "../src/schema_def.h"
+#undef P
+#undef F
+#undef E
+}
+
+static int is_spec_packet(unsigned g, unsigned t)
+{
+    size_t i;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        unsigned sg, st;
+        assert_int_equal(sscanf(spec[i], "%*s %x %x", &sg, &st), 2);
+        if (sg == g && st == t) {
+            return (int)i;
+        }
+    }
+    return -1;
+}
+
+static void lookup_finds_exactly_the_spec_packets_among_all_65536_ids(void **state)
+{
+    unsigned g, t;
+    (void)state;
+    for (g = 0; g < 256; g++) {
+        for (t = 0; t < 256; t++) {
+            const tase_packet_desc_t *p = tase_schema_find((uint8_t)g, (uint8_t)t);
+            int want = is_spec_packet(g, t);
+            if (want < 0) {
+                assert_null(p);
+            } else {
+                assert_non_null(p);
+                assert_int_equal(p->index, want);
+                assert_int_equal(p->id, TASE_ID(g, t));
+            }
+        }
+    }
+    assert_null(tase_schema_find(TASE_GROUP_STATUS, 0x00));
+}
+
+static void accepted_lengths_follow_the_spec_rules(void **state)
+{
+    size_t i, len;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        const char *name = tase_schema_packet_name(p);
+        int setup = TASE_ID_GROUP(p->id) == TASE_GROUP_SETUP;
+        for (len = 0; len <= 300; len++) {
+            int want = len == p->len;
+            if (len == 0 && (setup || strcmp(name, "SPOI_CMD") == 0)) {
+                want = 1; /* zero-length query form */
+            }
+            if (strcmp(name, "CAMERA_CMD") == 0 && len == 1) {
+                want = 1;
+            }
+            if (strcmp(name, "CAMERA_PASS") == 0) {
+                want = len >= 4 && len <= 4 + 249;
+            }
+            assert_int_equal(tase_schema_length_ok(p, len), want);
+            assert_int_equal(tase_schema_is_query(p, len),
+                             len == 0 && want && strcmp(name, "GYRO_ZERO_CMD") != 0);
+        }
+    }
+    assert_false(tase_schema_length_ok(NULL, 0));
+    assert_false(tase_schema_is_query(NULL, 0));
+}
+
+static void field_get_sign_extends_signed_fields_only(void **state)
+{
+    const tase_packet_desc_t *gps = tase_schema_find(0x10, 0x10);
+    const tase_packet_desc_t *sensor = tase_schema_find(0x08, 0x41);
+    uint8_t d[32];
+    int64_t v = 12345;
+    (void)state;
+    memset(d, 0, sizeof(d));
+    d[0] = 0xFF; d[1] = 0xFF; d[2] = 0xFF; d[3] = 0xFF; /* time: u32 */
+    d[4] = 0x80;                                        /* lat: INT32_MIN */
+    d[8] = 0x7F; d[9] = 0xFF; d[10] = 0xFF; d[11] = 0xFF; /* lon: INT32_MAX */
+    d[16] = 0x80; d[17] = 0x00;                         /* vnorth: INT16_MIN */
+    d[18] = 0xFF; d[19] = 0xFE;                         /* veast: -2 */
+    d[22] = 0xFF; d[23] = 0xFF;                         /* year: u16 65535 */
+    assert_int_equal(tase_field_get(gps, 0, d, 32, &v), TASE_OK);
+    assert_true(v == 0xFFFFFFFFll);
+    assert_int_equal(tase_field_get(gps, 1, d, 32, &v), TASE_OK);
+    assert_true(v == INT32_MIN);
+    assert_int_equal(tase_field_get(gps, 2, d, 32, &v), TASE_OK);
+    assert_true(v == INT32_MAX);
+    assert_int_equal(tase_field_get(gps, 4, d, 32, &v), TASE_OK);
+    assert_true(v == INT16_MIN);
+    assert_int_equal(tase_field_get(gps, 5, d, 32, &v), TASE_OK);
+    assert_true(v == -2);
+    assert_int_equal(tase_field_get(gps, 7, d, 32, &v), TASE_OK);
+    assert_true(v == 65535);
+    /* HOST_SENSOR tas (field 9, bytes 18-19, unsigned) */
+    d[18] = 0xFF; d[19] = 0xFF;
+    assert_int_equal(tase_field_get(sensor, 9, d, 20, &v), TASE_OK);
+    assert_true(v == 0xFFFF);
+    assert_int_equal(tase_field_get(sensor, 8, d, 20, &v), TASE_OK); /* z_accel 16-17 */
+    assert_true(v == INT16_MIN);
+    /* errors leave *value alone */
+    v = 99;
+    assert_int_equal(tase_field_get(gps, 15, d, 31, &v), TASE_ETRUNC);
+    assert_int_equal(tase_field_get(gps, 0, d, 0, &v), TASE_ETRUNC);
+    assert_int_equal(tase_field_get(gps, 16, d, 32, &v), TASE_EARG);
+    assert_int_equal(tase_field_get(NULL, 0, d, 32, &v), TASE_EARG);
+    assert_int_equal(tase_field_get(gps, 0, NULL, 32, &v), TASE_EARG);
+    assert_int_equal(tase_field_get(gps, 0, d, 32, NULL), TASE_EARG);
+    assert_true(v == 99);
+}
+
+static void names_resolve_both_ways_and_reject_unknown(void **state)
+{
+    size_t i, k;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        assert_ptr_equal(tase_schema_find_name(tase_schema_packet_name(p)), p);
+        for (k = 0; k < p->nfields; k++) {
+            assert_int_equal(tase_schema_field_index(p, tase_schema_field_name(p, k)), (int)k);
+        }
+    }
+    assert_string_equal(tase_schema_packet_name(tase_schema_find(0x08, 0x40)), "GIMBAL_RATE");
+    assert_null(tase_schema_find_name("GIMBAL_TELEMETRY"));
+    assert_null(tase_schema_find_name("gimbal_cmd"));
+    assert_null(tase_schema_find_name(NULL));
+    assert_null(tase_schema_packet_name(NULL));
+    assert_null(tase_schema_field_name(NULL, 0));
+    assert_null(tase_schema_field_name(tase_schema_at(0), 5));
+    assert_int_equal(tase_schema_field_index(tase_schema_at(0), "Pan"), TASE_EUNKNOWN);
+    assert_int_equal(tase_schema_field_index(NULL, "pan"), TASE_EARG);
+    assert_int_equal(tase_schema_field_index(tase_schema_at(0), NULL), TASE_EARG);
+    assert_null(tase_schema_field(NULL, 0));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(schema_matches_spec_transcription),
+        cmocka_unit_test(fields_are_in_range_ordered_disjoint_and_cover_all_but_reserved),
+        cmocka_unit_test(struct_members_match_field_width_sign_and_offset),
+        cmocka_unit_test(lookup_finds_exactly_the_spec_packets_among_all_65536_ids),
+        cmocka_unit_test(accepted_lengths_follow_the_spec_rules),
+        cmocka_unit_test(field_get_sign_extends_signed_fields_only),
+        cmocka_unit_test(names_resolve_both_ways_and_reject_unknown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,362 @@
+/* Tests of the SocketCAN port through its adopt-a-descriptor path. The
+ * peer is the other end of socketpair(AF_UNIX, SOCK_SEQPACKET), which
+ * keeps each struct can_frame as one message like a CAN_RAW socket. */
+#define _DEFAULT_SOURCE 1
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include <errno.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <linux/can.h>
+
+#include "tase/socketcan.h"
+
+typedef struct {
+    int peer; /* the test's end */
+    tase_socketcan_t s;
+} pair_t;
+
+static void open_pair(pair_t *p, tase_can_role_t role)
+{
+    int sv[2];
+    assert_int_equal(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv), 0);
+    assert_int_equal(tase_socketcan_adopt(&p->s, sv[0], role, TASE_SOCKETCAN_OWN_FD), TASE_OK);
+    p->peer = sv[1];
+}
+
+static void close_pair(pair_t *p)
+{
+    tase_socketcan_close(&p->s);
+    close(p->peer);
+}
+
+static void peer_send(pair_t *p, uint32_t raw_id, const uint8_t *d, uint8_t dlc)
+{
+    struct can_frame cf;
+    memset(&cf, 0, sizeof(cf));
+    cf.can_id = raw_id;
+    cf.can_dlc = dlc;
+    memcpy(cf.data, d, dlc);
+    assert_int_equal(write(p->peer, &cf, sizeof(cf)), (ssize_t)sizeof(cf));
+}
+
+/* Returns the frame count read; appends payloads to out, which holds
+ * TASE_FRAME_MAX bytes. */
+static size_t peer_drain(pair_t *p, uint32_t want_raw_id, uint8_t *out, size_t *len)
+{
+    struct can_frame cf;
+    size_t frames = 0;
+    *len = 0;
+    while (recv(p->peer, &cf, sizeof(cf), MSG_DONTWAIT) == (ssize_t)sizeof(cf)) {
+        assert_int_equal(cf.can_id, want_raw_id);
+        assert_true(cf.can_dlc >= 1 && cf.can_dlc <= 8);
+        assert_true(*len + cf.can_dlc <= TASE_FRAME_MAX);
+        memcpy(out + *len, cf.data, cf.can_dlc);
+        *len += cf.can_dlc;
+        frames++;
+    }
+    return frames;
+}
+
+static int make_packet(uint8_t *wire, uint8_t type, size_t len)
+{
+    uint8_t data[TASE_DATA_MAX];
+    size_t i;
+    for (i = 0; i < len; i++) {
+        data[i] = (uint8_t)(i ^ 0x5Au);
+    }
+    return tase_frame_encode(wire, TASE_FRAME_MAX, 0x00, type, data, len);
+}
+
+/* Reads from the port until `want` bytes came or the port times out. */
+static size_t read_all(tase_socketcan_t *s, uint8_t *buf, size_t want, size_t chunk)
+{
+    size_t got = 0;
+    int n;
+    while (got < want) {
+        n = tase_socketcan_read(s, buf + got, chunk < want - got ? chunk : want - got, 200);
+        assert_true(n >= 0);
+        if (n == 0) {
+            break;
+        }
+        got += (size_t)n;
+    }
+    return got;
+}
+
+static void write_splits_a_max_frame_into_33_frames_of_the_host_id(void **state)
+{
+    pair_t p;
+    uint8_t wire[TASE_FRAME_MAX], back[TASE_FRAME_MAX];
+    size_t len;
+    int n;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    n = make_packet(wire, 0x42, TASE_DATA_MAX);
+    assert_int_equal(n, 261);
+    assert_int_equal(tase_socketcan_write(&p.s, wire, (size_t)n), 261);
+    assert_int_equal(peer_drain(&p, 0x11000000u | CAN_EFF_FLAG, back, &len), 33);
+    assert_int_equal(len, 261);
+    assert_memory_equal(back, wire, 261);
+    assert_int_equal(p.s.stats.frames_tx, 33);
+    close_pair(&p);
+}
+
+static void gimbal_writes_with_its_own_id(void **state)
+{
+    pair_t p;
+    uint8_t wire[TASE_FRAME_MAX], back[TASE_FRAME_MAX];
+    size_t len;
+    int n;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_GIMBAL);
+    n = make_packet(wire, 0x10, 6);
+    assert_int_equal(tase_socketcan_write(&p.s, wire, (size_t)n), 14);
+    assert_int_equal(peer_drain(&p, 0x10000000u | CAN_EFF_FLAG, back, &len), 2);
+    assert_memory_equal(back, wire, 14);
+    close_pair(&p);
+}
+
+/* The peer splits a packet; the port's read() gives the bytes back
+ * whatever the reader's chunk size, and a datalink receiver decodes it. */
+static void read_reassembles_a_split_packet(tase_can_role_t role, uint32_t peer_id, size_t chunk)
+{
+    pair_t p;
+    uint8_t wire[TASE_FRAME_MAX], back[TASE_FRAME_MAX];
+    tase_rx_t rx;
+    int n, i;
+    open_pair(&p, role);
+    n = make_packet(wire, 0x42, TASE_DATA_MAX);
+    for (i = 0; i < n; i += 8) {
+        peer_send(&p, peer_id | CAN_EFF_FLAG, wire + i, (uint8_t)(n - i < 8 ? n - i : 8));
+    }
+    assert_int_equal(read_all(&p.s, back, (size_t)n, chunk), (size_t)n);
+    assert_memory_equal(back, wire, (size_t)n);
+    assert_int_equal(tase_rx_init(&rx), TASE_OK);
+    assert_int_equal(tase_rx_feed(&rx, back, (size_t)n, NULL, NULL), 1);
+    /* nothing more arrives */
+    assert_int_equal(tase_socketcan_read(&p.s, back, sizeof(back), 0), 0);
+    close_pair(&p);
+}
+
+static void gimbal_reads_a_max_packet_in_one_call(void **state)
+{
+    (void)state;
+    read_reassembles_a_split_packet(TASE_CAN_ROLE_GIMBAL, 0x11000000u, TASE_FRAME_MAX);
+}
+
+static void host_reads_a_max_packet_three_bytes_at_a_time(void **state)
+{
+    (void)state;
+    read_reassembles_a_split_packet(TASE_CAN_ROLE_HOST, 0x10000000u, 3);
+}
+
+static void frames_of_other_ids_are_ignored(void **state)
+{
+    pair_t p;
+    uint8_t b[16];
+    static const uint8_t x[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    peer_send(&p, 0x11000000u | CAN_EFF_FLAG, x, 8);  /* host's own direction */
+    peer_send(&p, 0x10000000u, x, 8);                 /* standard id (masked to 0) */
+    peer_send(&p, 0x10000000u | CAN_EFF_FLAG | CAN_RTR_FLAG, x, 0); /* remote */
+    peer_send(&p, 0x12020000u | CAN_EFF_FLAG, x, 2);  /* 3AX: not the host's */
+    peer_send(&p, 0x10000000u | CAN_EFF_FLAG, x, 0);  /* ours, empty */
+    peer_send(&p, 0x10000000u | CAN_EFF_FLAG, x + 2, 3);
+    assert_int_equal(tase_socketcan_read(&p.s, b, sizeof(b), 200), 3);
+    assert_memory_equal(b, x + 2, 3);
+    assert_int_equal(p.s.stats.frames_ignored, 3);
+    assert_int_equal(p.s.stats.bad_frames, 2);
+    assert_int_equal(p.s.stats.frames_rx, 6);
+    assert_int_equal(p.s.stats.bytes_rx, 3);
+    close_pair(&p);
+}
+
+static void threeax_move_goes_out_and_status_comes_back(void **state)
+{
+    pair_t p;
+    tase_can_3ax_move_t m;
+    tase_can_3ax_status_t st;
+    tase_can_frame_t f;
+    struct can_frame cf;
+    uint8_t b[8];
+    static const uint8_t status[2] = {0x40, 0x0A};
+    static const uint8_t pkt_part[4] = {0x00, 0xFF, 0x5A, 0x02};
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_GIMBAL);
+    m.command = TASE_3AX_RETRACT;
+    assert_int_equal(tase_can_3ax_move_encode(&m, &f), TASE_OK);
+    assert_int_equal(tase_socketcan_send_frame(&p.s, &f), TASE_OK);
+    assert_int_equal(recv(p.peer, &cf, sizeof(cf), MSG_DONTWAIT), (ssize_t)sizeof(cf));
+    assert_int_equal(cf.can_id, 0x12010000u | CAN_EFF_FLAG);
+    assert_int_equal(cf.can_dlc, 2);
+    assert_int_not_equal(cf.data[0], 0);
+    assert_int_equal(cf.data[1], 0);
+    /* A status arriving while the byte stream is read is kept for
+     * recv_frame(); the datalink bytes around it are not disturbed. */
+    peer_send(&p, 0x11000000u | CAN_EFF_FLAG, pkt_part, 2);
+    peer_send(&p, 0x12020000u | CAN_EFF_FLAG, status, 2);
+    peer_send(&p, 0x11000000u | CAN_EFF_FLAG, pkt_part + 2, 2);
+    assert_int_equal(read_all(&p.s, b, 4, 8), 4);
+    assert_memory_equal(b, pkt_part, 4);
+    assert_int_equal(tase_socketcan_recv_frame(&p.s, &f, 0), 1);
+    assert_int_equal(tase_can_3ax_status_decode(&f, &st), TASE_OK);
+    assert_int_equal(st.position, 0x40);
+    assert_int_equal(st.speed_dps, 50);
+    assert_int_equal(tase_socketcan_recv_frame(&p.s, &f, 0), 0);
+    /* And directly, without read() in between. */
+    peer_send(&p, 0x12020000u | CAN_EFF_FLAG, status, 2);
+    assert_int_equal(tase_socketcan_recv_frame(&p.s, &f, 200), 1);
+    assert_int_equal(f.id, TASE_CAN_ID_3AX_STATUS);
+    assert_true(f.extended);
+    close_pair(&p);
+}
+
+static void full_queue_is_reported_never_dropped(void **state)
+{
+    pair_t p;
+    uint8_t wire[TASE_FRAME_MAX];
+    struct can_frame cf;
+    size_t sent = 0, total = 0;
+    int n, rc, guard;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    p.s.tx_timeout_ms = 5;
+    n = make_packet(wire, 0x42, TASE_DATA_MAX);
+    /* Nobody reads the peer: the socket buffer fills up. */
+    for (guard = 0; guard < 100000; guard++) {
+        rc = tase_socketcan_write(&p.s, wire, (size_t)n);
+        if (rc != n) {
+            break;
+        }
+        sent += (size_t)n;
+    }
+    assert_true(rc == TASE_ENOBUFS || (rc > 0 && rc < n && rc % 8 == 0));
+    if (rc > 0) {
+        sent += (size_t)rc;
+    }
+    assert_true(p.s.stats.tx_full >= 1);
+    assert_true(p.s.stats.tx_retries >= 1);
+    /* Whatever write() said it took is exactly what the peer finds. */
+    while (recv(p.peer, &cf, sizeof(cf), MSG_DONTWAIT) == (ssize_t)sizeof(cf)) {
+        assert_int_equal(cf.can_id, 0x11000000u | CAN_EFF_FLAG);
+        /* bytes come back in order: frame k carries wire[k*8 % 261...] */
+        assert_memory_equal(cf.data, wire + total % (size_t)n, cf.can_dlc);
+        total += cf.can_dlc;
+    }
+    assert_int_equal(total, sent);
+    close_pair(&p);
+}
+
+static void write_retries_while_the_peer_drains(void **state)
+{
+    /* The queue is full when write() starts but frees up within the
+     * retry budget: all bytes go out. */
+    pair_t p;
+    uint8_t wire[TASE_FRAME_MAX];
+    int n, rc;
+    pid_t pid;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    n = make_packet(wire, 0x42, 10);
+    p.s.tx_timeout_ms = 0;
+    while (tase_socketcan_write(&p.s, wire, 8) == 8) {
+    }
+    pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        struct can_frame cf;
+        usleep(20000);
+        while (recv(p.peer, &cf, sizeof(cf), MSG_DONTWAIT) == (ssize_t)sizeof(cf)) {
+        }
+        _exit(0);
+    }
+    p.s.tx_timeout_ms = 2000;
+    rc = tase_socketcan_write(&p.s, wire, (size_t)n);
+    assert_int_equal(rc, n);
+    assert_true(p.s.stats.tx_retries >= 1);
+    assert_int_equal(waitpid(pid, NULL, 0), pid);
+    close_pair(&p);
+}
+
+static void adopt_and_open_check_their_arguments(void **state)
+{
+    tase_socketcan_t s;
+    int rc;
+    (void)state;
+    assert_int_equal(tase_socketcan_adopt(&s, -1, TASE_CAN_ROLE_HOST, 0), TASE_EARG);
+    assert_int_equal(tase_socketcan_adopt(NULL, 0, TASE_CAN_ROLE_HOST, 0), TASE_EARG);
+    assert_int_equal(tase_socketcan_adopt(&s, 0, (tase_can_role_t)3, 0), TASE_EARG);
+    assert_int_equal(tase_socketcan_adopt(&s, 0, TASE_CAN_ROLE_HOST, 0x80), TASE_EARG);
+    assert_int_equal(tase_socketcan_open(&s, "", TASE_CAN_ROLE_HOST), TASE_EARG);
+    assert_int_equal(tase_socketcan_open(&s, "a-name-longer-than-15", TASE_CAN_ROLE_HOST),
+                     TASE_EARG);
+    /* This kernel may or may not have CAN: either way the answer is a
+     * clean code, never a crash or a half-open socket. */
+    rc = tase_socketcan_open(&s, "tasenosuch0", TASE_CAN_ROLE_HOST);
+    assert_true(rc == TASE_EUNSUPPORTED || rc == TASE_ENODEV);
+}
+
+static void set_filter_on_a_non_can_socket_fails_cleanly(void **state)
+{
+    int sv[2];
+    tase_socketcan_t s;
+    (void)state;
+    assert_int_equal(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv), 0);
+    s.fd = 1234;
+    assert_int_equal(tase_socketcan_adopt(&s, sv[0], TASE_CAN_ROLE_GIMBAL,
+                                          TASE_SOCKETCAN_SET_FILTER), TASE_EIO);
+    assert_int_equal(s.fd, 1234);
+    close(sv[0]);
+    close(sv[1]);
+}
+
+static void port_table_moves_bytes_both_ways(void **state)
+{
+    pair_t p;
+    tase_port_t port;
+    uint8_t wire[TASE_FRAME_MAX], back[TASE_FRAME_MAX];
+    size_t len;
+    int n;
+    uint32_t t0;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_GIMBAL);
+    port = tase_socketcan_port(&p.s);
+    n = make_packet(wire, 0x10, 6);
+    assert_int_equal(port.ops->write(port.ctx, wire, (size_t)n), n);
+    assert_int_equal(peer_drain(&p, 0x10000000u | CAN_EFF_FLAG, back, &len), 2);
+    peer_send(&p, 0x11000000u | CAN_EFF_FLAG, wire, 5);
+    assert_int_equal(port.ops->read(port.ctx, back, sizeof(back), 100), 5);
+    assert_memory_equal(back, wire, 5);
+    t0 = port.ops->now_ms(port.ctx);
+    assert_int_equal(port.ops->read(port.ctx, back, sizeof(back), 30), 0);
+    assert_true(port.ops->now_ms(port.ctx) - t0 >= 25u);
+    close_pair(&p);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(write_splits_a_max_frame_into_33_frames_of_the_host_id),
+        cmocka_unit_test(gimbal_writes_with_its_own_id),
+        cmocka_unit_test(gimbal_reads_a_max_packet_in_one_call),
+        cmocka_unit_test(host_reads_a_max_packet_three_bytes_at_a_time),
+        cmocka_unit_test(frames_of_other_ids_are_ignored),
+        cmocka_unit_test(threeax_move_goes_out_and_status_comes_back),
+        cmocka_unit_test(full_queue_is_reported_never_dropped),
+        cmocka_unit_test(write_retries_while_the_peer_drains),
+        cmocka_unit_test(adopt_and_open_check_their_arguments),
+        cmocka_unit_test(set_filter_on_a_non_can_socket_fails_cleanly),
+        cmocka_unit_test(port_table_moves_bytes_both_ways),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,75 @@
+/* Tests of the unit conversions: scale factors, rounding half away from
+ * zero, saturation at the field limits, NaN. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "tase/units.h"
+
+/* No libm: the tests link without -lm. */
+static double absd(double v)
+{
+    return v < 0.0 ? -v : v;
+}
+
+static void to_wire_rounds_half_away_from_zero(void **state)
+{
+    (void)state;
+    assert_int_equal(tase_units_sat_i16(2.5), 3);
+    assert_int_equal(tase_units_sat_i16(-2.5), -3);
+    assert_int_equal(tase_units_sat_i16(2.4999), 2);
+    assert_int_equal(tase_units_sat_i16(-0.4), 0);
+    assert_int_equal(tase_units_deg_to_cdeg(-45.0), -4500);
+    assert_int_equal(tase_units_deg_to_cdeg(0.005), 1);
+    assert_int_equal(tase_units_mps2_to_accel(9.80665), 2942); /* 2941.995 */
+    assert_int_equal(tase_units_pdop_to_raw(1.25), 13);
+}
+
+static void to_wire_saturates_at_field_limits_and_maps_nan_to_zero(void **state)
+{
+    (void)state;
+    assert_int_equal(tase_units_deg_to_cdeg(1000.0), INT16_MAX);
+    assert_int_equal(tase_units_deg_to_cdeg(-1000.0), INT16_MIN);
+    assert_int_equal(tase_units_sat_i16(32767.49), 32767);
+    assert_int_equal(tase_units_sat_i16(-32768.49), -32768);
+    assert_int_equal(tase_units_deg_to_cdeg_u16(-1.0), 0);
+    assert_int_equal(tase_units_deg_to_cdeg_u16(1000.0), 65535);
+    assert_true(tase_units_deg_to_mas(1000.0) == INT32_MAX);
+    assert_true(tase_units_deg_to_mas(-1000.0) == INT32_MIN);
+    assert_true(tase_units_m_to_cm(1e12) == INT32_MAX);
+    assert_int_equal(tase_units_pdop_to_raw(99.0), 255);
+    assert_int_equal(tase_units_pdop_to_raw(-1.0), 0);
+    assert_int_equal(tase_units_sat_i16(NAN), 0);
+    assert_int_equal(tase_units_sat_u8(NAN), 0);
+    assert_true(tase_units_sat_i32(NAN) == 0);
+    assert_int_equal(tase_units_mps_to_cmps(INFINITY), INT16_MAX);
+}
+
+static void from_wire_applies_the_spec_scales(void **state)
+{
+    (void)state;
+    assert_true(absd(tase_units_cdeg_to_deg(-4500) - -45.0) < 1e-12);
+    assert_true(absd(tase_units_mas_to_deg(INT32_MIN) - -596.5232355555556) < 1e-9);
+    assert_true(absd(tase_units_mas_to_deg(3600000 * 45) - 45.0) < 1e-12);
+    assert_true(absd(tase_units_cm_to_m(123456) - 1234.56) < 1e-9);
+    assert_true(absd(tase_units_cmps_to_mps(-250) - -2.5) < 1e-12);
+    assert_true(absd(tase_units_accel_to_mps2(300) - 1.0) < 1e-12);
+    assert_true(absd(tase_units_raw_to_pdop(15) - 1.5) < 1e-12);
+    /* degrees -> mas -> degrees is exact to a milli-arcsecond */
+    assert_true(absd(tase_units_mas_to_deg(tase_units_deg_to_mas(-122.4194)) - -122.4194) <
+                1.0 / 3600000.0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(to_wire_rounds_half_away_from_zero),
+        cmocka_unit_test(to_wire_saturates_at_field_limits_and_maps_nan_to_zero),
+        cmocka_unit_test(from_wire_applies_the_spec_scales),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
