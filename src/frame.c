@@ -166,15 +166,17 @@ static void add_cand(tase_rx_t *rx, uint16_t start)
 }
 
 /* cand[i] has reached its event (Size byte or last byte, both already in
- * the window): judge it. The caller refreshes rx->next afterwards. */
-static void settle(tase_rx_t *rx, uint8_t i, tase_rx_handler_t on_frame, void *user)
+ * the window): judge it. Returns true when it is a valid frame, described
+ * in *out; the caller hands it on. The callback is not called from here so
+ * that it runs on the stack of tase_rx_feed() alone, not below this. The
+ * caller refreshes rx->next afterwards. */
+static bool settle(tase_rx_t *rx, uint8_t i, tase_frame_t *out)
 {
     tase_rx_cand_t *c = &rx->cand[i];
     uint16_t start = c->start;
     uint16_t end;
     uint16_t want;
     uint8_t last;
-    tase_frame_t frame;
 
     if (c->end == 0u) {
         uint8_t size = rx->buf[start + 3u];
@@ -184,7 +186,7 @@ static void settle(tase_rx_t *rx, uint8_t i, tase_rx_handler_t on_frame, void *u
         } else {
             c->end = (uint16_t)(start + size + 5u);
         }
-        return;
+        return false;
     }
 
     end = c->end;
@@ -192,7 +194,7 @@ static void settle(tase_rx_t *rx, uint8_t i, tase_rx_handler_t on_frame, void *u
     if (tase_checksum(0u, &rx->buf[start], (size_t)end - 1u - start) != want) {
         rx->stats.checksum_errors++;
         drop_cands(rx, i, (uint8_t)(i + 1u));
-        return;
+        return false;
     }
 
     /* Valid. Nested frames delivered earlier are already part of the
@@ -206,59 +208,63 @@ static void settle(tase_rx_t *rx, uint8_t i, tase_rx_handler_t on_frame, void *u
     drop_cands(rx, i, last);
     rx->stats.frames_ok++;
 
-    frame.offset = rx->stats.bytes_in - (uint32_t)(rx->len - start);
-    frame.group = rx->buf[start + 4u];
-    frame.type = rx->buf[start + 5u];
-    frame.len = (uint8_t)(rx->buf[start + 3u] - 2u);
-    frame.data = &rx->buf[start + TASE_FRAME_HEADER];
-    if (on_frame != NULL) {
-        on_frame(user, &frame);
-    }
+    out->offset = rx->stats.bytes_in - (uint32_t)(rx->len - start);
+    out->group = rx->buf[start + 4u];
+    out->type = rx->buf[start + 5u];
+    out->len = (uint8_t)(rx->buf[start + 3u] - 2u);
+    out->data = &rx->buf[start + TASE_FRAME_HEADER];
+    return true;
 }
 
 /* Examine bytes skipped while every candidate slot was busy. A candidate
- * found here may already be complete; it is judged at once. */
-static void rescan(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
+ * found here may already be complete; it is judged at once. Stops after a
+ * valid frame (returns true, frame in *out) so the caller can hand it on
+ * before looking further; returns false when the scan is done or the
+ * slots are full again. */
+static bool rescan(tase_rx_t *rx, tase_frame_t *out)
 {
-    while (rx->scan < rx->len) {
+    while (rx->scan < rx->len && rx->ncand < TASE_RX_CANDIDATES) {
         uint16_t q = rx->scan;
+        bool got = false;
         if (sync_ends_at(rx, q)) {
-            uint8_t i;
-            if (rx->ncand == TASE_RX_CANDIDATES) {
-                return;
-            }
+            uint8_t i = rx->ncand;
             add_cand(rx, (uint16_t)(q - 2u));
-            i = (uint8_t)(rx->ncand - 1u);
             if ((uint16_t)(q + 1u) < rx->len) {
-                settle(rx, i, on_frame, user); /* Size */
+                (void)settle(rx, i, out); /* Size */
                 if (rx->ncand > i && rx->cand[i].end < rx->len) {
-                    settle(rx, i, on_frame, user); /* checksum */
+                    got = settle(rx, i, out); /* checksum */
                 }
             }
         }
         rx->scan = (uint16_t)(q + 1u);
+        if (got) {
+            return true;
+        }
     }
+    return false;
 }
 
-/* Judge every candidate whose event is at index q, oldest first. */
-static void events_at(tase_rx_t *rx, uint16_t q, tase_rx_handler_t on_frame, void *user)
+/* Judge every candidate whose event is at index q, oldest first. At most
+ * one of them is valid: a valid one drops every later candidate that ends
+ * at q, since those began inside it. */
+static bool events_at(tase_rx_t *rx, uint16_t q, tase_frame_t *out)
 {
     uint8_t i = 0;
+    bool got = false;
     while (i < rx->ncand) {
         uint8_t before = rx->ncand;
         if (cand_event(&rx->cand[i]) != q) {
             i++;
             continue;
         }
-        settle(rx, i, on_frame, user);
+        if (settle(rx, i, out)) {
+            got = true;
+        }
         if (rx->ncand == before) {
             i++; /* Size accepted: the candidate stays */
         }
     }
-    if (rx->scan < rx->len && rx->ncand < TASE_RX_CANDIDATES) {
-        rescan(rx, on_frame, user);
-    }
-    update_next(rx);
+    return got;
 }
 
 /* Release buf[0..cut): every byte there not inside a delivered frame is
@@ -344,12 +350,15 @@ static void hunt_byte(tase_rx_t *rx, uint8_t b)
     rx->scan = len;
 }
 
-static void push_byte(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+/* Take one byte. Returns true when it completed a valid frame (in *out);
+ * the caller then hands it on and calls finish_event(). */
+static bool push_byte(tase_rx_t *rx, uint8_t b, tase_frame_t *out, bool *event)
 {
     uint16_t q;
+    *event = false;
     if (rx->ncand == 0u) {
         hunt_byte(rx, b);
-        return;
+        return false;
     }
     if (rx->len == RX_CAP) {
         make_room(rx);
@@ -371,9 +380,28 @@ static void push_byte(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void
             rx->scan = (uint16_t)(q + 1u);
         }
     }
-    if (q == rx->next) {
-        events_at(rx, q, on_frame, user);
+    if (q != rx->next) {
+        return false;
     }
+    *event = true;
+    return events_at(rx, q, out);
+}
+
+/* After an event: deliver the frame it completed, then the frames a rescan
+ * of skipped bytes finds, each as soon as it is found; then tidy up. */
+static void finish_event(tase_rx_t *rx, bool got, tase_frame_t *out, tase_rx_handler_t on_frame,
+                         void *user)
+{
+    for (;;) {
+        if (got && on_frame != NULL) {
+            on_frame(user, out);
+        }
+        got = rescan(rx, out);
+        if (!got) {
+            break;
+        }
+    }
+    update_next(rx);
     if (rx->ncand == 0u && rx->scan == rx->len) {
         go_idle(rx);
     }
@@ -384,6 +412,7 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
 {
     size_t i = 0;
     uint32_t before;
+    tase_frame_t frame;
     if (rx == NULL || (data == NULL && n > 0u)) {
         return TASE_EARG;
     }
@@ -410,7 +439,6 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
                 if (flen <= n - i && memchr(&data[i + 3u], TASE_SYNC3, flen - 3u) == NULL &&
                     tase_checksum(0u, &data[i], flen - 2u) ==
                         (uint16_t)(((uint16_t)data[i + flen - 2u] << 8) | data[i + flen - 1u])) {
-                    tase_frame_t frame;
                     frame.offset = rx->stats.bytes_in;
                     frame.group = data[i + 4u];
                     frame.type = data[i + 5u];
@@ -481,8 +509,14 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
                 }
             }
         }
-        push_byte(rx, data[i], on_frame, user);
-        i++;
+        {
+            bool event;
+            bool got = push_byte(rx, data[i], &frame, &event);
+            i++;
+            if (event) {
+                finish_event(rx, got, &frame, on_frame, user);
+            }
+        }
     }
     return (int)(rx->stats.frames_ok - before);
 }
@@ -490,6 +524,7 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
 {
     uint32_t before;
+    tase_frame_t frame;
     if (rx == NULL) {
         return TASE_EARG;
     }
@@ -503,7 +538,11 @@ int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
         if (rx->scan >= rx->len) {
             break;
         }
-        rescan(rx, on_frame, user);
+        while (rescan(rx, &frame)) {
+            if (on_frame != NULL) {
+                on_frame(user, &frame);
+            }
+        }
     }
     rx->floor = rx->len; /* nothing pending may start a frame */
     go_idle(rx);
