@@ -78,7 +78,7 @@ mon=$("$TASE" monitor "${L[@]}" --json --seconds 2)
 na=$(grep -c '"name":"GIMBAL_ANGLE"' <<<"$mon")
 nr=$(grep -c '"name":"GIMBAL_RATE"' <<<"$mon")
 check "telemetry follows PACKET_RATE (2 s: $na angle ~40, $nr rate ~10)" \
-    eval 'near $na 40 6 && near $nr 10 3'
+    eval 'near $na 40 10 && near $nr 10 4'
 
 # ---- pan/tilt position command ----
 "$TASE" send GIMBAL_CMD pan=3000 tilt=-1500 flags=0xA0 "${L[@]}" >/dev/null
