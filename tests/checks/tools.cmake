@@ -1,0 +1,11 @@
+# Issue 6: the bench tools. The decode golden files and the end-to-end run
+# of `tase` against a real `tase-sim` process over a pseudo-terminal.
+if(TARGET tase_cli AND TARGET tase_sim)
+  add_test(NAME tools_decode
+           COMMAND ${PROJECT_SOURCE_DIR}/scripts/tools-decode.sh $<TARGET_FILE:tase_cli>
+                   ${PROJECT_SOURCE_DIR}/tests/data)
+  add_test(NAME tools_e2e
+           COMMAND ${PROJECT_SOURCE_DIR}/scripts/tools-e2e.sh $<TARGET_FILE:tase_cli>
+                   $<TARGET_FILE:tase_sim>)
+  set_tests_properties(tools_decode tools_e2e PROPERTIES LABELS "check;e2e" TIMEOUT 180)
+endif()

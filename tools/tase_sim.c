@@ -1,0 +1,609 @@
+/* tase-sim: a simulated TASE gimbal on a pseudo-terminal or a CAN
+ * interface, built on the library's gimbal role (tase/gimbal.h). The
+ * physics is in sim_model.c; this file is the protocol glue. Behaviour and
+ * conventions: docs/TOOLS.md. */
+#define _XOPEN_SOURCE 700
+
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "sim_model.h"
+#include "tase/codec.h"
+#include "tase/flags.h"
+#include "tase/gimbal.h"
+#include "tase/klv.h"
+#include "tase/units.h"
+#include "toolkit.h"
+
+#define STEP_MS 5u          /* model step and service period */
+#define KLV_PERIOD_MS 900u  /* spec section 6: about every 900 ms */
+#define NCAM 3u
+
+static const char usage[] =
+    "usage: tase-sim [--link PATH | --can IFACE] [--klv-link PATH] [--seconds S]\n"
+    "                [--quiet]\n"
+    "A simulated TASE gimbal. By default it serves the serial datalink on a new\n"
+    "pseudo-terminal and prints its path; --link PATH also makes PATH a symlink to\n"
+    "it. --can IFACE serves the CAN datalink on a SocketCAN interface instead.\n"
+    "--klv-link PATH adds the KLV metadata output (an 87-byte packet about every\n"
+    "900 ms) on a second pseudo-terminal, symlinked at PATH. It answers every In\n"
+    "packet of the spec and streams GIMBAL_ANGLE, GIMBAL_RATE and GEOREFERENCE_DATA\n"
+    "at the PACKET_RATE rates. Runs until interrupted, or for S seconds.\n";
+
+typedef struct {
+    uint8_t type;       /* table 28, 0xFF none */
+    uint16_t max_hfov;  /* 1/100 deg */
+    uint16_t min_hfov;
+    double hfov;        /* current, deg */
+} camera_t;
+
+typedef struct {
+    tase_gimbal_t g;
+    sim_model_t m;
+    camera_t cam[NCAM];
+    uint8_t active_cam;
+    uint32_t t0;           /* start, ms */
+    int16_t p, q, r;       /* host body rates from HOST_SENSOR, 1/100 deg/s */
+    bool quiet;
+    bool spoi_valid;
+} sim_t;
+
+static volatile sig_atomic_t stop_flag;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    stop_flag = 1;
+}
+
+static void logf_(const sim_t *s, uint32_t now, const char *fmt, ...)
+{
+    va_list ap;
+    if (s->quiet) {
+        return;
+    }
+    printf("[%8.3f] ", (double)(uint32_t)(now - s->t0) / 1000.0);
+    va_start(ap, fmt);
+    vprintf(fmt, ap);
+    va_end(ap);
+    fputc('\n', stdout);
+    fflush(stdout);
+}
+
+/* Encode a typed packet and copy its data bytes (the frame's payload). */
+static int payload(uint16_t id, const void *msg, uint8_t *data, size_t cap)
+{
+    uint8_t frame[TASE_FRAME_MAX];
+    int n = tase_packet_encode(id, msg, frame, sizeof(frame));
+    if (n < (int)TASE_FRAME_OVERHEAD || (size_t)n - TASE_FRAME_OVERHEAD > cap) {
+        return n < 0 ? n : TASE_ENOSPC;
+    }
+    memcpy(data, frame + TASE_FRAME_HEADER, (size_t)n - TASE_FRAME_OVERHEAD);
+    return n - (int)TASE_FRAME_OVERHEAD;
+}
+
+static void send_packet(sim_t *s, unsigned port, uint16_t id, const void *msg)
+{
+    uint8_t data[TASE_DATA_MAX];
+    int n = payload(id, msg, data, sizeof(data));
+    if (n >= 0) {
+        (void)tase_gimbal_send(&s->g, port, TASE_ID_GROUP(id), TASE_ID_TYPE(id), data,
+                               (size_t)n);
+    }
+}
+
+static uint8_t mode_byte(const sim_t *s)
+{
+    static const uint8_t modes[] = {TASE_MODE_RATE, TASE_MODE_POSITION, TASE_MODE_SPOI,
+                                    TASE_MODE_RATE};
+    uint8_t b = TASE_MODE_SET_VALUE(0u, modes[s->m.mode]);
+    if (s->m.stabilised) {
+        b |= TASE_MODE_STAB;
+    }
+    if (s->m.tax == SIM_3AX_DEPLOYED) {
+        b |= TASE_MODE_3AX_DEPLOYED;
+    } else if (s->m.tax == SIM_3AX_RETRACTED) {
+        b |= TASE_MODE_3AX_RETRACTED;
+    }
+    return b;
+}
+
+/* ---- setup packets ---- */
+
+static void apply_axis(sim_t *s, const tase_axis_setting_t *a)
+{
+    s->m.axis_pan.nogo_center = tase_units_cdeg_to_deg(a->pan_nogo_center);
+    s->m.axis_pan.nogo_range = (double)a->pan_nogo_range / 100.0;
+    s->m.axis_tilt.nogo_center = tase_units_cdeg_to_deg(a->tilt_nogo_center);
+    s->m.axis_tilt.nogo_range = (double)a->tilt_nogo_range / 100.0;
+    s->m.axis_pan.max_rate = 5.0 * a->pan_max_rate;
+    s->m.axis_tilt.max_rate = 5.0 * a->tilt_max_rate;
+    s->m.axis_pan.gain = 0.1 * a->pan_pos_gain;
+    s->m.axis_tilt.gain = 0.1 * a->tilt_pos_gain;
+}
+
+static void decode_setup(uint8_t type, const uint8_t *data, size_t len, void *msg)
+{
+    tase_frame_t f;
+    f.offset = 0;
+    f.group = TASE_GROUP_SETUP;
+    f.type = type;
+    f.len = (uint8_t)len;
+    f.data = data;
+    (void)tase_packet_decode(&f, msg);
+}
+
+static int apply_setup(void *user, unsigned port, uint8_t type, uint8_t *data, size_t len)
+{
+    sim_t *s = user;
+    uint8_t cur[TASE_DATA_MAX];
+    int curlen = tase_gimbal_setup_get(&s->g, type, cur, sizeof(cur));
+    size_t i;
+    uint32_t now = tase_posix_now_ms();
+    (void)port;
+    if (curlen != (int)len) {
+        return -1;
+    }
+    if (type == TASE_ID_TYPE(TASE_ID_AXIS_SETTING)) {
+        /* 0xFF (0xFFFF for 16-bit values) means "do not change" */
+        tase_axis_setting_t a;
+        for (i = 0; i + 1 < 12; i += 2) {
+            if (data[i] == 0xFF && data[i + 1] == 0xFF) {
+                data[i] = cur[i];
+                data[i + 1] = cur[i + 1];
+            }
+        }
+        for (i = 12; i < len; i++) {
+            if (data[i] == 0xFF) {
+                data[i] = cur[i];
+            }
+        }
+        decode_setup(type, data, len, &a);
+        if (a.pan_max_rate == 0 || a.tilt_max_rate == 0) {
+            logf_(s, now, "AXIS_SETTING refused: a max rate of 0 would lock the axis");
+            return -1;
+        }
+        apply_axis(s, &a);
+        logf_(s, now, "AXIS_SETTING: pan no-go %.2f+-%.2f, tilt no-go %.2f+-%.2f, max rates "
+              "%.0f/%.0f deg/s", s->m.axis_pan.nogo_center, s->m.axis_pan.nogo_range / 2,
+              s->m.axis_tilt.nogo_center, s->m.axis_tilt.nogo_range / 2, s->m.axis_pan.max_rate,
+              s->m.axis_tilt.max_rate);
+    } else if (type == TASE_ID_TYPE(TASE_ID_CAMERA_TYPE)) {
+        for (i = 0; i < len; i++) {
+            if (data[i] == TASE_CAMTYPE_NO_CHANGE) {
+                data[i] = cur[i];
+            }
+        }
+    } else if (type == TASE_ID_TYPE(TASE_ID_PACKET_RATE)) {
+        logf_(s, now, "PACKET_RATE: port 1 angle %u/s, rate %u/s, georef %u/s", data[0],
+              data[1], data[2]);
+    }
+    return 0;
+}
+
+static void set_version(sim_t *s, uint32_t now)
+{
+    tase_system_version_t v;
+    uint8_t data[TASE_DATA_MAX];
+    int n;
+    memset(&v, 0, sizeof(v));
+    v.major = 2;
+    v.minor = 5;
+    v.sub = 1;
+    v.released = 1;
+    v.soft_year = 2024;
+    v.soft_month = 3;
+    v.soft_day = 15;
+    v.board_sn = 100123u;
+    v.board_rev = 3u;
+    v.board_config = 0x00010002u;
+    v.board_year = 2023;
+    v.board_month = 11;
+    v.board_day = 2;
+    v.camera_a = s->cam[0].type;
+    v.max_hfov_a = s->cam[0].max_hfov;
+    v.min_hfov_a = s->cam[0].min_hfov;
+    v.camera_b = s->cam[1].type;
+    v.max_hfov_b = s->cam[1].max_hfov;
+    v.min_hfov_b = s->cam[1].min_hfov;
+    v.camera_c = s->cam[2].type;
+    n = payload(TASE_ID_SYSTEM_VERSION, &v, data, sizeof(data));
+    if (n < 0 || tase_gimbal_setup_set(&s->g, TASE_ID_TYPE(TASE_ID_SYSTEM_VERSION), data,
+                                       (size_t)n, now) != TASE_OK) {
+        tk_die("internal error: cannot store SYSTEM_VERSION");
+    }
+}
+
+/* ---- telemetry ---- */
+
+static void gps_time(tase_georeference_t *r)
+{
+    struct timespec ts;
+    struct tm tm;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    gmtime_r(&ts.tv_sec, &tm);
+    r->year = (uint16_t)(tm.tm_year + 1900);
+    r->month = (uint8_t)(tm.tm_mon + 1);
+    r->day = (uint8_t)tm.tm_mday;
+    r->hour = (uint8_t)tm.tm_hour;
+    r->minute = (uint8_t)tm.tm_min;
+    r->second = (uint8_t)(tm.tm_sec > 59 ? 59 : tm.tm_sec);
+    r->frac_second = (uint8_t)(ts.tv_nsec / 10000000L);
+}
+
+static double vfov_of(double hfov)
+{
+    return 2.0 * atan(0.75 * tan(hfov * M_PI / 360.0)) * 180.0 / M_PI; /* 4:3 image */
+}
+
+static int fill_telemetry(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
+                          uint32_t now)
+{
+    sim_t *s = user;
+    const sim_model_t *m = &s->m;
+    if (id == TASE_ID_GIMBAL_ANGLE) {
+        tase_gimbal_angle_t a = {0, 0, 0};
+        a.pan = tase_units_deg_to_cdeg(m->pan);
+        a.tilt = tase_units_deg_to_cdeg(m->tilt);
+        return payload(id, &a, data, cap);
+    }
+    if (id == TASE_ID_GIMBAL_RATE) {
+        tase_gimbal_rate_t r;
+        memset(&r, 0, sizeof(r));
+        r.time = now - s->t0;
+        r.pan_rate = tase_units_deg_to_cdeg(m->pan_rate);
+        r.tilt_rate = tase_units_deg_to_cdeg(m->tilt_rate);
+        r.p = s->p;
+        r.q = s->q;
+        r.r = s->r;
+        r.mode = mode_byte(s);
+        return payload(id, &r, data, cap);
+    }
+    if (id == TASE_ID_GEOREFERENCE_DATA) {
+        tase_georeference_t r;
+        uint8_t rates[TASE_DATA_MAX];
+        double cr, cp, cy, hfov = s->cam[s->active_cam].hfov;
+        memset(&r, 0, sizeof(r));
+        r.time = now - s->t0;
+        r.lat = tase_units_deg_to_mas(m->host.lat);
+        r.lon = tase_units_deg_to_mas(m->host.lon);
+        r.height = tase_units_m_to_cm(m->host.height);
+        r.vnorth = tase_units_sat_i16(m->host.vn * 100.0);
+        r.veast = tase_units_sat_i16(m->host.ve * 100.0);
+        r.vdown = tase_units_sat_i16(m->host.vd * 100.0);
+        gps_time(&r);
+        r.num_sats = 12;
+        r.pdop = 12;
+        r.status = TASE_BITS16_SET(0u, 0, 2, TASE_GPS_FIX_3D);
+        sim_model_camera_euler(m, &cr, &cp, &cy);
+        r.camera_roll = tase_units_deg_to_cdeg(cr);
+        r.camera_pitch = tase_units_deg_to_cdeg(cp);
+        r.camera_yaw = tase_units_deg_to_cdeg(cy);
+        r.hfov = tase_units_deg_to_cdeg_u16(hfov);
+        r.vfov = tase_units_deg_to_cdeg_u16(vfov_of(hfov));
+        r.focal = tase_units_sat_u16(100.0 * 2.4 / tan(hfov * M_PI / 360.0)); /* 4.8 mm sensor */
+        r.mode = mode_byte(s);
+        if (tase_gimbal_setup_get(&s->g, TASE_ID_TYPE(TASE_ID_PACKET_RATE), rates,
+                                  sizeof(rates)) >= 13) {
+            r.sample_rate = rates[2u + 5u * port];
+        }
+        r.nav_health = 0xFFF0u; /* every health bit set, filter mode "normal" */
+        r.mount_roll = tase_units_deg_to_cdeg(m->att.roll);
+        r.mount_pitch = tase_units_deg_to_cdeg(m->att.pitch);
+        r.mount_yaw = tase_units_deg_to_cdeg(m->att.yaw);
+        r.pan = tase_units_deg_to_cdeg(m->pan);
+        r.tilt = tase_units_deg_to_cdeg(m->tilt);
+        r.camera = s->active_cam;
+        return payload(id, &r, data, cap);
+    }
+    return -1;
+}
+
+/* ---- commands and host data ---- */
+
+static const char *mode_name(const sim_model_t *m)
+{
+    static const char *const names[] = {"rate", "position", "SPOI", "impulse"};
+    return names[m->mode];
+}
+
+static void camera_cmd(sim_t *s, const tase_camera_cmd_t *c, int len, uint32_t now)
+{
+    camera_t *cam;
+    if (c->camera != 0xFF) {
+        if (c->camera >= NCAM || s->cam[c->camera].type == TASE_CAMTYPE_NONE) {
+            logf_(s, now, "CAMERA_CMD: no camera %u", (unsigned)c->camera);
+            return;
+        }
+        s->active_cam = c->camera;
+    }
+    cam = &s->cam[s->active_cam];
+    if (len > 1 && c->hfov != -1) {
+        double h = c->hfov > 0 ? c->hfov / 100.0 : cam->max_hfov / 100.0 / (-c->hfov / 100.0);
+        double lo = cam->min_hfov / 100.0, hi = cam->max_hfov / 100.0;
+        cam->hfov = h < lo ? lo : (h > hi ? hi : h);
+    }
+    logf_(s, now, "CAMERA_CMD: camera %c, HFOV %.2f deg", 'A' + s->active_cam, cam->hfov);
+}
+
+static void on_frame(void *user, unsigned port, const tase_frame_t *f)
+{
+    sim_t *s = user;
+    tase_packet_msg_t msg;
+    uint16_t id = TASE_ID(f->group, f->type);
+    uint32_t now = tase_posix_now_ms();
+    int len = tase_packet_decode(f, &msg);
+    if (len < 0) {
+        logf_(s, now, "ignored frame 0x%02X/0x%02X (%u bytes): %s", f->group, f->type,
+              (unsigned)f->len, tase_strerror(len));
+        return;
+    }
+    switch (id) {
+    case TASE_ID_GIMBAL_CMD: {
+        const tase_gimbal_cmd_t *c = &msg.gimbal_cmd;
+        if (sim_model_command(&s->m, c->pan / 100.0, c->tilt / 100.0, c->flags,
+                              c->impulse_time / 100.0) != 0) {
+            logf_(s, now, "GIMBAL_CMD: unknown flags 0x%02X ignored", c->flags);
+        } else {
+            logf_(s, now, "GIMBAL_CMD: %s pan %.2f tilt %.2f%s", mode_name(&s->m), c->pan / 100.0,
+                  c->tilt / 100.0, s->m.stabilised ? ", stabilised" : "");
+        }
+        break;
+    }
+    case TASE_ID_GYRO_ZERO_CMD:
+        logf_(s, now, "GYRO_ZERO_CMD: gyros zeroed");
+        break;
+    case TASE_ID_CAMERA_CMD:
+        camera_cmd(s, &msg.camera_cmd, len, now);
+        break;
+    case TASE_ID_LEGACY_CAMERA_CMD: {
+        camera_t *cam = &s->cam[0];
+        double z = (msg.legacy_camera_cmd.zoom > 0x4000 ? 0x4000 : msg.legacy_camera_cmd.zoom) /
+                   16384.0;
+        cam->hfov = cam->max_hfov / 100.0 * pow(cam->min_hfov / (double)cam->max_hfov, z);
+        logf_(s, now, "LEGACY_CAMERA_CMD: camera A HFOV %.2f deg", cam->hfov);
+        break;
+    }
+    case TASE_ID_CAMERA_PASS:
+        /* the simulated camera answers by echoing what it was sent */
+        send_packet(s, port, id, &msg.camera_pass);
+        logf_(s, now, "CAMERA_PASS: %u bytes echoed by camera %u", msg.camera_pass.len,
+              msg.camera_pass.camera);
+        break;
+    case TASE_ID_RETRACT_DEPLOY_CMD:
+        sim_model_retract_deploy(&s->m, msg.retract_deploy_cmd.deploy != 0);
+        logf_(s, now, "RETRACT_DEPLOY_CMD: %s", msg.retract_deploy_cmd.deploy ? "deploying"
+                                                                              : "retracting");
+        break;
+    case TASE_ID_HOST_SENSOR:
+        s->p = msg.host_sensor.roll;
+        s->q = msg.host_sensor.pitch;
+        s->r = msg.host_sensor.yaw;
+        break;
+    case TASE_ID_HOST_ATTITUDE:
+        s->m.att.roll = tase_units_cdeg_to_deg(msg.host_attitude.roll);
+        s->m.att.pitch = tase_units_cdeg_to_deg(msg.host_attitude.pitch);
+        s->m.att.yaw = tase_units_cdeg_to_deg(msg.host_attitude.yaw);
+        break;
+    case TASE_ID_HOST_GPS_DATA:
+        s->m.host.lat = tase_units_mas_to_deg(msg.host_gps.lat);
+        s->m.host.lon = tase_units_mas_to_deg(msg.host_gps.lon);
+        s->m.host.height = tase_units_cm_to_m(msg.host_gps.height);
+        s->m.host.vn = msg.host_gps.vnorth / 100.0;
+        s->m.host.ve = msg.host_gps.veast / 100.0;
+        s->m.host.vd = msg.host_gps.vdown / 100.0;
+        break;
+    case TASE_ID_SPOI_CMD:
+        if (len == 0) {
+            tase_spoi_cmd_t a;
+            memset(&a, 0, sizeof(a));
+            if (s->spoi_valid) {
+                a.lat = tase_units_deg_to_mas(s->m.spoi.lat);
+                a.lon = tase_units_deg_to_mas(s->m.spoi.lon);
+                a.height = tase_units_m_to_cm(s->m.spoi.height);
+                a.vnorth = tase_units_sat_i16(s->m.spoi.vn * 100.0);
+                a.veast = tase_units_sat_i16(s->m.spoi.ve * 100.0);
+                a.vdown = tase_units_sat_i16(s->m.spoi.vd * 100.0);
+            }
+            a.flags = (uint8_t)((s->m.stabilised ? TASE_SPOI_STAB : 0u) |
+                                TASE_BITS8_SET(0u, 1, 7, TASE_MODE_VALUE(mode_byte(s))));
+            send_packet(s, port, id, &a);
+        } else {
+            sim_pos_t t;
+            t.lat = tase_units_mas_to_deg(msg.spoi_cmd.lat);
+            t.lon = tase_units_mas_to_deg(msg.spoi_cmd.lon);
+            t.height = tase_units_cm_to_m(msg.spoi_cmd.height);
+            t.vn = msg.spoi_cmd.vnorth / 100.0;
+            t.ve = msg.spoi_cmd.veast / 100.0;
+            t.vd = msg.spoi_cmd.vdown / 100.0;
+            sim_model_spoi(&s->m, &t);
+            s->spoi_valid = true;
+            logf_(s, now, "SPOI_CMD: pointing at %.6f, %.6f, %.1f m", t.lat, t.lon, t.height);
+            if (msg.spoi_cmd.flags & TASE_SPOI_ECHO) {
+                send_packet(s, port, id, &msg.spoi_cmd);
+            }
+        }
+        break;
+    default:
+        logf_(s, now, "%s: not an In packet, ignored", tase_schema_packet_name(
+                                                           tase_schema_find(f->group, f->type)));
+        break;
+    }
+}
+
+/* ---- KLV ---- */
+
+static void send_klv(sim_t *s, const tase_port_t *klv)
+{
+    tase_klv_t k;
+    struct timespec ts;
+    uint8_t buf[TASE_KLV_PACKET_LEN];
+    double hfov = s->cam[s->active_cam].hfov;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    k.utc = (uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u;
+    k.lat = tase_klv_lat_raw(s->m.host.lat);
+    k.lon = tase_klv_lon_raw(s->m.host.lon);
+    k.alt = tase_klv_alt_raw(s->m.host.height);
+    k.pan = tase_klv_angle_raw(s->m.pan);
+    k.tilt = tase_klv_tilt_raw(s->m.tilt);
+    k.heading = tase_klv_angle_raw(s->m.att.yaw);
+    k.pitch = tase_klv_pitch_raw(s->m.att.pitch);
+    k.roll = tase_klv_roll_raw(s->m.att.roll);
+    k.vnorth = tase_klv_speed_raw(s->m.host.vn);
+    k.veast = tase_klv_speed_raw(s->m.host.ve);
+    k.hfov = tase_klv_fov_raw(hfov);
+    k.vfov = tase_klv_fov_raw(vfov_of(hfov));
+    k.gps_status = tase_klv_gps_status(TASE_KLV_GPS_FIX_3D, TASE_KLV_GPS_ANTENNA_OK, 0);
+    if (tase_klv_encode(&k, buf, sizeof(buf)) == (int)TASE_KLV_PACKET_LEN) {
+        (void)klv->ops->write(klv->ctx, buf, sizeof(buf)); /* nobody listening: dropped */
+    }
+}
+
+/* ---- main ---- */
+
+int main(int argc, char **argv)
+{
+    static sim_t s;
+    const char *link = NULL, *can = NULL, *klv_link = NULL;
+    double seconds = 0.0;
+    char path[256], klv_path[256];
+    tk_link_t dl, kl;
+    tase_port_t port, klv_port;
+    tase_gimbal_app_t app;
+    uint32_t now, last, next_klv;
+    double t_end;
+    struct sigaction sa;
+    int i, slave_fd = -1, klv_slave = -1;
+    bool have_klv = false;
+    uint8_t axis[TASE_DATA_MAX];
+    tase_axis_setting_t axs;
+
+    tk_prog = "tase-sim";
+    for (i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        bool more = i + 1 < argc;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            fputs(usage, stdout);
+            return 0;
+        } else if (strcmp(a, "--quiet") == 0) {
+            s.quiet = true;
+        } else if (strcmp(a, "--link") == 0 && more) {
+            link = argv[++i];
+        } else if (strcmp(a, "--can") == 0 && more) {
+            can = argv[++i];
+        } else if (strcmp(a, "--klv-link") == 0 && more) {
+            klv_link = argv[++i];
+        } else if (strcmp(a, "--seconds") == 0 && more) {
+            if (tk_parse_seconds(argv[++i], &seconds) != 0 || seconds <= 0.0) {
+                tk_usage_error("bad --seconds value '%s'", argv[i]);
+            }
+        } else if (a[0] == '-' && (strcmp(a, "--link") == 0 || strcmp(a, "--can") == 0 ||
+                                   strcmp(a, "--klv-link") == 0 ||
+                                   strcmp(a, "--seconds") == 0)) {
+            tk_usage_error("option %s needs a value", a);
+        } else {
+            tk_usage_error("unknown argument '%s' (see --help)", a);
+        }
+    }
+    if (link != NULL && can != NULL) {
+        tk_usage_error("give either --link or --can, not both");
+    }
+
+    sim_model_init(&s.m);
+    s.cam[0].type = 68; /* SONY_FCB_EX1010, 36x optical zoom */
+    s.cam[0].max_hfov = 5780;
+    s.cam[0].min_hfov = 170;
+    s.cam[0].hfov = 57.80;
+    s.cam[1].type = 97; /* FLIR_320_PHOTON_23 */
+    s.cam[1].max_hfov = 2300;
+    s.cam[1].min_hfov = 2300;
+    s.cam[1].hfov = 23.0;
+    s.cam[2].type = TASE_CAMTYPE_NONE;
+
+    if (can != NULL) {
+        tk_link_can(&dl, can, true);
+        snprintf(path, sizeof(path), "%s", can);
+    } else {
+        tk_link_pty(&dl, tk_pty_open(path, sizeof(path), link, &slave_fd));
+    }
+    port = tk_link_port(&dl);
+    if (klv_link != NULL) {
+        tk_link_pty(&kl, tk_pty_open(klv_path, sizeof(klv_path), klv_link, &klv_slave));
+        klv_port = tk_link_port(&kl);
+        have_klv = true;
+    }
+
+    memset(&app, 0, sizeof(app));
+    app.apply_setup = apply_setup;
+    app.fill_telemetry = fill_telemetry;
+    app.on_frame = on_frame;
+    app.user = &s;
+    now = tase_posix_now_ms();
+    s.t0 = now;
+    if (tase_gimbal_init(&s.g, &port, 1, &app, now) != TASE_OK) {
+        tk_die("internal error: gimbal role init failed");
+    }
+    set_version(&s, now);
+    /* the model starts from the role's stored (default) axis settings */
+    tase_gimbal_setup_get(&s.g, TASE_ID_TYPE(TASE_ID_AXIS_SETTING), axis, sizeof(axis));
+    decode_setup(TASE_ID_TYPE(TASE_ID_AXIS_SETTING), axis, 23, &axs);
+    apply_axis(&s, &axs);
+
+    memset(&sa, 0, sizeof(sa));
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+
+    printf("tase-sim: simulated gimbal on %s%s", can ? "CAN interface " : "", path);
+    printf(link ? " (link %s)\n" : "\n", link);
+    if (have_klv) {
+        printf("tase-sim: KLV output on %s (link %s)\n", klv_path, klv_link);
+    }
+    fflush(stdout);
+
+    last = now;
+    next_klv = now + KLV_PERIOD_MS;
+    t_end = tk_now_s() + seconds;
+    while (!stop_flag && (seconds == 0.0 || tk_now_s() < t_end)) {
+        struct timespec ts = {0, (long)STEP_MS * 1000000L};
+        uint32_t dt;
+        nanosleep(&ts, NULL);
+        now = tase_posix_now_ms();
+        dt = now - last;
+        last = now;
+        if (dt > 0 && sim_model_step(&s.m, (dt > 1000u ? 1000u : dt) / 1000.0)) {
+            tase_retract_deploy_cmd_t rd;
+            rd.deploy = s.m.tax == SIM_3AX_DEPLOYED ? 1u : 0u;
+            send_packet(&s, 0, TASE_ID_RETRACT_DEPLOY_CMD, &rd);
+            logf_(&s, now, "RETRACT_DEPLOY_CMD: %s, echoed", rd.deploy ? "deployed" : "retracted");
+        }
+        if (slave_fd >= 0 && tk_pty_unread(slave_fd) > 2048) {
+            /* nobody has read the link for a while: keep only fresh data */
+            (void)tk_pty_drop_unread(slave_fd);
+        }
+        (void)tase_gimbal_service(&s.g, now);
+        if (have_klv && (int32_t)(now - next_klv) >= 0) {
+            /* a packet still unread after 900 ms has no reader: drop it, as a
+             * serial line would, so a reader that opens later gets fresh data */
+            (void)tk_pty_drop_unread(klv_slave);
+            send_klv(&s, &klv_port);
+            next_klv += KLV_PERIOD_MS;
+        }
+    }
+    if (link != NULL) {
+        unlink(link);
+    }
+    if (klv_link != NULL) {
+        unlink(klv_link);
+    }
+    logf_(&s, tase_posix_now_ms(), "stopped: %lu frames in, %lu out",
+          (unsigned long)s.g.stats.frames_rx, (unsigned long)s.g.stats.frames_tx);
+    tk_link_close(&dl);
+    return 0;
+}
