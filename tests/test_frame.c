@@ -158,9 +158,8 @@ static void encode_in_place_payload_needs_no_copy(void **state)
     (void)state;
     assert_int_equal(tase_frame_encode(a, sizeof(a), 0x10, 0x41, data, sizeof(data)), 13);
     memcpy(b + TASE_FRAME_HEADER, data, sizeof(data));
-    assert_int_equal(tase_frame_encode(b, sizeof(b), 0x10, 0x41, b + TASE_FRAME_HEADER,
-                                       sizeof(data)),
-                     13);
+    assert_int_equal(
+        tase_frame_encode(b, sizeof(b), 0x10, 0x41, b + TASE_FRAME_HEADER, sizeof(data)), 13);
     assert_memory_equal(a, b, 13);
 }
 
