@@ -1,4 +1,6 @@
-# Issue 9's robustness checks. Each script also runs on its own; see
-# docs/ROBUSTNESS.md.
+# Issue 9's robustness checks (docs/ROBUSTNESS.md). Each script also runs
+# on its own from the source tree.
 add_test(NAME format COMMAND ${PROJECT_SOURCE_DIR}/scripts/format.sh)
-set_tests_properties(format PROPERTIES LABELS check TIMEOUT 120)
+add_test(NAME sanitize COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-sanitize.sh ${CMAKE_BINARY_DIR}/sanitize)
+add_test(NAME valgrind COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-valgrind.sh ${CMAKE_BINARY_DIR})
+set_tests_properties(format sanitize valgrind PROPERTIES LABELS check TIMEOUT 900)
