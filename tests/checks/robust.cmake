@@ -6,3 +6,5 @@ add_test(NAME valgrind COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-valgrind.sh $
 set_tests_properties(format sanitize valgrind PROPERTIES LABELS check TIMEOUT 900)
 add_test(NAME coverage COMMAND ${PROJECT_SOURCE_DIR}/scripts/coverage.sh ${CMAKE_BINARY_DIR}/coverage)
 set_tests_properties(coverage PROPERTIES LABELS check TIMEOUT 900)
+add_test(NAME static_analysis COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-static.sh ${CMAKE_BINARY_DIR}/static)
+set_tests_properties(static_analysis PROPERTIES LABELS check TIMEOUT 900)
