@@ -3,7 +3,8 @@
 # gate: fails below TASE_COV_LINES % of lines (95) or TASE_COV_BRANCHES %
 # of branches (90). One command produces the report:
 #   scripts/coverage.sh [OUTDIR]   (default build/coverage)
-# OUTDIR/index.html (per-file, annotated source) and OUTDIR/summary.txt.
+# OUTDIR/index.html (per-file, annotated source), OUTDIR/summary.txt (lines
+# per file) and OUTDIR/totals.txt (line, function and branch totals).
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 out=${1:-$TASE_ROOT/build/coverage}
@@ -21,10 +22,11 @@ cmake --build "$bld" -j2 >/dev/null
 gcovr --root "$TASE_ROOT" --object-directory "$bld" --filter "$TASE_ROOT/src/" \
     --exclude-unreachable-branches --exclude-directories '.*CompilerId.*' \
     --html-details "$out/index.html" --txt "$out/summary.txt" --print-summary \
-    --fail-under-line "$lines" --fail-under-branch "$branches" || {
+    --fail-under-line "$lines" --fail-under-branch "$branches" >"$out/totals.txt" || {
+    cat "$out/totals.txt"
     cat "$out/summary.txt"
     echo "coverage below the gate (lines >= $lines%, branches >= $branches%); report: $out/index.html"
     exit 1
 }
-cat "$out/summary.txt"
+cat "$out/summary.txt" "$out/totals.txt"
 echo "coverage gate passed (lines >= $lines%, branches >= $branches%); report: $out/index.html"
