@@ -158,9 +158,8 @@ static void encode_in_place_payload_needs_no_copy(void **state)
     (void)state;
     assert_int_equal(tase_frame_encode(a, sizeof(a), 0x10, 0x41, data, sizeof(data)), 13);
     memcpy(b + TASE_FRAME_HEADER, data, sizeof(data));
-    assert_int_equal(tase_frame_encode(b, sizeof(b), 0x10, 0x41, b + TASE_FRAME_HEADER,
-                                       sizeof(data)),
-                     13);
+    assert_int_equal(
+        tase_frame_encode(b, sizeof(b), 0x10, 0x41, b + TASE_FRAME_HEADER, sizeof(data)), 13);
     assert_memory_equal(a, b, 13);
 }
 
@@ -188,6 +187,37 @@ static void receiver_rejects_null_arguments(void **state)
     assert_int_equal(tase_rx_feed(&rx, NULL, 0, NULL, NULL), 0);
     assert_int_equal(tase_rx_flush(NULL, NULL, NULL), TASE_EARG);
     assert_int_equal(tase_rx_stats_reset(NULL), TASE_EARG);
+}
+
+static void api_extreme_lengths_give_error_codes_and_change_nothing(void **state)
+{
+    tase_rx_t rx, copy;
+    uint8_t out[TASE_FRAME_MAX], untouched[TASE_FRAME_MAX];
+    static const uint8_t data[4] = {1, 2, 3, 4};
+    (void)state;
+    memset(out, 0x5C, sizeof(out));
+    memcpy(untouched, out, sizeof(out));
+    /* lengths near SIZE_MAX must not overflow len + 8 into a small total */
+    assert_int_equal(tase_frame_encode(out, SIZE_MAX, 0, 0, data, SIZE_MAX), TASE_ETOOLONG);
+    assert_int_equal(tase_frame_encode(out, SIZE_MAX, 0, 0, data, SIZE_MAX - 7u), TASE_ETOOLONG);
+    assert_int_equal(tase_frame_encode(out, 0, 0, 0, NULL, 0), TASE_ENOSPC);
+    assert_int_equal(tase_frame_encode(NULL, 0, 0, 0, NULL, SIZE_MAX), TASE_EARG);
+    assert_memory_equal(out, untouched, sizeof(out));
+    /* a NULL buffer is never read, whatever the length */
+    assert_int_equal(tase_checksum(0x1234, NULL, SIZE_MAX), 0x1234);
+    /* a rejected feed leaves the whole receiver as it was, mid-frame too */
+    assert_int_equal(tase_rx_init(&rx), TASE_OK);
+    assert_int_equal(tase_frame_encode(out, sizeof(out), 0x08, 0x10, data, 4), 12);
+    assert_int_equal(tase_rx_feed(&rx, out, 7, NULL, NULL), 0);
+    memcpy(&copy, &rx, sizeof(rx));
+    assert_int_equal(tase_rx_feed(&rx, NULL, SIZE_MAX, NULL, NULL), TASE_EARG);
+    assert_memory_equal(&copy, &rx, sizeof(rx));
+    assert_int_equal(tase_rx_feed(&rx, out + 7, 5, NULL, NULL), 1);
+    /* flushing an empty receiver twice is harmless */
+    assert_int_equal(tase_rx_flush(&rx, NULL, NULL), 0);
+    memcpy(&copy, &rx, sizeof(rx));
+    assert_int_equal(tase_rx_flush(&rx, NULL, NULL), 0);
+    assert_memory_equal(&copy, &rx, sizeof(rx));
 }
 
 static void receiver_size_fits_budget(void **state)
@@ -752,6 +782,7 @@ int main(void)
         cmocka_unit_test(encode_in_place_payload_needs_no_copy),
         cmocka_unit_test(checksum_helper_matches_definition),
         cmocka_unit_test(receiver_rejects_null_arguments),
+        cmocka_unit_test(api_extreme_lengths_give_error_codes_and_change_nothing),
         cmocka_unit_test(receiver_size_fits_budget),
         cmocka_unit_test(every_split_point_gives_the_same_frame),
         cmocka_unit_test(random_split_points_of_a_long_stream),

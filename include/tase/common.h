@@ -29,25 +29,25 @@ extern "C" {
 
 /* Error codes. Stable: values never change meaning once released. */
 #define TASE_OK 0
-#define TASE_EARG (-1)        /* NULL pointer or out-of-range argument */
-#define TASE_ENOSPC (-2)      /* caller's buffer too small */
-#define TASE_ETOOLONG (-3)    /* data longer than the protocol allows */
-#define TASE_ELENGTH (-4)     /* wrong data length for this packet type */
-#define TASE_EUNKNOWN (-5)    /* group/type (or name, tag) not known */
-#define TASE_ECHECKSUM (-6)   /* checksum mismatch */
-#define TASE_EFORMAT (-7)     /* malformed input (bad key, tag, layout) */
-#define TASE_ERANGE (-8)      /* value outside its representable range */
-#define TASE_EAGAIN (-9)      /* nothing to do now / would block; retry */
-#define TASE_ETIMEOUT (-10)   /* no answer within the time allowed */
-#define TASE_EIO (-11)        /* operating-system I/O error */
-#define TASE_ENODEV (-12)     /* device or interface does not exist */
-#define TASE_EDOWN (-13)      /* interface exists but is down */
-#define TASE_EACCES (-14)     /* permission denied */
-#define TASE_EBUSY (-15)      /* a request is already in progress */
-#define TASE_ENOBUFS (-16)    /* transmit queue full; nothing was sent */
-#define TASE_ETRUNC (-17)     /* input ends before the item is complete */
+#define TASE_EARG (-1)          /* NULL pointer or out-of-range argument */
+#define TASE_ENOSPC (-2)        /* caller's buffer too small */
+#define TASE_ETOOLONG (-3)      /* data longer than the protocol allows */
+#define TASE_ELENGTH (-4)       /* wrong data length for this packet type */
+#define TASE_EUNKNOWN (-5)      /* group/type (or name, tag) not known */
+#define TASE_ECHECKSUM (-6)     /* checksum mismatch */
+#define TASE_EFORMAT (-7)       /* malformed input (bad key, tag, layout) */
+#define TASE_ERANGE (-8)        /* value outside its representable range */
+#define TASE_EAGAIN (-9)        /* nothing to do now / would block; retry */
+#define TASE_ETIMEOUT (-10)     /* no answer within the time allowed */
+#define TASE_EIO (-11)          /* operating-system I/O error */
+#define TASE_ENODEV (-12)       /* device or interface does not exist */
+#define TASE_EDOWN (-13)        /* interface exists but is down */
+#define TASE_EACCES (-14)       /* permission denied */
+#define TASE_EBUSY (-15)        /* a request is already in progress */
+#define TASE_ENOBUFS (-16)      /* transmit queue full; nothing was sent */
+#define TASE_ETRUNC (-17)       /* input ends before the item is complete */
 #define TASE_EUNSUPPORTED (-18) /* valid request this build/port cannot do */
-#define TASE_ESTATE (-19)     /* call not valid in the current state */
+#define TASE_ESTATE (-19)       /* call not valid in the current state */
 
 /* Returns a short constant English description of a TASE_E* code (or of
  * TASE_OK). Unknown codes give "unknown error". Never returns NULL.

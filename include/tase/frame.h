@@ -96,9 +96,9 @@ extern "C" {
 /* A received frame. `data` points into the receiver's window or into the
  * caller's input buffer and is valid only until the callback returns. */
 typedef struct {
-    uint32_t offset;     /* stream offset of the first sync byte, counted
-                            like stats.bytes_in: from tase_rx_init() or the
-                            last tase_rx_stats_reset(), modulo 2^32 */
+    /* Stream offset of the first sync byte, counted like stats.bytes_in:
+     * from tase_rx_init() or the last tase_rx_stats_reset(), modulo 2^32. */
+    uint32_t offset;
     uint8_t group;
     uint8_t type;
     uint8_t len;         /* data length, 0..253 */
@@ -161,8 +161,8 @@ uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n);
  * On error nothing is written. `data` may point at out + TASE_FRAME_HEADER
  * (encode the payload in place, then frame it without a copy); any other
  * overlap is allowed too. O(len), reentrant, ISR-safe. */
-int tase_frame_encode(uint8_t *out, size_t cap, uint8_t group, uint8_t type,
-                      const uint8_t *data, size_t len);
+int tase_frame_encode(uint8_t *out, size_t cap, uint8_t group, uint8_t type, const uint8_t *data,
+                      size_t len);
 
 /* Initialise (or reset) a receiver: empty window, all counters zero.
  * Returns TASE_OK, or TASE_EARG if rx is NULL. */
@@ -176,8 +176,8 @@ int tase_rx_init(tase_rx_t *rx);
  * frames and counters. Not reentrant per receiver; different receivers
  * are independent. Call from one context (e.g. the main loop draining an
  * ISR ring buffer), not concurrently. Worst case O(n * TASE_FRAME_MAX). */
-int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n,
-                 tase_rx_handler_t on_frame, void *user);
+int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
+                 void *user);
 
 /* End of input (end of a capture file, link closed): settle every pending
  * candidate. Frames that can still be completed from the bytes held are

@@ -12,7 +12,7 @@
 
 #define TASE_ID(group, type) ((uint16_t)(((unsigned)(group) << 8) | (unsigned)(type)))
 #define TASE_ID_GROUP(id) ((uint8_t)((unsigned)(id) >> 8))
-#define TASE_ID_TYPE(id) ((uint8_t)((unsigned)(id) & 0xFFu))
+#define TASE_ID_TYPE(id) ((uint8_t)(0xFFu & (unsigned)(id)))
 
 /* Groups (spec table 3) */
 #define TASE_GROUP_COMMAND 0x00u  /* command and control input */
