@@ -34,8 +34,7 @@ int tase_can_frame_check(const tase_can_frame_t *f)
     return f->dlc > TASE_CAN_DLC_MAX ? TASE_ELENGTH : TASE_OK;
 }
 
-int tase_can_split_init(tase_can_split_t *s, tase_can_role_t sender, const uint8_t *data,
-                        size_t n)
+int tase_can_split_init(tase_can_split_t *s, tase_can_role_t sender, const uint8_t *data, size_t n)
 {
     uint32_t id;
     if (s == NULL || (data == NULL && n > 0) || tase_can_role_ids(sender, &id, NULL) != TASE_OK) {
@@ -199,8 +198,7 @@ int tase_can_3ax_status_encode(const tase_can_3ax_status_t *st, tase_can_frame_t
     units = st->speed_dps / TASE_3AX_SPEED_STEP_DPS;
     /* Two's complement byte built arithmetically: no implementation-defined
      * signed-to-unsigned conversion. */
-    frame2(out, TASE_CAN_ID_3AX_STATUS, st->position,
-           (uint8_t)(units < 0 ? units + 256 : units));
+    frame2(out, TASE_CAN_ID_3AX_STATUS, st->position, (uint8_t)(units < 0 ? units + 256 : units));
     return TASE_OK;
 }
 

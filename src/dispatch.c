@@ -3,8 +3,8 @@
 #include "tase/dispatch.h"
 
 int tase_dispatch_init(tase_dispatch_t *d, const tase_packet_handler_t *handlers,
-                       tase_rx_handler_t on_default, tase_dispatch_error_t on_error,
-                       void *user, tase_rx_stats_t *stats)
+                       tase_rx_handler_t on_default, tase_dispatch_error_t on_error, void *user,
+                       tase_rx_stats_t *stats)
 {
     if (d == NULL) {
         return TASE_EARG;

@@ -33,13 +33,13 @@ typedef char tase_rx_cand_check[(TASE_RX_CANDIDATES >= 1 && TASE_RX_CANDIDATES <
 #if UINTPTR_MAX > 0xFFFFFFFFu
 typedef uint64_t sum_word_t;
 #define SUM_LANES 0x00FF00FF00FF00FFu
-#define FOLD(w) (((w) & 0x0000FFFF0000FFFFu) + (((w) >> 16) & 0x0000FFFF0000FFFFu))
-#define LANE_TOTAL(w) ((uint32_t)((w) & 0xFFFFFFFFu) + (uint32_t)((w) >> 32))
+#define FOLD(w) (((w)&0x0000FFFF0000FFFFu) + (((w) >> 16) & 0x0000FFFF0000FFFFu))
+#define LANE_TOTAL(w) ((uint32_t)((w)&0xFFFFFFFFu) + (uint32_t)((w) >> 32))
 #else
 typedef uint32_t sum_word_t;
 #define SUM_LANES 0x00FF00FFu
 #define FOLD(w) (w)
-#define LANE_TOTAL(w) (((w) & 0xFFFFu) + ((w) >> 16))
+#define LANE_TOTAL(w) (((w)&0xFFFFu) + ((w) >> 16))
 #endif
 
 uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n)
@@ -70,8 +70,8 @@ uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n)
     return (uint16_t)sum;
 }
 
-int tase_frame_encode(uint8_t *out, size_t cap, uint8_t group, uint8_t type,
-                      const uint8_t *data, size_t len)
+int tase_frame_encode(uint8_t *out, size_t cap, uint8_t group, uint8_t type, const uint8_t *data,
+                      size_t len)
 {
     uint16_t sum;
     size_t total;

@@ -9,14 +9,13 @@
 #define SETUP_SYSTEM_VERSION 0x03u
 #define SETUP_PACKET_RATE 0x00u
 #define RATE_BYTES_PER_PORT 5u /* Angle, Rate, Geo-ref, Camera, Reserved */
-#define SETUP_APPLY_MAX 23u /* longest writable setup packet: AXIS_SETTING */
+#define SETUP_APPLY_MAX 23u    /* longest writable setup packet: AXIS_SETTING */
 #define SERVICE_CHUNK 64u
 #define SERVICE_READS 64u
 
 /* Data length and offset into g->setup of each setup packet (spec 4.4). */
 static const uint8_t setup_len[TASE_GIMBAL_SETUP_TYPES] = {16u, 2u, 23u, 42u, 2u, 3u, 6u, 16u};
-static const uint8_t setup_off[TASE_GIMBAL_SETUP_TYPES] = {0u, 16u, 18u, 41u, 83u, 85u, 88u,
-                                                           94u};
+static const uint8_t setup_off[TASE_GIMBAL_SETUP_TYPES] = {0u, 16u, 18u, 41u, 83u, 85u, 88u, 94u};
 
 /* Defaults the spec states. PACKET_RATE: 10, 10, 4 per port. SENSOR_FILTER:
  * 10 Hz cutoff (0.1 Hz units), 0.5 deg/s decimation (0.1 deg/s units).
@@ -30,13 +29,13 @@ static const uint8_t setup_defaults[TASE_GIMBAL_SETUP_BYTES] = {
     /* SENSOR_FILTER */
     100u, 5u,
     /* AXIS_SETTING */
-    0x00u, 0x00u, 0x00u, 0x00u, 0x23u, 0x28u, 0x17u, 0x70u, 0x00u, 0x00u, 0x00u, 0x00u,
-    60u, 0u, 60u, 0u, 50u, 50u, 0u, 40u, 40u, 0u, 0u,
+    0x00u, 0x00u, 0x00u, 0x00u, 0x23u, 0x28u, 0x17u, 0x70u, 0x00u, 0x00u, 0x00u, 0x00u, 60u, 0u,
+    60u, 0u, 50u, 50u, 0u, 40u, 40u, 0u, 0u,
     /* SYSTEM_VERSION, NAV_SOURCE, CAMERA_TYPE, GPS_LEVER_ARM, CAMERA_ALIGN: 0 */
 };
 
-static const uint16_t stream_id[TASE_GIMBAL_STREAMS] = {
-    TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE, TASE_ID_GEOREFERENCE_DATA};
+static const uint16_t stream_id[TASE_GIMBAL_STREAMS] = {TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE,
+                                                        TASE_ID_GEOREFERENCE_DATA};
 
 /* Slot k's offset from t0. k < rate <= 255 keeps the product small. */
 static uint32_t slot_ms(uint32_t k, uint32_t rate)
@@ -176,8 +175,7 @@ int tase_gimbal_setup_set(tase_gimbal_t *g, uint8_t type, const uint8_t *data, s
     return TASE_OK;
 }
 
-static void handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f,
-                         uint32_t now_ms)
+static void handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f, uint32_t now_ms)
 {
     uint8_t type = f->type;
     uint8_t tmp[SETUP_APPLY_MAX];
@@ -275,15 +273,14 @@ static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_
     if (s->rate == 0 || !reached(now_ms, s->t0 + slot_ms(s->k, s->rate))) {
         return 0;
     }
-    n = g->app.fill_telemetry(g->app.user, port, id, frame + TASE_FRAME_HEADER,
-                              TASE_DATA_MAX, now_ms);
+    n = g->app.fill_telemetry(g->app.user, port, id, frame + TASE_FRAME_HEADER, TASE_DATA_MAX,
+                              now_ms);
     if (n < 0 || n > (int)TASE_DATA_MAX) {
         g->stats.telemetry_skipped++;
     } else {
         n = tase_frame_encode(frame, sizeof frame, TASE_ID_GROUP(id), TASE_ID_TYPE(id),
                               frame + TASE_FRAME_HEADER, (size_t)n);
-        if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >=
-            0) {
+        if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >= 0) {
             g->stats.telemetry_tx++;
             sent = 1;
         }

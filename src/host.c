@@ -9,8 +9,7 @@ enum { HOST_IDLE = 0, HOST_WAITING = 1, HOST_COMPLETE = 2 };
 
 #define HOST_SERVICE_CHUNK 64u
 
-int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on_frame,
-                   void *user)
+int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on_frame, void *user)
 {
     if (h == NULL || port == NULL || port->ops == NULL || port->ops->write == NULL) {
         return TASE_EARG;
@@ -24,8 +23,7 @@ int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on
     return TASE_OK;
 }
 
-static int host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
-                     size_t len)
+static int host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len)
 {
     int r = tase_port_send_frame(&h->port, group, type, data, len);
     if (r >= 0) {
@@ -36,8 +34,7 @@ static int host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t 
     return r;
 }
 
-int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
-                   size_t len)
+int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len)
 {
     if (h == NULL) {
         return TASE_EARG;
@@ -45,10 +42,9 @@ int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *d
     return host_send(h, group, type, data, len);
 }
 
-int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type,
-                            const uint8_t *data, size_t len, uint8_t *reply,
-                            size_t reply_cap, uint32_t timeout_ms, uint8_t retries,
-                            uint32_t now_ms)
+int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
+                            size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
+                            uint8_t retries, uint32_t now_ms)
 {
     int r;
 
@@ -84,11 +80,10 @@ int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type,
 }
 
 int tase_host_query_start(tase_host_t *h, uint8_t group, uint8_t type, uint8_t *reply,
-                          size_t reply_cap, uint32_t timeout_ms, uint8_t retries,
-                          uint32_t now_ms)
+                          size_t reply_cap, uint32_t timeout_ms, uint8_t retries, uint32_t now_ms)
 {
-    return tase_host_request_start(h, group, type, NULL, 0, reply, reply_cap, timeout_ms,
-                                   retries, now_ms);
+    return tase_host_request_start(h, group, type, NULL, 0, reply, reply_cap, timeout_ms, retries,
+                                   now_ms);
 }
 
 int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
@@ -193,9 +188,8 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms)
     return n;
 }
 
-int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
-                       size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
-                       uint8_t retries)
+int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len,
+                       uint8_t *reply, size_t reply_cap, uint32_t timeout_ms, uint8_t retries)
 {
     int r;
 
@@ -205,8 +199,8 @@ int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_
     if (h->port.ops->read == NULL || h->port.ops->now_ms == NULL) {
         return TASE_EUNSUPPORTED;
     }
-    r = tase_host_request_start(h, group, type, data, len, reply, reply_cap, timeout_ms,
-                                retries, h->port.ops->now_ms(h->port.ctx));
+    r = tase_host_request_start(h, group, type, data, len, reply, reply_cap, timeout_ms, retries,
+                                h->port.ops->now_ms(h->port.ctx));
     if (r < 0) {
         return r;
     }

@@ -17,15 +17,12 @@ typedef char tase_klv_window_check[TASE_KLV_PACKET_MAX <= 255u ? 1 : -1];
 #define BER_MAX_OCTETS 4u
 #define SET_START (TASE_KLV_KEY_LEN + 1u) /* with a short-form length */
 
-static const uint8_t klv_key[TASE_KLV_KEY_LEN] = {
-    0x06, 0x0E, 0x2B, 0x34, 0x02, 0x03, 0x01, 0x01,
-    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00
-};
+static const uint8_t klv_key[TASE_KLV_KEY_LEN] = {0x06, 0x0E, 0x2B, 0x34, 0x02, 0x03, 0x01, 0x01,
+                                                  0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00};
 
 /* Value length of each tag; index 0 is unused. */
-static const uint8_t item_len[TASE_KLV_ITEMS + 1u] = {
-    0, 8, 4, 4, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2
-};
+static const uint8_t item_len[TASE_KLV_ITEMS + 1u] = {0, 8, 4, 4, 2, 2, 2, 2,
+                                                      2, 2, 2, 2, 2, 2, 2, 2};
 
 /* Two's complement reinterpretation without implementation-defined
  * conversions of out-of-range unsigned values. */
@@ -297,9 +294,8 @@ static int rx_scan(tase_klv_rx_t *rx, int final, tase_klv_handler_t on_packet,
     }
 }
 
-int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n,
-                     tase_klv_handler_t on_packet, tase_klv_error_handler_t on_error,
-                     void *user)
+int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n, tase_klv_handler_t on_packet,
+                     tase_klv_error_handler_t on_error, void *user)
 {
     int delivered = 0;
     if (rx == NULL || (data == NULL && n > 0u)) {
@@ -460,10 +456,10 @@ uint16_t tase_klv_fov_raw(double deg)
 
 /* ---- GPS status word (spec bit 0 = MSB) ------------------------------- */
 
-#define GPS_FLAGS                                                                          \
-    (TASE_KLV_GPS_DEAD_RECKONED | TASE_KLV_GPS_SBAS | TASE_KLV_GPS_FAST_ACQ |              \
-     TASE_KLV_GPS_RAW | TASE_KLV_GPS_COLD_START | TASE_KLV_GPS_DIFFERENTIAL |              \
-     TASE_KLV_GPS_POSITION_LOCK | TASE_KLV_GPS_AUTO_SURVEY | TASE_KLV_GPS_FEW_SATS)
+#define GPS_FLAGS                                                                                  \
+    (TASE_KLV_GPS_DEAD_RECKONED | TASE_KLV_GPS_SBAS | TASE_KLV_GPS_FAST_ACQ | TASE_KLV_GPS_RAW |   \
+     TASE_KLV_GPS_COLD_START | TASE_KLV_GPS_DIFFERENTIAL | TASE_KLV_GPS_POSITION_LOCK |            \
+     TASE_KLV_GPS_AUTO_SURVEY | TASE_KLV_GPS_FEW_SATS)
 
 unsigned tase_klv_gps_fix(uint16_t status)
 {

@@ -8,8 +8,7 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n)
     size_t done = 0;
     unsigned idle = 0;
 
-    if (port == NULL || port->ops == NULL || port->ops->write == NULL ||
-        (data == NULL && n > 0)) {
+    if (port == NULL || port->ops == NULL || port->ops->write == NULL || (data == NULL && n > 0)) {
         return TASE_EARG;
     }
     if (n > (size_t)0x7FFFFFFF) {
@@ -40,8 +39,8 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n)
     return (int)n;
 }
 
-int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type,
-                         const uint8_t *data, size_t len)
+int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *data,
+                         size_t len)
 {
     uint8_t buf[TASE_FRAME_MAX];
     int n = tase_frame_encode(buf, sizeof buf, group, type, data, len);

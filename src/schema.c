@@ -34,16 +34,16 @@ enum {
 /* C99 has no _Static_assert: a negative array size fails the build.
  * Every member must be as wide as its field, and the enumeration in
  * schema.h must follow the list. */
-#define P(N, g, t, fl, l, sz) \
+#define P(N, g, t, fl, l, sz)                                                                      \
     typedef char chk_idx_##N[((int)TASE_PKT_##N == (int)PKTIDX_##N) ? 1 : -1];
-#define F(T, m, o, w, s) \
+#define F(T, m, o, w, s)                                                                           \
     typedef char chk_##T##_##m[(sizeof(((T *)0)->m) == (w) && offsetof(T, m) < 256u) ? 1 : -1];
 #include "schema_def.h"
 #undef P
 #undef F
 #undef E
-typedef char chk_count[((int)PKTIDX_COUNT == (int)TASE_PKT_COUNT && TASE_PKT_COUNT == TASE_PACKET_COUNT)
-                           ? 1 : -1];
+typedef char chk_count
+    [((int)PKTIDX_COUNT == (int)TASE_PKT_COUNT && TASE_PKT_COUNT == TASE_PACKET_COUNT) ? 1 : -1];
 typedef char chk_fields[(FIELD_TOTAL < 256) ? 1 : -1];
 
 #define FMT_U 0u
@@ -60,7 +60,7 @@ static const tase_field_t fields[FIELD_TOTAL] = {
 };
 
 static const tase_packet_desc_t packets[TASE_PKT_COUNT] = {
-#define P(N, g, t, fl, l, sz) \
+#define P(N, g, t, fl, l, sz)                                                                      \
     {TASE_ID(g, t), l, fl, FIRST_##N, END_##N - FIRST_##N, sz, TASE_PKT_##N},
 #define F(T, m, o, w, s)
 #define E(N)
@@ -163,8 +163,8 @@ bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len)
     return p != NULL && len == 0u && (p->flags & TASE_LEN_QUERY) != 0u;
 }
 
-int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data,
-                   size_t len, int64_t *value)
+int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
+                   int64_t *value)
 {
     const tase_field_t *f = tase_schema_field(p, i);
     unsigned w, k;

@@ -17,10 +17,10 @@ typedef struct {
     size_t nout;
     uint8_t in[FAKE_CAP]; /* bytes waiting to be read */
     size_t nin, rin;
-    int write_result;      /* < 0: every write fails with it */
-    size_t write_limit;    /* > 0: a write takes at most this many bytes */
-    unsigned writes;       /* write() calls that took bytes */
-    int discard;           /* true: count written bytes, keep none */
+    int write_result;   /* < 0: every write fails with it */
+    size_t write_limit; /* > 0: a write takes at most this many bytes */
+    unsigned writes;    /* write() calls that took bytes */
+    int discard;        /* true: count written bytes, keep none */
     size_t discarded;
     /* Scripted peer: after `reply_after` frames were written, the frame
      * reply[0..nreply) becomes readable (once). 0 disables. */
@@ -35,8 +35,8 @@ static inline void fake_push(fake_port_t *f, const uint8_t *p, size_t n)
     f->nin += n;
 }
 
-static inline void fake_push_frame(fake_port_t *f, uint8_t group, uint8_t type,
-                                   const uint8_t *data, size_t len)
+static inline void fake_push_frame(fake_port_t *f, uint8_t group, uint8_t type, const uint8_t *data,
+                                   size_t len)
 {
     uint8_t fr[TASE_FRAME_MAX];
     int n = tase_frame_encode(fr, sizeof fr, group, type, data, len);

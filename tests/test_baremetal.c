@@ -60,7 +60,7 @@ static void a_full_ring_drops_and_counts_every_extra_byte(void **state)
         assert_int_equal(out[i], i); /* the dropped 0xEE never got in */
     }
     assert_int_equal(tase_ring_count(&r), 0);
-    assert_true(tase_ring_put(&r, 42)); /* room again */
+    assert_true(tase_ring_put(&r, 42));           /* room again */
     assert_int_equal(tase_ring_overflows(&r), 5); /* not reset by reading */
 }
 
@@ -168,8 +168,7 @@ static void run_stress(uint32_t ring_size, unsigned consumer_pause_every)
             continue;
         }
         if (got[k] != stream_byte(j)) {
-            fail_msg("byte %u (received #%u) is %u, expected %u", j, k, got[k],
-                     stream_byte(j));
+            fail_msg("byte %u (received #%u) is %u, expected %u", j, k, got[k], stream_byte(j));
         }
         k++;
     }
@@ -249,8 +248,7 @@ static void port_read_waits_on_the_millisecond_hook_and_wakes_on_rx(void **state
     hw.now = 0xFFFFFFF0u; /* the wait spans the 2^32 wrap */
     hw.uart = &u;
     assert_int_equal(tase_bm_uart_init(&u, storage, 48, &fake_hooks, &hw), TASE_EARG);
-    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw),
-                     TASE_OK);
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw), TASE_OK);
     port = tase_bm_uart_port(&u);
 
     hw.deliver_after_idles = -1;
@@ -274,8 +272,7 @@ static void port_write_goes_to_the_tx_hook_whole_or_reports_its_error(void **sta
     (void)state;
 
     memset(&hw, 0, sizeof hw);
-    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw),
-                     TASE_OK);
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw), TASE_OK);
     port = tase_bm_uart_port(&u);
     assert_int_equal(port.ops->write(port.ctx, (const uint8_t *)"hello", 5), 5);
     assert_memory_equal(hw.tx, "hello", 5);
@@ -347,8 +344,7 @@ static void main_loop_poll_delivers_every_frame_the_isr_received(void **state)
     (void)state;
 
     memset(&hw, 0, sizeof hw);
-    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw),
-                     TASE_OK);
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw), TASE_OK);
     assert_int_equal(tase_rx_init(&rx), TASE_OK);
     s.u = &u;
     s.done = 0;

@@ -50,22 +50,22 @@ static void malformed_lines_are_rejected_and_leave_output_alone(void **state)
     static const char *bad[] = {
         "",
         "\n",
-        "1700000000.123456 vcan0 123#00",        /* no parentheses */
-        "(1700000000.12345) vcan0 123#00",       /* 5 microsecond digits */
-        "(1700000000.1234567) vcan0 123#00",     /* 7 */
-        "(1700000000.123456)vcan0 123#00",       /* no space */
-        "(1700000000.123456) vcan0 12#00",       /* 2-digit id */
-        "(1700000000.123456) vcan0 1234#00",     /* 4-digit id */
-        "(1700000000.123456) vcan0 800#00",      /* standard id too big */
-        "(1700000000.123456) vcan0 123#0",       /* odd nibble */
-        "(1700000000.123456) vcan0 123#0G",      /* not hex */
+        "1700000000.123456 vcan0 123#00",                   /* no parentheses */
+        "(1700000000.12345) vcan0 123#00",                  /* 5 microsecond digits */
+        "(1700000000.1234567) vcan0 123#00",                /* 7 */
+        "(1700000000.123456)vcan0 123#00",                  /* no space */
+        "(1700000000.123456) vcan0 12#00",                  /* 2-digit id */
+        "(1700000000.123456) vcan0 1234#00",                /* 4-digit id */
+        "(1700000000.123456) vcan0 800#00",                 /* standard id too big */
+        "(1700000000.123456) vcan0 123#0",                  /* odd nibble */
+        "(1700000000.123456) vcan0 123#0G",                 /* not hex */
         "(1700000000.123456) vcan0 123#001122334455667788", /* 9 bytes */
-        "(1700000000.123456) vcan0 123#00.",     /* dangling dot */
-        "(1700000000.123456) vcan0 123#00 junk", /* trailing text */
-        "(1700000000.123456) vcan0 C0000000#00", /* flag bits 30/31 */
+        "(1700000000.123456) vcan0 123#00.",                /* dangling dot */
+        "(1700000000.123456) vcan0 123#00 junk",            /* trailing text */
+        "(1700000000.123456) vcan0 C0000000#00",            /* flag bits 30/31 */
         "(1700000000.123456) averyveryverylongname 123#00", /* name > 15 */
-        "(1700000000.123456) vcan0 123",         /* no '#' */
-        "(99999999999999999999.000000) vcan0 123#00", /* > 2^64 seconds */
+        "(1700000000.123456) vcan0 123",                    /* no '#' */
+        "(99999999999999999999.000000) vcan0 123#00",       /* > 2^64 seconds */
         "(-1.000000) vcan0 123#00",
     };
     tase_candump_rec_t r;
@@ -88,8 +88,7 @@ static void frames_we_cannot_represent_are_unsupported(void **state)
     (void)state;
     assert_int_equal(parse("(1.000000) vcan0 123#R", &r), TASE_EUNSUPPORTED);
     assert_int_equal(parse("(1.000000) vcan0 123##100", &r), TASE_EUNSUPPORTED);
-    assert_int_equal(parse("(1.000000) vcan0 20000080#0000000000000000", &r),
-                     TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 20000080#0000000000000000", &r), TASE_EUNSUPPORTED);
     assert_int_equal(parse("(1.000000) vcan0 123#1122334455667788_E", &r), TASE_EUNSUPPORTED);
 }
 

@@ -42,8 +42,8 @@ static void gimbal_cmd_extremes_encode_to_hand_computed_frame(void **state)
      * flags rate+stab = 0x90, impulse 200 = C8. Size = 8 + 2 = 0x0A.
      * Sum: 00+FF+5A+0A+00+80 = 483; 80+00+FF+FF+7F+FF+90+C8 = 1364;
      * 1847 = 0x0737. */
-    static const uint8_t want[] = {0x00, 0xFF, 0x5A, 0x0A, 0x00, 0x80, 0x80, 0x00, 0xFF,
-                                   0xFF, 0x7F, 0xFF, 0x90, 0xC8, 0x07, 0x37};
+    static const uint8_t want[] = {0x00, 0xFF, 0x5A, 0x0A, 0x00, 0x80, 0x80, 0x00,
+                                   0xFF, 0xFF, 0x7F, 0xFF, 0x90, 0xC8, 0x07, 0x37};
     tase_gimbal_cmd_t m = {INT16_MIN, -1, INT16_MAX, TASE_GIMBAL_FLAGS_RATE_STAB, 200};
     tase_gimbal_cmd_t back;
     uint8_t out[64];
@@ -70,8 +70,8 @@ static void gyro_zero_and_camera_short_forms_encode_to_hand_computed_frames(void
     static const uint8_t cam1[] = {0x00, 0xFF, 0x5A, 0x03, 0x00, 0x41, 0x01, 0x01, 0x9E};
     /* CAMERA_PASS camera C, 57600 baud = 48 * 1200 (0x30), bytes 'A' 'B':
      * 00 FF 5A 08 00 42 02 30 00 00 41 42, sum 600 = 0x0258. */
-    static const uint8_t pass[] = {0x00, 0xFF, 0x5A, 0x08, 0x00, 0x42, 0x02, 0x30,
-                                   0x00, 0x00, 0x41, 0x42, 0x02, 0x58};
+    static const uint8_t pass[] = {0x00, 0xFF, 0x5A, 0x08, 0x00, 0x42, 0x02,
+                                   0x30, 0x00, 0x00, 0x41, 0x42, 0x02, 0x58};
     tase_camera_cmd_t cam = {TASE_CAMERA_B, 1234, 0xFFFF, 1, 2, 3, 0x80};
     tase_camera_pass_t cp = {TASE_CAMERA_C, 48, 2, (const uint8_t *)"AB"};
     tase_camera_pass_t cpb;
@@ -109,8 +109,8 @@ static void gimbal_angle_encodes_to_hand_computed_frame(void **state)
 {
     /* pan 1.00 deg = 100 = 00 64, tilt -45.00 deg = -4500 = EE 6C, roll 0.
      * Sum: 00+FF+5A+08+08+10 = 377; 64+EE+6C = 446; 823 = 0x0337. */
-    static const uint8_t want[] = {0x00, 0xFF, 0x5A, 0x08, 0x08, 0x10, 0x00, 0x64,
-                                   0xEE, 0x6C, 0x00, 0x00, 0x03, 0x37};
+    static const uint8_t want[] = {0x00, 0xFF, 0x5A, 0x08, 0x08, 0x10, 0x00,
+                                   0x64, 0xEE, 0x6C, 0x00, 0x00, 0x03, 0x37};
     tase_gimbal_angle_t m = {100, -4500, 0};
     uint8_t out[32];
     (void)state;
@@ -154,10 +154,9 @@ static void axis_setting_leaves_byte_13_reserved_zero(void **state)
     /* Data: B9B0 (-18000) FFFF 2328 (9000) 1770 (6000) 0000 0000, 3C,
      * [13] 00, 3C FF 32 32 FF 28 28 FF 01. Size 23 + 2 = 0x19.
      * Sum: header FF+5A+19+48+02 = 444; data 2147; 2591 = 0x0A1F. */
-    static const uint8_t want[] = {0x00, 0xFF, 0x5A, 0x19, 0x48, 0x02, 0xB9, 0xB0, 0xFF,
-                                   0xFF, 0x23, 0x28, 0x17, 0x70, 0x00, 0x00, 0x00, 0x00,
-                                   0x3C, 0x00, 0x3C, 0xFF, 0x32, 0x32, 0xFF, 0x28, 0x28,
-                                   0xFF, 0x01, 0x0A, 0x1F};
+    static const uint8_t want[] = {0x00, 0xFF, 0x5A, 0x19, 0x48, 0x02, 0xB9, 0xB0, 0xFF, 0xFF, 0x23,
+                                   0x28, 0x17, 0x70, 0x00, 0x00, 0x00, 0x00, 0x3C, 0x00, 0x3C, 0xFF,
+                                   0x32, 0x32, 0xFF, 0x28, 0x28, 0xFF, 0x01, 0x0A, 0x1F};
     tase_axis_setting_t m;
     uint8_t out[64];
     (void)state;
@@ -209,9 +208,9 @@ static void fill_fields(const tase_packet_desc_t *p, uint8_t *data, int mode)
         for (b = 0; b < w; b++) {
             uint8_t v;
             switch (mode) {
-            case 0: v = 0xFF; break;                      /* -1, 0xFFFF, 0xFFFFFFFF */
-            case 1: v = b == 0 ? 0x80 : 0x00; break;      /* INT16_MIN, INT32_MIN */
-            case 2: v = b == 0 ? 0x7F : 0xFF; break;      /* INT16_MAX, INT32_MAX */
+            case 0: v = 0xFF; break;                 /* -1, 0xFFFF, 0xFFFFFFFF */
+            case 1: v = b == 0 ? 0x80 : 0x00; break; /* INT16_MIN, INT32_MIN */
+            case 2: v = b == 0 ? 0x7F : 0xFF; break; /* INT16_MAX, INT32_MAX */
             case 3: v = 0x00; break;
             default: v = (uint8_t)rnd(); break;
             }
@@ -244,8 +243,8 @@ static void every_packet_round_trips_random_and_extreme_values(void **state)
                     memcpy(data + len, tail, extra);
                     len += extra;
                 }
-                n = tase_frame_encode(wire, sizeof(wire), TASE_ID_GROUP(p->id),
-                                      TASE_ID_TYPE(p->id), data, len);
+                n = tase_frame_encode(wire, sizeof(wire), TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id),
+                                      data, len);
                 assert_int_equal(n, (int)len + 8);
                 f = frame_of(wire, n);
                 /* wire -> struct: every member equals the raw field value */
@@ -350,8 +349,7 @@ static void argument_errors_are_reported_and_write_nothing(void **state)
     assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, NULL, out, 64), TASE_EARG);
     assert_int_equal(tase_packet_encode(TASE_ID(0x28, 0x00), &m, out, 64), TASE_EUNKNOWN);
     assert_int_equal(tase_packet_encode_query(TASE_ID(0x00, 0x99), out, 64), TASE_EUNKNOWN);
-    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)),
-                     TASE_ETOOLONG);
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), TASE_ETOOLONG);
     cp.len = 3;
     cp.data = NULL;
     assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), TASE_EARG);

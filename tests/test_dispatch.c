@@ -55,16 +55,16 @@ static void on_error(void *user, const tase_frame_t *f, int err)
 }
 
 static const tase_packet_handler_t all_typed[TASE_PKT_COUNT] = {
-    [TASE_PKT_GIMBAL_CMD] = on_typed,     [TASE_PKT_GYRO_ZERO_CMD] = on_typed,
-    [TASE_PKT_CAMERA_CMD] = on_typed,     [TASE_PKT_LEGACY_CAMERA_CMD] = on_typed,
-    [TASE_PKT_CAMERA_PASS] = on_typed,    [TASE_PKT_RETRACT_DEPLOY_CMD] = on_typed,
-    [TASE_PKT_GIMBAL_ANGLE] = on_typed,   [TASE_PKT_GIMBAL_RATE] = on_typed,
-    [TASE_PKT_HOST_SENSOR] = on_typed,    [TASE_PKT_HOST_ATTITUDE] = on_typed,
-    [TASE_PKT_HOST_GPS_DATA] = on_typed,  [TASE_PKT_SPOI_CMD] = on_typed,
+    [TASE_PKT_GIMBAL_CMD] = on_typed,        [TASE_PKT_GYRO_ZERO_CMD] = on_typed,
+    [TASE_PKT_CAMERA_CMD] = on_typed,        [TASE_PKT_LEGACY_CAMERA_CMD] = on_typed,
+    [TASE_PKT_CAMERA_PASS] = on_typed,       [TASE_PKT_RETRACT_DEPLOY_CMD] = on_typed,
+    [TASE_PKT_GIMBAL_ANGLE] = on_typed,      [TASE_PKT_GIMBAL_RATE] = on_typed,
+    [TASE_PKT_HOST_SENSOR] = on_typed,       [TASE_PKT_HOST_ATTITUDE] = on_typed,
+    [TASE_PKT_HOST_GPS_DATA] = on_typed,     [TASE_PKT_SPOI_CMD] = on_typed,
     [TASE_PKT_GEOREFERENCE_DATA] = on_typed, [TASE_PKT_PACKET_RATE] = on_typed,
-    [TASE_PKT_SENSOR_FILTER] = on_typed,  [TASE_PKT_AXIS_SETTING] = on_typed,
-    [TASE_PKT_SYSTEM_VERSION] = on_typed, [TASE_PKT_NAV_SOURCE] = on_typed,
-    [TASE_PKT_CAMERA_TYPE] = on_typed,    [TASE_PKT_GPS_LEVER_ARM] = on_typed,
+    [TASE_PKT_SENSOR_FILTER] = on_typed,     [TASE_PKT_AXIS_SETTING] = on_typed,
+    [TASE_PKT_SYSTEM_VERSION] = on_typed,    [TASE_PKT_NAV_SOURCE] = on_typed,
+    [TASE_PKT_CAMERA_TYPE] = on_typed,       [TASE_PKT_GPS_LEVER_ARM] = on_typed,
     [TASE_PKT_CAMERA_ALIGN] = on_typed,
 };
 
@@ -74,13 +74,11 @@ static void start(tase_rx_t *rx, tase_dispatch_t *d, log_t *l,
 {
     memset(l, 0, sizeof(*l));
     assert_int_equal(tase_rx_init(rx), TASE_OK);
-    assert_int_equal(tase_dispatch_init(d, handlers, on_default, on_error, l, &rx->stats),
-                     TASE_OK);
+    assert_int_equal(tase_dispatch_init(d, handlers, on_default, on_error, l, &rx->stats), TASE_OK);
 }
 
 /* Frame `len` bytes of `fill` as (g, t) and feed it to rx through d. */
-static void feed(tase_rx_t *rx, tase_dispatch_t *d, uint8_t g, uint8_t t, size_t len,
-                 uint8_t fill)
+static void feed(tase_rx_t *rx, tase_dispatch_t *d, uint8_t g, uint8_t t, size_t len, uint8_t fill)
 {
     uint8_t data[TASE_DATA_MAX], out[TASE_FRAME_MAX];
     int n;
@@ -237,9 +235,9 @@ static void null_hooks_and_stats_are_allowed(void **state)
     tase_rx_init(&rx);
     assert_int_equal(tase_dispatch_init(NULL, NULL, NULL, NULL, NULL, NULL), TASE_EARG);
     assert_int_equal(tase_dispatch_init(&d, NULL, NULL, NULL, NULL, NULL), TASE_OK);
-    feed(&rx, &d, 0x28, 0x01, 2, 0);   /* unknown, no hook, no stats */
-    feed(&rx, &d, 0x08, 0x10, 5, 0);   /* bad length, no hook */
-    feed(&rx, &d, 0x08, 0x10, 6, 0);   /* no handler */
+    feed(&rx, &d, 0x28, 0x01, 2, 0); /* unknown, no hook, no stats */
+    feed(&rx, &d, 0x08, 0x10, 5, 0); /* bad length, no hook */
+    feed(&rx, &d, 0x08, 0x10, 6, 0); /* no handler */
     tase_dispatch_frame(NULL, &f);
     tase_dispatch_frame(&d, NULL);
     assert_int_equal(rx.stats.frames_ok, 3);

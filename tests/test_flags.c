@@ -51,7 +51,8 @@ static void byte_flags_use_msb_first_numbering(void **state)
     assert_int_equal(TASE_CAMERA_FLAG_STAB, 0x02);
     assert_int_equal(TASE_CAMERA_FLAG_TITLE, 0x01);
     assert_int_equal(TASE_HOST_SENSOR_BIAS_CORRECTED | TASE_HOST_SENSOR_ACCEL_VALID |
-                         TASE_HOST_SENSOR_TAS_VALID, 0xE0);
+                         TASE_HOST_SENSOR_TAS_VALID,
+                     0xE0);
     assert_int_equal(TASE_HOST_ATT_AID_YAW, 0x02);
     assert_int_equal(TASE_HOST_ATT_OVERWRITE, 0x01); /* "7 (lsb)" */
     assert_int_equal(TASE_SPOI_ECHO, 0x80);
@@ -66,14 +67,14 @@ static void byte_flags_use_msb_first_numbering(void **state)
 static void gps_status_and_nav_health_fields_decode(void **state)
 {
     (void)state;
-    assert_int_equal(TASE_GPS_FIX(0xE000), TASE_GPS_FIX_3D);         /* 111 */
-    assert_int_equal(TASE_GPS_FIX(0xC000), TASE_GPS_FIX_2D);         /* 110 */
+    assert_int_equal(TASE_GPS_FIX(0xE000), TASE_GPS_FIX_3D);           /* 111 */
+    assert_int_equal(TASE_GPS_FIX(0xC000), TASE_GPS_FIX_2D);           /* 110 */
     assert_int_equal(TASE_GPS_FIX(0x4000), TASE_GPS_FIX_BAD_GEOMETRY); /* 010 */
     assert_int_equal(TASE_GPS_DEAD_RECKONED, 0x1000);
     assert_int_equal(TASE_GPS_INSUFFICIENT_SATS, 0x0008);
-    assert_int_equal(TASE_GPS_ANTENNA(0x0006), TASE_GPS_ANTENNA_NO_POWER);  /* 11 */
+    assert_int_equal(TASE_GPS_ANTENNA(0x0006), TASE_GPS_ANTENNA_NO_POWER);     /* 11 */
     assert_int_equal(TASE_GPS_ANTENNA(0x0004), TASE_GPS_ANTENNA_UNDERCURRENT); /* 10 */
-    assert_int_equal(TASE_GPS_ANTENNA(0x0002), TASE_GPS_ANTENNA_OVERCURRENT); /* 01 */
+    assert_int_equal(TASE_GPS_ANTENNA(0x0002), TASE_GPS_ANTENNA_OVERCURRENT);  /* 01 */
     assert_int_equal(TASE_GPS_ANTENNA(0xFFF9), TASE_GPS_ANTENNA_GOOD);
     assert_int_equal(TASE_NAV_POSITION, 0x8000);
     assert_int_equal(TASE_NAV_MAG_BIAS, 0x0020);

@@ -65,8 +65,7 @@ static int app_apply(void *user, unsigned port, uint8_t type, uint8_t *data, siz
     return 0;
 }
 
-static int app_fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
-                    uint32_t now)
+static int app_fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap, uint32_t now)
 {
     fix_t *x = user;
     unsigned s = stream_of(id);
@@ -124,8 +123,8 @@ static fix_t *make(uint32_t now, unsigned nports, bool with_fill)
     return x;
 }
 
-static void feed(fix_t *x, unsigned port, uint8_t group, uint8_t type, const uint8_t *d,
-                 size_t len, uint32_t now)
+static void feed(fix_t *x, unsigned port, uint8_t group, uint8_t type, const uint8_t *d, size_t len,
+                 uint32_t now)
 {
     uint8_t fr[TASE_FRAME_MAX];
     int n = tase_frame_encode(fr, sizeof fr, group, type, d, len);
@@ -440,7 +439,7 @@ static void a_late_poll_sends_one_packet_not_a_burst_and_keeps_the_grid(void **s
     x->port[0].discard = 1;
     run(x, 0, 1000, 0); /* 10 angle packets, last at 1000 */
     assert_int_equal(x->count[0][0], 10);
-    tase_gimbal_poll(&x->g, 6050); /* the main loop stalled for 5 s */
+    tase_gimbal_poll(&x->g, 6050);        /* the main loop stalled for 5 s */
     assert_int_equal(x->count[0][0], 11); /* one packet, not 50 */
     /* Slots 1100..6000 were due; 6000's went out; 49 angle slots passed,
      * 49 rate slots, 19 georef slots (1250..5750; 6000 sent). */

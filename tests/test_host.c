@@ -16,7 +16,7 @@
 typedef struct {
     fake_port_t port;
     tase_host_t host;
-    unsigned others;      /* frames handed to on_frame */
+    unsigned others; /* frames handed to on_frame */
     uint8_t last_group, last_type, last_len;
 } fix_t;
 
@@ -86,9 +86,9 @@ static void a_query_is_a_zero_length_frame_completed_by_the_echo(void **state)
     tase_frame_t f;
 
     memset(reply, 0xCC, sizeof reply);
-    assert_int_equal(tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x00, reply,
-                                           sizeof reply, 100, 2, 1000),
-                     TASE_OK);
+    assert_int_equal(
+        tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x00, reply, sizeof reply, 100, 2, 1000),
+        TASE_OK);
     assert_int_equal(fake_frames_out(&x->port), 1);
     f = written_frame(x, 0, d);
     assert_int_equal(f.group, 0x48);
@@ -113,9 +113,9 @@ static void an_echo_of_another_type_does_not_complete_the_query(void **state)
     fix_t *x = *state;
     uint8_t reply[64];
 
-    assert_int_equal(tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x00, reply,
-                                           sizeof reply, 100, 0, 0),
-                     TASE_OK);
+    assert_int_equal(
+        tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x00, reply, sizeof reply, 100, 0, 0),
+        TASE_OK);
     feed_frame(x, 0x48, 0x01, (const uint8_t *)"\x64\x05", 2, 10); /* SENSOR_FILTER */
     assert_int_equal(tase_host_poll(&x->host, 10), TASE_EAGAIN);
     assert_int_equal(x->others, 1);
@@ -137,8 +137,8 @@ static void a_silent_gimbal_gets_every_retry_then_a_timeout(void **state)
     uint8_t reply[64], d[TASE_DATA_MAX];
     unsigned i;
 
-    assert_int_equal(tase_host_request_start(&x->host, TASE_GROUP_SETUP, 0x00, rates, 16,
-                                             reply, sizeof reply, 100, 2, 5000),
+    assert_int_equal(tase_host_request_start(&x->host, TASE_GROUP_SETUP, 0x00, rates, 16, reply,
+                                             sizeof reply, 100, 2, 5000),
                      TASE_OK);
     assert_int_equal(tase_host_poll(&x->host, 5099), TASE_EAGAIN);
     assert_int_equal(fake_frames_out(&x->port), 1);
@@ -172,9 +172,9 @@ static void a_late_echo_after_a_retry_completes_the_query(void **state)
     fix_t *x = *state;
     uint8_t reply[64];
 
-    assert_int_equal(tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x03, reply,
-                                           sizeof reply, 100, 3, 0),
-                     TASE_OK);
+    assert_int_equal(
+        tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x03, reply, sizeof reply, 100, 3, 0),
+        TASE_OK);
     assert_int_equal(tase_host_poll(&x->host, 130), TASE_EAGAIN); /* re-sent at 130 */
     assert_int_equal(fake_frames_out(&x->port), 2);
     /* The answer to the first attempt, 150 ms late. */
@@ -193,11 +193,9 @@ static void one_request_at_a_time_but_commands_still_go_out(void **state)
     const uint8_t cmd[8] = {0x01, 0x2C, 0xFF, 0x38, 0, 0, 0x00, 0};
     tase_frame_t f;
 
-    assert_int_equal(tase_host_query_start(&x->host, 0x10, 0x40, reply, sizeof reply, 50, 0,
-                                           0),
+    assert_int_equal(tase_host_query_start(&x->host, 0x10, 0x40, reply, sizeof reply, 50, 0, 0),
                      TASE_OK);
-    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 50, 0,
-                                           0),
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 50, 0, 0),
                      TASE_EBUSY);
     assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, cmd, sizeof cmd), 16);
     f = written_frame(x, 1, d);
@@ -206,8 +204,7 @@ static void one_request_at_a_time_but_commands_still_go_out(void **state)
     assert_memory_equal(d, cmd, 8);
     assert_int_equal(tase_host_cancel(&x->host), TASE_OK);
     assert_int_equal(tase_host_poll(&x->host, 1000), TASE_ESTATE); /* no outcome */
-    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 50, 0,
-                                           0),
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 50, 0, 0),
                      TASE_OK);
 }
 
@@ -217,8 +214,7 @@ static void a_reply_longer_than_the_buffer_is_enospc_and_copies_nothing(void **s
     uint8_t reply[8];
 
     memset(reply, 0xAB, sizeof reply);
-    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 50, 0,
-                                           0),
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 50, 0, 0),
                      TASE_OK);
     feed_frame(x, 0x48, 0x00, rates, 16, 1);
     assert_int_equal(tase_host_poll(&x->host, 1), TASE_ENOSPC);
@@ -235,8 +231,7 @@ static void timeouts_work_across_the_clock_wrap(void **state)
     uint8_t reply[64];
     uint32_t t0 = 0xFFFFFFC0u;
 
-    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1,
-                                           t0),
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1, t0),
                      TASE_OK);
     assert_int_equal(tase_host_poll(&x->host, t0 + 99u), TASE_EAGAIN);
     assert_int_equal(fake_frames_out(&x->port), 1);
@@ -252,16 +247,14 @@ static void a_port_that_refuses_the_request_leaves_the_host_idle(void **state)
     uint8_t reply[64];
 
     x->port.write_result = TASE_EDOWN;
-    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1,
-                                           0),
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1, 0),
                      TASE_EDOWN);
     assert_false(tase_host_busy(&x->host));
     assert_int_equal(x->host.stats.tx_errors, 1);
     assert_int_equal(tase_host_send(&x->host, 0, 0x80, rates, 8), TASE_EDOWN);
     /* A refused retry still uses up its attempt. */
     x->port.write_result = 0;
-    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1,
-                                           0),
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1, 0),
                      TASE_OK);
     x->port.write_result = TASE_EDOWN;
     assert_int_equal(tase_host_poll(&x->host, 100), TASE_EAGAIN);
@@ -276,8 +269,8 @@ static void transact_blocks_until_the_scripted_gimbal_answers(void **state)
 
     /* The fake gimbal answers only the third attempt. */
     x->port.reply_after = 3;
-    x->port.nreply = (size_t)tase_frame_encode(x->port.reply, sizeof x->port.reply, 0x48,
-                                               0x03, rates, 16);
+    x->port.nreply =
+        (size_t)tase_frame_encode(x->port.reply, sizeof x->port.reply, 0x48, 0x03, rates, 16);
     x->port.now = 777;
     n = tase_host_transact(&x->host, 0x48, 0x03, NULL, 0, reply, sizeof reply, 250, 5);
     assert_int_equal(n, 16);
@@ -294,8 +287,7 @@ static void transact_times_out_after_all_attempts(void **state)
     uint8_t reply[64];
 
     x->port.now = 0;
-    assert_int_equal(tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply,
-                                        100, 2),
+    assert_int_equal(tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 100, 2),
                      TASE_ETIMEOUT);
     assert_int_equal(fake_frames_out(&x->port), 3);
     assert_int_equal(x->port.now, 300);
@@ -315,8 +307,7 @@ static void bad_arguments_are_rejected(void **state)
     assert_int_equal(tase_host_query_start(&x->host, 0x48, 0, NULL, 8, 10, 0, 0), TASE_EARG);
     assert_int_equal(tase_host_request_start(&x->host, 0x48, 0, NULL, 3, reply, 8, 10, 0, 0),
                      TASE_EARG);
-    assert_int_equal(tase_host_request_start(&x->host, 0x48, 0, rates, 254, reply, 8, 10, 0,
-                                             0),
+    assert_int_equal(tase_host_request_start(&x->host, 0x48, 0, rates, 254, reply, 8, 10, 0, 0),
                      TASE_ETOOLONG);
     assert_int_equal(tase_host_poll(NULL, 0), TASE_EARG);
     assert_int_equal(tase_host_feed(NULL, rates, 1, 0), TASE_EARG);
@@ -328,25 +319,24 @@ static void bad_arguments_are_rejected(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup_teardown(a_query_is_a_zero_length_frame_completed_by_the_echo,
-                                        setup, teardown),
-        cmocka_unit_test_setup_teardown(an_echo_of_another_type_does_not_complete_the_query,
-                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(a_query_is_a_zero_length_frame_completed_by_the_echo, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(an_echo_of_another_type_does_not_complete_the_query, setup,
+                                        teardown),
         cmocka_unit_test_setup_teardown(a_silent_gimbal_gets_every_retry_then_a_timeout, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(a_late_echo_after_a_retry_completes_the_query, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(one_request_at_a_time_but_commands_still_go_out, setup,
                                         teardown),
-        cmocka_unit_test_setup_teardown(
-            a_reply_longer_than_the_buffer_is_enospc_and_copies_nothing, setup, teardown),
+        cmocka_unit_test_setup_teardown(a_reply_longer_than_the_buffer_is_enospc_and_copies_nothing,
+                                        setup, teardown),
         cmocka_unit_test_setup_teardown(timeouts_work_across_the_clock_wrap, setup, teardown),
-        cmocka_unit_test_setup_teardown(a_port_that_refuses_the_request_leaves_the_host_idle,
-                                        setup, teardown),
-        cmocka_unit_test_setup_teardown(transact_blocks_until_the_scripted_gimbal_answers,
-                                        setup, teardown),
-        cmocka_unit_test_setup_teardown(transact_times_out_after_all_attempts, setup,
+        cmocka_unit_test_setup_teardown(a_port_that_refuses_the_request_leaves_the_host_idle, setup,
                                         teardown),
+        cmocka_unit_test_setup_teardown(transact_blocks_until_the_scripted_gimbal_answers, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(transact_times_out_after_all_attempts, setup, teardown),
         cmocka_unit_test_setup_teardown(bad_arguments_are_rejected, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -18,26 +18,24 @@
  * the checksum. */
 static const uint8_t hand_packet[87] = {
     /* universal key */
-    0x06, 0x0E, 0x2B, 0x34, 0x02, 0x03, 0x01, 0x01,
-    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
-    0x46,                                           /* BER length 70 */
+    0x06, 0x0E, 0x2B, 0x34, 0x02, 0x03, 0x01, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+    0x46,                                              /* BER length 70 */
     0x01, 0x08, 0, 0, 0, 0x01, 0x02, 0x03, 0x04, 0x05, /* 1+8+1+2+3+4+5 = 24 */
-    0x02, 0x04, 0x12, 0x34, 0x56, 0x78,   /* 2+4+18+52+86+120     = 282  */
-    0x03, 0x04, 0xFF, 0xFF, 0xFF, 0xFE,   /* 3+4+255+255+255+254  = 1026 */
-    0x04, 0x02, 0x10, 0x00,               /* 4+2+16               = 22   */
-    0x05, 0x02, 0x80, 0x00,               /* 5+2+128              = 135  */
-    0x06, 0x02, 0xFF, 0x00,               /* 6+2+255              = 263  */
-    0x07, 0x02, 0x40, 0x00,               /* 7+2+64               = 73   */
-    0x08, 0x02, 0x01, 0x02,               /* 8+2+1+2              = 13   */
-    0x09, 0x02, 0xFF, 0xFF,               /* 9+2+255+255          = 521  */
-    0x0A, 0x02, 0x00, 0x10,               /* 10+2+16              = 28   */
-    0x0B, 0x02, 0xFF, 0xF0,               /* 11+2+255+240         = 508  */
-    0x0C, 0x02, 0x20, 0x00,               /* 12+2+32              = 46   */
-    0x0D, 0x02, 0x18, 0x00,               /* 13+2+24              = 39   */
-    0x0E, 0x02, 0xE0, 0x00,               /* 14+2+224             = 240  */
+    0x02, 0x04, 0x12, 0x34, 0x56, 0x78,                /* 2+4+18+52+86+120     = 282  */
+    0x03, 0x04, 0xFF, 0xFF, 0xFF, 0xFE,                /* 3+4+255+255+255+254  = 1026 */
+    0x04, 0x02, 0x10, 0x00,                            /* 4+2+16               = 22   */
+    0x05, 0x02, 0x80, 0x00,                            /* 5+2+128              = 135  */
+    0x06, 0x02, 0xFF, 0x00,                            /* 6+2+255              = 263  */
+    0x07, 0x02, 0x40, 0x00,                            /* 7+2+64               = 73   */
+    0x08, 0x02, 0x01, 0x02,                            /* 8+2+1+2              = 13   */
+    0x09, 0x02, 0xFF, 0xFF,                            /* 9+2+255+255          = 521  */
+    0x0A, 0x02, 0x00, 0x10,                            /* 10+2+16              = 28   */
+    0x0B, 0x02, 0xFF, 0xF0,                            /* 11+2+255+240         = 508  */
+    0x0C, 0x02, 0x20, 0x00,                            /* 12+2+32              = 46   */
+    0x0D, 0x02, 0x18, 0x00,                            /* 13+2+24              = 39   */
+    0x0E, 0x02, 0xE0, 0x00,                            /* 14+2+224             = 240  */
     /* 24+282+1026+22+135+263+73+13+521+28+508+46+39+240 = 3220 = 0x0C94 */
-    0x0F, 0x02, 0x0C, 0x94
-};
+    0x0F, 0x02, 0x0C, 0x94};
 
 static tase_klv_t hand_values(void)
 {
@@ -285,8 +283,8 @@ static void checksum_covers_exactly_the_items_before_it(void **state)
     tase_klv_t got;
     (void)state;
     memcpy(p, hand_packet, sizeof(p));
-    p[19] = 1;  /* first UTC byte, +1 */
-    p[26] = 4;  /* last UTC byte, 5 -> 4 */
+    p[19] = 1; /* first UTC byte, +1 */
+    p[26] = 4; /* last UTC byte, 5 -> 4 */
     assert_int_equal(tase_klv_decode(p, sizeof(p), &got), 87);
     assert_true(got.utc == 0x0100000102030404ull);
 }
@@ -407,8 +405,8 @@ static void on_error(void *user, uint32_t offset, int err)
 typedef struct {
     uint8_t bytes[4096];
     size_t len;
-    size_t n;                    /* clean packets */
-    uint32_t offset[MAX_SEEN];   /* where each clean packet starts */
+    size_t n;                  /* clean packets */
+    uint32_t offset[MAX_SEEN]; /* where each clean packet starts */
     tase_klv_t klv[MAX_SEEN];
 } stream_t;
 
@@ -627,8 +625,7 @@ static void packet_behind_a_cut_packet_comes_out_with_its_last_byte(void **state
         assert_int_equal(tase_klv_rx_init(&rx), TASE_OK);
         assert_int_equal(tase_klv_rx_feed(&rx, hand_packet, cut, on_packet, NULL, &seen), 0);
         for (i = 0; i < 86; i++) {
-            assert_int_equal(tase_klv_rx_feed(&rx, hand_packet + i, 1, on_packet, NULL, &seen),
-                             0);
+            assert_int_equal(tase_klv_rx_feed(&rx, hand_packet + i, 1, on_packet, NULL, &seen), 0);
         }
         assert_int_equal(tase_klv_rx_feed(&rx, hand_packet + 86, 1, on_packet, NULL, &seen), 1);
         assert_int_equal(seen.offset[0], cut);
@@ -661,12 +658,12 @@ static void scanner_rejects_bad_arguments_and_resets_counters(void **state)
 static void raw_to_units_match_hand_computed_values(void **state)
 {
     (void)state;
-    assert_float_equal(tase_klv_lat_deg(0x40000000), 45.0, EPS);     /* 2^30*180/2^32 */
+    assert_float_equal(tase_klv_lat_deg(0x40000000), 45.0, EPS); /* 2^30*180/2^32 */
     assert_float_equal(tase_klv_lat_deg(INT32_MIN), -90.0, EPS);
     assert_float_equal(tase_klv_lon_deg(0x40000000), 90.0, EPS);
     assert_float_equal(tase_klv_lon_deg(-0x20000000), -45.0, EPS);
     assert_float_equal(tase_klv_alt_m(0), -900.0, EPS);
-    assert_float_equal(tase_klv_alt_m(32768), 4550.0, EPS);          /* 10900/2 - 900 */
+    assert_float_equal(tase_klv_alt_m(32768), 4550.0, EPS); /* 10900/2 - 900 */
     assert_float_equal(tase_klv_angle_deg(16384), 90.0, EPS);
     assert_float_equal(tase_klv_angle_deg(49152), 270.0, EPS);
     assert_float_equal(tase_klv_tilt_deg(-16384), -90.0, EPS);
@@ -675,7 +672,7 @@ static void raw_to_units_match_hand_computed_values(void **state)
     assert_float_equal(tase_klv_roll_deg(16384), 25.0, EPS);
     assert_float_equal(tase_klv_roll_deg(INT16_MIN), -50.0, EPS);
     assert_float_equal(tase_klv_speed_mps(16384), 127.5, EPS);
-    assert_float_equal(tase_klv_speed_mps(-256), -1.9921875, EPS);   /* -510/256 */
+    assert_float_equal(tase_klv_speed_mps(-256), -1.9921875, EPS); /* -510/256 */
     assert_float_equal(tase_klv_fov_deg(32768), 90.0, EPS);
     assert_float_equal(tase_klv_fov_deg(16384), 45.0, EPS);
     assert_float_equal(tase_klv_utc_s(1500000u), 1.5, EPS);
@@ -731,7 +728,7 @@ static void circular_units_to_raw_wrap(void **state)
     assert_int_equal(tase_klv_lon_raw(765.0), 0x20000000); /* 720 + 45 */
     assert_int_equal(tase_klv_angle_raw(-90.0), 49152);
     assert_int_equal(tase_klv_angle_raw(360.0), 0);
-    assert_int_equal(tase_klv_angle_raw(359.999), 0);       /* 65535.82 -> 65536 */
+    assert_int_equal(tase_klv_angle_raw(359.999), 0); /* 65535.82 -> 65536 */
     assert_int_equal(tase_klv_tilt_raw(180.0), INT16_MIN);
     assert_int_equal(tase_klv_tilt_raw(270.0), -16384);
     assert_int_equal(tase_klv_tilt_raw(-90.0), -16384);

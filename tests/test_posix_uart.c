@@ -167,8 +167,8 @@ static void standard_rates_are_set_and_read_back(void **state)
     static const struct {
         uint32_t baud;
         speed_t code;
-    } rates[] = {{9600, B9600}, {19200, B19200}, {57600, B57600}, {115200, B115200},
-                 {230400, B230400}, {1200, B1200}};
+    } rates[] = {{9600, B9600},     {19200, B19200},   {57600, B57600},
+                 {115200, B115200}, {230400, B230400}, {1200, B1200}};
     size_t i;
     (void)state;
 
@@ -209,9 +209,8 @@ static void open_puts_the_line_in_raw_8n1_without_flow_control(void **state)
     assert_int_equal(tase_posix_uart_open(&a, p.name, 57600), TASE_OK);
     assert_int_equal(tcgetattr(p.slave, &t), 0);
     assert_int_equal(t.c_lflag & (ECHO | ECHONL | ICANON | ISIG | IEXTEN), 0);
-    assert_int_equal(t.c_iflag & (ICRNL | INLCR | IGNCR | IXON | IXOFF | IXANY | ISTRIP |
-                                  BRKINT | PARMRK),
-                     0);
+    assert_int_equal(
+        t.c_iflag & (ICRNL | INLCR | IGNCR | IXON | IXOFF | IXANY | ISTRIP | BRKINT | PARMRK), 0);
     assert_int_equal(t.c_oflag & OPOST, 0);
     assert_int_equal(t.c_cflag & CSIZE, CS8);
     assert_int_equal(t.c_cflag & (PARENB | CSTOPB | CRTSCTS), 0);
@@ -256,8 +255,7 @@ static void an_unsupported_rate_fails_before_the_device_is_touched(void **state)
     assert_true(tase_posix_uart_baud_supported(9600));
     assert_true(tase_posix_uart_baud_supported(57600));
     /* Not even the missing device is noticed: the rate is checked first. */
-    assert_int_equal(tase_posix_uart_open(&a, "/dev/tase-no-such-tty", 12345),
-                     TASE_EUNSUPPORTED);
+    assert_int_equal(tase_posix_uart_open(&a, "/dev/tase-no-such-tty", 12345), TASE_EUNSUPPORTED);
     assert_int_equal(tase_posix_uart_open(&a, "/dev/tase-no-such-tty", 0), TASE_EUNSUPPORTED);
 
     pty_open(&p);
@@ -320,7 +318,7 @@ static void write_gives_up_after_its_timeout_when_the_peer_never_reads(void **st
     a.write_timeout_ms = 100;
     t0 = tase_posix_now_ms();
     n = pa.ops->write(pa.ctx, big, sizeof big);
-    assert_true(n > 0); /* the kernel queue took some ... */
+    assert_true(n > 0);               /* the kernel queue took some ... */
     assert_true(n < (int)sizeof big); /* ... but not a megabyte */
     assert_true(tase_posix_now_ms() - t0 >= 100);
     assert_int_equal(pa.ops->write(pa.ctx, big, 16), TASE_EAGAIN); /* queue full */

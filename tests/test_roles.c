@@ -31,12 +31,10 @@ typedef struct {
     unsigned spoi_queries;
 } gimbal_side_t;
 
-static const uint8_t spoi_now[19] = {0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07,
-                                     0x08, 0x09, 0x0A, 0x0B, 0x0C, 0, 0,
-                                     0, 0, 0, 0, 0x80};
+static const uint8_t spoi_now[19] = {0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08, 0x09, 0x0A,
+                                     0x0B, 0x0C, 0,    0,    0,    0,    0,    0,    0x80};
 
-static int fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
-                uint32_t now)
+static int fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap, uint32_t now)
 {
     size_t len = id == TASE_ID_GIMBAL_ANGLE ? 6u : id == TASE_ID_GIMBAL_RATE ? 22u : 40u;
     (void)user;
@@ -81,7 +79,7 @@ static void *gimbal_thread(void *arg)
 }
 
 typedef struct {
-    uint32_t since;     /* count telemetry arriving at or after this time */
+    uint32_t since; /* count telemetry arriving at or after this time */
     uint32_t until;
     unsigned count[3];
     unsigned all;
@@ -92,8 +90,10 @@ static void host_frame(void *user, const tase_frame_t *f)
     host_side_t *h = user;
     uint32_t now = tase_posix_now_ms();
     uint16_t id = TASE_ID(f->group, f->type);
-    int s = id == TASE_ID_GIMBAL_ANGLE ? 0 : id == TASE_ID_GIMBAL_RATE ? 1
-                                           : id == TASE_ID_GEOREFERENCE_DATA ? 2 : -1;
+    int s = id == TASE_ID_GIMBAL_ANGLE        ? 0
+            : id == TASE_ID_GIMBAL_RATE       ? 1
+            : id == TASE_ID_GEOREFERENCE_DATA ? 2
+                                              : -1;
     h->all++;
     if (s >= 0 && (uint32_t)(now - h->since) < (uint32_t)(h->until - h->since)) {
         h->count[s]++;

@@ -67,8 +67,7 @@ static const char *const spec[] = {
 };
 
 /* Reserved bytes per packet in the spec's tables (same order). */
-static const unsigned reserved[] = {0, 0, 1, 0, 2, 1, 0, 1, 0, 0, 0,
-                                    0, 0, 3, 0, 1, 3, 0, 0, 0, 0};
+static const unsigned reserved[] = {0, 0, 1, 0, 2, 1, 0, 1, 0, 0, 0, 0, 0, 3, 0, 1, 3, 0, 0, 0, 0};
 
 static void schema_matches_spec_transcription(void **state)
 {
@@ -85,15 +84,16 @@ static void schema_matches_spec_transcription(void **state)
         unsigned want_flags;
         assert_non_null(p);
         assert_int_equal(p->index, i);
-        assert_int_equal(sscanf(spec[i], "%31s %x %x %3s %u %3s :%n", name, &g, &t, dir, &len,
-                                forms, &used),
-                         6);
+        assert_int_equal(
+            sscanf(spec[i], "%31s %x %x %3s %u %3s :%n", name, &g, &t, dir, &len, forms, &used), 6);
         assert_string_equal(tase_schema_packet_name(p), name);
         assert_int_equal(p->id, TASE_ID(g, t));
         assert_int_equal(p->len, len);
         want_flags = dir[0] == 'I' ? TASE_DIR_IN : dir[0] == 'O' ? TASE_DIR_OUT : TASE_DIR_BOTH;
-        want_flags |= forms[0] == 'Q' ? TASE_LEN_QUERY : forms[0] == '1' ? TASE_LEN_SHORT1
-                      : forms[0] == 'T' ? TASE_LEN_TAIL : 0u;
+        want_flags |= forms[0] == 'Q'   ? TASE_LEN_QUERY
+                      : forms[0] == '1' ? TASE_LEN_SHORT1
+                      : forms[0] == 'T' ? TASE_LEN_TAIL
+                                        : 0u;
         assert_int_equal(p->flags, want_flags);
         rest = spec[i] + used;
         while (*rest != '\0') {
@@ -144,25 +144,25 @@ static void fields_are_in_range_ordered_disjoint_and_cover_all_but_reserved(void
 static void struct_members_match_field_width_sign_and_offset(void **state)
 {
     (void)state;
-#define P(N, g, t, fl, l, sz) \
-    {                         \
-        const tase_packet_desc_t *p = tase_schema_at(TASE_PKT_##N); \
+#define P(N, g, t, fl, l, sz)                                                                      \
+    {                                                                                              \
+        const tase_packet_desc_t *p = tase_schema_at(TASE_PKT_##N);                                \
         size_t k = 0;
-#define F(T, m, o, w, s)                                                       \
-    {                                                                          \
-        T x;                                                                   \
-        const tase_field_t *f = tase_schema_field(p, k++);                     \
-        memset(&x, 0, sizeof(x));                                              \
-        x.m = 0;                                                               \
-        x.m--; /* -1 if signed, the maximum if unsigned */                     \
-        assert_non_null(f);                                                    \
-        assert_int_equal(sizeof(x.m), w);                                      \
-        assert_int_equal(f->member, offsetof(T, m));                           \
-        assert_int_equal(TASE_FIELD_IS_SIGNED(f), !(x.m > 0));                 \
-        assert_string_equal(tase_schema_field_name(p, k - 1), #m);             \
+#define F(T, m, o, w, s)                                                                           \
+    {                                                                                              \
+        T x;                                                                                       \
+        const tase_field_t *f = tase_schema_field(p, k++);                                         \
+        memset(&x, 0, sizeof(x));                                                                  \
+        x.m = 0;                                                                                   \
+        x.m--; /* -1 if signed, the maximum if unsigned */                                         \
+        assert_non_null(f);                                                                        \
+        assert_int_equal(sizeof(x.m), w);                                                          \
+        assert_int_equal(f->member, offsetof(T, m));                                               \
+        assert_int_equal(TASE_FIELD_IS_SIGNED(f), !(x.m > 0));                                     \
+        assert_string_equal(tase_schema_field_name(p, k - 1), #m);                                 \
     }
-#define E(N)                                \
-        assert_int_equal(k, p->nfields);    \
+#define E(N)                                                                                       \
+    assert_int_equal(k, p->nfields);                                                               \
     }
 #include "../src/schema_def.h"
 #undef P
@@ -239,12 +239,21 @@ static void field_get_sign_extends_signed_fields_only(void **state)
     int64_t v = 12345;
     (void)state;
     memset(d, 0, sizeof(d));
-    d[0] = 0xFF; d[1] = 0xFF; d[2] = 0xFF; d[3] = 0xFF; /* time: u32 */
-    d[4] = 0x80;                                        /* lat: INT32_MIN */
-    d[8] = 0x7F; d[9] = 0xFF; d[10] = 0xFF; d[11] = 0xFF; /* lon: INT32_MAX */
-    d[16] = 0x80; d[17] = 0x00;                         /* vnorth: INT16_MIN */
-    d[18] = 0xFF; d[19] = 0xFE;                         /* veast: -2 */
-    d[22] = 0xFF; d[23] = 0xFF;                         /* year: u16 65535 */
+    d[0] = 0xFF;
+    d[1] = 0xFF;
+    d[2] = 0xFF;
+    d[3] = 0xFF; /* time: u32 */
+    d[4] = 0x80; /* lat: INT32_MIN */
+    d[8] = 0x7F;
+    d[9] = 0xFF;
+    d[10] = 0xFF;
+    d[11] = 0xFF; /* lon: INT32_MAX */
+    d[16] = 0x80;
+    d[17] = 0x00; /* vnorth: INT16_MIN */
+    d[18] = 0xFF;
+    d[19] = 0xFE; /* veast: -2 */
+    d[22] = 0xFF;
+    d[23] = 0xFF; /* year: u16 65535 */
     assert_int_equal(tase_field_get(gps, 0, d, 32, &v), TASE_OK);
     assert_true(v == 0xFFFFFFFFll);
     assert_int_equal(tase_field_get(gps, 1, d, 32, &v), TASE_OK);
@@ -258,7 +267,8 @@ static void field_get_sign_extends_signed_fields_only(void **state)
     assert_int_equal(tase_field_get(gps, 7, d, 32, &v), TASE_OK);
     assert_true(v == 65535);
     /* HOST_SENSOR tas (field 9, bytes 18-19, unsigned) */
-    d[18] = 0xFF; d[19] = 0xFF;
+    d[18] = 0xFF;
+    d[19] = 0xFF;
     assert_int_equal(tase_field_get(sensor, 9, d, 20, &v), TASE_OK);
     assert_true(v == 0xFFFF);
     assert_int_equal(tase_field_get(sensor, 8, d, 20, &v), TASE_OK); /* z_accel 16-17 */

@@ -166,11 +166,11 @@ static void frames_of_other_ids_are_ignored(void **state)
     static const uint8_t x[8] = {1, 2, 3, 4, 5, 6, 7, 8};
     (void)state;
     open_pair(&p, TASE_CAN_ROLE_HOST);
-    peer_send(&p, 0x11000000u | CAN_EFF_FLAG, x, 8);  /* host's own direction */
-    peer_send(&p, 0x10000000u, x, 8);                 /* standard id (masked to 0) */
+    peer_send(&p, 0x11000000u | CAN_EFF_FLAG, x, 8);                /* host's own direction */
+    peer_send(&p, 0x10000000u, x, 8);                               /* standard id (masked to 0) */
     peer_send(&p, 0x10000000u | CAN_EFF_FLAG | CAN_RTR_FLAG, x, 0); /* remote */
-    peer_send(&p, 0x12020000u | CAN_EFF_FLAG, x, 2);  /* 3AX: not the host's */
-    peer_send(&p, 0x10000000u | CAN_EFF_FLAG, x, 0);  /* ours, empty */
+    peer_send(&p, 0x12020000u | CAN_EFF_FLAG, x, 2);                /* 3AX: not the host's */
+    peer_send(&p, 0x10000000u | CAN_EFF_FLAG, x, 0);                /* ours, empty */
     peer_send(&p, 0x10000000u | CAN_EFF_FLAG, x + 2, 3);
     assert_int_equal(tase_socketcan_read(&p.s, b, sizeof(b), 200), 3);
     assert_memory_equal(b, x + 2, 3);
@@ -313,8 +313,8 @@ static void set_filter_on_a_non_can_socket_fails_cleanly(void **state)
     (void)state;
     assert_int_equal(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv), 0);
     s.fd = 1234;
-    assert_int_equal(tase_socketcan_adopt(&s, sv[0], TASE_CAN_ROLE_GIMBAL,
-                                          TASE_SOCKETCAN_SET_FILTER), TASE_EIO);
+    assert_int_equal(
+        tase_socketcan_adopt(&s, sv[0], TASE_CAN_ROLE_GIMBAL, TASE_SOCKETCAN_SET_FILTER), TASE_EIO);
     assert_int_equal(s.fd, 1234);
     close(sv[0]);
     close(sv[1]);

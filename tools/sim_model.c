@@ -96,19 +96,19 @@ int sim_model_command(sim_model_t *m, double pan, double tilt, uint8_t flags, do
     sim_mode_t mode;
     bool stab;
     switch (flags) {
-    case 0x00: case 0x02: case 0x10: case 0x90:
-        mode = SIM_MODE_RATE;
-        break;
-    case 0x01: case 0x03: case 0x20: case 0xA0:
-        mode = SIM_MODE_POSITION;
-        break;
-    case 0x30: case 0xB0:
-        mode = SIM_MODE_IMPULSE;
-        break;
-    case 0xC0: case 0xD0:
-        return 0;
-    default:
-        return -1;
+    case 0x00:
+    case 0x02:
+    case 0x10:
+    case 0x90: mode = SIM_MODE_RATE; break;
+    case 0x01:
+    case 0x03:
+    case 0x20:
+    case 0xA0: mode = SIM_MODE_POSITION; break;
+    case 0x30:
+    case 0xB0: mode = SIM_MODE_IMPULSE; break;
+    case 0xC0:
+    case 0xD0: return 0;
+    default: return -1;
     }
     stab = (flags & 0x80u) != 0 || flags == 0x02 || flags == 0x03;
     m->mode = mode;

@@ -51,23 +51,19 @@ typedef enum {
     SIM_MODE_IMPULSE = 3
 } sim_mode_t;
 
-typedef enum {
-    SIM_3AX_DEPLOYED = 0,
-    SIM_3AX_RETRACTED = 1,
-    SIM_3AX_MOVING = 2
-} sim_3ax_t;
+typedef enum { SIM_3AX_DEPLOYED = 0, SIM_3AX_RETRACTED = 1, SIM_3AX_MOVING = 2 } sim_3ax_t;
 
 typedef struct {
-    double max_rate;     /* deg/s, > 0 */
-    double gain;         /* position gain, (deg/s) per degree of error */
-    double nogo_center;  /* deg */
-    double nogo_range;   /* deg, 0 = free running */
+    double max_rate;    /* deg/s, > 0 */
+    double gain;        /* position gain, (deg/s) per degree of error */
+    double nogo_center; /* deg */
+    double nogo_range;  /* deg, 0 = free running */
 } sim_axis_t;
 
 typedef struct {
-    double lat, lon;     /* degrees */
-    double height;       /* metres above the ellipsoid */
-    double vn, ve, vd;   /* m/s */
+    double lat, lon;   /* degrees */
+    double height;     /* metres above the ellipsoid */
+    double vn, ve, vd; /* m/s */
 } sim_pos_t;
 
 typedef struct {
@@ -81,8 +77,8 @@ typedef struct {
     sim_mode_t mode;
     bool stabilised;
     /* command */
-    double cmd_pan, cmd_tilt;   /* deg (position) or deg/s (rate, impulse) */
-    double impulse_left;        /* s */
+    double cmd_pan, cmd_tilt; /* deg (position) or deg/s (rate, impulse) */
+    double impulse_left;      /* s */
     /* settings */
     sim_axis_t axis_pan, axis_tilt;
     /* environment */
@@ -92,8 +88,8 @@ typedef struct {
     /* retract/deploy mechanism */
     sim_3ax_t tax;
     bool tax_target_deployed;
-    double tax_left;            /* s until the move completes */
-    double tax_duration;        /* s a full move takes */
+    double tax_left;     /* s until the move completes */
+    double tax_duration; /* s a full move takes */
 } sim_model_t;
 
 /* Defaults of spec table 22: max rate 300 deg/s, gain 4, pan free, tilt

@@ -178,8 +178,8 @@ static void open_link(const link_opts_t *lo, tk_link_t *l, tase_port_t *port)
 
 typedef struct {
     bool json;
-    long count;    /* frames printed */
-    long limit;    /* 0: no limit */
+    long count; /* frames printed */
+    long limit; /* 0: no limit */
     const char *dir;
 } printer_t;
 
@@ -265,15 +265,14 @@ static bool req_opt(args_t *a, req_opts_t *r)
 }
 
 /* Wait for the answer to a request; dies with the reason on failure. */
-static int transact(tase_host_t *h, const tase_packet_desc_t *p, const uint8_t *data,
-                    size_t len, uint8_t *reply, const req_opts_t *r)
+static int transact(tase_host_t *h, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
+                    uint8_t *reply, const req_opts_t *r)
 {
     int rc = tase_host_transact(h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len, reply,
                                 TASE_DATA_MAX, r->timeout_ms, r->retries);
     if (rc == TASE_ETIMEOUT) {
-        tk_die("timeout: no answer to %s after %u attempt%s of %lu ms",
-               tase_schema_packet_name(p), (unsigned)r->retries + 1u, r->retries ? "s" : "",
-               (unsigned long)r->timeout_ms);
+        tk_die("timeout: no answer to %s after %u attempt%s of %lu ms", tase_schema_packet_name(p),
+               (unsigned)r->retries + 1u, r->retries ? "s" : "", (unsigned long)r->timeout_ms);
     }
     if (rc < 0) {
         tk_die("%s request failed: %s", tase_schema_packet_name(p), tase_strerror(rc));
@@ -321,7 +320,8 @@ static int cmd_query(args_t *a)
     p = tk_packet_by_name(name);
     if ((p->flags & TASE_LEN_QUERY) == 0) {
         tk_usage_error("%s has no zero-length query form (queryable: the setup packets, "
-                       "SPOI_CMD, SYSTEM_VERSION)", tase_schema_packet_name(p));
+                       "SPOI_CMD, SYSTEM_VERSION)",
+                       tase_schema_packet_name(p));
     }
     open_link(&lo, &link, &port);
     tase_host_init(&h, &port, NULL, NULL);
@@ -591,10 +591,10 @@ static void print_klv(void *user, uint32_t offset, const tase_klv_t *k)
            "\"vfov_deg\":%.3f,\"gps_fix\":%u,\"gps_antenna\":%u}}\n",
            tase_klv_utc_s(k->utc), tase_klv_lat_deg(k->lat), tase_klv_lon_deg(k->lon),
            tase_klv_alt_m(k->alt), tase_klv_angle_deg(k->pan), tase_klv_tilt_deg(k->tilt),
-           tase_klv_angle_deg(k->heading), tase_klv_pitch_deg(k->pitch),
-           tase_klv_roll_deg(k->roll), tase_klv_speed_mps(k->vnorth),
-           tase_klv_speed_mps(k->veast), tase_klv_fov_deg(k->hfov), tase_klv_fov_deg(k->vfov),
-           tase_klv_gps_fix(k->gps_status), tase_klv_gps_antenna(k->gps_status));
+           tase_klv_angle_deg(k->heading), tase_klv_pitch_deg(k->pitch), tase_klv_roll_deg(k->roll),
+           tase_klv_speed_mps(k->vnorth), tase_klv_speed_mps(k->veast), tase_klv_fov_deg(k->hfov),
+           tase_klv_fov_deg(k->vfov), tase_klv_gps_fix(k->gps_status),
+           tase_klv_gps_antenna(k->gps_status));
     fflush(stdout);
 }
 
@@ -666,9 +666,12 @@ int main(int argc, char **argv)
         int (*run)(args_t *);
         const char *usage;
     } cmds[] = {
-        {"monitor", cmd_monitor, usage_monitor}, {"send", cmd_send, usage_send},
-        {"query", cmd_query, usage_query},       {"decode", cmd_decode, usage_decode},
-        {"klv", cmd_klv, usage_klv},             {"list", cmd_list, usage_list},
+        {"monitor", cmd_monitor, usage_monitor},
+        {"send", cmd_send, usage_send},
+        {"query", cmd_query, usage_query},
+        {"decode", cmd_decode, usage_decode},
+        {"klv", cmd_klv, usage_klv},
+        {"list", cmd_list, usage_list},
     };
     args_t a;
     size_t i;

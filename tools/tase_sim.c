@@ -20,8 +20,8 @@
 #include "tase/units.h"
 #include "toolkit.h"
 
-#define STEP_MS 5u          /* model step and service period */
-#define KLV_PERIOD_MS 900u  /* spec section 6: about every 900 ms */
+#define STEP_MS 5u         /* model step and service period */
+#define KLV_PERIOD_MS 900u /* spec section 6: about every 900 ms */
 #define NCAM 3u
 
 static const char usage[] =
@@ -36,10 +36,10 @@ static const char usage[] =
     "at the PACKET_RATE rates. Runs until interrupted, or for S seconds.\n";
 
 typedef struct {
-    uint8_t type;       /* table 28, 0xFF none */
-    uint16_t max_hfov;  /* 1/100 deg */
+    uint8_t type;      /* table 28, 0xFF none */
+    uint16_t max_hfov; /* 1/100 deg */
     uint16_t min_hfov;
-    double hfov;        /* current, deg */
+    double hfov; /* current, deg */
 } camera_t;
 
 typedef struct {
@@ -47,8 +47,8 @@ typedef struct {
     sim_model_t m;
     camera_t cam[NCAM];
     uint8_t active_cam;
-    uint32_t t0;           /* start, ms */
-    int16_t p, q, r;       /* host body rates from HOST_SENSOR, 1/100 deg/s */
+    uint32_t t0;     /* start, ms */
+    int16_t p, q, r; /* host body rates from HOST_SENSOR, 1/100 deg/s */
     bool quiet;
     bool spoi_valid;
 } sim_t;
@@ -92,8 +92,7 @@ static void send_packet(sim_t *s, unsigned port, uint16_t id, const void *msg)
     uint8_t data[TASE_DATA_MAX];
     int n = payload(id, msg, data, sizeof(data));
     if (n >= 0) {
-        (void)tase_gimbal_send(&s->g, port, TASE_ID_GROUP(id), TASE_ID_TYPE(id), data,
-                               (size_t)n);
+        (void)tase_gimbal_send(&s->g, port, TASE_ID_GROUP(id), TASE_ID_TYPE(id), data, (size_t)n);
     }
 }
 
@@ -169,10 +168,11 @@ static int apply_setup(void *user, unsigned port, uint8_t type, uint8_t *data, s
             return -1;
         }
         apply_axis(s, &a);
-        logf_(s, now, "AXIS_SETTING: pan no-go %.2f+-%.2f, tilt no-go %.2f+-%.2f, max rates "
-              "%.0f/%.0f deg/s", s->m.axis_pan.nogo_center, s->m.axis_pan.nogo_range / 2,
-              s->m.axis_tilt.nogo_center, s->m.axis_tilt.nogo_range / 2, s->m.axis_pan.max_rate,
-              s->m.axis_tilt.max_rate);
+        logf_(s, now,
+              "AXIS_SETTING: pan no-go %.2f+-%.2f, tilt no-go %.2f+-%.2f, max rates "
+              "%.0f/%.0f deg/s",
+              s->m.axis_pan.nogo_center, s->m.axis_pan.nogo_range / 2, s->m.axis_tilt.nogo_center,
+              s->m.axis_tilt.nogo_range / 2, s->m.axis_pan.max_rate, s->m.axis_tilt.max_rate);
     } else if (type == TASE_ID_TYPE(TASE_ID_CAMERA_TYPE)) {
         for (i = 0; i < len; i++) {
             if (data[i] == TASE_CAMTYPE_NO_CHANGE) {
@@ -180,8 +180,8 @@ static int apply_setup(void *user, unsigned port, uint8_t type, uint8_t *data, s
             }
         }
     } else if (type == TASE_ID_TYPE(TASE_ID_PACKET_RATE)) {
-        logf_(s, now, "PACKET_RATE: port 1 angle %u/s, rate %u/s, georef %u/s", data[0],
-              data[1], data[2]);
+        logf_(s, now, "PACKET_RATE: port 1 angle %u/s, rate %u/s, georef %u/s", data[0], data[1],
+              data[2]);
     }
     return 0;
 }
@@ -213,8 +213,8 @@ static void set_version(sim_t *s, uint32_t now)
     v.min_hfov_b = s->cam[1].min_hfov;
     v.camera_c = s->cam[2].type;
     n = payload(TASE_ID_SYSTEM_VERSION, &v, data, sizeof(data));
-    if (n < 0 || tase_gimbal_setup_set(&s->g, TASE_ID_TYPE(TASE_ID_SYSTEM_VERSION), data,
-                                       (size_t)n, now) != TASE_OK) {
+    if (n < 0 || tase_gimbal_setup_set(&s->g, TASE_ID_TYPE(TASE_ID_SYSTEM_VERSION), data, (size_t)n,
+                                       now) != TASE_OK) {
         tk_die("internal error: cannot store SYSTEM_VERSION");
     }
 }
@@ -288,8 +288,8 @@ static int fill_telemetry(void *user, unsigned port, uint16_t id, uint8_t *data,
         r.vfov = tase_units_deg_to_cdeg_u16(vfov_of(hfov));
         r.focal = tase_units_sat_u16(100.0 * 2.4 / tan(hfov * M_PI / 360.0)); /* 4.8 mm sensor */
         r.mode = mode_byte(s);
-        if (tase_gimbal_setup_get(&s->g, TASE_ID_TYPE(TASE_ID_PACKET_RATE), rates,
-                                  sizeof(rates)) >= 13) {
+        if (tase_gimbal_setup_get(&s->g, TASE_ID_TYPE(TASE_ID_PACKET_RATE), rates, sizeof(rates)) >=
+            13) {
             r.sample_rate = rates[2u + 5u * port];
         }
         r.nav_health = 0xFFF0u; /* every health bit set, filter mode "normal" */
@@ -355,16 +355,12 @@ static void on_frame(void *user, unsigned port, const tase_frame_t *f)
         }
         break;
     }
-    case TASE_ID_GYRO_ZERO_CMD:
-        logf_(s, now, "GYRO_ZERO_CMD: gyros zeroed");
-        break;
-    case TASE_ID_CAMERA_CMD:
-        camera_cmd(s, &msg.camera_cmd, len, now);
-        break;
+    case TASE_ID_GYRO_ZERO_CMD: logf_(s, now, "GYRO_ZERO_CMD: gyros zeroed"); break;
+    case TASE_ID_CAMERA_CMD: camera_cmd(s, &msg.camera_cmd, len, now); break;
     case TASE_ID_LEGACY_CAMERA_CMD: {
         camera_t *cam = &s->cam[0];
-        double z = (msg.legacy_camera_cmd.zoom > 0x4000 ? 0x4000 : msg.legacy_camera_cmd.zoom) /
-                   16384.0;
+        double z =
+            (msg.legacy_camera_cmd.zoom > 0x4000 ? 0x4000 : msg.legacy_camera_cmd.zoom) / 16384.0;
         cam->hfov = cam->max_hfov / 100.0 * pow(cam->min_hfov / (double)cam->max_hfov, z);
         logf_(s, now, "LEGACY_CAMERA_CMD: camera A HFOV %.2f deg", cam->hfov);
         break;
@@ -377,8 +373,8 @@ static void on_frame(void *user, unsigned port, const tase_frame_t *f)
         break;
     case TASE_ID_RETRACT_DEPLOY_CMD:
         sim_model_retract_deploy(&s->m, msg.retract_deploy_cmd.deploy != 0);
-        logf_(s, now, "RETRACT_DEPLOY_CMD: %s", msg.retract_deploy_cmd.deploy ? "deploying"
-                                                                              : "retracting");
+        logf_(s, now, "RETRACT_DEPLOY_CMD: %s",
+              msg.retract_deploy_cmd.deploy ? "deploying" : "retracting");
         break;
     case TASE_ID_HOST_SENSOR:
         s->p = msg.host_sensor.roll;
@@ -430,8 +426,8 @@ static void on_frame(void *user, unsigned port, const tase_frame_t *f)
         }
         break;
     default:
-        logf_(s, now, "%s: not an In packet, ignored", tase_schema_packet_name(
-                                                           tase_schema_find(f->group, f->type)));
+        logf_(s, now, "%s: not an In packet, ignored",
+              tase_schema_packet_name(tase_schema_find(f->group, f->type)));
         break;
     }
 }
@@ -503,8 +499,7 @@ int main(int argc, char **argv)
                 tk_usage_error("bad --seconds value '%s'", argv[i]);
             }
         } else if (a[0] == '-' && (strcmp(a, "--link") == 0 || strcmp(a, "--can") == 0 ||
-                                   strcmp(a, "--klv-link") == 0 ||
-                                   strcmp(a, "--seconds") == 0)) {
+                                   strcmp(a, "--klv-link") == 0 || strcmp(a, "--seconds") == 0)) {
             tk_usage_error("option %s needs a value", a);
         } else {
             tk_usage_error("unknown argument '%s' (see --help)", a);

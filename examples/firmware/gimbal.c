@@ -8,8 +8,8 @@
 /* Software 0.1.0 released 2024-05-17; board fields zero; camera A type 3
  * with 40.00..2.00 degrees of field of view; no cameras B and C. */
 static const uint8_t version_info[GIMBAL_VERSION_LEN] = {
-    0, 1, 0, 1, 0x07, 0xE8, 5, 17, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
-    3, 0, 0x0F, 0xA0, 0x00, 0xC8, 0xFF, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0,
+    0, 1, 0, 1, 0x07, 0xE8, 5,    17,   0,    0,    0, 0, 0, 0, 0, 0,    0, 0, 0, 0, 0,
+    0, 0, 0, 3, 0,    0x0F, 0xA0, 0x00, 0xC8, 0xFF, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0,
 };
 
 static void put16(uint8_t *p, int32_t v)
@@ -33,13 +33,13 @@ int16_t gimbal_sim_pan(uint32_t t)
 
 int16_t gimbal_sim_tilt(uint32_t t)
 {
-    return (int16_t)-(int32_t)(t & 0x3FFFu);
+    return (int16_t) - (int32_t)(t & 0x3FFFu);
 }
 
 void gimbal_init(gimbal_t *g, gimbal_tx_t tx, void *tx_user)
 {
-    static const uint8_t default_rates[GIMBAL_RATES_LEN] = {10, 10, 4, 0, 0, 10, 10, 4,
-                                                            0,  0,  10, 10, 4, 0, 0, 0};
+    static const uint8_t default_rates[GIMBAL_RATES_LEN] = {10, 10, 4,  0,  0, 10, 10, 4,
+                                                            0,  0,  10, 10, 4, 0,  0,  0};
     memset(g, 0, sizeof(*g));
     memcpy(g->rates, default_rates, sizeof(g->rates));
     g->filter[0] = 100; /* 10 Hz cutoff */
@@ -60,8 +60,7 @@ static void send(gimbal_t *g, uint16_t id, const uint8_t *data, size_t len)
 /* A setup packet with data stores it; with or without data the gimbal
  * answers with its current settings (spec 4.4: "each of these packets can
  * be sent as zero length in order to query the current settings"). */
-static void on_setting(gimbal_t *g, uint16_t id, uint8_t *store, size_t size,
-                       const tase_frame_t *f)
+static void on_setting(gimbal_t *g, uint16_t id, uint8_t *store, size_t size, const tase_frame_t *f)
 {
     if (f->len != 0u && f->len != size) {
         g->wrong_length++;
@@ -98,9 +97,7 @@ void gimbal_on_frame(void *user, const tase_frame_t *f)
     gimbal_t *g = user;
     uint16_t id = TASE_ID(f->group, f->type);
     switch (id) {
-    case TASE_ID_GIMBAL_CMD:
-        on_gimbal_cmd(g, f);
-        break;
+    case TASE_ID_GIMBAL_CMD: on_gimbal_cmd(g, f); break;
     case TASE_ID_GYRO_ZERO_CMD:
         if (f->len == 0u) {
             g->gyro_zeros++;
@@ -108,21 +105,11 @@ void gimbal_on_frame(void *user, const tase_frame_t *f)
             g->wrong_length++;
         }
         break;
-    case TASE_ID_PACKET_RATE:
-        on_setting(g, id, g->rates, sizeof(g->rates), f);
-        break;
-    case TASE_ID_SENSOR_FILTER:
-        on_setting(g, id, g->filter, sizeof(g->filter), f);
-        break;
-    case TASE_ID_NAV_SOURCE:
-        on_setting(g, id, g->nav, sizeof(g->nav), f);
-        break;
-    case TASE_ID_SYSTEM_VERSION:
-        on_setting(g, id, NULL, GIMBAL_VERSION_LEN, f);
-        break;
-    default:
-        g->ignored++;
-        break;
+    case TASE_ID_PACKET_RATE: on_setting(g, id, g->rates, sizeof(g->rates), f); break;
+    case TASE_ID_SENSOR_FILTER: on_setting(g, id, g->filter, sizeof(g->filter), f); break;
+    case TASE_ID_NAV_SOURCE: on_setting(g, id, g->nav, sizeof(g->nav), f); break;
+    case TASE_ID_SYSTEM_VERSION: on_setting(g, id, NULL, GIMBAL_VERSION_LEN, f); break;
+    default: g->ignored++; break;
     }
 }
 

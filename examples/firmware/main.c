@@ -22,11 +22,11 @@
 #include "stream.h"
 #include "tase/ids.h"
 
-#define CPU_HZ 25000000u     /* mps2-an385 */
-#define TICK_HZ 1000u        /* one simulated millisecond per SysTick */
-#define BYTES_PER_TICK 12u   /* ~115200 baud */
-#define RUN_MS 1000u         /* simulated run time */
-#define RING_SIZE 64u        /* power of two */
+#define CPU_HZ 25000000u   /* mps2-an385 */
+#define TICK_HZ 1000u      /* one simulated millisecond per SysTick */
+#define BYTES_PER_TICK 12u /* ~115200 baud */
+#define RUN_MS 1000u       /* simulated run time */
+#define RING_SIZE 64u      /* power of two */
 
 #define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
 #define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
@@ -100,8 +100,8 @@ static void on_rx_frame(void *user, const tase_frame_t *f)
     if (k < sizeof(expect_frames) / sizeof(expect_frames[0])) {
         const expect_frame_t *e = &expect_frames[k];
         check(f->offset == e->offset, "frame offset", f->offset, e->offset);
-        check(f->group == e->group && f->type == e->type, "frame id",
-              TASE_ID(f->group, f->type), TASE_ID(e->group, e->type));
+        check(f->group == e->group && f->type == e->type, "frame id", TASE_ID(f->group, f->type),
+              TASE_ID(e->group, e->type));
         check(f->len == e->len, "frame length", f->len, e->len);
         check(f->len == e->len && e->offset + 6u + e->len <= sizeof(stream_bytes) &&
                   memcmp(f->data, &stream_bytes[e->offset + 6u], e->len) == 0,
@@ -225,8 +225,8 @@ int main(void)
            (unsigned long)app.gimbal.ignored);
     check(app.gimbal.cmd_pan == EXPECT_CMD_PAN, "commanded pan", (unsigned long)app.gimbal.cmd_pan,
           (unsigned long)EXPECT_CMD_PAN);
-    check(app.gimbal.cmd_tilt == EXPECT_CMD_TILT, "commanded tilt", (unsigned long)app.gimbal.cmd_tilt,
-          EXPECT_CMD_TILT);
+    check(app.gimbal.cmd_tilt == EXPECT_CMD_TILT, "commanded tilt",
+          (unsigned long)app.gimbal.cmd_tilt, EXPECT_CMD_TILT);
     check(app.gimbal.gyro_zeros == EXPECT_GYRO_ZEROS, "gyro zeros", app.gimbal.gyro_zeros,
           EXPECT_GYRO_ZEROS);
     check(app.gimbal.ignored == EXPECT_IGNORED, "ignored", app.gimbal.ignored, EXPECT_IGNORED);

@@ -29,7 +29,10 @@ __attribute__((section(".isr_vector"), used)) const vector_t vector_table[16 + 3
     Fault_Handler,   /* MemManage */
     Fault_Handler,   /* BusFault */
     Fault_Handler,   /* UsageFault */
-    0, 0, 0, 0,
+    0,
+    0,
+    0,
+    0,
     Default_Handler, /* SVCall */
     Default_Handler, /* DebugMonitor */
     0,
@@ -56,8 +59,8 @@ void Reset_Handler(void)
 /* Semihosting SYS_EXIT with "run-time error": QEMU exits with status 1. */
 static void semihosting_fail(void)
 {
-    register uint32_t op __asm__("r0") = 0x18u;        /* SYS_EXIT */
-    register uint32_t arg __asm__("r1") = 0x20023u;    /* ADP_Stopped_RunTimeErrorUnknown */
+    register uint32_t op __asm__("r0") = 0x18u;     /* SYS_EXIT */
+    register uint32_t arg __asm__("r1") = 0x20023u; /* ADP_Stopped_RunTimeErrorUnknown */
     __asm__ volatile("bkpt 0xAB" : : "r"(op), "r"(arg) : "memory");
     for (;;) {
     }

@@ -96,8 +96,7 @@ typedef struct {
  * frame, several, or a part; n == 0 gives no frames. Returns TASE_OK or
  * TASE_EARG (s NULL, unknown role, data NULL with n > 0; s untouched).
  * O(1), reentrant. */
-int tase_can_split_init(tase_can_split_t *s, tase_can_role_t sender, const uint8_t *data,
-                        size_t n);
+int tase_can_split_init(tase_can_split_t *s, tase_can_role_t sender, const uint8_t *data, size_t n);
 
 /* Next frame: 8 bytes while at least 8 remain, then the 1..7 left over.
  * Returns the frame's dlc (1..8), 0 when every byte has been handed out

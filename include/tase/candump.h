@@ -38,9 +38,9 @@ extern "C" {
 
 /* One log record. */
 typedef struct {
-    uint64_t sec;                          /* seconds (Unix time in captures) */
-    uint32_t usec;                         /* 0..999999 */
-    char ifname[TASE_CANDUMP_IFNAME_MAX];  /* NUL-terminated, 1..15 chars */
+    uint64_t sec;                         /* seconds (Unix time in captures) */
+    uint32_t usec;                        /* 0..999999 */
+    char ifname[TASE_CANDUMP_IFNAME_MAX]; /* NUL-terminated, 1..15 chars */
     tase_can_frame_t frame;
 } tase_candump_rec_t;
 

@@ -30,159 +30,159 @@ extern "C" {
 
 /* ---- group 0x00: command and control ------------------------------- */
 
-typedef struct {             /* GIMBAL_CMD 0x00/0x80, In, 8 bytes */
-    int16_t pan;             /* 1/100 deg or deg/s (see flags) */
-    int16_t tilt;            /* 1/100 deg or deg/s */
-    int16_t roll;            /* 1/100 deg or deg/s; ignored by the gimbal */
-    uint8_t flags;           /* TASE_GIMBAL_FLAGS_* (tase/flags.h) */
-    uint8_t impulse_time;    /* 1/100 s */
+typedef struct {          /* GIMBAL_CMD 0x00/0x80, In, 8 bytes */
+    int16_t pan;          /* 1/100 deg or deg/s (see flags) */
+    int16_t tilt;         /* 1/100 deg or deg/s */
+    int16_t roll;         /* 1/100 deg or deg/s; ignored by the gimbal */
+    uint8_t flags;        /* TASE_GIMBAL_FLAGS_* (tase/flags.h) */
+    uint8_t impulse_time; /* 1/100 s */
 } tase_gimbal_cmd_t;
 
-typedef struct {             /* CAMERA_CMD 0x00/0x41, In, 10 or 1 bytes */
-    uint8_t camera;          /* 0 A, 1 B, 2 C, 0xFF do not change */
-    int16_t hfov;            /* 1/100 deg; < 0: -zoom ratio; -1 no change */
-    uint16_t focus;          /* mm, or TASE_FOCUS_* special values */
-    uint8_t exposure;        /* TASE_EXPOSURE_* */
-    uint8_t shutter_speed;   /* VISCA 0x00..0x15, 0xFF no change */
-    uint8_t bright;          /* 0x00..0x1F, 0xFF no change */
-    uint8_t flags;           /* TASE_CAMERA_FLAG_* */
+typedef struct {           /* CAMERA_CMD 0x00/0x41, In, 10 or 1 bytes */
+    uint8_t camera;        /* 0 A, 1 B, 2 C, 0xFF do not change */
+    int16_t hfov;          /* 1/100 deg; < 0: -zoom ratio; -1 no change */
+    uint16_t focus;        /* mm, or TASE_FOCUS_* special values */
+    uint8_t exposure;      /* TASE_EXPOSURE_* */
+    uint8_t shutter_speed; /* VISCA 0x00..0x15, 0xFF no change */
+    uint8_t bright;        /* 0x00..0x1F, 0xFF no change */
+    uint8_t flags;         /* TASE_CAMERA_FLAG_* */
 } tase_camera_cmd_t;
 
-typedef struct {             /* LEGACY_CAMERA_CMD 0x00/0x81, In, 8 bytes */
-    uint16_t zoom;           /* VISCA 0x0000 (wide) .. 0x4000 (narrow) */
-    uint16_t focus;          /* VISCA, or TASE_LEGACY_FOCUS_* */
-    uint8_t auto_exposure;   /* TASE_LEGACY_AE_* */
-    uint8_t shutter_speed;   /* VISCA 0x00..0x15, 0xFF no change */
-    uint8_t iris;            /* VISCA 0x00..0x11 */
-    uint8_t gain;            /* VISCA 0x00..0x0F */
+typedef struct {           /* LEGACY_CAMERA_CMD 0x00/0x81, In, 8 bytes */
+    uint16_t zoom;         /* VISCA 0x0000 (wide) .. 0x4000 (narrow) */
+    uint16_t focus;        /* VISCA, or TASE_LEGACY_FOCUS_* */
+    uint8_t auto_exposure; /* TASE_LEGACY_AE_* */
+    uint8_t shutter_speed; /* VISCA 0x00..0x15, 0xFF no change */
+    uint8_t iris;          /* VISCA 0x00..0x11 */
+    uint8_t gain;          /* VISCA 0x00..0x0F */
 } tase_legacy_camera_cmd_t;
 
-typedef struct {             /* CAMERA_PASS 0x00/0x42, Both, 4 + 0..249 */
-    uint8_t camera;          /* 0 A, 1 B, 2 C */
-    uint8_t baud;            /* units of 1200 baud; 0 do not change */
-    uint8_t len;             /* number of camera bytes, 0..249 */
-    const uint8_t *data;     /* camera bytes. Encode: read (may be NULL
+typedef struct {         /* CAMERA_PASS 0x00/0x42, Both, 4 + 0..249 */
+    uint8_t camera;      /* 0 A, 1 B, 2 C */
+    uint8_t baud;        /* units of 1200 baud; 0 do not change */
+    uint8_t len;         /* number of camera bytes, 0..249 */
+    const uint8_t *data; /* camera bytes. Encode: read (may be NULL
                                 when len is 0). Decode: points into the
                                 frame, valid as long as the frame is. */
 } tase_camera_pass_t;
 #define TASE_CAMERA_PASS_MAX 249u
 
-typedef struct {             /* RETRACT_DEPLOY_CMD 0x00/0x43, Both, 2 */
-    uint8_t deploy;          /* non-zero deploy, 0 retract */
+typedef struct {    /* RETRACT_DEPLOY_CMD 0x00/0x43, Both, 2 */
+    uint8_t deploy; /* non-zero deploy, 0 retract */
 } tase_retract_deploy_cmd_t;
 
 /* ---- group 0x08: dynamics ------------------------------------------ */
 
-typedef struct {             /* GIMBAL_ANGLE 0x08/0x10, Out, 6 bytes */
-    int16_t pan;             /* 1/100 deg */
+typedef struct { /* GIMBAL_ANGLE 0x08/0x10, Out, 6 bytes */
+    int16_t pan; /* 1/100 deg */
     int16_t tilt;
-    int16_t roll;            /* always 0: no roll axis */
+    int16_t roll; /* always 0: no roll axis */
 } tase_gimbal_angle_t;
 
-typedef struct {             /* GIMBAL_RATE 0x08/0x40, Out, 18 bytes */
-    uint32_t time;           /* ms since gimbal reset */
-    int16_t pan_rate;        /* 1/100 deg/s, axis relative to mount */
+typedef struct {      /* GIMBAL_RATE 0x08/0x40, Out, 18 bytes */
+    uint32_t time;    /* ms since gimbal reset */
+    int16_t pan_rate; /* 1/100 deg/s, axis relative to mount */
     int16_t tilt_rate;
     int16_t roll_rate;
-    int16_t p;               /* 1/100 deg/s, mount body roll rate */
-    int16_t q;               /* mount body pitch rate */
-    int16_t r;               /* mount body yaw rate */
-    uint8_t mode;            /* TASE_MODE_* (tase/flags.h) */
+    int16_t p;    /* 1/100 deg/s, mount body roll rate */
+    int16_t q;    /* mount body pitch rate */
+    int16_t r;    /* mount body yaw rate */
+    uint8_t mode; /* TASE_MODE_* (tase/flags.h) */
 } tase_gimbal_rate_t;
 
-typedef struct {             /* HOST_SENSOR 0x08/0x41, In, 20 bytes */
-    uint32_t time;           /* host ms */
-    int16_t roll;            /* 1/100 deg/s body rates */
+typedef struct {   /* HOST_SENSOR 0x08/0x41, In, 20 bytes */
+    uint32_t time; /* host ms */
+    int16_t roll;  /* 1/100 deg/s body rates */
     int16_t pitch;
     int16_t yaw;
-    uint8_t flags;           /* TASE_HOST_SENSOR_* */
-    uint8_t sample_rate;     /* packets per second */
-    int16_t x_accel;         /* 1/300 m/s^2 */
+    uint8_t flags;       /* TASE_HOST_SENSOR_* */
+    uint8_t sample_rate; /* packets per second */
+    int16_t x_accel;     /* 1/300 m/s^2 */
     int16_t y_accel;
     int16_t z_accel;
-    uint16_t tas;            /* 1/100 m/s; 0xFFFF unavailable */
+    uint16_t tas; /* 1/100 m/s; 0xFFFF unavailable */
 } tase_host_sensor_t;
 
-typedef struct {             /* HOST_ATTITUDE 0x08/0x42, In, 12 bytes */
-    uint32_t time;           /* host ms */
-    int16_t roll;            /* 1/100 deg, -180..180 */
-    int16_t pitch;           /* 1/100 deg, -90..90 */
-    int16_t yaw;             /* 1/100 deg, -180..180 */
-    uint8_t flags;           /* TASE_HOST_ATT_* */
-    uint8_t sample_rate;     /* packets per second */
+typedef struct {         /* HOST_ATTITUDE 0x08/0x42, In, 12 bytes */
+    uint32_t time;       /* host ms */
+    int16_t roll;        /* 1/100 deg, -180..180 */
+    int16_t pitch;       /* 1/100 deg, -90..90 */
+    int16_t yaw;         /* 1/100 deg, -180..180 */
+    uint8_t flags;       /* TASE_HOST_ATT_* */
+    uint8_t sample_rate; /* packets per second */
 } tase_host_attitude_t;
 
 /* ---- group 0x10: position ------------------------------------------ */
 
-typedef struct {             /* HOST_GPS_DATA 0x10/0x10, In, 32 bytes */
-    uint32_t time;           /* host ms */
-    int32_t lat;             /* milli-arcseconds */
-    int32_t lon;             /* milli-arcseconds */
-    int32_t height;          /* cm above WGS-84 ellipsoid */
-    int16_t vnorth;          /* cm/s */
+typedef struct {    /* HOST_GPS_DATA 0x10/0x10, In, 32 bytes */
+    uint32_t time;  /* host ms */
+    int32_t lat;    /* milli-arcseconds */
+    int32_t lon;    /* milli-arcseconds */
+    int32_t height; /* cm above WGS-84 ellipsoid */
+    int16_t vnorth; /* cm/s */
     int16_t veast;
     int16_t vdown;
     uint16_t year;
     uint8_t month, day, hour, minute, second;
-    uint8_t frac_second;     /* 1/100 s, 0..99 */
-    uint8_t valid;           /* 1 valid, 0 not */
-    uint8_t sample_rate;     /* packets per second */
+    uint8_t frac_second; /* 1/100 s, 0..99 */
+    uint8_t valid;       /* 1 valid, 0 not */
+    uint8_t sample_rate; /* packets per second */
 } tase_host_gps_t;
 
-typedef struct {             /* SPOI_CMD 0x10/0x40, Both, 19 or 0 bytes */
-    int32_t lat;             /* milli-arcseconds */
+typedef struct { /* SPOI_CMD 0x10/0x40, Both, 19 or 0 bytes */
+    int32_t lat; /* milli-arcseconds */
     int32_t lon;
-    int32_t height;          /* cm above ellipsoid */
-    int16_t vnorth;          /* cm/s */
+    int32_t height; /* cm above ellipsoid */
+    int16_t vnorth; /* cm/s */
     int16_t veast;
     int16_t vdown;
-    uint8_t flags;           /* TASE_SPOI_* */
+    uint8_t flags; /* TASE_SPOI_* */
 } tase_spoi_cmd_t;
 
-typedef struct {             /* GEOREFERENCE_DATA 0x10/0x41, Out, 63 */
-    uint32_t time;           /* ms since gimbal reset */
-    int32_t lat;             /* milli-arcseconds */
+typedef struct {   /* GEOREFERENCE_DATA 0x10/0x41, Out, 63 */
+    uint32_t time; /* ms since gimbal reset */
+    int32_t lat;   /* milli-arcseconds */
     int32_t lon;
-    int32_t height;          /* cm above ellipsoid */
-    int16_t vnorth;          /* cm/s */
+    int32_t height; /* cm above ellipsoid */
+    int16_t vnorth; /* cm/s */
     int16_t veast;
     int16_t vdown;
     uint16_t year;
     uint8_t month, day, hour, minute, second;
-    uint8_t frac_second;     /* 1/100 s */
+    uint8_t frac_second; /* 1/100 s */
     uint8_t num_sats;
-    uint8_t pdop;            /* 0.1 PDOP */
-    uint16_t status;         /* TASE_GPS_* (tase/flags.h) */
-    int16_t camera_roll;     /* 1/100 deg Euler angles of the camera */
+    uint8_t pdop;        /* 0.1 PDOP */
+    uint16_t status;     /* TASE_GPS_* (tase/flags.h) */
+    int16_t camera_roll; /* 1/100 deg Euler angles of the camera */
     int16_t camera_pitch;
     int16_t camera_yaw;
-    uint16_t hfov;           /* 1/100 deg */
-    uint16_t vfov;           /* 1/100 deg */
-    uint16_t focal;          /* 1/100 mm */
-    uint8_t mode;            /* TASE_MODE_* */
-    uint8_t sample_rate;     /* packets per second */
-    uint16_t nav_health;     /* TASE_NAV_* */
-    int16_t mount_roll;      /* 1/100 deg Euler angles of the mount */
+    uint16_t hfov;       /* 1/100 deg */
+    uint16_t vfov;       /* 1/100 deg */
+    uint16_t focal;      /* 1/100 mm */
+    uint8_t mode;        /* TASE_MODE_* */
+    uint8_t sample_rate; /* packets per second */
+    uint16_t nav_health; /* TASE_NAV_* */
+    int16_t mount_roll;  /* 1/100 deg Euler angles of the mount */
     int16_t mount_pitch;
     int16_t mount_yaw;
-    int16_t pan;             /* 1/100 deg gimbal angles */
+    int16_t pan; /* 1/100 deg gimbal angles */
     int16_t tilt;
     int16_t roll;
-    uint8_t camera;          /* active camera 0 A, 1 B, 2 C */
+    uint8_t camera; /* active camera 0 A, 1 B, 2 C */
 } tase_georeference_t;
 
 /* ---- group 0x48: setup (every one Both, echoed, zero-length query) -- */
 
-typedef struct {             /* PACKET_RATE 0x48/0x00, 16 bytes */
+typedef struct {                                  /* PACKET_RATE 0x48/0x00, 16 bytes */
     uint8_t angle_1, rate_1, geo_ref_1, camera_1; /* port 1, packets/s */
     uint8_t angle_2, rate_2, geo_ref_2, camera_2; /* port 2 */
     uint8_t angle_3, rate_3, geo_ref_3, camera_3; /* port 3 */
-    uint8_t temporary;       /* 1: do not store in non-volatile memory */
+    uint8_t temporary;                            /* 1: do not store in non-volatile memory */
 } tase_packet_rate_t;
 
-typedef struct {             /* SENSOR_FILTER 0x48/0x01, 2 bytes */
-    uint8_t cutoff;          /* 0.1 Hz */
-    uint8_t decimation;      /* 0.1 deg/s */
+typedef struct {        /* SENSOR_FILTER 0x48/0x01, 2 bytes */
+    uint8_t cutoff;     /* 0.1 Hz */
+    uint8_t decimation; /* 0.1 deg/s */
 } tase_sensor_filter_t;
 
 typedef struct {             /* AXIS_SETTING 0x48/0x02, 23 bytes */
@@ -192,21 +192,21 @@ typedef struct {             /* AXIS_SETTING 0x48/0x02, 23 bytes */
     uint16_t tilt_nogo_range;
     int16_t roll_nogo_center;
     uint16_t roll_nogo_range;
-    uint8_t pan_max_rate;    /* 5 deg/s; 0xFF no change */
+    uint8_t pan_max_rate; /* 5 deg/s; 0xFF no change */
     uint8_t tilt_max_rate;
     uint8_t roll_max_rate;
-    uint8_t pan_max_accel;   /* 200 deg/s^2 */
+    uint8_t pan_max_accel; /* 200 deg/s^2 */
     uint8_t tilt_max_accel;
     uint8_t roll_max_accel;
-    uint8_t pan_pos_gain;    /* 0.1 (deg/s)/deg */
+    uint8_t pan_pos_gain; /* 0.1 (deg/s)/deg */
     uint8_t tilt_pos_gain;
     uint8_t roll_pos_gain;
     uint8_t temporary;
 } tase_axis_setting_t;
 
-typedef struct {             /* SYSTEM_VERSION 0x48/0x03, 42 bytes */
+typedef struct { /* SYSTEM_VERSION 0x48/0x03, 42 bytes */
     uint8_t major, minor, sub;
-    uint8_t released;        /* 1 released, else test version */
+    uint8_t released; /* 1 released, else test version */
     uint16_t soft_year;
     uint8_t soft_month, soft_day;
     uint32_t board_sn;
@@ -214,37 +214,37 @@ typedef struct {             /* SYSTEM_VERSION 0x48/0x03, 42 bytes */
     uint32_t board_config;
     uint16_t board_year;
     uint8_t board_month, board_day;
-    uint8_t camera_a;        /* TASE_CAMTYPE_* */
-    uint16_t max_hfov_a;     /* 1/100 deg */
+    uint8_t camera_a;    /* TASE_CAMTYPE_* */
+    uint16_t max_hfov_a; /* 1/100 deg */
     uint16_t min_hfov_a;
-    uint8_t camera_b;        /* 0xFF none */
+    uint8_t camera_b; /* 0xFF none */
     uint16_t max_hfov_b;
     uint16_t min_hfov_b;
-    uint8_t camera_c;        /* 0xFF none */
+    uint8_t camera_c; /* 0xFF none */
     uint16_t max_hfov_c;
     uint16_t min_hfov_c;
 } tase_system_version_t;
 
-typedef struct {             /* NAV_SOURCE 0x48/0x04, 2 bytes */
+typedef struct {               /* NAV_SOURCE 0x48/0x04, 2 bytes */
     uint8_t external_attitude; /* non-zero: use HOST_ATTITUDE */
     uint8_t external_gps;      /* non-zero: use HOST_GPS_DATA */
 } tase_nav_source_t;
 
-typedef struct {             /* CAMERA_TYPE 0x48/0x05, 3 bytes */
-    uint8_t camera_a;        /* TASE_CAMTYPE_*, 0 no change, 0xFF none */
+typedef struct {      /* CAMERA_TYPE 0x48/0x05, 3 bytes */
+    uint8_t camera_a; /* TASE_CAMTYPE_*, 0 no change, 0xFF none */
     uint8_t camera_b;
     uint8_t camera_c;
 } tase_camera_type_t;
 
-typedef struct {             /* GPS_LEVER_ARM 0x48/0x06, 6 bytes */
-    int16_t x;               /* mm, IMU to GPS antenna */
+typedef struct { /* GPS_LEVER_ARM 0x48/0x06, 6 bytes */
+    int16_t x;   /* mm, IMU to GPS antenna */
     int16_t y;
     int16_t z;
 } tase_gps_lever_arm_t;
 
-typedef struct {             /* CAMERA_ALIGN 0x48/0x07, 16 bytes */
-    uint16_t zoom_1;         /* 1/100 zoom ratio of measurement 1 */
-    int16_t pan_err_1;       /* 1/100 deg */
+typedef struct {       /* CAMERA_ALIGN 0x48/0x07, 16 bytes */
+    uint16_t zoom_1;   /* 1/100 zoom ratio of measurement 1 */
+    int16_t pan_err_1; /* 1/100 deg */
     int16_t tilt_err_1;
     int16_t roll_err_1;
     uint16_t zoom_2;
@@ -296,8 +296,7 @@ int tase_packet_encode(uint16_t id, const void *msg, uint8_t *out, size_t cap);
  * only" (only msg->camera is sent). For CAMERA_PASS len must be
  * 4 + msg->len. Returns as tase_packet_encode(), plus TASE_ELENGTH when
  * len is not accepted. */
-int tase_packet_encode_len(uint16_t id, const void *msg, size_t len, uint8_t *out,
-                           size_t cap);
+int tase_packet_encode_len(uint16_t id, const void *msg, size_t len, uint8_t *out, size_t cap);
 
 /* Encode the zero-length form of packet `id`: the query of a setup
  * packet, SPOI_CMD or SYSTEM_VERSION, and the GYRO_ZERO_CMD command.

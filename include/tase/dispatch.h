@@ -57,8 +57,7 @@ extern "C" {
 #endif
 
 /* Typed handler: msg points at the packet's typed struct. */
-typedef void (*tase_packet_handler_t)(void *user, const tase_frame_t *frame,
-                                      const void *msg);
+typedef void (*tase_packet_handler_t)(void *user, const tase_frame_t *frame, const void *msg);
 
 /* Error hook: a valid frame the packet layer rejects (err is
  * TASE_ELENGTH: wrong data length for its type). */
@@ -78,8 +77,8 @@ typedef struct {
  * ever incremented). The dispatcher keeps the pointers: the handler table
  * and stats must outlive it. Returns TASE_OK or TASE_EARG if d is NULL. */
 int tase_dispatch_init(tase_dispatch_t *d, const tase_packet_handler_t *handlers,
-                       tase_rx_handler_t on_default, tase_dispatch_error_t on_error,
-                       void *user, tase_rx_stats_t *stats);
+                       tase_rx_handler_t on_default, tase_dispatch_error_t on_error, void *user,
+                       tase_rx_stats_t *stats);
 
 /* Dispatch one frame as described above; `dispatcher` is a
  * tase_dispatch_t *. Ignores the call if either argument is NULL.

@@ -23,21 +23,20 @@
 #define TASE_BIT8(n) ((uint8_t)(0x80u >> (n)))
 #define TASE_BIT16(n) ((uint16_t)(0x8000u >> (n)))
 /* Mask of spec bits first..last (inclusive, first <= last). */
-#define TASE_MASK8(first, last) \
-    ((uint8_t)(((0xFFu >> (first)) & (0xFFu << (7u - (last)))) & 0xFFu))
-#define TASE_MASK16(first, last) \
+#define TASE_MASK8(first, last) ((uint8_t)(((0xFFu >> (first)) & (0xFFu << (7u - (last)))) & 0xFFu))
+#define TASE_MASK16(first, last)                                                                   \
     ((uint16_t)(((0xFFFFu >> (first)) & (0xFFFFu << (15u - (last)))) & 0xFFFFu))
 /* Value of spec bits first..last of v, right-aligned. */
-#define TASE_BITS8_GET(v, first, last) \
-    ((unsigned)(((unsigned)(v) & TASE_MASK8(first, last)) >> (7u - (last))))
-#define TASE_BITS16_GET(v, first, last) \
-    ((unsigned)(((unsigned)(v) & TASE_MASK16(first, last)) >> (15u - (last))))
+#define TASE_BITS8_GET(v, first, last)                                                             \
+    ((unsigned)(((unsigned)(v)&TASE_MASK8(first, last)) >> (7u - (last))))
+#define TASE_BITS16_GET(v, first, last)                                                            \
+    ((unsigned)(((unsigned)(v)&TASE_MASK16(first, last)) >> (15u - (last))))
 /* v with spec bits first..last replaced by x (excess bits of x dropped). */
-#define TASE_BITS8_SET(v, first, last, x) \
-    ((uint8_t)(((unsigned)(v) & ~(unsigned)TASE_MASK8(first, last)) | \
+#define TASE_BITS8_SET(v, first, last, x)                                                          \
+    ((uint8_t)(((unsigned)(v) & ~(unsigned)TASE_MASK8(first, last)) |                              \
                (((unsigned)(x) << (7u - (last))) & TASE_MASK8(first, last))))
-#define TASE_BITS16_SET(v, first, last, x) \
-    ((uint16_t)(((unsigned)(v) & ~(unsigned)TASE_MASK16(first, last)) | \
+#define TASE_BITS16_SET(v, first, last, x)                                                         \
+    ((uint16_t)(((unsigned)(v) & ~(unsigned)TASE_MASK16(first, last)) |                            \
                 (((unsigned)(x) << (15u - (last))) & TASE_MASK16(first, last))))
 
 /* ---- GIMBAL_CMD flags byte (4.1.1) ----------------------------------- */
@@ -61,7 +60,7 @@
 /* Command kind of a flags byte (0 for the legacy encoding). */
 #define TASE_GIMBAL_KIND(flags) TASE_BITS8_GET(flags, 1, 3)
 /* Flags byte for a kind and stabilisation (0/1). */
-#define TASE_GIMBAL_FLAGS(kind, stab) \
+#define TASE_GIMBAL_FLAGS(kind, stab)                                                              \
     ((uint8_t)(TASE_BITS8_SET(0u, 1, 3, kind) | ((stab) ? TASE_GIMBAL_STAB : 0u)))
 /* The values of the spec's table. */
 #define TASE_GIMBAL_FLAGS_RATE 0x10u
@@ -77,12 +76,12 @@
 #define TASE_CAMERA_A 0u
 #define TASE_CAMERA_B 1u
 #define TASE_CAMERA_C 2u
-#define TASE_CAMERA_NO_CHANGE 0xFFu      /* camera designator */
-#define TASE_HFOV_NO_CHANGE (-1)         /* hfov (0xFFFF on the wire) */
+#define TASE_CAMERA_NO_CHANGE 0xFFu /* camera designator */
+#define TASE_HFOV_NO_CHANGE (-1)    /* hfov (0xFFFF on the wire) */
 #define TASE_FOCUS_AUTO 0x0000u
-#define TASE_FOCUS_TRIGGER 0xFFFDu       /* printed 0xFFFFD in the spec */
-#define TASE_FOCUS_INFINITE 0xFFFEu      /* printed 0xFFFFE */
-#define TASE_FOCUS_NO_CHANGE 0xFFFFu     /* printed 0xFFFFF */
+#define TASE_FOCUS_TRIGGER 0xFFFDu   /* printed 0xFFFFD in the spec */
+#define TASE_FOCUS_INFINITE 0xFFFEu  /* printed 0xFFFFE */
+#define TASE_FOCUS_NO_CHANGE 0xFFFFu /* printed 0xFFFFF */
 #define TASE_LEGACY_FOCUS_AUTO_FAST 0x0000u
 #define TASE_LEGACY_FOCUS_AUTO_SLOW 0x0001u
 #define TASE_EXPOSURE_AUTO 0u

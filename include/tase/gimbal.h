@@ -64,9 +64,9 @@
 extern "C" {
 #endif
 
-#define TASE_GIMBAL_PORTS 3u   /* external communications ports 1..3 */
-#define TASE_GIMBAL_STREAMS 3u /* telemetry packets per port */
-#define TASE_GIMBAL_SETUP_TYPES 8u /* setup types 0x00..0x07 */
+#define TASE_GIMBAL_PORTS 3u         /* external communications ports 1..3 */
+#define TASE_GIMBAL_STREAMS 3u       /* telemetry packets per port */
+#define TASE_GIMBAL_SETUP_TYPES 8u   /* setup types 0x00..0x07 */
 #define TASE_GIMBAL_SETUP_BYTES 110u /* sum of their data lengths */
 
 /* Telemetry streams, in PACKET_RATE byte order. */

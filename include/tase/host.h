@@ -75,7 +75,7 @@ typedef struct {
     tase_port_t port;
     tase_rx_handler_t on_frame;
     void *user;
-    uint8_t *reply;      /* caller's reply buffer of the pending request */
+    uint8_t *reply; /* caller's reply buffer of the pending request */
     size_t reply_cap;
     uint32_t timeout_ms; /* per attempt */
     uint32_t sent_at;    /* when the current attempt was sent */
@@ -92,15 +92,13 @@ typedef struct {
  * (may be NULL) receives every valid frame that does not complete the
  * pending request, with `user`. Returns TASE_OK or TASE_EARG (h or port
  * or port->ops or port->ops->write NULL). O(1). */
-int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on_frame,
-                   void *user);
+int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on_frame, void *user);
 
 /* Send one frame now (a command, host data, anything; a request may be
  * pending meanwhile). Returns the frame length, or TASE_EARG (h NULL,
  * data NULL with len > 0), TASE_ETOOLONG (len > 253), or a port error
  * from tase_port_write_all() (port_io.h). O(len). */
-int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
-                   size_t len);
+int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len);
 
 /* Start a request: send (group, type, data[0..len)) and wait for the
  * gimbal's frame of the same group and type. len 0 is a query. Up to
@@ -115,15 +113,13 @@ int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *d
  *   TASE_EBUSY    a request is pending (it is left untouched);
  *   a port error  the first attempt could not be sent (no request pending).
  * O(len). */
-int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type,
-                            const uint8_t *data, size_t len, uint8_t *reply,
-                            size_t reply_cap, uint32_t timeout_ms, uint8_t retries,
-                            uint32_t now_ms);
+int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
+                            size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
+                            uint8_t retries, uint32_t now_ms);
 
 /* tase_host_request_start() with no data: a zero-length query. */
 int tase_host_query_start(tase_host_t *h, uint8_t group, uint8_t type, uint8_t *reply,
-                          size_t reply_cap, uint32_t timeout_ms, uint8_t retries,
-                          uint32_t now_ms);
+                          size_t reply_cap, uint32_t timeout_ms, uint8_t retries, uint32_t now_ms);
 
 /* Feed received bytes (from the port, a ring buffer, a capture). Frames
  * complete the pending request or go to on_frame. now_ms is not used for
@@ -172,9 +168,8 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms);
  * or a negative code (TASE_ETIMEOUT after 1 + retries attempts). Waits at
  * most about (1 + retries) * timeout_ms. Frames that arrive meanwhile go
  * to on_frame. */
-int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
-                       size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
-                       uint8_t retries);
+int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len,
+                       uint8_t *reply, size_t reply_cap, uint32_t timeout_ms, uint8_t retries);
 
 #ifdef __cplusplus
 }

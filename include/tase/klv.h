@@ -82,12 +82,12 @@
 extern "C" {
 #endif
 
-#define TASE_KLV_KEY_LEN 16u       /* universal key */
-#define TASE_KLV_SET_LEN 70u       /* local set: 15 x (tag+len) + 40 */
-#define TASE_KLV_SET_LEN_SPEC 69u  /* what the spec declares */
-#define TASE_KLV_PACKET_LEN 87u    /* key + 1 length byte + set */
-#define TASE_KLV_PACKET_MAX 91u    /* with the longest BER length accepted */
-#define TASE_KLV_SUM_LEN 66u       /* local-set bytes covered by the sum */
+#define TASE_KLV_KEY_LEN 16u      /* universal key */
+#define TASE_KLV_SET_LEN 70u      /* local set: 15 x (tag+len) + 40 */
+#define TASE_KLV_SET_LEN_SPEC 69u /* what the spec declares */
+#define TASE_KLV_PACKET_LEN 87u   /* key + 1 length byte + set */
+#define TASE_KLV_PACKET_MAX 91u   /* with the longest BER length accepted */
+#define TASE_KLV_SUM_LEN 66u      /* local-set bytes covered by the sum */
 #define TASE_KLV_ITEMS 15u
 
 /* Tags of the local set, in the order they must appear. */
@@ -196,9 +196,8 @@ int tase_klv_rx_init(tase_klv_rx_t *rx);
  * Worst case O(n * TASE_KLV_PACKET_MAX) (a stream of near-miss
  * candidates); a clean stream costs O(n) when fed in large chunks and
  * O(n * 87) when fed one byte at a time. */
-int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n,
-                     tase_klv_handler_t on_packet, tase_klv_error_handler_t on_error,
-                     void *user);
+int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n, tase_klv_handler_t on_packet,
+                     tase_klv_error_handler_t on_error, void *user);
 
 /* End of input: settle the bytes held. A candidate that can no longer be
  * completed is counted as truncated (reported with TASE_ETRUNC) and the
@@ -213,16 +212,16 @@ int tase_klv_rx_stats_reset(tase_klv_rx_t *rx);
 
 /* ---- units (corrected formulas; reentrant, ISR-safe, no libm) --------- */
 
-double tase_klv_lat_deg(int32_t v);      /* v * 180 / 2^32 */
-double tase_klv_lon_deg(int32_t v);      /* v * 360 / 2^32 */
-double tase_klv_alt_m(uint16_t v);       /* v * 10900 / 65536 - 900 */
-double tase_klv_angle_deg(uint16_t v);   /* pan, heading: v * 360 / 65536 */
-double tase_klv_tilt_deg(int16_t v);     /* v * 360 / 65536 */
-double tase_klv_pitch_deg(int16_t v);    /* v * 40 / 65536 */
-double tase_klv_roll_deg(int16_t v);     /* v * 100 / 65536 */
-double tase_klv_speed_mps(int16_t v);    /* vnorth, veast: v * 510 / 65536 */
-double tase_klv_fov_deg(uint16_t v);     /* hfov, vfov: v * 180 / 65536 */
-double tase_klv_utc_s(uint64_t v);       /* seconds since 1970 */
+double tase_klv_lat_deg(int32_t v);    /* v * 180 / 2^32 */
+double tase_klv_lon_deg(int32_t v);    /* v * 360 / 2^32 */
+double tase_klv_alt_m(uint16_t v);     /* v * 10900 / 65536 - 900 */
+double tase_klv_angle_deg(uint16_t v); /* pan, heading: v * 360 / 65536 */
+double tase_klv_tilt_deg(int16_t v);   /* v * 360 / 65536 */
+double tase_klv_pitch_deg(int16_t v);  /* v * 40 / 65536 */
+double tase_klv_roll_deg(int16_t v);   /* v * 100 / 65536 */
+double tase_klv_speed_mps(int16_t v);  /* vnorth, veast: v * 510 / 65536 */
+double tase_klv_fov_deg(uint16_t v);   /* hfov, vfov: v * 180 / 65536 */
+double tase_klv_utc_s(uint64_t v);     /* seconds since 1970 */
 
 /* Inverses: nearest raw value. Saturating unless marked "wraps". */
 int32_t tase_klv_lat_raw(double deg);    /* [-90, 90) */

@@ -44,8 +44,8 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n);
  * TASE_FRAME_MAX bytes and write it with tase_port_write_all().
  * Returns the frame length, an encoder error (TASE_EARG, TASE_ETOOLONG:
  * nothing sent) or a tase_port_write_all() error. Uses 261 bytes of stack. */
-int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type,
-                         const uint8_t *data, size_t len);
+int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *data,
+                         size_t len);
 
 #ifdef __cplusplus
 }

@@ -74,9 +74,9 @@ enum {
 #define TASE_DIR_OUT 0x02u  /* from the gimbal */
 #define TASE_DIR_BOTH 0x03u /* either way (setup echo, pass-through) */
 /* ... and the data lengths accepted besides `len` itself. */
-#define TASE_LEN_QUERY 0x04u /* 0 bytes: query (the setup echo answers) */
+#define TASE_LEN_QUERY 0x04u  /* 0 bytes: query (the setup echo answers) */
 #define TASE_LEN_SHORT1 0x08u /* 1 byte: CAMERA_CMD "change camera only" */
-#define TASE_LEN_TAIL 0x10u  /* len + 0..(253-len) trailing bytes */
+#define TASE_LEN_TAIL 0x10u   /* len + 0..(253-len) trailing bytes */
 
 /* Field format byte: width in bytes (1, 2, 4, 8) in bits 0-3 (LSB
  * numbering here: this is a C value, not a wire byte), signed in bit 4. */
@@ -129,8 +129,8 @@ bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len);
  *   TASE_EARG  p, data (with len > 0) or value is NULL, or i >= nfields;
  *   TASE_ETRUNC the field does not lie within len bytes (e.g. a query).
  * O(width), reentrant, ISR-safe. */
-int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data,
-                   size_t len, int64_t *value);
+int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
+                   int64_t *value);
 
 /* ---- names (src/schema_names.c; not linked unless used) ----------- */
 

@@ -64,38 +64,68 @@ static inline uint8_t tase_units_sat_u8(double v)
 }
 
 /* 1/100 degree (or deg/s) */
-static inline double tase_units_cdeg_to_deg(int32_t cdeg) { return (double)cdeg / 100.0; }
-static inline int16_t tase_units_deg_to_cdeg(double deg) { return tase_units_sat_i16(deg * 100.0); }
+static inline double tase_units_cdeg_to_deg(int32_t cdeg)
+{
+    return (double)cdeg / 100.0;
+}
+static inline int16_t tase_units_deg_to_cdeg(double deg)
+{
+    return tase_units_sat_i16(deg * 100.0);
+}
 static inline uint16_t tase_units_deg_to_cdeg_u16(double deg)
 {
     return tase_units_sat_u16(deg * 100.0); /* HFOV, VFOV, no-go ranges */
 }
 
 /* milli-arcseconds: 1 degree = 3 600 000 mas */
-static inline double tase_units_mas_to_deg(int32_t mas) { return (double)mas / 3600000.0; }
+static inline double tase_units_mas_to_deg(int32_t mas)
+{
+    return (double)mas / 3600000.0;
+}
 static inline int32_t tase_units_deg_to_mas(double deg)
 {
     return tase_units_sat_i32(deg * 3600000.0);
 }
 
 /* centimetres (32-bit heights) */
-static inline double tase_units_cm_to_m(int32_t cm) { return (double)cm / 100.0; }
-static inline int32_t tase_units_m_to_cm(double m) { return tase_units_sat_i32(m * 100.0); }
+static inline double tase_units_cm_to_m(int32_t cm)
+{
+    return (double)cm / 100.0;
+}
+static inline int32_t tase_units_m_to_cm(double m)
+{
+    return tase_units_sat_i32(m * 100.0);
+}
 
 /* cm/s (16-bit signed velocities; use sat_u16(mps * 100) for TAS) */
-static inline double tase_units_cmps_to_mps(int32_t cmps) { return (double)cmps / 100.0; }
-static inline int16_t tase_units_mps_to_cmps(double mps) { return tase_units_sat_i16(mps * 100.0); }
+static inline double tase_units_cmps_to_mps(int32_t cmps)
+{
+    return (double)cmps / 100.0;
+}
+static inline int16_t tase_units_mps_to_cmps(double mps)
+{
+    return tase_units_sat_i16(mps * 100.0);
+}
 
 /* 1/300 m/s^2 */
-static inline double tase_units_accel_to_mps2(int32_t raw) { return (double)raw / 300.0; }
+static inline double tase_units_accel_to_mps2(int32_t raw)
+{
+    return (double)raw / 300.0;
+}
 static inline int16_t tase_units_mps2_to_accel(double mps2)
 {
     return tase_units_sat_i16(mps2 * 300.0);
 }
 
 /* 0.1 PDOP */
-static inline double tase_units_raw_to_pdop(uint8_t raw) { return (double)raw / 10.0; }
-static inline uint8_t tase_units_pdop_to_raw(double pdop) { return tase_units_sat_u8(pdop * 10.0); }
+static inline double tase_units_raw_to_pdop(uint8_t raw)
+{
+    return (double)raw / 10.0;
+}
+static inline uint8_t tase_units_pdop_to_raw(double pdop)
+{
+    return tase_units_sat_u8(pdop * 10.0);
+}
 
 #ifdef __cplusplus
 }

@@ -22,8 +22,7 @@ void tase_bm_uart_rx_isr(tase_bm_uart_t *u, uint8_t byte)
     (void)tase_ring_put(&u->rx, byte);
 }
 
-int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_frame,
-                      void *user)
+int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
 {
     uint8_t chunk[DRAIN_CHUNK];
     uint32_t budget;

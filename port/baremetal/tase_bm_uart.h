@@ -80,8 +80,7 @@ void tase_bm_uart_rx_isr(tase_bm_uart_t *u, uint8_t byte);
  * chunks of 32 bytes. Returns the number of frames delivered (>= 0) or
  * TASE_EARG. Bounded: stops after one ring capacity's worth of bytes even
  * if the ISR keeps adding, so the main loop cannot be starved. */
-int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_frame,
-                      void *user);
+int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_frame, void *user);
 
 /* The tase_port_t of u: {&tase_bm_uart_ops, u}. */
 tase_port_t tase_bm_uart_port(tase_bm_uart_t *u);

@@ -14,8 +14,7 @@
 
 int tase_ring_init(tase_ring_t *r, uint8_t *buf, size_t cap)
 {
-    if (r == NULL || buf == NULL || cap == 0 || cap > 0x80000000u ||
-        (cap & (cap - 1u)) != 0) {
+    if (r == NULL || buf == NULL || cap == 0 || cap > 0x80000000u || (cap & (cap - 1u)) != 0) {
         return TASE_EARG;
     }
     r->buf = buf;

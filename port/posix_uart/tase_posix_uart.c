@@ -16,10 +16,9 @@ typedef struct {
 } baud_map_t;
 
 static const baud_map_t baud_map[] = {
-    {50u, B50},         {75u, B75},         {110u, B110},       {134u, B134},
-    {150u, B150},       {200u, B200},       {300u, B300},       {600u, B600},
-    {1200u, B1200},     {1800u, B1800},     {2400u, B2400},     {4800u, B4800},
-    {9600u, B9600},     {19200u, B19200},   {38400u, B38400},
+    {50u, B50},           {75u, B75},     {110u, B110},   {134u, B134},     {150u, B150},
+    {200u, B200},         {300u, B300},   {600u, B600},   {1200u, B1200},   {1800u, B1800},
+    {2400u, B2400},       {4800u, B4800}, {9600u, B9600}, {19200u, B19200}, {38400u, B38400},
 #ifdef B57600
     {57600u, B57600},
 #endif
@@ -99,14 +98,11 @@ static int map_open_errno(int e)
     case ENXIO:
     case ENODEV:
     case ENOTDIR:
-    case ENOTTY:
-        return TASE_ENODEV;
+    case ENOTTY: return TASE_ENODEV;
     case EACCES:
     case EPERM:
-    case EROFS:
-        return TASE_EACCES;
-    default:
-        return TASE_EIO;
+    case EROFS: return TASE_EACCES;
+    default: return TASE_EIO;
     }
 }
 
@@ -120,8 +116,8 @@ static int configure(int fd, speed_t code)
     if (tcgetattr(fd, &t) != 0) {
         return map_open_errno(errno);
     }
-    t.c_iflag &= ~(tcflag_t)(IGNBRK | BRKINT | PARMRK | ISTRIP | INLCR | IGNCR | ICRNL |
-                             IXON | IXOFF | IXANY | INPCK);
+    t.c_iflag &= ~(tcflag_t)(IGNBRK | BRKINT | PARMRK | ISTRIP | INLCR | IGNCR | ICRNL | IXON |
+                             IXOFF | IXANY | INPCK);
     t.c_oflag &= ~(tcflag_t)OPOST;
     t.c_lflag &= ~(tcflag_t)(ECHO | ECHOE | ECHOK | ECHONL | ICANON | ISIG | IEXTEN);
     t.c_cflag &= ~(tcflag_t)(CSIZE | PARENB | CSTOPB);

@@ -36,7 +36,7 @@ extern "C" {
 #define TASE_POSIX_UART_WRITE_TIMEOUT_MS 1000u
 
 typedef struct {
-    int fd;                    /* -1 when closed */
+    int fd; /* -1 when closed */
     uint32_t baud;
     uint32_t write_timeout_ms; /* may be changed after open */
 } tase_posix_uart_t;

@@ -64,15 +64,15 @@ extern "C" {
 #define TASE_SOCKETCAN_SET_FILTER 0x2u /* install the role's CAN_RAW_FILTER */
 
 typedef struct {
-    uint32_t frames_rx;       /* frames read from the socket */
-    uint32_t frames_tx;       /* frames written */
-    uint32_t bytes_rx;        /* datalink payload bytes returned by read() */
-    uint32_t frames_ignored;  /* outside the role's ID set (dropped) */
-    uint32_t bad_frames;      /* wrong size, remote/error frames, bad dlc */
-    uint32_t side_dropped;    /* side-queue overflow */
-    uint32_t tx_retries;      /* EAGAIN/ENOBUFS retried */
-    uint32_t tx_full;         /* writes that ran out of time (TASE_ENOBUFS or short) */
-    int last_errno;           /* errno of the last TASE_EIO */
+    uint32_t frames_rx;      /* frames read from the socket */
+    uint32_t frames_tx;      /* frames written */
+    uint32_t bytes_rx;       /* datalink payload bytes returned by read() */
+    uint32_t frames_ignored; /* outside the role's ID set (dropped) */
+    uint32_t bad_frames;     /* wrong size, remote/error frames, bad dlc */
+    uint32_t side_dropped;   /* side-queue overflow */
+    uint32_t tx_retries;     /* EAGAIN/ENOBUFS retried */
+    uint32_t tx_full;        /* writes that ran out of time (TASE_ENOBUFS or short) */
+    int last_errno;          /* errno of the last TASE_EIO */
 } tase_socketcan_stats_t;
 
 /* Instance; every field but `stats` and `tx_timeout_ms` is private. */
