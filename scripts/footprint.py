@@ -176,6 +176,66 @@ def met(value, target):
     return "met" if value <= target else "**missed** (+%d)" % (value - target)
 
 
+def contributors(obj, n=4):
+    """The n largest functions/constants of an object file (name, bytes)."""
+    syms = []
+    for line in run(["arm-none-eabi-nm", "-S", "--size-sort", "--defined-only", obj]).splitlines():
+        parts = line.split()
+        if len(parts) == 4 and parts[2] in "tTrRdD":
+            syms.append((parts[3], int(parts[1], 16)))
+    return sorted(syms, key=lambda x: -x[1])[:n]
+
+
+def firmware_image(out):
+    """Build examples/firmware (Cortex-M3) and measure the ELF: totals from
+    arm-none-eabi-size, the library's share per object from the link map,
+    and (when QEMU is there) the stack high-water mark the image prints."""
+    bdir = os.path.join(out, "firmware")
+    run(["cmake", "-S", os.path.join(ROOT, "examples", "firmware"), "-B", bdir,
+         "-DCMAKE_TOOLCHAIN_FILE=" + os.path.join(ROOT, "cmake", "arm-none-eabi.cmake"),
+         "-DTASE_CPU=cortex-m3"])
+    run(["cmake", "--build", bdir, "-j2"])
+    elf = os.path.join(bdir, "tase_gimbal.elf")
+    text, data, bss = berkeley(elf)
+    # Link map: input sections kept in the image, by archive member.
+    share = {}
+    pending = None
+    for line in open(os.path.join(bdir, "tase_gimbal.map")):
+        if line.startswith("Linker script and memory map"):
+            share.clear()
+            pending = None
+        m = re.match(r"^ (\.(?:text|rodata|data|bss)\S*)\s*$", line)
+        if m:
+            pending = m.group(1)
+            continue
+        m = re.match(r"^ (\.(?:text|rodata|data|bss)\S*)?\s+0x([0-9a-f]+)\s+0x([0-9a-f]+)\s+(\S+)$",
+                     line)
+        if m and (m.group(1) or pending):
+            path = m.group(4)
+            a = re.search(r"(libtase(?:_bm)?\.a)\((\w+)\.c\.obj\)", path)
+            if a:
+                key = "%s %s" % (a.group(1), a.group(2))
+            elif "tase_gimbal.elf.dir" in path:
+                key = "application (startup.c, main.c, gimbal.c)"
+            else:
+                key = "newlib, libgcc (printf, semihosting, memcpy, ...)"
+            sec = m.group(1) or pending
+            kind = "ram" if sec.startswith((".data", ".bss")) else "flash"
+            share.setdefault(key, {"flash": 0, "ram": 0})[kind] += int(m.group(3), 16)
+        pending = None
+    stack = None
+    try:
+        o = subprocess.run(["qemu-system-arm", "-M", "mps2-an385", "-nographic", "-monitor",
+                            "none", "-icount", "shift=5,sleep=off", "-semihosting-config",
+                            "enable=on,target=native", "-kernel", elf],
+                           capture_output=True, text=True, timeout=120).stdout
+        m = re.search(r"\+ (\d+) B stack used", o)
+        stack = int(m.group(1)) if m else None
+    except (OSError, subprocess.TimeoutExpired):
+        pass
+    return {"text": text, "data": data, "bss": bss, "share": share, "stack": stack}
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "FOOTPRINT.md"))
@@ -183,6 +243,7 @@ def main():
     args = ap.parse_args()
     os.makedirs(args.build, exist_ok=True)
 
+    img = firmware_image(args.build)
     res = {}
     for cpu in CPUS:
         bdir, objs = build(cpu, args.build)
@@ -199,6 +260,8 @@ def main():
         res[cpu] = {
             "mods": mods,
             "rx": linked_size(cpu, objs.values(), rx_roots, args.build),
+            "rx_frame": linked_size(cpu, objs.values(),
+                                    ["tase_rx_init", "tase_rx_feed", "tase_rx_flush"], args.build),
             "core": linked_size(cpu, core, roots_core, args.build),
             "core_float": linked_size(cpu, core, roots_all, args.build),
             "rest": linked_size(cpu, list(objs.values()), roots_rest, args.build)
@@ -296,18 +359,96 @@ def main():
     p("")
     frame_max = m4["types"][1]
     stats = types.get("tase_rx_stats_t", 0)
-    p("Why the receiver is %d bytes, not 272: its window holds one whole frame "
-      "(TASE_FRAME_MAX = %d bytes) so that a frame is delivered as one contiguous view with zero "
-      "added latency; the statistics are %d bytes of 32-bit counters (%d of them: 8-bit "
-      "counters that overflow are what STYLE.md tells us to avoid); the remaining %d bytes are the "
-      "bookkeeping of TASE_RX_CANDIDATES overlapping candidates (6 bytes each) plus indices and "
-      "padding. The window alone leaves %d bytes under the 272 target. Without the counters "
-      "in the instance the receiver would be about %d bytes; with TASE_RX_CANDIDATES=1 as well, "
-      "about %d. "
-      "The lead's design note in include/tase/frame.h accepts 328 as the budget "
-      "(TASE_RX_SIZE_BUDGET)." % (rxsz, frame_max, stats, stats // 4, rxsz - frame_max - stats,
-                                  TARGET_RX_RAM - frame_max, rxsz - stats, rxsz - stats - 18))
+    mods4 = m4["mods"]
+    fl = lambda m: mods4[m][0] + mods4[m][1] if m in mods4 else 0
+    top = {m: contributors(o) for m, o in m4["objs"].items()}
+    biggest = lambda m, k=2: ", ".join("`%s` %d" % x for x in top.get(m, [])[:k])
+    p("### Gaps and their reasons (Cortex-M4)")
     p("")
+    rx_gap = m4["rx"][0] - TARGET_RX_FLASH
+    p("- **Receive path flash, %d B against 1024 (%s).** Framing alone links to %d B: the "
+      "zero-latency receiver tracks up to TASE_RX_CANDIDATES overlapping candidate frames "
+      "(a corrupted Size cannot swallow the frames behind it, no re-scan latency), delivers "
+      "frames in place from the caller's buffer, skips idle bytes with memchr and copies in "
+      "runs, and re-scans its window when more candidates overlap than it tracks; that "
+      "machinery and its fast paths are the ~2 KB (largest symbols: %s). A classic "
+      "single-state parser would be smaller but loses the frames behind a corrupted Size "
+      "or re-scans after each failure; we chose zero latency and ~9 instructions per byte "
+      "(docs/PERFORMANCE.md) over the 1 KB. Dispatch adds %d B: the generic decoder of the "
+      "codec (largest symbols of codec.c: %s) and the schema's ROM tables and lookup "
+      "(schema.c: %s), which describe every packet of the spec once." % (
+          m4["rx"][0], "met" if rx_gap <= 0 else "+%d" % rx_gap, m4["rx_frame"][0],
+          biggest("frame", 3), m4["rx"][0] - m4["rx_frame"][0], biggest("codec"),
+          biggest("schema")))
+    core_gap = m4["core"][0] - TARGET_CORE_FLASH
+    p("- **Whole core flash, %d B against 4096 (%s).** By module (object file, everything "
+      "compiled in): %s. Framing is the ~2 KB above; KLV (the MISB ST 0601 "
+      "metadata encoder, decoder and stream receiver) is the other large one; the schema is the ROM description of all 21 packets and their fields that the "
+      "codec, dispatcher and tools share." % (
+          m4["core"][0], "met" if core_gap <= 0 else "+%d" % core_gap,
+          ", ".join("%s %d" % (m, fl(m)) for m in sorted(CORE_MODULES, key=lambda x: -fl(x))
+                    if m in mods4)))
+    p("- **RAM per receiver, %d B against 272 (%s).** 272 is impossible with 32-bit "
+      "counters in the instance (docs/DESIGN.md, \"RAM: why not 272 bytes\"): a maximal "
+      "frame is %d bytes, and even a receiver that keeps only Group, PktType and the data "
+      "holds 255, leaving nothing for 32-bit counters. Ours: the %d-byte window (one whole "
+      "frame, delivered as one contiguous view with zero added latency), %d bytes of "
+      "counters (%d of them), and %d bytes of candidate bookkeeping, indices and padding. "
+      "Without the counters it would be about %d bytes; with TASE_RX_CANDIDATES=1 as well, "
+      "about %d. include/tase/frame.h sets the budget at 328 (TASE_RX_SIZE_BUDGET)." % (
+          rxsz, "met" if rxsz <= TARGET_RX_RAM else "+%d" % (rxsz - TARGET_RX_RAM), frame_max,
+          frame_max, stats, stats // 4, rxsz - frame_max - stats, rxsz - stats,
+          rxsz - stats - 18))
+    st4 = rx_stack("cortex-m4")[0]
+    p("- **Receive path stack, %d B against 128 (%s)**, plus the application's handler." % (
+        st4, met(st4, TARGET_RX_STACK)))
+    p("")
+    p("### Biggest contributors per module (Cortex-M4, `arm-none-eabi-nm --size-sort`)")
+    p("")
+    p("| module | flash | largest symbols (bytes) |")
+    p("|---|---:|---|")
+    for m in sorted(mods4, key=lambda x: -fl(x)):
+        p("| %s | %d | %s |" % (m, fl(m), biggest(m, 4)))
+    p("")
+    if img is not None:
+        p("## The example firmware image (Cortex-M3, QEMU mps2-an385)")
+        p("")
+        p("`examples/firmware` linked with `--gc-sections` (`arm-none-eabi-size` of "
+          "`tase_gimbal.elf`; the share of each object from the link map). It uses the receiver, "
+          "the dispatcher with typed decode, the typed encoder, the gimbal role and the "
+          "bare-metal ring/UART port; everything else is semihosting and newlib's printf, "
+          "which a real firmware would not carry.")
+        p("")
+        p("| | bytes |")
+        p("|---|---:|")
+        p("| flash (text + rodata + data) | %d |" % (img["text"] + img["data"]))
+        p("| RAM, static (data + bss) | %d |" % (img["data"] + img["bss"]))
+        if img["stack"] is not None:
+            p("| stack high-water mark measured by the image under QEMU (main loop + SysTick "
+              "interrupt, before printf) | %d |" % img["stack"])
+        p("")
+        p("| part | flash | static RAM |")
+        p("|---|---:|---:|")
+        lib = [k for k in img["share"] if k.startswith("libtase.a")]
+        port = [k for k in img["share"] if k.startswith("libtase_bm.a")]
+        for k in sorted(lib) + sorted(port):
+            p("| %s | %d | %d |" % (k, img["share"][k]["flash"], img["share"][k]["ram"]))
+        p("| **library total (libtase.a)** | %d | %d |" % (
+            sum(img["share"][k]["flash"] for k in lib), sum(img["share"][k]["ram"] for k in lib)))
+        p("| **bare-metal port total (libtase_bm.a)** | %d | %d |" % (
+            sum(img["share"][k]["flash"] for k in port),
+            sum(img["share"][k]["ram"] for k in port)))
+        for k in sorted(img["share"]):
+            if k not in lib and k not in port:
+                p("| %s | %d | %d |" % (k, img["share"][k]["flash"], img["share"][k]["ram"]))
+        p("")
+        p("The library has no static data: its RAM is the instances the application owns "
+          "(two tase_rx_t of %d B, the host-side one only for the self-check; a "
+          "tase_gimbal_t of %d B, which carries three receivers of its own that this image "
+          "leaves unused because it feeds its own receiver through the dispatcher; a "
+          "tase_dispatch_t of %d B)." % (rxsz, types.get("tase_gimbal_t", 0),
+                                         types.get("tase_dispatch_t", 0)))
+        p("")
     p("## sizeof of the public types")
     p("")
     p("| header | type | " + " | ".join(CPUS) + " |")

@@ -1,160 +1,199 @@
-/* The gimbal's behaviour: setup echo, commands, telemetry. */
+/* The gimbal application: typed handlers, error hook, default handler,
+ * and the callbacks of the library's gimbal role. */
 #include "gimbal.h"
 
 #include <string.h>
 
-#include "tase/ids.h"
-
 /* Software 0.1.0 released 2024-05-17; board fields zero; camera A type 3
  * with 40.00..2.00 degrees of field of view; no cameras B and C. */
-static const uint8_t version_info[GIMBAL_VERSION_LEN] = {
+static const uint8_t version_info[42] = {
     0, 1, 0, 1, 0x07, 0xE8, 5,    17,   0,    0,    0, 0, 0, 0, 0, 0,    0, 0, 0, 0, 0,
     0, 0, 0, 3, 0,    0x0F, 0xA0, 0x00, 0xC8, 0xFF, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0,
 };
 
-static void put16(uint8_t *p, int32_t v)
-{
-    p[0] = (uint8_t)(((uint32_t)v >> 8) & 0xFFu);
-    p[1] = (uint8_t)((uint32_t)v & 0xFFu);
-}
-
-static void put32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)(v >> 24);
-    p[1] = (uint8_t)(v >> 16);
-    p[2] = (uint8_t)(v >> 8);
-    p[3] = (uint8_t)v;
-}
-
 int16_t gimbal_sim_pan(uint32_t t)
 {
-    return (int16_t)(int32_t)((t * 3u) & 0x7FFFu);
+    return (int16_t)(t * 3u % 18000u);
 }
 
 int16_t gimbal_sim_tilt(uint32_t t)
 {
-    return (int16_t) - (int32_t)(t & 0x3FFFu);
+    return (int16_t) - (int32_t)(t % 9000u);
 }
 
-void gimbal_init(gimbal_t *g, gimbal_tx_t tx, void *tx_user)
+static void trace(gimbal_app_t *app, const tase_frame_t *f, unsigned route, const int64_t *v,
+                  size_t n)
 {
-    static const uint8_t default_rates[GIMBAL_RATES_LEN] = {10, 10, 4,  0,  0, 10, 10, 4,
-                                                            0,  0,  10, 10, 4, 0,  0,  0};
-    memset(g, 0, sizeof(*g));
-    memcpy(g->rates, default_rates, sizeof(g->rates));
-    g->filter[0] = 100; /* 10 Hz cutoff */
-    g->filter[1] = 5;   /* 0.5 deg/s decimation */
-    g->tx = tx;
-    g->tx_user = tx_user;
-}
-
-static void send(gimbal_t *g, uint16_t id, const uint8_t *data, size_t len)
-{
-    uint8_t out[TASE_FRAME_MAX];
-    int n = tase_frame_encode(out, sizeof(out), TASE_ID_GROUP(id), TASE_ID_TYPE(id), data, len);
-    if (n < 0 || g->tx(g->tx_user, out, (size_t)n) != n) {
-        g->tx_errors++;
+    if (app->trace != NULL) {
+        app->trace(app->trace_user, f, route, v, n);
     }
 }
 
-/* A setup packet with data stores it; with or without data the gimbal
- * answers with its current settings (spec 4.4: "each of these packets can
- * be sent as zero length in order to query the current settings"). */
-static void on_setting(gimbal_t *g, uint16_t id, uint8_t *store, size_t size, const tase_frame_t *f)
+static void on_gimbal_cmd(void *user, const tase_frame_t *f, const void *msg)
 {
-    if (f->len != 0u && f->len != size) {
-        g->wrong_length++;
-        return;
-    }
-    if (f->len == size && store != NULL) {
-        memcpy(store, f->data, size);
-    }
-    send(g, id, store != NULL ? store : version_info, size);
-    g->replies++;
+    gimbal_app_t *app = user;
+    const tase_gimbal_cmd_t *m = msg;
+    int64_t v[5];
+    v[0] = m->pan;
+    v[1] = m->tilt;
+    v[2] = m->roll;
+    v[3] = m->flags;
+    v[4] = m->impulse_time;
+    app->cmd_pan = m->pan;
+    app->cmd_tilt = m->tilt;
+    app->cmd_flags = m->flags;
+    app->commands++;
+    trace(app, f, GIMBAL_ROUTE_TYPED, v, 5u);
 }
 
-static void on_gimbal_cmd(gimbal_t *g, const tase_frame_t *f)
+static void on_gyro_zero(void *user, const tase_frame_t *f, const void *msg)
 {
-    if (f->len != 8u) {
-        g->wrong_length++;
-        return;
-    }
-    g->cmd_pan = (int16_t)(int32_t)(((uint32_t)f->data[0] << 8) | f->data[1]);
-    g->cmd_tilt = (int16_t)(int32_t)(((uint32_t)f->data[2] << 8) | f->data[3]);
-    g->cmd_flags = f->data[6];
-    g->commands++;
+    gimbal_app_t *app = user;
+    (void)msg; /* NULL: GYRO_ZERO_CMD has no data */
+    app->gyro_zeros++;
+    trace(app, f, GIMBAL_ROUTE_TYPED, NULL, 0u);
 }
 
-/* PLUG-IN POINT for typed dispatch. Today this switch on the raw
- * (group, type) is the dispatcher and the handlers read bytes. When the
- * dispatch/codec modules are merged, register on_gimbal_cmd/on_setting as
- * handlers in a tase dispatch table (with typed structs from the codec),
- * make the dispatcher's frame handler the one main.c passes to
- * tase_rx_feed(), and let its default handler count `ignored` and its
- * error hook count `wrong_length`. */
-void gimbal_on_frame(void *user, const tase_frame_t *f)
+static void on_host_attitude(void *user, const tase_frame_t *f, const void *msg)
 {
-    gimbal_t *g = user;
-    uint16_t id = TASE_ID(f->group, f->type);
-    switch (id) {
-    case TASE_ID_GIMBAL_CMD: on_gimbal_cmd(g, f); break;
-    case TASE_ID_GYRO_ZERO_CMD:
-        if (f->len == 0u) {
-            g->gyro_zeros++;
-        } else {
-            g->wrong_length++;
+    gimbal_app_t *app = user;
+    const tase_host_attitude_t *m = msg;
+    int64_t v[6];
+    v[0] = m->time;
+    v[1] = m->roll;
+    v[2] = m->pitch;
+    v[3] = m->yaw;
+    v[4] = m->flags;
+    v[5] = m->sample_rate;
+    app->host_attitudes++;
+    trace(app, f, GIMBAL_ROUTE_TYPED, v, 6u);
+}
+
+/* Every setup packet: show the decoded fields, then let the library's
+ * gimbal role store, answer and reschedule. */
+static void on_setup(void *user, const tase_frame_t *f, const void *msg)
+{
+    gimbal_app_t *app = user;
+    int64_t v[GIMBAL_TRACE_MAX];
+    size_t n = 0;
+
+    if (f->type == TASE_ID_TYPE(TASE_ID_PACKET_RATE)) {
+        const tase_packet_rate_t *m = msg;
+        const uint8_t r[13] = {m->angle_1,   m->rate_1,    m->geo_ref_1, m->camera_1, m->angle_2,
+                               m->rate_2,    m->geo_ref_2, m->camera_2,  m->angle_3,  m->rate_3,
+                               m->geo_ref_3, m->camera_3,  m->temporary};
+        for (n = 0; n < sizeof r; n++) {
+            v[n] = r[n];
         }
-        break;
-    case TASE_ID_PACKET_RATE: on_setting(g, id, g->rates, sizeof(g->rates), f); break;
-    case TASE_ID_SENSOR_FILTER: on_setting(g, id, g->filter, sizeof(g->filter), f); break;
-    case TASE_ID_NAV_SOURCE: on_setting(g, id, g->nav, sizeof(g->nav), f); break;
-    case TASE_ID_SYSTEM_VERSION: on_setting(g, id, NULL, GIMBAL_VERSION_LEN, f); break;
-    default: g->ignored++; break;
+    } else if (f->type == TASE_ID_TYPE(TASE_ID_SENSOR_FILTER)) {
+        const tase_sensor_filter_t *m = msg;
+        v[0] = m->cutoff;
+        v[1] = m->decimation;
+        n = 2;
+    } else if (f->type == TASE_ID_TYPE(TASE_ID_NAV_SOURCE)) {
+        const tase_nav_source_t *m = msg;
+        v[0] = m->external_attitude;
+        v[1] = m->external_gps;
+        n = 2;
+    }
+    app->setups++;
+    trace(app, f, GIMBAL_ROUTE_TYPED, v, n);
+    (void)tase_gimbal_handle_frame(&app->role, 0, f, app->now_ms);
+}
+
+static void on_length_error(void *user, const tase_frame_t *f, int err)
+{
+    gimbal_app_t *app = user;
+    if (err == TASE_ELENGTH) {
+        app->length_errors++;
+        trace(app, f, GIMBAL_ROUTE_ERROR, NULL, 0u);
     }
 }
 
-static void send_telemetry(gimbal_t *g, unsigned which, uint32_t t)
+static void on_unknown(void *user, const tase_frame_t *f)
 {
-    uint8_t d[63];
-    size_t i;
-    switch (which) {
-    case 0: /* GIMBAL_ANGLE: pan, tilt, roll */
-        put16(&d[0], gimbal_sim_pan(t));
-        put16(&d[2], gimbal_sim_tilt(t));
-        put16(&d[4], 0);
-        send(g, TASE_ID_GIMBAL_ANGLE, d, 6u);
-        break;
-    case 1: /* GIMBAL_RATE: time, axis rates, body rates, reserved, mode */
-        memset(d, 0, 18u);
-        put32(&d[0], t);
-        put16(&d[4], 300);
-        put16(&d[6], -100);
-        d[17] = (uint8_t)(0x80u | (g->cmd_flags & 0x20u ? 0x08u : 0u));
-        send(g, TASE_ID_GIMBAL_RATE, d, 18u);
-        break;
-    default: /* GEOREFERENCE_DATA: time, then a pattern standing in for
-              * position and camera geometry */
-        put32(&d[0], t);
-        for (i = 4u; i < sizeof(d); i++) {
-            d[i] = (uint8_t)(i + t);
-        }
-        send(g, TASE_ID_GEOREFERENCE_DATA, d, sizeof(d));
-        break;
-    }
-    g->telemetry++;
+    gimbal_app_t *app = user;
+    app->unknown++;
+    trace(app, f, GIMBAL_ROUTE_DEFAULT, NULL, 0u);
 }
 
-void gimbal_poll(gimbal_t *g, uint32_t now_ms)
+/* In ROM: one entry per packet of the schema, NULL sends a packet to the
+ * default handler. */
+static const tase_packet_handler_t handlers[TASE_PKT_COUNT] = {
+    [TASE_PKT_GIMBAL_CMD] = on_gimbal_cmd,       [TASE_PKT_GYRO_ZERO_CMD] = on_gyro_zero,
+    [TASE_PKT_HOST_ATTITUDE] = on_host_attitude, [TASE_PKT_PACKET_RATE] = on_setup,
+    [TASE_PKT_SENSOR_FILTER] = on_setup,         [TASE_PKT_AXIS_SETTING] = on_setup,
+    [TASE_PKT_SYSTEM_VERSION] = on_setup,        [TASE_PKT_NAV_SOURCE] = on_setup,
+    [TASE_PKT_CAMERA_TYPE] = on_setup,           [TASE_PKT_GPS_LEVER_ARM] = on_setup,
+    [TASE_PKT_CAMERA_ALIGN] = on_setup,
+};
+
+/* The role calls this when a telemetry packet is due: fill its typed
+ * struct and let the codec lay out the bytes. */
+static int fill_telemetry(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
+                          uint32_t now_ms)
 {
-    unsigned k;
-    for (k = 0; k < 3u; k++) {
-        uint8_t rate = g->rates[k]; /* external port 1 */
-        if (rate == 0u) {
-            continue;
+    gimbal_app_t *app = user;
+    tase_packet_msg_t m;
+    uint8_t frame[TASE_FRAME_OVERHEAD + 63u];
+    int n;
+
+    (void)port;
+    memset(&m, 0, sizeof m);
+    if (id == TASE_ID_GIMBAL_ANGLE) {
+        m.gimbal_angle.pan = gimbal_sim_pan(now_ms);
+        m.gimbal_angle.tilt = gimbal_sim_tilt(now_ms);
+    } else if (id == TASE_ID_GIMBAL_RATE) {
+        m.gimbal_rate.time = now_ms;
+        m.gimbal_rate.pan_rate = app->cmd_pan;
+        m.gimbal_rate.tilt_rate = app->cmd_tilt;
+        m.gimbal_rate.mode = app->cmd_flags; /* stands in for the mode byte */
+    } else if (id == TASE_ID_GEOREFERENCE_DATA) {
+        uint8_t rates[16];
+        m.georeference.time = now_ms;
+        m.georeference.lat = (int32_t)(now_ms * 1000u);
+        m.georeference.lon = -(int32_t)(now_ms * 2000u);
+        m.georeference.height = 12345;
+        m.georeference.pan = gimbal_sim_pan(now_ms);
+        m.georeference.tilt = gimbal_sim_tilt(now_ms);
+        if (tase_gimbal_setup_get(&app->role, 0, rates, sizeof rates) == 16) {
+            m.georeference.sample_rate = rates[2];
         }
-        while ((int32_t)(now_ms - g->next_due[k]) >= 0) {
-            send_telemetry(g, k, g->next_due[k]);
-            g->next_due[k] += 1000u / rate;
-        }
+        m.georeference.hfov = 4000u;
+    } else {
+        return TASE_EUNKNOWN;
     }
+    n = tase_packet_encode(id, &m, frame, sizeof frame);
+    if (n < (int)TASE_FRAME_OVERHEAD || (size_t)n - TASE_FRAME_OVERHEAD > cap) {
+        app->encode_errors++;
+        return n < 0 ? n : TASE_ENOSPC;
+    }
+    n -= (int)TASE_FRAME_OVERHEAD;
+    memcpy(data, &frame[TASE_FRAME_HEADER], (size_t)n);
+    return n;
+}
+
+int gimbal_app_init(gimbal_app_t *app, const tase_port_t *port, tase_rx_stats_t *stats,
+                    gimbal_trace_t trace_fn, void *trace_user, uint32_t now_ms)
+{
+    tase_gimbal_app_t cb;
+    int r;
+
+    memset(app, 0, sizeof *app);
+    app->trace = trace_fn;
+    app->trace_user = trace_user;
+    app->now_ms = now_ms;
+    r = tase_dispatch_init(&app->dispatch, handlers, on_unknown, on_length_error, app, stats);
+    if (r < 0) {
+        return r;
+    }
+    memset(&cb, 0, sizeof cb);
+    cb.fill_telemetry = fill_telemetry; /* apply_setup NULL: accept every setting */
+    cb.user = app;
+    r = tase_gimbal_init(&app->role, port, 1u, &cb, now_ms);
+    if (r < 0) {
+        return r;
+    }
+    return tase_gimbal_setup_set(&app->role, TASE_ID_TYPE(TASE_ID_SYSTEM_VERSION), version_info,
+                                 sizeof version_info, now_ms);
 }

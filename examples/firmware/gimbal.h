@@ -1,60 +1,68 @@
 /*
- * gimbal.h - the gimbal side of the example firmware: what a TASE gimbal
- * does with the frames it receives, and the telemetry it sends.
+ * gimbal.h - the application of the example firmware: what this gimbal
+ * does with the packets it receives, built from the library's pieces.
  *
- * Board-independent: frames come in through gimbal_on_frame() (a
- * tase_rx_handler_t), bytes go out through a transmit function, time comes
- * in as milliseconds. The same code would run on a real Cortex-M with a
- * real UART.
+ *  - tase_dispatch_t with a static const handler table (ROM): typed
+ *    handlers for GIMBAL_CMD, GYRO_ZERO_CMD, HOST_ATTITUDE and the eight
+ *    setup packets; wrong-length frames go to the error hook, packets the
+ *    schema does not know to the default handler.
+ *  - tase_gimbal_t, the library's gimbal role, on one port: the setup
+ *    handler hands each setup frame to it, and it answers queries and
+ *    echoes settings; tase_gimbal_poll() sends GIMBAL_ANGLE, GIMBAL_RATE
+ *    and GEOREFERENCE_DATA at the rates of PACKET_RATE, their contents
+ *    written by the fill_telemetry callback through the typed encoder.
+ *
+ * Board-independent: the board (main.c) gives the port the role writes
+ * to, feeds frames to tase_dispatch_frame() with &app->dispatch, sets
+ * app->now_ms and polls. A trace hook shows the self-checks every frame
+ * and how it was routed.
  */
 #ifndef GIMBAL_H
 #define GIMBAL_H
 
-#include "tase/frame.h"
+#include "tase/codec.h"
+#include "tase/dispatch.h"
+#include "tase/gimbal.h"
 
-/* Transmit a complete frame. Returns n or a negative TASE_E* code. */
-typedef int (*gimbal_tx_t)(void *user, const uint8_t *data, size_t n);
+/* How a received frame reached the application (stream.h ROUTE_*). */
+#define GIMBAL_ROUTE_TYPED 0u
+#define GIMBAL_ROUTE_ERROR 1u
+#define GIMBAL_ROUTE_DEFAULT 2u
+#define GIMBAL_TRACE_MAX 13u /* most decoded values passed to the trace */
 
-#define GIMBAL_RATES_LEN 16u   /* PACKET_RATE (spec 4.4.1) */
-#define GIMBAL_FILTER_LEN 2u   /* SENSOR_FILTER (4.4.2) */
-#define GIMBAL_NAV_LEN 2u      /* NAV_SOURCE (4.4.5) */
-#define GIMBAL_VERSION_LEN 42u /* SYSTEM_VERSION (4.4.4), read only */
+/* Called for every received frame: its route and, for a typed frame, the
+ * decoded fields in the spec's order (n values). */
+typedef void (*gimbal_trace_t)(void *user, const tase_frame_t *frame, unsigned route,
+                               const int64_t *values, size_t n);
 
 typedef struct {
-    /* Settings the setup group reads and writes (persistent on a real
-     * gimbal; RAM here). */
-    uint8_t rates[GIMBAL_RATES_LEN];
-    uint8_t filter[GIMBAL_FILTER_LEN];
-    uint8_t nav[GIMBAL_NAV_LEN];
+    tase_gimbal_t role;       /* library: setup echo/query, telemetry */
+    tase_dispatch_t dispatch; /* library: typed dispatch */
+    uint32_t now_ms;          /* set by the main loop before feeding */
     /* Last GIMBAL_CMD. */
     int16_t cmd_pan;
     int16_t cmd_tilt;
     uint8_t cmd_flags;
     /* Counters. */
-    uint32_t commands;     /* GIMBAL_CMD accepted */
-    uint32_t gyro_zeros;   /* GYRO_ZERO_CMD accepted */
-    uint32_t replies;      /* setup echoes sent */
-    uint32_t telemetry;    /* telemetry frames sent */
-    uint32_t ignored;      /* valid frames this gimbal does not act on */
-    uint32_t wrong_length; /* known packet with a length it cannot have */
-    uint32_t tx_errors;    /* encode or transmit failures */
-    /* Telemetry schedule: next due time of ANGLE, RATE, GEOREFERENCE. */
-    uint32_t next_due[3];
-    gimbal_tx_t tx;
-    void *tx_user;
-} gimbal_t;
+    uint32_t commands;       /* GIMBAL_CMD */
+    uint32_t gyro_zeros;     /* GYRO_ZERO_CMD */
+    uint32_t host_attitudes; /* HOST_ATTITUDE */
+    uint32_t setups;         /* setup packets handed to the role */
+    uint32_t length_errors;  /* error hook calls */
+    uint32_t unknown;        /* default handler calls */
+    uint32_t encode_errors;  /* telemetry the typed encoder refused */
+    gimbal_trace_t trace;
+    void *trace_user;
+} gimbal_app_t;
 
-/* Factory settings, nothing sent yet, telemetry due from time 0. */
-void gimbal_init(gimbal_t *g, gimbal_tx_t tx, void *tx_user);
+/* Set up the dispatcher (its counters go to *stats, usually &rx.stats) and
+ * the gimbal role on `port` with SYSTEM_VERSION filled in, anchored at
+ * now_ms. Returns TASE_OK or the library's error code. */
+int gimbal_app_init(gimbal_app_t *app, const tase_port_t *port, tase_rx_stats_t *stats,
+                    gimbal_trace_t trace, void *trace_user, uint32_t now_ms);
 
-/* Receive handler: act on one valid frame (user is the gimbal_t). */
-void gimbal_on_frame(void *user, const tase_frame_t *frame);
-
-/* Send every telemetry frame due at or before now_ms. */
-void gimbal_poll(gimbal_t *g, uint32_t now_ms);
-
-/* Telemetry contents are a function of the scheduled time t (ms), so a
- * receiver can check them: pan = 3t, tilt = -t (1/100 degree, wrapping). */
+/* Telemetry contents are functions of the poll time t (ms) so that a
+ * receiver can check them: pan = 3t mod 18000, tilt = -(t mod 9000). */
 int16_t gimbal_sim_pan(uint32_t t);
 int16_t gimbal_sim_tilt(uint32_t t);
 

@@ -66,6 +66,90 @@ def model(stream):
     return out, csum_err, bad_size, len(stream) - len(covered), overlap
 
 
+# ---- what the gimbal application does (examples/firmware/gimbal.c), as a
+# model: which frames it gets and how, what it answers, what telemetry it
+# sends when. Written from the spec's tables (4.1 .. 4.4), not from src/.
+
+BYTES_PER_TICK = 12  # the simulated UART interrupt delivers 12 bytes per 1 ms tick
+RUN_MS = 1000        # the main loop polls the gimbal at t = 1 .. RUN_MS
+
+# Big-endian layouts of the packets in the stream (spec tables 5, 14, 20,
+# 21, 24): one letter per field, x = reserved byte.
+LAYOUT = {
+    (0x00, 0x80): ("hhhBB", 8),             # GIMBAL_CMD
+    (0x00, 0x40): ("", 0),                  # GYRO_ZERO_CMD
+    (0x08, 0x42): ("IhhhBB", 12),           # HOST_ATTITUDE
+    (0x48, 0x00): ("BBBBxBBBBxBBBBxB", 16),  # PACKET_RATE
+    (0x48, 0x01): ("BB", 2),                # SENSOR_FILTER
+    (0x48, 0x03): (None, 42),               # SYSTEM_VERSION (queried only)
+    (0x48, 0x04): ("BB", 2),                # NAV_SOURCE
+}
+QUERYABLE = {(0x48, t) for t in range(8)}
+ROUTE_TYPED, ROUTE_ERROR, ROUTE_DEFAULT = 0, 1, 2
+
+
+def fields(fmt, data):
+    out, i = [], 0
+    for c in fmt:
+        w = {"B": 1, "h": 2, "I": 4, "x": 1}[c]
+        v = int.from_bytes(bytes(data[i:i + w]), "big", signed=(c == "h"))
+        i += w
+        if c != "x":
+            out.append(v)
+    assert i == len(data)
+    return out
+
+
+def route(group, ptype, n):
+    if (group, ptype) not in LAYOUT:
+        return ROUTE_DEFAULT
+    if n == LAYOUT[(group, ptype)][1] or (n == 0 and (group, ptype) in QUERYABLE):
+        return ROUTE_TYPED
+    return ROUTE_ERROR
+
+
+def sim_pan(t):
+    return (3 * t) % 18000
+
+
+def sim_tilt(t):
+    return -(t % 9000)
+
+
+def telemetry(events):
+    """Per-millisecond model of the gimbal role's schedule (gimbal.h,
+    SCHEDULE): a stream anchored at a with rate r sends slot n >= 1 at
+    a + floor(n * 1000 / r). The main loop polls at t, then handles the
+    frames whose last byte arrived in tick t, so a change made at tick t
+    counts from the poll at t + 1. Rate changes re-anchor at t; unchanged
+    streams keep their phase."""
+    rates = [10, 10, 4]
+    anchor, nxt = [0, 0, 0], [1, 1, 1]
+    cmd = (0, 0, 0)  # pan, tilt, flags of the last GIMBAL_CMD
+    out = []
+    ids = [(0x08, 0x10), (0x08, 0x40), (0x10, 0x41)]
+    for t in range(1, RUN_MS + 1):
+        for s in range(3):
+            if rates[s] and t >= anchor[s] + nxt[s] * 1000 // rates[s]:
+                nxt[s] += 1
+                if s == 0:
+                    v = [sim_pan(t), sim_tilt(t), 0]
+                elif s == 1:
+                    v = [t, cmd[0], cmd[1], 0, 0, 0, 0, cmd[2]]
+                else:
+                    v = [t, 1000 * t, -2000 * t, 12345, sim_pan(t), sim_tilt(t), rates[2], 4000]
+                out.append((ids[s], t, v))
+        for kind, data in events.get(t, []):
+            if kind == "cmd":
+                cmd = (data[0], data[1], data[3])
+            else:
+                new = [data[0], data[1], data[2]]
+                for s in range(3):
+                    if new[s] != rates[s]:
+                        rates[s], anchor[s], nxt[s] = new[s], t, 1
+    return out
+
+
 def main():
     rnd = random.Random(8)
     stream, intended, replies = [], [], []
@@ -90,6 +174,7 @@ def main():
         stream.extend(f)
 
     rates_default = [10, 10, 4, 0, 0] * 3 + [0]
+    rates_new = [20, 10, 4, 0, 0] + [10, 10, 4, 0, 0] * 2 + [1]  # angle on port 1 at 20 Hz
     version = [0, 1, 0, 1, 0x07, 0xE8, 5, 17] + [0] * 16 + [3, 0, 0x0F, 0xA0, 0x00, 0xC8] \
         + [0xFF, 0, 0, 0, 0, 0] * 2
     noise(37)
@@ -103,19 +188,24 @@ def main():
     corrupt(0x48, 0x03, [], lambda f: f.__setitem__(3, 0xFF))  # Size claims 253 bytes
     clean(0x48, 0x03, [], version)                       # SYSTEM_VERSION query, inside it
     clean(0x00, 0x40, [])                                # GYRO_ZERO_CMD
+    clean(0x48, 0x00, rates_new, rates_new)              # PACKET_RATE set: echoed
     noise(20)
     clean(0x48, 0x01, [80, 3], [80, 3])                  # SENSOR_FILTER set: echoed
+    clean(0x00, 0x80, [0x11, 0x94, 0xFC, 0x18, 0, 0])    # GIMBAL_CMD, 6 bytes: error hook
     corrupt(0x48, 0x04, [], lambda f: f.__setitem__(3, 1))  # Size 1
     corrupt(0x48, 0x04, [], lambda f: f.__setitem__(3, 0))  # Size 0
     clean(0x48, 0x04, [], [0, 0])                        # NAV_SOURCE query
+    clean(0x28, 0x00, [1, 2, 3])                         # group 0x28: unknown, default handler
     stream.extend(frame(0x08, 0x42, list(range(12)))[:9])   # truncated HOST_ATTITUDE
     clean(0x00, 0x80, [0xEE, 0x6C, 0x03, 0xE8, 0, 0, 0xA0, 0])  # GIMBAL_CMD -45.00/10.00
+    clean(0x48, 0x01, [7, 8, 9])                         # SENSOR_FILTER, 3 bytes: error hook
     for _ in range(6):                                   # garbage with false syncs
         noise(rnd.randrange(3, 40))
         stream.extend(SYNC + [rnd.randrange(2, 256)])
     noise(300)  # outlasts the false syncs' claimed sizes
     corrupt(0x08, 0x41, list(range(18)), lambda f: f.__setitem__(len(f) - 1, f[-1] ^ 1))
     clean(0x48, 0x01, [], [80, 3])                       # SENSOR_FILTER query: kept
+    clean(0x48, 0x00, [], rates_new)                     # PACKET_RATE query: the new rates
     for _ in range(3):
         clean(0x08, 0x42, [rnd.randrange(256) for _ in range(12)])  # HOST_ATTITUDE
         noise(rnd.randrange(0, 8))
@@ -124,6 +214,25 @@ def main():
     found, csum_err, bad_size, discarded, overlap = model(stream)
     assert found == intended, (found, intended)
     assert overlap <= MAX_CANDIDATES, overlap
+    assert len(stream) <= BYTES_PER_TICK * RUN_MS
+
+    # What each frame must reach the application as, and when.
+    rows, values, events = [], [], {}
+    for s, g, t, n in found:
+        data = stream[s + 6:s + 6 + n]
+        r = route(g, t, n)
+        v = []
+        fmt = LAYOUT.get((g, t), (None, 0))[0]
+        if r == ROUTE_TYPED and fmt is not None:  # a query decodes to zeros
+            v = fields(fmt, data) if n > 0 else [0] * len(fmt.replace("x", ""))
+        rows.append((s, g, t, n, r, len(values), len(v)))
+        values.extend(v)
+        tick = (s + n + 7) // BYTES_PER_TICK + 1  # tick that delivers its last byte
+        if r == ROUTE_TYPED and (g, t) == (0x00, 0x80):
+            events.setdefault(tick, []).append(("cmd", v))
+        if r == ROUTE_TYPED and (g, t) == (0x48, 0x00) and n > 0:
+            events.setdefault(tick, []).append(("rates", data))
+    telem = telemetry(events)
 
     w = print
     w("/* Generated by examples/firmware/mkstream.py: do not edit. The recorded")
@@ -132,25 +241,42 @@ def main():
     w("#define STREAM_H")
     w("#include <stdint.h>")
     w("")
+    w("#define STREAM_BYTES_PER_TICK %du" % BYTES_PER_TICK)
+    w("#define STREAM_RUN_MS %du" % RUN_MS)
+    w("")
     w("static const uint8_t stream_bytes[%d] = {" % len(stream))
     for i in range(0, len(stream), 16):
         w("    " + " ".join("0x%02X," % b for b in stream[i:i + 16]))
     w("};")
     w("")
+    w("/* How a frame reaches the application. */")
+    w("#define ROUTE_TYPED 0u   /* typed handler, decoded */")
+    w("#define ROUTE_ERROR 1u   /* error hook, TASE_ELENGTH */")
+    w("#define ROUTE_DEFAULT 2u /* default handler: unknown packet */")
+    w("")
     w("typedef struct {")
     w("    uint32_t offset;")
-    w("    uint8_t group, type, len;")
+    w("    uint8_t group, type, len, route;")
+    w("    uint8_t first, nfields; /* decoded fields: expect_values[first..] */")
     w("} expect_frame_t;")
     w("")
     w("/* Every clean frame, in delivery order. */")
-    w("static const expect_frame_t expect_frames[%d] = {" % len(found))
-    for s, g, t, n in found:
-        w("    {%u, 0x%02X, 0x%02X, %u}," % (s, g, t, n))
+    w("static const expect_frame_t expect_frames[%d] = {" % len(rows))
+    for s, g, t, n, r, first, nf in rows:
+        w("    {%u, 0x%02X, 0x%02X, %u, %u, %u, %u}," % (s, g, t, n, r, first, nf))
+    w("};")
+    w("")
+    w("/* Decoded field values of the typed frames, in the spec's field order. */")
+    w("static const int64_t expect_values[%d] = {" % len(values))
+    for i in range(0, len(values), 8):
+        w("    " + " ".join("%d," % v for v in values[i:i + 8]))
     w("};")
     w("")
     w("#define EXPECT_CHECKSUM_ERRORS %du" % csum_err)
     w("#define EXPECT_BAD_SIZE %du" % bad_size)
     w("#define EXPECT_BYTES_DISCARDED %du" % discarded)
+    w("#define EXPECT_BAD_LENGTH %du" % sum(1 for r in rows if r[4] == ROUTE_ERROR))
+    w("#define EXPECT_UNKNOWN %du" % sum(1 for r in rows if r[4] == ROUTE_DEFAULT))
     w("")
     w("/* The replies the gimbal must send, in order: setup packets echoed with")
     w(" * the current settings. */")
@@ -167,12 +293,20 @@ def main():
         w("    {0x%02X, 0x%02X, %d, reply_data_%d}," % (g, t, len(d), i))
     w("};")
     w("")
-    w("/* Last clean GIMBAL_CMD: pan, tilt in 1/100 degree. */")
-    w("#define EXPECT_CMD_PAN (-4500)")
-    w("#define EXPECT_CMD_TILT 1000")
-    w("#define EXPECT_GYRO_ZEROS 1u")
-    w("/* Valid frames the gimbal does not act on (HOST_ATTITUDE). */")
-    w("#define EXPECT_IGNORED %du" % sum(1 for f in found if f[1] not in (0x00, 0x48)))
+    w("/* The telemetry the gimbal must send, in order: packet, the poll time")
+    w(" * (ms) and decoded values. GIMBAL_ANGLE: pan, tilt, roll. GIMBAL_RATE:")
+    w(" * time, pan_rate, tilt_rate, roll_rate, p, q, r, mode. GEOREFERENCE_DATA:")
+    w(" * time, lat, lon, height, pan, tilt, sample_rate, hfov. */")
+    w("typedef struct {")
+    w("    uint8_t group, type;")
+    w("    uint16_t t;")
+    w("    int32_t v[8];")
+    w("} expect_telemetry_t;")
+    w("")
+    w("static const expect_telemetry_t expect_telemetry[%d] = {" % len(telem))
+    for (g, t), ms, v in telem:
+        w("    {0x%02X, 0x%02X, %d, {%s}}," % (g, t, ms, ", ".join(str(x) for x in v)))
+    w("};")
     w("")
     w("#endif /* STREAM_H */")
 

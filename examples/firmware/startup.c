@@ -8,7 +8,9 @@
 
 #include "board.h"
 
-extern uint32_t _estack, _sidata, _sdata, _edata, _sbss, _ebss;
+extern uint32_t _estack, _sidata, _sdata, _edata, _sbss, _ebss, _sstack_paint;
+
+#define STACK_PAINT 0x5AC3A55Cu
 extern int main(void);
 /* newlib's rdimon: opens stdin/stdout/stderr on the semihosting host. */
 extern void initialise_monitor_handles(void);
@@ -52,8 +54,25 @@ void Reset_Handler(void)
     for (dst = &_sbss; dst < &_ebss; dst++) {
         *dst = 0u;
     }
+    /* Paint the stack area below our own frame (board_stack_used()). */
+    {
+        uint32_t *sp;
+        __asm__ volatile("mov %0, sp" : "=r"(sp));
+        for (dst = &_sstack_paint; dst < sp - 16; dst++) {
+            *dst = STACK_PAINT;
+        }
+    }
     initialise_monitor_handles();
     exit(main());
+}
+
+unsigned long board_stack_used(void)
+{
+    const uint32_t *p = &_sstack_paint;
+    while (p < &_estack && *p == STACK_PAINT) {
+        p++;
+    }
+    return (unsigned long)((uintptr_t)&_estack - (uintptr_t)p);
 }
 
 /* Semihosting SYS_EXIT with "run-time error": QEMU exits with status 1. */
