@@ -83,7 +83,9 @@ int tase_can_split(tase_can_role_t sender, const uint8_t *data, size_t n, tase_c
     if (count > cap || count > (size_t)INT16_MAX) {
         return TASE_ENOSPC;
     }
-    while (tase_can_split_next(&s, &out[i]) > 0) {
+    /* i < count first: with n == 0, out may be NULL and &out[0] is not
+     * even to be formed. */
+    while (i < count && tase_can_split_next(&s, &out[i]) > 0) {
         i++;
     }
     return (int)i;
