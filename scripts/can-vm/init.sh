@@ -185,7 +185,14 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     usleep 400000
     s=$($T send GIMBAL_CMD pan=3000 tilt=-1500 flags=0xA0 $L)
     check "send GIMBAL_CMD ($s)" [ "$s" = "sent GIMBAL_CMD (8 data bytes)" ]
+    # A long packet both ways: 44 data bytes = 52 bytes = 7 CAN frames to the
+    # gimbal, whose simulated camera echoes the bytes back.
+    pass=$(seq -s, 201 240)
+    s=$($T send CAMERA_PASS camera=1 baud=8 data=$pass $L)
+    check "send CAMERA_PASS, 40 camera bytes ($s)" [ "$s" = "sent CAMERA_PASS (44 data bytes)" ]
     wait $mon
+    check "monitor got the CAMERA_PASS echo with the 40 bytes" \
+        grep -q "\"name\":\"CAMERA_PASS\",\"size\":44,\"fields\":{\"camera\":1,\"baud\":8},\"data\":\[$pass\]}" /tmp/move.json
     first=$(grep '"GIMBAL_ANGLE"' /tmp/move.json | head -1)
     last=$(grep '"GIMBAL_ANGLE"' /tmp/move.json | tail -1)
     echo "   first $first"
@@ -226,6 +233,10 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
               grep -q "\"dir\":\"in\".*\"name\":\"PACKET_RATE\",\"size\":0," /tmp/dec.json'
     check "decoded: GIMBAL_CMD in, pan 3000 tilt -1500 flags 0xA0" \
         grep -q '"dir":"in","group":0,"type":128,"name":"GIMBAL_CMD","size":8,"fields":{"pan":3000,"tilt":-1500,.*"flags":160' /tmp/dec.json
+    check "decoded: CAMERA_PASS in and its echo out, same 40 bytes" \
+        eval '[ "$(grep -c "\"name\":\"CAMERA_PASS\",\"size\":44,\"fields\":{\"camera\":1,\"baud\":8},\"data\":\[$pass\]}" /tmp/dec.json)" = 2 ] &&
+              grep -q "\"dir\":\"in\",\"group\":0,\"type\":66," /tmp/dec.json &&
+              grep -q "\"dir\":\"out\",\"group\":0,\"type\":66," /tmp/dec.json'
     nd=$(grep -c '"dir":"out".*"name":"GIMBAL_ANGLE"' /tmp/dec.json)
     check "decoded: $nd GIMBAL_ANGLE out, at least the $na the 2 s monitor printed" [ "$nd" -ge "$na" ]
     check "decoded: no frame with a wrong length" eval '! grep -q "\"error\"" /tmp/dec.json'
