@@ -1,6 +1,7 @@
 #!/bin/busybox sh
 # /init of the CAN test VM (busybox sh). Loads the CAN modules, creates
-# vcan0, runs the project's agent against can-utils, prints one
+# vcan0, runs the project's agent against can-utils, then the bench tools
+# (tase-sim --can, tase --can) with candump recording, prints one
 # "CAN-VM: PASS" or "CAN-VM: FAIL <why>" line and powers off.
 export PATH=/bin:/sbin:/usr/bin:/usr/sbin
 /bin/busybox --install -s /bin
@@ -117,6 +118,132 @@ $A send vcan0 host max > /dev/null || fail "send (host)"
 wait $p || { cat /tmp/p2p.out; fail "p2p max packet not received"; }
 grep -q '^PKT 00 42 253 070A0D' /tmp/p2p.out || fail "p2p packet content"
 grep -q 'END items=1 checksum_errors=0 ignored=0' /tmp/p2p.out || { cat /tmp/p2p.out; fail "p2p counters"; }
+
+# ---- the bench tools over vcan0 (issue 6): tase-sim is the gimbal, tase
+# the host, candump the independent recorder. Each check prints a PASS or
+# FAIL line; any FAIL fails the VM.
+if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
+    step "bench tools over vcan0: tase-sim --can, tase --can, candump"
+    nfail=0
+    check() {
+        name=$1
+        shift
+        if "$@"; then echo "PASS tools: $name"; else echo "FAIL tools: $name"; nfail=$((nfail + 1)); fi
+    }
+    # json_int LINE KEY: the integer value of "KEY": in one JSON line
+    json_int() { echo "$1" | sed -n "s/.*\"$2\":\(-\{0,1\}[0-9][0-9]*\).*/\1/p"; }
+    # near A B TOL: |A - B| <= TOL
+    near() { [ -n "$1" ] && d=$(($1 - $2)) && [ "${d#-}" -le "$3" ]; }
+    # one_line_error FILE PATTERN: exactly one stderr line, matching PATTERN
+    one_line_error() { [ "$(wc -l < "$1")" -eq 1 ] && grep -q "$2" "$1"; }
+
+    T=/bin/tase
+    L="--can vcan0"
+    $T monitor --can vcan1 --seconds 1 2> /tmp/t.err
+    rc=$?
+    check "monitor on a down interface: exit 1, one line ($(cat /tmp/t.err))" \
+        eval '[ $rc -eq 1 ] && one_line_error /tmp/t.err "vcan1: interface is down"'
+    tase-sim --can tasenosuch0 --seconds 1 > /dev/null 2> /tmp/t.err
+    rc=$?
+    check "tase-sim on a missing interface: exit 1, one line ($(cat /tmp/t.err))" \
+        eval '[ $rc -eq 1 ] && one_line_error /tmp/t.err "tasenosuch0: no such device"'
+    $T query SYSTEM_VERSION $L --timeout 200 --retries 0 2> /tmp/t.err
+    rc=$?
+    check "query with no gimbal on the bus times out ($(cat /tmp/t.err))" \
+        eval '[ $rc -eq 1 ] && one_line_error /tmp/t.err "timeout: no answer to SYSTEM_VERSION"'
+
+    candump -L vcan0 > /tmp/tools.log &
+    tdump=$!
+    i=0
+    until grep -q ' 7FF#03' /tmp/tools.log 2>/dev/null; do
+        cansend vcan0 7FF#03; usleep 20000; i=$((i + 1)); [ $i -gt 200 ] && fail "candump never started (tools)"
+    done
+    tase-sim --can vcan0 --seconds 40 > /tmp/sim.log 2>&1 &
+    sim=$!
+    wait_for /tmp/sim.log 'simulated gimbal on CAN interface vcan0' || { cat /tmp/sim.log; fail "tase-sim --can vcan0 did not start"; }
+
+    v=$($T query SYSTEM_VERSION $L --json)
+    echo "   $v"
+    check "query SYSTEM_VERSION: version 2.5.1, cameras 68/97/255 (none)" \
+        eval '[ "$(json_int "$v" major)/$(json_int "$v" minor)/$(json_int "$v" sub)" = 2/5/1 ] &&
+              [ "$(json_int "$v" camera_a)/$(json_int "$v" camera_b)/$(json_int "$v" camera_c)" = 68/97/255 ] &&
+              echo "$v" | grep -q "\"name\":\"SYSTEM_VERSION\",\"size\":42,"'
+
+    e=$($T send PACKET_RATE angle_1=20 rate_1=5 geo_ref_1=2 $L --json)
+    check "send PACKET_RATE: the gimbal echoes 20/5/2" \
+        eval '[ "$(json_int "$e" angle_1)/$(json_int "$e" rate_1)/$(json_int "$e" geo_ref_1)" = 20/5/2 ]'
+    $T monitor $L --json --seconds 2 > /tmp/mon.json
+    na=$(grep -c '"name":"GIMBAL_ANGLE"' /tmp/mon.json)
+    nr=$(grep -c '"name":"GIMBAL_RATE"' /tmp/mon.json)
+    ng=$(grep -c '"name":"GEOREFERENCE_DATA"' /tmp/mon.json)
+    check "monitor 2 s follows PACKET_RATE: $na GIMBAL_ANGLE (40+-8), $nr GIMBAL_RATE (10+-3), $ng GEOREFERENCE_DATA (4+-2)" \
+        eval 'near $na 40 8 && near $nr 10 3 && near $ng 4 2'
+
+    # The monitor runs while the position command goes out on the bus.
+    $T monitor $L --json --seconds 3.5 > /tmp/move.json &
+    mon=$!
+    usleep 400000
+    s=$($T send GIMBAL_CMD pan=3000 tilt=-1500 flags=0xA0 $L)
+    check "send GIMBAL_CMD ($s)" [ "$s" = "sent GIMBAL_CMD (8 data bytes)" ]
+    # A long packet both ways: 44 data bytes = 52 bytes = 7 CAN frames to the
+    # gimbal, whose simulated camera echoes the bytes back.
+    pass=$(seq -s, 201 240)
+    s=$($T send CAMERA_PASS camera=1 baud=8 data=$pass $L)
+    check "send CAMERA_PASS, 40 camera bytes ($s)" [ "$s" = "sent CAMERA_PASS (44 data bytes)" ]
+    wait $mon
+    check "monitor got the CAMERA_PASS echo with the 40 bytes" \
+        grep -q "\"name\":\"CAMERA_PASS\",\"size\":44,\"fields\":{\"camera\":1,\"baud\":8},\"data\":\[$pass\]}" /tmp/move.json
+    first=$(grep '"GIMBAL_ANGLE"' /tmp/move.json | head -1)
+    last=$(grep '"GIMBAL_ANGLE"' /tmp/move.json | tail -1)
+    echo "   first $first"
+    echo "   last  $last"
+    check "GIMBAL_CMD position: the monitored angle goes from 0/0 to 30/-15 deg" \
+        eval 'near "$(json_int "$first" pan)" 0 2 && near "$(json_int "$first" tilt)" 0 2 &&
+              near "$(json_int "$last" pan)" 3000 15 && near "$(json_int "$last" tilt)" -1500 15'
+
+    kill $sim
+    wait $sim
+    check "tase-sim stopped cleanly and logged the session" \
+        eval 'grep -q "GIMBAL_CMD" /tmp/sim.log && grep -q "stopped:" /tmp/sim.log'
+    cansend vcan0 7FF#04
+    wait_for /tmp/tools.log ' 7FF#04' || fail "end marker not seen (tools)"
+    kill $tdump
+
+    # candump's record, first raw, then decoded offline by the tool. The
+    # SYSTEM_VERSION query framed by hand: 00 FF 5A, size 2, group 0x48,
+    # type 0x03, checksum 0x01A6 (sum of all bytes before it): one frame.
+    check "candump saw the SYSTEM_VERSION query frame 11000000#00FF5A02480301A6" \
+        grep -q ' vcan0 11000000#00FF5A02480301A6$' /tmp/tools.log
+    check "candump saw the SYSTEM_VERSION answer start 10000000#00FF5A2C4803" \
+        grep -q ' vcan0 10000000#00FF5A2C4803' /tmp/tools.log
+    $T decode --candump /tmp/tools.log > /tmp/dec.json 2> /tmp/t.err
+    rc=$?
+    echo "   candump: $(wc -l < /tmp/tools.log) frames; decoded: $(wc -l < /tmp/dec.json) packets," \
+        "$(grep -c '"dir":"in"' /tmp/dec.json) in, $(grep -c '"dir":"out"' /tmp/dec.json) out"
+    check "tase decode --candump of the capture exits 0 ($(cat /tmp/t.err))" [ $rc -eq 0 ]
+    check "decoded: SYSTEM_VERSION query (in, size 0)" \
+        grep -q '"dir":"in","group":72,"type":3,"name":"SYSTEM_VERSION","size":0,"fields":{}}' /tmp/dec.json
+    ve=$(grep '"dir":"out","group":72,"type":3,"name":"SYSTEM_VERSION","size":42,' /tmp/dec.json)
+    check "decoded: SYSTEM_VERSION answer (out) 2.5.1 as tase query printed it" \
+        eval '[ "$(echo "$ve" | wc -l)" = 1 ] && [ "$(json_int "$ve" major)/$(json_int "$ve" minor)/$(json_int "$ve" sub)" = 2/5/1 ] &&
+              [ "${ve#*\"fields\"}" = "${v#*\"fields\"}" ]'
+    check "decoded: PACKET_RATE in both directions (queries, set 20/5/2 and echoes)" \
+        eval '[ "$(grep -c "\"dir\":\"in\".*\"name\":\"PACKET_RATE\",\"size\":16,\"fields\":{\"angle_1\":20,\"rate_1\":5,\"geo_ref_1\":2," /tmp/dec.json)" = 1 ] &&
+              [ "$(grep -c "\"dir\":\"out\".*\"name\":\"PACKET_RATE\",\"size\":16,\"fields\":{\"angle_1\":20,\"rate_1\":5,\"geo_ref_1\":2," /tmp/dec.json)" = 1 ] &&
+              grep -q "\"dir\":\"in\".*\"name\":\"PACKET_RATE\",\"size\":0," /tmp/dec.json'
+    check "decoded: GIMBAL_CMD in, pan 3000 tilt -1500 flags 0xA0" \
+        grep -q '"dir":"in","group":0,"type":128,"name":"GIMBAL_CMD","size":8,"fields":{"pan":3000,"tilt":-1500,.*"flags":160' /tmp/dec.json
+    check "decoded: CAMERA_PASS in and its echo out, same 40 bytes" \
+        eval '[ "$(grep -c "\"name\":\"CAMERA_PASS\",\"size\":44,\"fields\":{\"camera\":1,\"baud\":8},\"data\":\[$pass\]}" /tmp/dec.json)" = 2 ] &&
+              grep -q "\"dir\":\"in\",\"group\":0,\"type\":66," /tmp/dec.json &&
+              grep -q "\"dir\":\"out\",\"group\":0,\"type\":66," /tmp/dec.json'
+    nd=$(grep -c '"dir":"out".*"name":"GIMBAL_ANGLE"' /tmp/dec.json)
+    check "decoded: $nd GIMBAL_ANGLE out, at least the $na the 2 s monitor printed" [ "$nd" -ge "$na" ]
+    check "decoded: no frame with a wrong length" eval '! grep -q "\"error\"" /tmp/dec.json'
+    [ $nfail -eq 0 ] || fail "$nfail bench tool check(s) over vcan0 failed"
+else
+    step "bench tools over vcan0: SKIPPED (tase and tase-sim are not built)"
+fi
 
 echo "CAN-VM: PASS"
 poweroff -f

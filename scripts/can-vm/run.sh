@@ -1,14 +1,20 @@
 #!/usr/bin/env bash
 # Real SocketCAN test: boots Debian's own kernel under qemu (TCG, no KVM)
 # with a small initramfs (busybox, iproute2's ip, can-utils' candump and
-# cansend, the project's static agent), and runs scripts/can-vm/init.sh in
-# it. Passes when the VM prints "CAN-VM: PASS".
-# Usage: scripts/can-vm/run.sh AGENT CACHE_DIR
+# cansend, the project's static agent and, when given, static builds of the
+# bench tools tase and tase-sim), and runs scripts/can-vm/init.sh in it.
+# Passes when the VM prints "CAN-VM: PASS".
+# Usage: scripts/can-vm/run.sh AGENT CACHE_DIR [TASE TASE_SIM]
 # Exit: 0 pass, 1 fail, 77 skipped (qemu cannot run at all).
 set -euo pipefail
 . "$(dirname "$0")/../lib.sh"
 agent=${1:?path of the static tase_can_vm_agent}
 cache=${2:?cache directory (kept between runs)}
+tase=${3:-}
+tase_sim=${4:-}
+if [ -n "$tase" ] && [ -z "$tase_sim" ]; then
+    echo "FAIL: give both TASE and TASE_SIM, or neither"; exit 1
+fi
 here="$TASE_ROOT/scripts/can-vm"
 mkdir -p "$cache"
 t_start=$(date +%s%N)
@@ -76,6 +82,17 @@ for prog in "$(command -v ip)" "$(command -v candump)" "$(command -v cansend)"; 
     done
 done
 cp "$agent" "$root/bin/agent"
+# The bench tools run over vcan0 too; without them init.sh skips that part
+# (the tools are not built) and says so.
+if [ -n "$tase" ]; then
+    for prog in "$tase" "$tase_sim"; do
+        if ldd "$prog" >/dev/null 2>&1; then
+            echo "FAIL: $prog is not a static executable"; exit 1
+        fi
+    done
+    cp "$tase" "$root/bin/tase"
+    cp "$tase_sim" "$root/bin/tase-sim"
+fi
 cp "$here/init.sh" "$root/init"
 chmod +x "$root/init"
 (cd "$root" && find . | cpio -o -H newc --quiet | gzip -1) > "$cache/initramfs.cpio.gz"

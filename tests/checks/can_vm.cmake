@@ -1,13 +1,32 @@
 # Issue 4: real SocketCAN in a VM. Boots Debian's kernel under qemu (TCG),
 # creates vcan0 and runs the project's static agent against can-utils'
-# candump and cansend. Skipped (exit 77) only when qemu cannot run at all.
+# candump and cansend, then the bench tools of issue 6 (tase-sim --can and
+# tase --can, built static for the VM) over vcan0. Skipped (exit 77) only
+# when qemu cannot run at all.
 if(TARGET tase_port AND CMAKE_SYSTEM_NAME STREQUAL "Linux")
   add_executable(tase_can_vm_agent ${CMAKE_CURRENT_SOURCE_DIR}/vm/can_vm_agent.c)
   target_link_libraries(tase_can_vm_agent PRIVATE tase_port tase)
   target_link_options(tase_can_vm_agent PRIVATE -static)
   target_compile_options(tase_can_vm_agent PRIVATE ${TASE_WARNINGS})
+  # Static copies of the tools from the same sources (the VM has no libc).
+  # Static glibc warns about getaddrinfo/NSS; the tools use neither.
+  set(TASE_CAN_VM_TOOLS "")
+  if(TARGET tase_toolkit AND TARGET tase_sim_model)
+    add_executable(tase_can_vm_cli ${PROJECT_SOURCE_DIR}/tools/tase.c)
+    target_link_libraries(tase_can_vm_cli PRIVATE tase_toolkit)
+    add_executable(tase_can_vm_sim ${PROJECT_SOURCE_DIR}/tools/tase_sim.c)
+    target_link_libraries(tase_can_vm_sim PRIVATE tase_toolkit tase_sim_model)
+    foreach(t tase_can_vm_cli tase_can_vm_sim)
+      target_link_options(${t} PRIVATE -static)
+      target_compile_options(${t} PRIVATE ${TASE_WARNINGS})
+    endforeach()
+    set(TASE_CAN_VM_TOOLS $<TARGET_FILE:tase_can_vm_cli> $<TARGET_FILE:tase_can_vm_sim>)
+  else()
+    message(STATUS "can_vm: the bench tools are not built; the VM test skips their CAN part")
+  endif()
   add_test(NAME can_vm
            COMMAND ${PROJECT_SOURCE_DIR}/scripts/can-vm/run.sh
-                   $<TARGET_FILE:tase_can_vm_agent> ${CMAKE_BINARY_DIR}/can-vm)
+                   $<TARGET_FILE:tase_can_vm_agent> ${CMAKE_BINARY_DIR}/can-vm
+                   ${TASE_CAN_VM_TOOLS})
   set_tests_properties(can_vm PROPERTIES LABELS check TIMEOUT 600 SKIP_RETURN_CODE 77)
 endif()
