@@ -182,10 +182,8 @@ int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, s
         return TASE_EARG;
     }
     w = TASE_FIELD_WIDTH(f);
-    /* Widths are 1..8 (checked at build time above); a zero width is
-     * refused too, as its sign bit would lie outside the field. data is
-     * NULL only with len 0. */
-    if (w == 0u || data == NULL || (size_t)f->offset + w > len) {
+    /* data is NULL only with len 0, where no field fits. */
+    if (data == NULL || (size_t)f->offset + w > len) {
         return TASE_ETRUNC;
     }
     for (k = 0; k < w; k++) {
