@@ -60,11 +60,11 @@ int tase_can_split_next(tase_can_split_t *s, tase_can_frame_t *out)
     if (chunk > TASE_CAN_DLC_MAX) {
         chunk = TASE_CAN_DLC_MAX;
     }
-    memset(out, 0, sizeof(*out));
+    (void)memset(out, 0, sizeof(*out));
     out->id = s->id;
     out->extended = true;
     out->dlc = (uint8_t)chunk;
-    memcpy(out->data, s->data + s->pos, chunk);
+    (void)memcpy(out->data, s->data + s->pos, chunk);
     s->pos += chunk;
     return (int)chunk;
 }
@@ -111,7 +111,7 @@ int tase_can_rx_init(tase_can_rx_t *crx, tase_can_role_t role)
     if (crx == NULL || !role_valid(role)) {
         return TASE_EARG;
     }
-    memset(crx, 0, sizeof(*crx));
+    (void)memset(crx, 0, sizeof(*crx));
     crx->role = role;
     return tase_rx_init(&crx->rx);
 }
@@ -143,7 +143,7 @@ int tase_can_rx_feed(tase_can_rx_t *crx, const tase_can_frame_t *f, tase_rx_hand
 /* Both 3AX frames are an extended ID with exactly two bytes. */
 static void frame2(tase_can_frame_t *out, uint32_t id, uint8_t b0, uint8_t b1)
 {
-    memset(out, 0, sizeof(*out));
+    (void)memset(out, 0, sizeof(*out));
     out->id = id;
     out->extended = true;
     out->dlc = 2;
@@ -207,13 +207,12 @@ int tase_can_3ax_status_encode(const tase_can_3ax_status_t *st, tase_can_frame_t
 int tase_can_3ax_status_decode(const tase_can_frame_t *f, tase_can_3ax_status_t *st)
 {
     int rc;
-    int units;
     if (f == NULL || st == NULL) {
         return TASE_EARG;
     }
     rc = check2(f, TASE_CAN_ID_3AX_STATUS);
     if (rc == TASE_OK) {
-        units = f->data[1] >= 0x80u ? (int)f->data[1] - 256 : (int)f->data[1];
+        int units = f->data[1] >= 0x80u ? (int)f->data[1] - 256 : (int)f->data[1];
         st->position = f->data[0];
         st->speed_dps = (int16_t)(units * TASE_3AX_SPEED_STEP_DPS);
     }

@@ -19,13 +19,13 @@ static int peek(const cursor_t *c)
 static int hexval(int ch)
 {
     if (ch >= '0' && ch <= '9') {
-        return ch - '0';
+        return ch - (int)'0';
     }
     if (ch >= 'A' && ch <= 'F') {
-        return ch - 'A' + 10;
+        return ch - (int)'A' + 10;
     }
     if (ch >= 'a' && ch <= 'f') {
-        return ch - 'a' + 10;
+        return ch - (int)'a' + 10;
     }
     return -1;
 }
@@ -100,7 +100,8 @@ static bool read_ifname(cursor_t *c, char *name)
         if (n + 1u >= TASE_CANDUMP_IFNAME_MAX) {
             return false;
         }
-        name[n++] = (char)peek(c);
+        name[n] = (char)peek(c);
+        n++;
         c->i++;
     }
     name[n] = '\0';
@@ -113,14 +114,15 @@ static int read_id(cursor_t *c, uint32_t *id, bool *extended)
 {
     uint32_t v = 0;
     size_t n = 0;
-    int d;
-    while ((d = hexval(peek(c))) >= 0) {
+    int d = hexval(peek(c));
+    while (d >= 0) {
         if (n == 8u) {
             return TASE_EFORMAT;
         }
         v = (v << 4) | (uint32_t)d;
         c->i++;
         n++;
+        d = hexval(peek(c));
     }
     if (peek(c) != '#') {
         return TASE_EFORMAT;
@@ -148,14 +150,13 @@ static int read_id(cursor_t *c, uint32_t *id, bool *extended)
 static int read_data(cursor_t *c, uint8_t *data, uint8_t *dlc)
 {
     uint8_t n = 0;
-    int hi;
-    int lo;
     int ch = peek(c);
     if (ch == '#' || ch == 'R' || ch == 'r') {
         return TASE_EUNSUPPORTED; /* CAN FD or remote frame */
     }
     for (;;) {
-        hi = hexval(peek(c));
+        int hi = hexval(peek(c));
+        int lo;
         if (hi < 0) {
             break;
         }
@@ -165,7 +166,8 @@ static int read_data(cursor_t *c, uint8_t *data, uint8_t *dlc)
             return TASE_EFORMAT;
         }
         c->i++;
-        data[n++] = (uint8_t)((hi << 4) | lo);
+        data[n] = (uint8_t)(((unsigned)hi << 4) | (unsigned)lo);
+        n++;
         /* A '.' separates bytes; it may not end the data. */
         if (peek(c) == '.') {
             c->i++;
@@ -186,7 +188,7 @@ static bool at_line_end(cursor_t *c)
 {
     if (skip_blanks(c) > 0 && (peek(c) == 'T' || peek(c) == 'R')) {
         c->i++;
-        skip_blanks(c);
+        (void)skip_blanks(c);
     }
     if (peek(c) == '\r') {
         c->i++;
@@ -208,8 +210,8 @@ int tase_candump_parse(const char *line, size_t len, tase_candump_rec_t *rec)
     c.p = line;
     c.len = len;
     c.i = 0;
-    memset(&r, 0, sizeof(r));
-    skip_blanks(&c);
+    (void)memset(&r, 0, sizeof(r));
+    (void)skip_blanks(&c);
     if (!read_timestamp(&c, &r.sec, &r.usec) || skip_blanks(&c) == 0 ||
         !read_ifname(&c, r.ifname) || skip_blanks(&c) == 0) {
         return TASE_EFORMAT;
@@ -238,15 +240,23 @@ static size_t put_hex(char *out, uint32_t v, unsigned digits)
     return digits;
 }
 
+static size_t put_char(char *out, char ch)
+{
+    out[0] = ch;
+    return 1u;
+}
+
 static size_t put_dec(char *out, uint64_t v, unsigned min_digits)
 {
     char tmp[20];
+    uint64_t rest = v;
     size_t n = 0;
     size_t k;
     do {
-        tmp[n++] = (char)('0' + (int)(v % 10u));
-        v /= 10u;
-    } while (v != 0u || n < min_digits);
+        tmp[n] = (char)('0' + (int)(rest % 10u));
+        n++;
+        rest /= 10u;
+    } while (rest != 0u || n < min_digits);
     for (k = 0; k < n; k++) {
         out[k] = tmp[n - 1u - k];
     }
@@ -273,25 +283,25 @@ int tase_candump_format(const tase_candump_rec_t *rec, char *out, size_t cap)
     if (namelen == 0u || namelen == TASE_CANDUMP_IFNAME_MAX) {
         return TASE_EARG;
     }
-    line[n++] = '(';
+    n += put_char(&line[n], '(');
     n += put_dec(&line[n], rec->sec, 10);
-    line[n++] = '.';
+    n += put_char(&line[n], '.');
     n += put_dec(&line[n], rec->usec, 6);
-    line[n++] = ')';
-    line[n++] = ' ';
-    memcpy(&line[n], rec->ifname, namelen);
+    n += put_char(&line[n], ')');
+    n += put_char(&line[n], ' ');
+    (void)memcpy(&line[n], rec->ifname, namelen);
     n += namelen;
-    line[n++] = ' ';
+    n += put_char(&line[n], ' ');
     n += put_hex(&line[n], rec->frame.id, rec->frame.extended ? 8u : 3u);
-    line[n++] = '#';
+    n += put_char(&line[n], '#');
     for (k = 0; k < rec->frame.dlc; k++) {
         n += put_hex(&line[n], rec->frame.data[k], 2);
     }
-    line[n++] = '\n';
+    n += put_char(&line[n], '\n');
     if (n + 1u > cap) {
         return TASE_ENOSPC;
     }
-    memcpy(out, line, n);
+    (void)memcpy(out, line, n);
     out[n] = '\0';
     return (int)n;
 }

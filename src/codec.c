@@ -10,30 +10,51 @@
 
 #include <string.h>
 
-static uint64_t member_load(const uint8_t *src, unsigned w)
+/* The member's own type is not known here, only its width: hence void. */
+static uint64_t member_load(const void *src, unsigned w)
 {
     uint8_t b;
     uint16_t h;
     uint32_t x;
     uint64_t q;
     switch (w) {
-    case 1: memcpy(&b, src, 1); return b;
-    case 2: memcpy(&h, src, 2); return h;
-    case 4: memcpy(&x, src, 4); return x;
-    default: memcpy(&q, src, 8); return q;
+    case 1: (void)memcpy(&b, src, 1); return b;
+    case 2: (void)memcpy(&h, src, 2); return h;
+    case 4: (void)memcpy(&x, src, 4); return x;
+    default: (void)memcpy(&q, src, 8); return q;
     }
 }
 
-static void member_store(uint8_t *dst, unsigned w, uint64_t v)
+static void member_store(void *dst, unsigned w, uint64_t v)
 {
     uint8_t b = (uint8_t)v;
     uint16_t h = (uint16_t)v;
     uint32_t x = (uint32_t)v;
     switch (w) {
-    case 1: memcpy(dst, &b, 1); break;
-    case 2: memcpy(dst, &h, 2); break;
-    case 4: memcpy(dst, &x, 4); break;
-    default: memcpy(dst, &v, 8); break;
+    case 1: (void)memcpy(dst, &b, 1); break;
+    case 2: (void)memcpy(dst, &h, 2); break;
+    case 4: (void)memcpy(dst, &x, 4); break;
+    default: (void)memcpy(dst, &v, 8); break;
+    }
+}
+
+/* The fields of msg that lie within len bytes, big-endian into body. */
+static void pack_fields(const tase_packet_desc_t *p, const void *msg, size_t len, uint8_t *body)
+{
+    size_t i;
+    for (i = 0; i < p->nfields; i++) {
+        const tase_field_t *f = tase_schema_field(p, i);
+        unsigned w = TASE_FIELD_WIDTH(f);
+        uint64_t v;
+        if ((size_t)f->offset + w > len) {
+            continue; /* short form: CAMERA_CMD camera byte only */
+        }
+        v = member_load((const uint8_t *)msg + f->member, w);
+        while (w > 0u) {
+            w--;
+            body[f->offset + w] = (uint8_t)v;
+            v >>= 8;
+        }
     }
 }
 
@@ -42,7 +63,7 @@ static int encode(const tase_packet_desc_t *p, const void *msg, size_t len, uint
 {
     const tase_camera_pass_t *cp = msg;
     uint8_t *body;
-    size_t i, fixed;
+    size_t fixed;
     if (out == NULL || (msg == NULL && len > 0u)) {
         return TASE_EARG;
     }
@@ -64,24 +85,16 @@ static int encode(const tase_packet_desc_t *p, const void *msg, size_t len, uint
         return TASE_ENOSPC;
     }
     body = out + TASE_FRAME_HEADER;
-    fixed = len < p->len ? len : p->len;
-    if (len > fixed) {
+    if (len > p->len) {
+        fixed = p->len;
         /* The tail first: its source may lie anywhere in out. */
-        memmove(body + fixed, cp->data, len - fixed);
+        (void)memmove(&body[fixed], cp->data, len - fixed);
+    } else {
+        fixed = len;
     }
-    memset(body, 0, fixed); /* reserved bytes */
-    for (i = 0; i < p->nfields; i++) {
-        const tase_field_t *f = tase_schema_field(p, i);
-        unsigned w = TASE_FIELD_WIDTH(f);
-        uint64_t v;
-        if ((size_t)f->offset + w > len) {
-            continue; /* short form: CAMERA_CMD camera byte only */
-        }
-        v = member_load((const uint8_t *)msg + f->member, w);
-        while (w-- > 0u) {
-            body[f->offset + w] = (uint8_t)v;
-            v >>= 8;
-        }
+    (void)memset(body, 0, fixed); /* reserved bytes */
+    if (msg != NULL) {            /* else a query: no data */
+        pack_fields(p, msg, len, body);
     }
     return tase_frame_encode(out, cap, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), body, len);
 }
@@ -114,10 +127,31 @@ int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap)
     return tase_packet_encode_len(id, NULL, 0u, out, cap);
 }
 
+/* The fields that lie within the frame's data, into msg. Only the wire
+ * bits are needed (no sign extension: see the top of this file), and
+ * reading them inline instead of through tase_field_get() keeps the
+ * receive path's stack small. */
+static void unpack_fields(const tase_packet_desc_t *p, const tase_frame_t *f, void *msg)
+{
+    size_t i;
+    for (i = 0; i < p->nfields; i++) {
+        const tase_field_t *fd = tase_schema_field(p, i);
+        unsigned w = TASE_FIELD_WIDTH(fd);
+        unsigned k;
+        uint64_t v = 0u;
+        if ((size_t)fd->offset + w > f->len) {
+            continue;
+        }
+        for (k = 0; k < w; k++) {
+            v = (v << 8) | f->data[fd->offset + k];
+        }
+        member_store((uint8_t *)msg + fd->member, w, v);
+    }
+}
+
 int tase_packet_decode(const tase_frame_t *f, void *msg)
 {
     const tase_packet_desc_t *p;
-    size_t i;
     if (f == NULL || (f->data == NULL && f->len > 0u)) {
         return TASE_EARG;
     }
@@ -131,22 +165,9 @@ int tase_packet_decode(const tase_frame_t *f, void *msg)
     if (msg == NULL) {
         return f->len == 0u ? 0 : TASE_EARG;
     }
-    memset(msg, 0, p->size);
-    /* Only the wire bits are needed here (no sign extension: see the top
-     * of this file), and reading them inline instead of through
-     * tase_field_get() keeps the receive path's stack small. */
-    for (i = 0; i < p->nfields; i++) {
-        const tase_field_t *fd = tase_schema_field(p, i);
-        unsigned w = TASE_FIELD_WIDTH(fd);
-        unsigned k;
-        uint64_t v = 0u;
-        if ((size_t)fd->offset + w > f->len) {
-            continue;
-        }
-        for (k = 0; k < w; k++) {
-            v = (v << 8) | f->data[fd->offset + k];
-        }
-        member_store((uint8_t *)msg + fd->member, w, v);
+    (void)memset(msg, 0, p->size);
+    if (f->data != NULL) { /* else a query: no data */
+        unpack_fields(p, f, msg);
     }
     if ((p->flags & TASE_LEN_TAIL) != 0u) {
         tase_camera_pass_t *cp = msg;

@@ -40,6 +40,8 @@ void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
         return;
     } else if (d->handlers != NULL) {
         h = d->handlers[p->index];
+    } else {
+        /* no handler table: everything goes to on_default */
     }
     if (h == NULL) {
         if (d->on_default != NULL) {

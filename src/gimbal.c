@@ -17,26 +17,6 @@
 static const uint8_t setup_len[TASE_GIMBAL_SETUP_TYPES] = {16u, 2u, 23u, 42u, 2u, 3u, 6u, 16u};
 static const uint8_t setup_off[TASE_GIMBAL_SETUP_TYPES] = {0u, 16u, 18u, 41u, 83u, 85u, 88u, 94u};
 
-/* Defaults the spec states. PACKET_RATE: 10, 10, 4 per port. SENSOR_FILTER:
- * 10 Hz cutoff (0.1 Hz units), 0.5 deg/s decimation (0.1 deg/s units).
- * AXIS_SETTING: tilt no-go centre 90 deg and range 60 deg (0.01 deg units),
- * pan/tilt max rate 300 deg/s (5 deg/s units), max acceleration
- * 10000 deg/s^2 (200 units), position gain 4 (0.1 units); byte 13 is
- * missing from table 22 and stays 0. The rest has no stated default. */
-static const uint8_t setup_defaults[TASE_GIMBAL_SETUP_BYTES] = {
-    /* PACKET_RATE */
-    10u, 10u, 4u, 0u, 0u, 10u, 10u, 4u, 0u, 0u, 10u, 10u, 4u, 0u, 0u, 0u,
-    /* SENSOR_FILTER */
-    100u, 5u,
-    /* AXIS_SETTING */
-    0x00u, 0x00u, 0x00u, 0x00u, 0x23u, 0x28u, 0x17u, 0x70u, 0x00u, 0x00u, 0x00u, 0x00u, 60u, 0u,
-    60u, 0u, 50u, 50u, 0u, 40u, 40u, 0u, 0u,
-    /* SYSTEM_VERSION, NAV_SOURCE, CAMERA_TYPE, GPS_LEVER_ARM, CAMERA_ALIGN: 0 */
-};
-
-static const uint16_t stream_id[TASE_GIMBAL_STREAMS] = {TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE,
-                                                        TASE_ID_GEOREFERENCE_DATA};
-
 /* Slot k's offset from t0. k < rate <= 255 keeps the product small. */
 static uint32_t slot_ms(uint32_t k, uint32_t rate)
 {
@@ -69,7 +49,8 @@ static void sched_start(tase_gimbal_sched_t *s, uint8_t rate, uint32_t now_ms)
 
 static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
 {
-    unsigned p, s;
+    unsigned p;
+    unsigned s;
     for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
         for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
             uint8_t rate = g->setup[setup_off[SETUP_PACKET_RATE] + p * RATE_BYTES_PER_PORT + s];
@@ -83,6 +64,23 @@ static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
 int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, size_t nports,
                      const tase_gimbal_app_t *app, uint32_t now_ms)
 {
+    /* Defaults the spec states. PACKET_RATE: 10, 10, 4 per port. SENSOR_FILTER:
+     * 10 Hz cutoff (0.1 Hz units), 0.5 deg/s decimation (0.1 deg/s units).
+     * AXIS_SETTING: tilt no-go centre 90 deg and range 60 deg (0.01 deg units),
+     * pan/tilt max rate 300 deg/s (5 deg/s units), max acceleration
+     * 10000 deg/s^2 (200 units), position gain 4 (0.1 units); byte 13 is
+     * missing from table 22 and stays 0. The rest has no stated default and
+     * stays 0 too, from the memset. */
+    static const uint8_t setup_defaults[] = {
+        /* PACKET_RATE */
+        10u, 10u, 4u, 0u, 0u, 10u, 10u, 4u, 0u, 0u, 10u, 10u, 4u, 0u, 0u, 0u,
+        /* SENSOR_FILTER */
+        100u, 5u,
+        /* AXIS_SETTING */
+        0x00u, 0x00u, 0x00u, 0x00u, 0x23u, 0x28u, 0x17u, 0x70u, 0x00u, 0x00u, 0x00u, 0x00u, 60u, 0u,
+        60u, 0u, 50u, 50u, 0u, 40u, 40u, 0u, 0u,
+        /* SYSTEM_VERSION .. CAMERA_ALIGN: none stated (0) */
+    };
     size_t i;
 
     if (g == NULL || (ports == NULL && nports > 0) || nports > TASE_GIMBAL_PORTS) {
@@ -93,7 +91,7 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, size_t nports,
             return TASE_EARG;
         }
     }
-    memset(g, 0, sizeof *g);
+    (void)memset(g, 0, sizeof *g);
     for (i = 0; i < nports; i++) {
         g->port[i] = ports[i];
     }
@@ -103,7 +101,7 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, size_t nports,
     if (app != NULL) {
         g->app = *app;
     }
-    memcpy(g->setup, setup_defaults, sizeof g->setup);
+    (void)memcpy(g->setup, setup_defaults, sizeof setup_defaults);
     sched_from_rates(g, now_ms, true);
     return TASE_OK;
 }
@@ -115,6 +113,8 @@ static int gimbal_write(tase_gimbal_t *g, int r)
         g->stats.frames_tx++;
     } else if (r != TASE_EARG && r != TASE_ETOOLONG) {
         g->stats.tx_errors++;
+    } else {
+        /* the caller's mistake, not the link's */
     }
     return r;
 }
@@ -147,13 +147,13 @@ int tase_gimbal_setup_get(const tase_gimbal_t *g, uint8_t type, uint8_t *out, si
     if (cap < setup_len[type]) {
         return TASE_ENOSPC;
     }
-    memcpy(out, &g->setup[setup_off[type]], setup_len[type]);
+    (void)memcpy(out, &g->setup[setup_off[type]], setup_len[type]);
     return setup_len[type];
 }
 
 static void setup_store(tase_gimbal_t *g, uint8_t type, const uint8_t *data, uint32_t now_ms)
 {
-    memcpy(&g->setup[setup_off[type]], data, setup_len[type]);
+    (void)memcpy(&g->setup[setup_off[type]], data, setup_len[type]);
     if (type == SETUP_PACKET_RATE) {
         sched_from_rates(g, now_ms, false);
     }
@@ -186,7 +186,7 @@ static void handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f,
         g->stats.bad_length++;
         return;
     } else {
-        memcpy(tmp, f->data, f->len);
+        (void)memcpy(tmp, f->data, f->len);
         if (g->app.apply_setup == NULL ||
             g->app.apply_setup(g->app.user, port, type, tmp, f->len) >= 0) {
             setup_store(g, type, tmp, now_ms);
@@ -213,6 +213,8 @@ int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t
         }
     } else if (g->app.on_frame != NULL) {
         g->app.on_frame(g->app.user, port, frame);
+    } else {
+        /* nobody to tell */
     }
     return TASE_OK;
 }
@@ -263,12 +265,15 @@ static void sched_catch_up(tase_gimbal_t *g, tase_gimbal_sched_t *s, uint32_t no
 
 static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_t now_ms)
 {
+    static const uint16_t stream_id[TASE_GIMBAL_STREAMS] = {
+        TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE, TASE_ID_GEOREFERENCE_DATA};
     tase_gimbal_sched_t *s = &g->sched[port][stream];
     /* The application writes the data where the frame will carry it, and
      * the frame is encoded around it in place: one buffer, not two. */
     uint8_t frame[TASE_FRAME_MAX];
     uint16_t id = stream_id[stream];
-    int n, sent = 0;
+    int n;
+    int sent = 0;
 
     if (s->rate == 0 || !reached(now_ms, s->t0 + slot_ms(s->k, s->rate))) {
         return 0;
@@ -297,7 +302,8 @@ static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_
 
 int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
 {
-    unsigned p, s;
+    unsigned p;
+    unsigned s;
     int sent = 0;
 
     if (g == NULL) {
@@ -320,7 +326,8 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
 int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
 {
     uint8_t buf[SERVICE_CHUNK];
-    unsigned p, i;
+    unsigned p;
+    unsigned i;
 
     if (g == NULL) {
         return TASE_EARG;

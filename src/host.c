@@ -14,7 +14,7 @@ int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on
     if (h == NULL || port == NULL || port->ops == NULL || port->ops->write == NULL) {
         return TASE_EARG;
     }
-    memset(h, 0, sizeof *h);
+    (void)memset(h, 0, sizeof *h);
     (void)tase_rx_init(&h->rx);
     h->port = *port;
     h->on_frame = on_frame;
@@ -30,6 +30,8 @@ static int host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t 
         h->stats.frames_tx++;
     } else if (r != TASE_EARG && r != TASE_ETOOLONG) {
         h->stats.tx_errors++;
+    } else {
+        /* the caller's mistake, not the link's */
     }
     return r;
 }
@@ -63,7 +65,7 @@ int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const u
         return r;
     }
     if (len > 0) {
-        memcpy(h->req, data, len);
+        (void)memcpy(h->req, data, len);
     }
     h->req_len = (uint8_t)len;
     h->group = group;
@@ -101,7 +103,7 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
         } else if (frame->len > h->reply_cap) {
             h->result = TASE_ENOSPC;
         } else {
-            memcpy(h->reply, frame->data, frame->len);
+            (void)memcpy(h->reply, frame->data, frame->len);
             h->result = (int)frame->len;
         }
         h->state = HOST_COMPLETE;

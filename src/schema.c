@@ -12,6 +12,9 @@
 #define P(N, g, t, fl, l, sz) FIRST_##N, FIRST_##N##_ = FIRST_##N - 1,
 #define F(T, m, o, w, s) FLD_##T##_##m,
 #define E(N) END_##N, END_##N##_ = END_##N - 1,
+/* The rewinding markers give the next constant its marker's value on
+ * purpose: that is how a marker takes no slot. */
+/* cppcheck-suppress misra-c2012-8.12 */
 enum {
 #include "schema_def.h"
     FIELD_TOTAL
@@ -36,6 +39,8 @@ enum {
  * schema.h must follow the list. */
 #define P(N, g, t, fl, l, sz)                                                                      \
     typedef char chk_idx_##N[((int)TASE_PKT_##N == (int)PKTIDX_##N) ? 1 : -1];
+/* T is a type and m a member name: neither can be parenthesised. */
+/* cppcheck-suppress misra-c2012-20.7 */
 #define F(T, m, o, w, s)                                                                           \
     typedef char chk_##T##_##m[(sizeof(((T *)0)->m) == (w) && offsetof(T, m) < 256u) ? 1 : -1];
 #include "schema_def.h"
@@ -49,6 +54,9 @@ typedef char chk_fields[(FIELD_TOTAL < 256) ? 1 : -1];
 #define FMT_U 0u
 #define FMT_S TASE_FIELD_SIGNED
 
+/* Generated from the list like its siblings here, so it stays at file
+ * scope although only tase_schema_field() reads it. */
+/* cppcheck-suppress misra-c2012-8.9 */
 static const tase_field_t fields[FIELD_TOTAL] = {
 #define P(N, g, t, fl, l, sz)
 #define F(T, m, o, w, s) {o, offsetof(T, m), (w) | FMT_##s},
@@ -70,23 +78,7 @@ static const tase_packet_desc_t packets[TASE_PKT_COUNT] = {
 #undef E
 };
 
-/* Direct index: the spec uses only 15 distinct type numbers across its
- * four groups, so (group slot, type slot) -> packet index + 1 fits in 60
- * bytes of ROM, against 1 KB for full 256-entry rows. */
 #define NSLOTS 15u
-static const uint8_t by_slot[4][NSLOTS] = {
-    /* types: 00..07, 10, 40..43, 80, 81 */
-    {0, 0, 0, 0, 0, 0, 0, 0, 0, TASE_PKT_GYRO_ZERO_CMD + 1, TASE_PKT_CAMERA_CMD + 1,
-     TASE_PKT_CAMERA_PASS + 1, TASE_PKT_RETRACT_DEPLOY_CMD + 1, TASE_PKT_GIMBAL_CMD + 1,
-     TASE_PKT_LEGACY_CAMERA_CMD + 1},
-    {0, 0, 0, 0, 0, 0, 0, 0, TASE_PKT_GIMBAL_ANGLE + 1, TASE_PKT_GIMBAL_RATE + 1,
-     TASE_PKT_HOST_SENSOR + 1, TASE_PKT_HOST_ATTITUDE + 1, 0, 0, 0},
-    {0, 0, 0, 0, 0, 0, 0, 0, TASE_PKT_HOST_GPS_DATA + 1, TASE_PKT_SPOI_CMD + 1,
-     TASE_PKT_GEOREFERENCE_DATA + 1, 0, 0, 0, 0},
-    {TASE_PKT_PACKET_RATE + 1, TASE_PKT_SENSOR_FILTER + 1, TASE_PKT_AXIS_SETTING + 1,
-     TASE_PKT_SYSTEM_VERSION + 1, TASE_PKT_NAV_SOURCE + 1, TASE_PKT_CAMERA_TYPE + 1,
-     TASE_PKT_GPS_LEVER_ARM + 1, TASE_PKT_CAMERA_ALIGN + 1, 0, 0, 0, 0, 0, 0, 0},
-};
 
 static unsigned group_slot(uint8_t group)
 {
@@ -118,6 +110,22 @@ static unsigned type_slot(uint8_t type)
 
 const tase_packet_desc_t *tase_schema_find(uint8_t group, uint8_t type)
 {
+    /* Direct index: the spec uses only 15 distinct type numbers across its
+     * four groups, so (group slot, type slot) -> packet index + 1 fits in 60
+     * bytes of ROM, against 1 KB for full 256-entry rows. */
+    static const uint8_t by_slot[4][NSLOTS] = {
+        /* types: 00..07, 10, 40..43, 80, 81 */
+        {0, 0, 0, 0, 0, 0, 0, 0, 0, TASE_PKT_GYRO_ZERO_CMD + 1, TASE_PKT_CAMERA_CMD + 1,
+         TASE_PKT_CAMERA_PASS + 1, TASE_PKT_RETRACT_DEPLOY_CMD + 1, TASE_PKT_GIMBAL_CMD + 1,
+         TASE_PKT_LEGACY_CAMERA_CMD + 1},
+        {0, 0, 0, 0, 0, 0, 0, 0, TASE_PKT_GIMBAL_ANGLE + 1, TASE_PKT_GIMBAL_RATE + 1,
+         TASE_PKT_HOST_SENSOR + 1, TASE_PKT_HOST_ATTITUDE + 1, 0, 0, 0},
+        {0, 0, 0, 0, 0, 0, 0, 0, TASE_PKT_HOST_GPS_DATA + 1, TASE_PKT_SPOI_CMD + 1,
+         TASE_PKT_GEOREFERENCE_DATA + 1, 0, 0, 0, 0},
+        {TASE_PKT_PACKET_RATE + 1, TASE_PKT_SENSOR_FILTER + 1, TASE_PKT_AXIS_SETTING + 1,
+         TASE_PKT_SYSTEM_VERSION + 1, TASE_PKT_NAV_SOURCE + 1, TASE_PKT_CAMERA_TYPE + 1,
+         TASE_PKT_GPS_LEVER_ARM + 1, TASE_PKT_CAMERA_ALIGN + 1, 0, 0, 0, 0, 0, 0, 0},
+    };
     unsigned g = group_slot(group);
     unsigned t = type_slot(type);
     unsigned k;
@@ -167,24 +175,29 @@ int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, s
                    int64_t *value)
 {
     const tase_field_t *f = tase_schema_field(p, i);
-    unsigned w, k;
+    unsigned w;
+    unsigned k;
     uint64_t v = 0u;
     if (f == NULL || value == NULL || (data == NULL && len > 0u)) {
         return TASE_EARG;
     }
     w = TASE_FIELD_WIDTH(f);
-    if ((size_t)f->offset + w > len) {
+    /* data is NULL only with len 0, where no field fits. */
+    if (data == NULL || (size_t)f->offset + w > len) {
         return TASE_ETRUNC;
     }
     for (k = 0; k < w; k++) {
         v = (v << 8) | data[f->offset + k];
     }
-    if (TASE_FIELD_IS_SIGNED(f) && ((v >> (8u * w - 1u)) & 1u) != 0u) {
+    /* Big-endian: the sign bit is the top bit of the first byte. */
+    if (TASE_FIELD_IS_SIGNED(f) && (data[f->offset] & 0x80u) != 0u) {
         /* Two's complement by arithmetic, without an implementation-
          * defined conversion of an out-of-range unsigned value. */
         uint64_t mag = ~v;
         if (w < 8u) {
-            mag &= (((uint64_t)1u) << (8u * w)) - 1u;
+            unsigned bits = 8u * w;
+            uint64_t mask = ((uint64_t)1u << bits) - 1u;
+            mag &= mask;
         }
         *value = -(int64_t)mag - 1;
     } else {

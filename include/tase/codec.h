@@ -123,7 +123,11 @@ typedef struct {    /* HOST_GPS_DATA 0x10/0x10, In, 32 bytes */
     int16_t veast;
     int16_t vdown;
     uint16_t year;
-    uint8_t month, day, hour, minute, second;
+    uint8_t month;
+    uint8_t day;
+    uint8_t hour;
+    uint8_t minute;
+    uint8_t second;
     uint8_t frac_second; /* 1/100 s, 0..99 */
     uint8_t valid;       /* 1 valid, 0 not */
     uint8_t sample_rate; /* packets per second */
@@ -148,7 +152,11 @@ typedef struct {   /* GEOREFERENCE_DATA 0x10/0x41, Out, 63 */
     int16_t veast;
     int16_t vdown;
     uint16_t year;
-    uint8_t month, day, hour, minute, second;
+    uint8_t month;
+    uint8_t day;
+    uint8_t hour;
+    uint8_t minute;
+    uint8_t second;
     uint8_t frac_second; /* 1/100 s */
     uint8_t num_sats;
     uint8_t pdop;        /* 0.1 PDOP */
@@ -173,11 +181,20 @@ typedef struct {   /* GEOREFERENCE_DATA 0x10/0x41, Out, 63 */
 
 /* ---- group 0x48: setup (every one Both, echoed, zero-length query) -- */
 
-typedef struct {                                  /* PACKET_RATE 0x48/0x00, 16 bytes */
-    uint8_t angle_1, rate_1, geo_ref_1, camera_1; /* port 1, packets/s */
-    uint8_t angle_2, rate_2, geo_ref_2, camera_2; /* port 2 */
-    uint8_t angle_3, rate_3, geo_ref_3, camera_3; /* port 3 */
-    uint8_t temporary;                            /* 1: do not store in non-volatile memory */
+typedef struct {     /* PACKET_RATE 0x48/0x00, 16 bytes */
+    uint8_t angle_1; /* port 1, packets/s */
+    uint8_t rate_1;
+    uint8_t geo_ref_1;
+    uint8_t camera_1;
+    uint8_t angle_2; /* port 2 */
+    uint8_t rate_2;
+    uint8_t geo_ref_2;
+    uint8_t camera_2;
+    uint8_t angle_3; /* port 3 */
+    uint8_t rate_3;
+    uint8_t geo_ref_3;
+    uint8_t camera_3;
+    uint8_t temporary; /* 1: do not store in non-volatile memory */
 } tase_packet_rate_t;
 
 typedef struct {        /* SENSOR_FILTER 0x48/0x01, 2 bytes */
@@ -205,15 +222,19 @@ typedef struct {             /* AXIS_SETTING 0x48/0x02, 23 bytes */
 } tase_axis_setting_t;
 
 typedef struct { /* SYSTEM_VERSION 0x48/0x03, 42 bytes */
-    uint8_t major, minor, sub;
+    uint8_t major;
+    uint8_t minor;
+    uint8_t sub;
     uint8_t released; /* 1 released, else test version */
     uint16_t soft_year;
-    uint8_t soft_month, soft_day;
+    uint8_t soft_month;
+    uint8_t soft_day;
     uint32_t board_sn;
     uint32_t board_rev;
     uint32_t board_config;
     uint16_t board_year;
-    uint8_t board_month, board_day;
+    uint8_t board_month;
+    uint8_t board_day;
     uint8_t camera_a;    /* TASE_CAMTYPE_* */
     uint16_t max_hfov_a; /* 1/100 deg */
     uint16_t min_hfov_a;

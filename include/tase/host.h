@@ -82,7 +82,8 @@ typedef struct {
     int result;          /* reply length or error once complete */
     uint8_t state;       /* idle / waiting / complete */
     uint8_t retries_left;
-    uint8_t group, type; /* of the pending request */
+    uint8_t group; /* of the pending request */
+    uint8_t type;
     uint8_t req_len;
     uint8_t req[TASE_DATA_MAX]; /* the request's data, for re-sending */
 } tase_host_t;

@@ -232,12 +232,10 @@ static bool from_linux(const struct can_frame *cf, tase_can_frame_t *f)
 static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, uint32_t deadline)
 {
     struct can_frame cf;
-    ssize_t n;
-    int e;
     to_linux(f, &cf);
     for (;;) {
-        n = write(s->fd, &cf, sizeof(cf));
-        e = errno;
+        ssize_t n = write(s->fd, &cf, sizeof(cf));
+        int e = errno;
         if (n == (ssize_t)sizeof(cf)) {
             s->stats.frames_tx++;
             return TASE_OK;
@@ -281,16 +279,15 @@ int tase_socketcan_write(tase_socketcan_t *s, const uint8_t *data, size_t n)
 {
     tase_can_split_t sp;
     tase_can_frame_t f;
-    size_t before;
     uint32_t deadline;
-    int rc;
     if (s == NULL || s->fd < 0 || n > (size_t)0x7FFFFFFF ||
         tase_can_split_init(&sp, s->role, data, n) != TASE_OK) {
         return TASE_EARG;
     }
     deadline = tase_socketcan_now_ms(NULL) + s->tx_timeout_ms;
     for (;;) {
-        before = sp.pos;
+        size_t before = sp.pos;
+        int rc;
         if (tase_can_split_next(&sp, &f) <= 0) {
             return (int)n;
         }
@@ -305,11 +302,9 @@ int tase_socketcan_write(tase_socketcan_t *s, const uint8_t *data, size_t n)
 static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_ms)
 {
     struct can_frame cf;
-    ssize_t n;
     uint32_t deadline = tase_socketcan_now_ms(NULL) + timeout_ms;
-    int rc;
     for (;;) {
-        n = read(s->fd, &cf, sizeof(cf));
+        ssize_t n = read(s->fd, &cf, sizeof(cf));
         if (n == (ssize_t)sizeof(cf)) {
             s->stats.frames_rx++;
             if (from_linux(&cf, f)) {
@@ -338,8 +333,7 @@ static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_m
         if (remaining(deadline) == 0u) {
             return 0;
         }
-        rc = wait_fd(s->fd, POLLIN, remaining(deadline));
-        if (rc < 0) {
+        if (wait_fd(s->fd, POLLIN, remaining(deadline)) < 0) {
             s->stats.last_errno = errno;
             return TASE_EIO;
         }
@@ -350,9 +344,8 @@ static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_m
 static int recv_wanted(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_ms)
 {
     uint32_t deadline = tase_socketcan_now_ms(NULL) + timeout_ms;
-    int rc;
     for (;;) {
-        rc = raw_recv(s, f, remaining(deadline));
+        int rc = raw_recv(s, f, remaining(deadline));
         if (rc <= 0 || role_wants(s->role, f)) {
             return rc;
         }
@@ -388,7 +381,6 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
     tase_can_frame_t f;
     uint32_t deadline;
     size_t got;
-    int rc;
     if (s == NULL || s->fd < 0 || buf == NULL || cap > (size_t)0x7FFFFFFF) {
         return TASE_EARG;
     }
@@ -396,7 +388,7 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
     got = take_pending(s, buf, cap);
     /* Once some bytes are in hand, only drain what is already queued. */
     while (got < cap) {
-        rc = recv_wanted(s, &f, got > 0u ? 0u : remaining(deadline));
+        int rc = recv_wanted(s, &f, got > 0u ? 0u : remaining(deadline));
         if (rc < 0) {
             return got > 0u ? (int)got : rc;
         }
