@@ -11,7 +11,7 @@
  *              syncrand   00 FF 5A then a random Size, repeated
  *              noise      uniformly random bytes
  *              zeros      0x00 repeated (every byte may start a sync)
- *     CHUNK    bytes per tase_rx_feed() call (1 = drained byte by byte)
+ *     CHUNK    bytes per tase_rx_feed() call (1 = byte by byte with tase_rx_push())
  *     MODE     once   feed the stream once (for callgrind)
  *              empty  build the stream, feed nothing (callgrind baseline)
  *              time   feed it repeatedly for ~0.3 s and print MB/s
@@ -166,6 +166,12 @@ static void feed_all(tase_rx_t *rx, const uint8_t *s, size_t n, size_t chunk,
                      tase_rx_handler_t h, void *user)
 {
     size_t i;
+    if (chunk == 1u) { /* byte at a time: the one-byte entry point */
+        for (i = 0; i < n; i++) {
+            (void)tase_rx_push(rx, s[i], h, user);
+        }
+        return;
+    }
     for (i = 0; i < n; i += chunk) {
         (void)tase_rx_feed(rx, &s[i], (n - i < chunk) ? n - i : chunk, h, user);
     }

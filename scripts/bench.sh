@@ -48,7 +48,9 @@ for stream in telemetry badsize sync4 syncrand noise zeros; do
         frames=$(sed -n 's/.*frames=\([0-9]*\).*/\1/p' <<<"$line")
         cols=()
         for chunk in 4096 64 1; do
-            n=$(ir --toggle-collect='tase_rx_feed' "$bin" "$stream" "$chunk" once "${extra[@]}")
+            tog=tase_rx_feed
+            [ "$chunk" = 1 ] && tog=tase_rx_push # chunk 1 goes through tase_rx_push()
+            n=$(ir --toggle-collect="$tog" "$bin" "$stream" "$chunk" once "${extra[@]}")
             cols+=("$(per_byte "$n" "$bytes")")
         done
         full=$(ir "$bin" "$stream" 4096 once "${extra[@]}")
@@ -95,7 +97,7 @@ status=$(awk -v a="$tele" 'BEGIN {print (a <= 10) ? "met" : "**missed**"}')
     echo "feeds nothing (it also includes \`tase_rx_init\`/\`tase_rx_flush\`)."
     echo "**MB/s** is wall clock on a shared machine: informational only."
     echo
-    echo "CHUNK is the number of bytes per \`tase_rx_feed()\` call: 4096 is a \`read()\` from a"
+    echo "CHUNK is the number of bytes per \`tase_rx_feed()\` call (chunk 1 calls \`tase_rx_push()\` per byte and is counted inside it): 4096 is a \`read()\` from a"
     echo "tty or socket, 64 a DMA half-buffer, 1 a firmware that feeds each byte from its"
     echo "UART interrupt ring."
     echo

@@ -551,6 +551,31 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
     return (int)(rx->stats.frames_ok - before);
 }
 
+int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user)
+{
+    uint16_t len;
+    if (rx == NULL) {
+        return TASE_EARG;
+    }
+    len = rx->len;
+    /* Most bytes of a frame only need storing: inside a tracked candidate,
+     * fully scanned, not a 5A that may end a sync, not an event, room. */
+    if (rx->ncand != 0u && rx->scan == len && byte != TASE_SYNC3 && len != rx->next &&
+        len < RX_CAP) {
+        rx->buf[len] = byte;
+        len++;
+        rx->len = len;
+        rx->scan = len;
+        rx->stats.bytes_in++;
+        return 0;
+    }
+    if (rx->ncand == 0u) {
+        hunt_byte(rx, byte);
+        return 0;
+    }
+    return tase_rx_feed(rx, &byte, 1u, on_frame, user);
+}
+
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
 {
     uint32_t before;

@@ -74,11 +74,17 @@ static size_t make_frame(uint8_t *out, uint8_t group, uint8_t type, size_t len)
     return (size_t)n;
 }
 
+/* Byte at a time, alternating the two one-byte entry points so both are
+ * held to every expectation of the tests that use this. */
 static void feed_bytes_one_by_one(tase_rx_t *rx, const uint8_t *p, size_t n, recorder_t *r)
 {
     size_t i;
     for (i = 0; i < n; i++) {
-        assert_true(tase_rx_feed(rx, &p[i], 1, record, r) >= 0);
+        if ((i / 7u) % 2u == 0u) {
+            assert_true(tase_rx_push(rx, p[i], record, r) >= 0);
+        } else {
+            assert_true(tase_rx_feed(rx, &p[i], 1, record, r) >= 0);
+        }
     }
 }
 
@@ -772,6 +778,37 @@ static void strerror_names_every_code(void **state)
     assert_string_equal(tase_strerror(5), "unknown error");
 }
 
+static void push_one_byte_at_a_time_equals_feeding_one_buffer(void **state)
+{
+    static uint8_t buf[1 << 19];
+    static size_t starts[2000], ends[2000];
+    tase_rx_t a, b;
+    recorder_t *ra;
+    recorder_t *rb;
+    size_t n, i, k;
+    (void)state;
+    ra = new_recorder(&a);
+    rb = new_recorder(&b);
+    rng_state = 0xABCDu;
+    n = build_noisy_stream(buf, sizeof(buf), 2000, starts, ends);
+    for (i = 0; i < n; i++) {
+        assert_true(tase_rx_push(&a, buf[i], record, ra) >= 0);
+    }
+    assert_true(tase_rx_feed(&b, buf, n, record, rb) >= 0);
+    assert_true(tase_rx_flush(&a, record, ra) >= 0);
+    assert_true(tase_rx_flush(&b, record, rb) >= 0);
+    assert_int_equal(ra->n, rb->n);
+    assert_int_equal(ra->n, 2000);
+    for (k = 0; k < ra->n; k++) {
+        assert_int_equal(ra->f[k].offset, rb->f[k].offset);
+        assert_int_equal(ra->f[k].offset, starts[k]);
+    }
+    assert_memory_equal(&a.stats, &b.stats, sizeof(a.stats));
+    assert_int_equal(tase_rx_push(NULL, 0, NULL, NULL), TASE_EARG);
+    free(ra);
+    free(rb);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -795,6 +832,7 @@ int main(void)
         cmocka_unit_test(noisy_stream_delivers_every_clean_packet_once_in_order),
         cmocka_unit_test(bit_errors_cost_untouched_frames_no_latency),
         cmocka_unit_test(any_split_gives_identical_frames_and_counters),
+        cmocka_unit_test(push_one_byte_at_a_time_equals_feeding_one_buffer),
         cmocka_unit_test(more_overlapping_candidates_than_slots_still_loses_nothing),
         cmocka_unit_test(flush_finds_clean_packets_held_at_end_of_input),
         cmocka_unit_test(flush_of_clean_stream_changes_nothing),

@@ -179,6 +179,13 @@ int tase_rx_init(tase_rx_t *rx);
 int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
                  void *user);
 
+/* Feed one byte: the same as tase_rx_feed(rx, &byte, 1, on_frame, user),
+ * with a shorter path for the common bytes (inside a frame, or noise while
+ * hunting for a sync), for callers that get one byte at a time. Returns
+ * the number of frames delivered (0 or more) or TASE_EARG if rx is NULL.
+ * Same context rules as tase_rx_feed(). */
+int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user);
+
 /* End of input (end of a capture file, link closed): settle every pending
  * candidate. Frames that can still be completed from the bytes held are
  * delivered; incomplete ones are released and counted in bytes_discarded.
