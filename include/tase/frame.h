@@ -54,9 +54,11 @@
  * call and has no 5A byte after its sync (so no other candidate can start
  * in it) is checked and delivered straight from the caller's buffer. Other
  * bytes are copied in runs (memchr/memcpy) between sync bytes and frame
- * ends. A clean telemetry stream costs about 8.5 instructions per byte on
- * x86-64 (gcc -O2); a stream made only of false syncs claiming 255 bytes is
- * the worst case, about 250. docs/PERFORMANCE.md has the measured numbers.
+ * ends. On x86-64 (gcc -O2, callgrind) a clean telemetry stream costs
+ * about 9 instructions per byte fed in 4 KB buffers and about 47 fed one
+ * byte at a time through tase_rx_push(); a stream made only of false syncs
+ * claiming 253 data bytes is the worst case, about 240 (300 byte at a
+ * time). docs/PERFORMANCE.md has the measured numbers.
  *
  * RAM. sizeof(tase_rx_t) is TASE_FRAME_MAX window bytes + counters +
  * candidate bookkeeping; checked against TASE_RX_SIZE_BUDGET at compile
