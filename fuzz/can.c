@@ -83,8 +83,8 @@ static void on_frame(void *user, const tase_frame_t *fr)
     got[ngot].end = fr->offset + (uint32_t)total;
     got[ngot].ours = 0;
     for (k = 0; k < ndl && !got[ngot].ours; k++) {
-        got[ngot].ours = dl[k].end - dl[k].start == total &&
-                         memcmp(txs + dl[k].start, enc, total) == 0;
+        got[ngot].ours =
+            dl[k].end - dl[k].start == total && memcmp(txs + dl[k].start, enc, total) == 0;
     }
     ngot++;
 }
@@ -210,8 +210,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fz_in_t in = {data, size};
     uint8_t mode = fz_u8(&in);
     tase_can_role_t sender = (mode & 1u) != 0u ? TASE_CAN_ROLE_GIMBAL : TASE_CAN_ROLE_HOST;
-    tase_can_role_t receiver = sender == TASE_CAN_ROLE_HOST ? TASE_CAN_ROLE_GIMBAL
-                                                            : TASE_CAN_ROLE_HOST;
+    tase_can_role_t receiver =
+        sender == TASE_CAN_ROLE_HOST ? TASE_CAN_ROLE_GIMBAL : TASE_CAN_ROLE_HOST;
     uint32_t rx_id, tx_id, ignored = 0, bad_len = 0, fed = 0;
     size_t ntx = 0, ncf = 0, nacc = 0, nrx = 0, i, k;
     int damaged = 0;

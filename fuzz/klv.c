@@ -90,8 +90,8 @@ static int klv_eq(const tase_klv_t *a, const tase_klv_t *b)
 
 static int documented_error(int rc)
 {
-    return rc == TASE_ETRUNC || rc == TASE_EFORMAT || rc == TASE_ELENGTH ||
-           rc == TASE_EUNKNOWN || rc == TASE_ECHECKSUM;
+    return rc == TASE_ETRUNC || rc == TASE_EFORMAT || rc == TASE_ELENGTH || rc == TASE_EUNKNOWN ||
+           rc == TASE_ECHECKSUM;
 }
 
 /* Decode in[0..n) with every check above; returns the result. */
@@ -249,10 +249,10 @@ static size_t put_packet(fz_in_t *in)
     for (j = 0; j < 8u; j++) {
         k.utc = (k.utc << 8) | v[j];
     }
-    k.lat = (int32_t)(((uint32_t)v[8] << 24) | ((uint32_t)v[9] << 16) | ((uint32_t)v[10] << 8) |
-                      v[11]);
-    k.lon = (int32_t)(((uint32_t)v[12] << 24) | ((uint32_t)v[13] << 16) |
-                      ((uint32_t)v[14] << 8) | v[15]);
+    k.lat =
+        (int32_t)(((uint32_t)v[8] << 24) | ((uint32_t)v[9] << 16) | ((uint32_t)v[10] << 8) | v[11]);
+    k.lon = (int32_t)(((uint32_t)v[12] << 24) | ((uint32_t)v[13] << 16) | ((uint32_t)v[14] << 8) |
+                      v[15]);
     k.alt = be16(v + 16);
     k.pan = be16(v + 18);
     k.tilt = (int16_t)be16(v + 20);

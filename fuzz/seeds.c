@@ -254,9 +254,8 @@ static int seeds_can(const char *dir)
             }
         }
         for (j = 0; j < 24; j++) { /* drop, duplicate, swap, inject each kind */
-            static const uint8_t ops[] = {0, 4, 0, 5, 0, 6, 0,    7, 1,    2,    3,    4,
-                                          0, 0, 0, 7, 15, 0x7F, 0xFF, 0x23, 0x47, 0x67,
-                                          0, 0x37};
+            static const uint8_t ops[] = {0, 4, 0, 5, 0,  6,    0,    7,    1,    2,    3, 4,
+                                          0, 0, 0, 7, 15, 0x7F, 0xFF, 0x23, 0x47, 0x67, 0, 0x37};
             put_byte(k == 0 ? 0 : ops[j]);
         }
         bad |= save(dir, "can", k);

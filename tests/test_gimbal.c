@@ -506,7 +506,7 @@ static void a_poll_in_the_last_period_of_a_second_catches_up_into_the_next(void 
     /* one sent, the rest skipped: angle and rate 8 each (1200..1900),
      * georef 2 (1500, 1750; 1250 went out) */
     assert_int_equal(x->g.stats.slots_skipped, 8u + 8u + 2u);
-    run(x, 1951, 48, 0); /* up to 1999 */
+    run(x, 1951, 48, 0);                  /* up to 1999 */
     assert_int_equal(x->count[0][0], 11); /* nothing before 2000 */
     run(x, 2000, 1000, 0);
     /* the grid of the next second, from its first slot: 2000 .. 3000 */
