@@ -3,6 +3,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -381,9 +382,78 @@ static void frame_check_enforces_id_width_and_dlc(void **state)
     assert_int_equal(tase_can_frame_check(NULL), TASE_EARG);
 }
 
+static void split_refuses_counts_an_int_result_cannot_carry(void **state)
+{
+    /* 32768 frames of 8 bytes: the count would not fit the contract's
+     * int16 bound, even with an array large enough for it */
+    size_t n = 8u * 32768u;
+    uint8_t *data = calloc(n, 1);
+    tase_can_frame_t *out = calloc(32768u, sizeof(*out));
+    (void)state;
+    assert_non_null(data);
+    assert_non_null(out);
+    out[0].dlc = 0xAB;
+    assert_int_equal(tase_can_split(TASE_CAN_ROLE_HOST, data, n, out, 32768u), TASE_ENOSPC);
+    assert_int_equal(out[0].dlc, 0xAB);
+    /* one frame fewer is fine */
+    assert_int_equal(tase_can_split(TASE_CAN_ROLE_HOST, data, n - 8u, out, 32768u), 32767);
+    assert_int_equal(out[32766].dlc, 8);
+    free(data);
+    free(out);
+}
+
+static void null_and_unknown_roles_are_rejected_without_counting(void **state)
+{
+    tase_can_rx_t crx;
+    tase_can_split_t s;
+    tase_can_frame_t f = ext_frame(TASE_CAN_ID_TO_GIMBAL, angle_pkt, 8), copy;
+    tase_can_3ax_move_t m = {TASE_3AX_RETRACT};
+    tase_can_3ax_status_t st = {7, 5};
+    got_t got;
+    (void)state;
+    memset(&got, 0, sizeof(got));
+    assert_int_equal(tase_can_rx_init(NULL, TASE_CAN_ROLE_GIMBAL), TASE_EARG);
+    memset(&crx, 0x5A, sizeof(crx));
+    assert_int_equal(tase_can_rx_init(&crx, (tase_can_role_t)2), TASE_EARG);
+    assert_int_equal(crx.stats.frames_in, 0x5A5A5A5Au); /* untouched */
+    assert_int_equal(tase_can_rx_init(&crx, TASE_CAN_ROLE_GIMBAL), TASE_OK);
+    assert_int_equal(tase_can_rx_feed(NULL, &f, on_frame, &got), TASE_EARG);
+    assert_int_equal(tase_can_rx_feed(&crx, NULL, on_frame, &got), TASE_EARG);
+    /* an instance whose role was overwritten counts nothing */
+    crx.role = (tase_can_role_t)9;
+    assert_int_equal(tase_can_rx_feed(&crx, &f, on_frame, &got), TASE_EARG);
+    assert_int_equal(crx.stats.frames_in, 0);
+    assert_int_equal(crx.rx.stats.bytes_in, 0);
+    assert_int_equal(got.n, 0);
+    assert_int_equal(tase_can_accept(TASE_CAN_ROLE_HOST, NULL), TASE_EARG);
+
+    assert_int_equal(tase_can_split_init(NULL, TASE_CAN_ROLE_HOST, angle_pkt, 3), TASE_EARG);
+    assert_int_equal(tase_can_split_init(&s, (tase_can_role_t)3, angle_pkt, 3), TASE_EARG);
+    assert_int_equal(tase_can_split_init(&s, TASE_CAN_ROLE_HOST, angle_pkt, 3), TASE_OK);
+    assert_int_equal(tase_can_split_next(&s, NULL), TASE_EARG);
+    assert_int_equal(s.pos, 0);
+
+    copy = f;
+    assert_int_equal(tase_can_3ax_move_encode(&m, NULL), TASE_EARG);
+    assert_int_equal(tase_can_3ax_status_encode(NULL, &f), TASE_EARG);
+    assert_int_equal(tase_can_3ax_status_encode(&st, NULL), TASE_EARG);
+    assert_memory_equal(&f, &copy, sizeof(f));
+    assert_int_equal(tase_can_3ax_move_encode(&m, &f), TASE_OK);
+    assert_int_equal(tase_can_3ax_move_decode(NULL, &m), TASE_EARG);
+    assert_int_equal(tase_can_3ax_move_decode(&f, NULL), TASE_EARG);
+    assert_int_equal(tase_can_3ax_status_encode(&st, &f), TASE_OK);
+    assert_int_equal(tase_can_3ax_status_decode(NULL, &st), TASE_EARG);
+    assert_int_equal(tase_can_3ax_status_decode(&f, NULL), TASE_EARG);
+    assert_int_equal(st.position, 7);
+    assert_int_equal(st.speed_dps, 5);
+    assert_int_equal(m.command, TASE_3AX_RETRACT);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(split_refuses_counts_an_int_result_cannot_carry),
+        cmocka_unit_test(null_and_unknown_roles_are_rejected_without_counting),
         cmocka_unit_test(role_ids_follow_the_spec),
         cmocka_unit_test(angle_packet_from_gimbal_is_8_plus_6_bytes),
         cmocka_unit_test(split_covers_every_length_in_order),

@@ -398,9 +398,35 @@ static void camera_pass_carries_249_bytes_and_may_be_encoded_in_place(void **sta
     assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), 12);
 }
 
+static void unknown_ids_and_missing_structs_are_told_apart_from_missing_buffers(void **state)
+{
+    uint8_t out[TASE_FRAME_MAX];
+    tase_camera_pass_t cp = {1, 2, 0, NULL};
+    tase_frame_t gyro = {0, 0x00, 0x40, 0, NULL};
+    tase_frame_t pass = {0, 0x00, 0x42, 4, NULL};
+    (void)state;
+    memset(out, 0xAA, sizeof(out));
+    /* unknown packet: no buffer is TASE_EARG, else TASE_EUNKNOWN */
+    assert_int_equal(tase_packet_encode(TASE_ID(0x28, 0x00), &cp, NULL, 64), TASE_EARG);
+    assert_int_equal(tase_packet_encode_len(TASE_ID(0x28, 0x00), &cp, 4, NULL, 64), TASE_EARG);
+    assert_int_equal(tase_packet_encode_len(TASE_ID(0x28, 0x00), &cp, 4, out, 64), TASE_EUNKNOWN);
+    /* CAMERA_PASS without its struct: its 4 header bytes have no source */
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, NULL, out, sizeof(out)), TASE_EARG);
+    assert_int_equal(out[0], 0xAA);
+    /* ... with an empty tail it is the 4-byte form */
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), 12);
+    assert_int_equal(out[6], 1);
+    assert_int_equal(out[7], 2);
+    /* a zero-length frame may come without data; a longer one may not */
+    assert_int_equal(tase_packet_decode(&gyro, NULL), 0);
+    assert_int_equal(tase_packet_decode(&pass, &cp), TASE_EARG);
+    assert_int_equal(cp.camera, 1); /* untouched */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(unknown_ids_and_missing_structs_are_told_apart_from_missing_buffers),
         cmocka_unit_test(gimbal_cmd_extremes_encode_to_hand_computed_frame),
         cmocka_unit_test(gyro_zero_and_camera_short_forms_encode_to_hand_computed_frames),
         cmocka_unit_test(gimbal_angle_encodes_to_hand_computed_frame),

@@ -494,6 +494,167 @@ static void absent_ports_get_nothing_and_bad_arguments_are_rejected(void **state
     free(x);
 }
 
+static void a_poll_in_the_last_period_of_a_second_catches_up_into_the_next(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    (void)state;
+    x->port[0].discard = 1;
+    run(x, 0, 1000, 0); /* angle at 100 .. 1000 */
+    assert_int_equal(x->count[0][0], 10);
+    tase_gimbal_poll(&x->g, 1950); /* 1100 .. 1900 were due */
+    assert_int_equal(x->count[0][0], 11);
+    /* one sent, the rest skipped: angle and rate 8 each (1200..1900),
+     * georef 2 (1500, 1750; 1250 went out) */
+    assert_int_equal(x->g.stats.slots_skipped, 8u + 8u + 2u);
+    run(x, 1951, 48, 0);                  /* up to 1999 */
+    assert_int_equal(x->count[0][0], 11); /* nothing before 2000 */
+    run(x, 2000, 1000, 0);
+    /* the grid of the next second, from its first slot: 2000 .. 3000 */
+    assert_int_equal(x->count[0][0], 22);
+    assert_int_equal(x->last[0][0], 3000);
+    assert_int_equal(x->g.stats.slots_skipped, 18u);
+    free(x);
+}
+
+static void port_write_errors_are_counted_argument_errors_are_not(void **state)
+{
+    fix_t *x = make(0, 1, false);
+    uint8_t d[TASE_DATA_MAX + 1];
+    (void)state;
+    memset(d, 0, sizeof d);
+    assert_int_equal(tase_gimbal_send(&x->g, 0, 0x00, 0x42, d, sizeof d), TASE_ETOOLONG);
+    assert_int_equal(tase_gimbal_send(&x->g, 0, 0x00, 0x42, NULL, 4), TASE_EARG);
+    assert_int_equal(x->g.stats.tx_errors, 0);
+    x->port[0].write_result = TASE_EIO;
+    assert_int_equal(tase_gimbal_send(&x->g, 0, 0x00, 0x42, d, 4), TASE_EIO);
+    /* a query whose echo cannot be written is still counted as answered */
+    feed(x, 0, 0x48, 0x01, NULL, 0, 5);
+    assert_int_equal(x->g.stats.tx_errors, 2);
+    assert_int_equal(x->g.stats.frames_tx, 0);
+    assert_int_equal(x->g.stats.setup_queries, 1);
+    x->port[0].write_result = 0;
+    assert_int_equal(tase_gimbal_send(&x->g, 0, 0x00, 0x42, d, 4), 12);
+    assert_int_equal(x->g.stats.frames_tx, 1);
+    free(x);
+}
+
+static void every_function_rejects_null_and_out_of_range_arguments(void **state)
+{
+    fix_t *x = make(0, 3, true);
+    uint8_t d[TASE_DATA_MAX];
+    tase_frame_t f = {0, 0x08, 0x41, 0, d};
+    tase_frame_t nodata = {0, 0x08, 0x41, 0, NULL};
+    tase_gimbal_stats_t before;
+    uint8_t setup_before[TASE_GIMBAL_SETUP_BYTES];
+    (void)state;
+    memset(d, 0, sizeof d);
+    memcpy(setup_before, x->g.setup, sizeof setup_before);
+    before = x->g.stats;
+    assert_int_equal(tase_gimbal_init(&x->g, NULL, 1, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_feed(NULL, 0, d, 1, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_handle_frame(NULL, 0, &f, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_handle_frame(&x->g, 0, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_handle_frame(&x->g, 0, &nodata, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_handle_frame(&x->g, 3, &f, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_poll(NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_service(NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_send(NULL, 0, 0, 0x80, d, 8), TASE_EARG);
+    assert_int_equal(tase_gimbal_send(&x->g, 3, 0, 0x80, d, 8), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_get(NULL, 0, d, sizeof d), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0, NULL, sizeof d), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_set(NULL, 0, d, 16, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_set(&x->g, 0, NULL, 16, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_set(&x->g, 8, d, 16, 0), TASE_EUNKNOWN);
+    assert_int_equal(tase_gimbal_setup_set(&x->g, 0, d, 15, 0), TASE_ELENGTH);
+    /* nothing changed, nothing was sent */
+    assert_memory_equal(&x->g.stats, &before, sizeof before);
+    assert_memory_equal(x->g.setup, setup_before, sizeof setup_before);
+    assert_int_equal(x->port[0].nout + x->port[1].nout + x->port[2].nout, 0);
+    free(x);
+}
+
+static void frames_from_absent_ports_and_without_callbacks_are_only_counted(void **state)
+{
+    tase_gimbal_t g;
+    fake_port_t *fp = calloc(1, sizeof *fp);
+    tase_port_t ports[2] = {{NULL, NULL}, {&fake_ops, NULL}};
+    uint8_t d[16] = {1, 2, 3};
+    tase_frame_t setup = {0, 0x48, 0x00, 16, d};
+    tase_frame_t cmd = {0, 0x00, 0x80, 8, d};
+    (void)state;
+    assert_non_null(fp);
+    ports[1].ctx = fp;
+    /* no application at all: setup packets are accepted as they are */
+    assert_int_equal(tase_gimbal_init(&g, ports, 2, NULL, 0), TASE_OK);
+    /* port 0 is absent: a setup packet there is neither applied nor echoed */
+    assert_int_equal(tase_gimbal_handle_frame(&g, 0, &setup, 1), TASE_OK);
+    assert_int_equal(g.stats.frames_rx, 1);
+    assert_int_equal(g.stats.setup_applied, 0);
+    assert_int_equal(tase_gimbal_handle_frame(&g, 0, &cmd, 1), TASE_OK);
+    assert_int_equal(g.stats.frames_rx, 2);
+    /* on port 1 (present) the same packet is stored and echoed */
+    assert_int_equal(tase_gimbal_handle_frame(&g, 1, &setup, 1), TASE_OK);
+    assert_int_equal(g.stats.setup_applied, 1);
+    assert_int_equal(fake_frames_out(fp), 1);
+    {
+        uint8_t got[16];
+        assert_int_equal(tase_gimbal_setup_get(&g, 0, got, sizeof got), 16);
+        assert_memory_equal(got, d, 16);
+    }
+    free(fp);
+}
+
+/* A port with a clock and a read that fails. */
+static int broken_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    (void)ctx, (void)buf, (void)cap, (void)timeout_ms;
+    return TASE_EIO;
+}
+
+static void service_reads_every_port_feeds_it_and_polls(void **state)
+{
+    static const tase_port_ops_t write_only = {fake_write, NULL, NULL};
+    static const tase_port_ops_t broken = {fake_write, broken_read, fake_now};
+    fix_t *x = calloc(1, sizeof *x);
+    tase_port_t ports[3];
+    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL};
+    uint8_t g, t, d[TASE_DATA_MAX], noise[5000];
+    (void)state;
+    assert_non_null(x);
+    app.user = x;
+    ports[0].ops = &fake_ops;
+    ports[0].ctx = &x->port[0];
+    ports[1].ops = &write_only;
+    ports[1].ctx = &x->port[1];
+    ports[2].ops = &broken;
+    ports[2].ctx = &x->port[2];
+    assert_int_equal(tase_gimbal_init(&x->g, ports, 3, &app, 0), TASE_OK);
+
+    /* a query arrives on port 0 and is answered there; nothing is due yet */
+    fake_push_frame(&x->port[0], 0x48, 0x01, NULL, 0);
+    fake_push_frame(&x->port[0], 0x00, 0x80, d, 8);
+    assert_int_equal(tase_gimbal_service(&x->g, 10), 0);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 2);
+    assert_int_equal(g, 0x48);
+    assert_int_equal(t, 0x01);
+    assert_int_equal(x->others, 1);
+    assert_int_equal(x->other_type, 0x80);
+    assert_int_equal(x->port[1].nout + x->port[2].nout, 0);
+    /* at 100 ms the first angle and rate packets are due on each port */
+    x->port[0].discard = x->port[1].discard = x->port[2].discard = 1;
+    assert_int_equal(tase_gimbal_service(&x->g, 100), 6);
+    /* a call reads at most 64 x 64 bytes from a port, then moves on */
+    memset(noise, 0x11, sizeof noise);
+    fake_push(&x->port[0], noise, sizeof noise);
+    x->port[0].rin = x->port[0].nin - sizeof noise;
+    assert_int_equal(tase_gimbal_service(&x->g, 101), 0);
+    assert_int_equal(x->port[0].nin - x->port[0].rin, sizeof noise - 64u * 64u);
+    assert_int_equal(tase_gimbal_service(&x->g, 102), 0);
+    assert_int_equal(x->port[0].nin, x->port[0].rin);
+    assert_int_equal(x->g.rx[0].stats.bytes_in, 8 + 16 + sizeof noise);
+    free(x);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -511,6 +672,11 @@ int main(void)
         cmocka_unit_test(a_late_poll_sends_one_packet_not_a_burst_and_keeps_the_grid),
         cmocka_unit_test(a_declined_slot_is_counted_and_the_schedule_moves_on),
         cmocka_unit_test(absent_ports_get_nothing_and_bad_arguments_are_rejected),
+        cmocka_unit_test(a_poll_in_the_last_period_of_a_second_catches_up_into_the_next),
+        cmocka_unit_test(port_write_errors_are_counted_argument_errors_are_not),
+        cmocka_unit_test(every_function_rejects_null_and_out_of_range_arguments),
+        cmocka_unit_test(frames_from_absent_ports_and_without_callbacks_are_only_counted),
+        cmocka_unit_test(service_reads_every_port_feeds_it_and_polls),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -316,6 +316,111 @@ static void bad_arguments_are_rejected(void **state)
     assert_int_equal(x->port.nout, 0); /* nothing was sent by any of these */
 }
 
+/* A port that can only write: no read, no clock. */
+static const tase_port_ops_t write_only_ops = {fake_write, NULL, NULL};
+
+static void service_and_transact_need_a_readable_port_with_a_clock(void **state)
+{
+    fix_t *x = *state;
+    tase_host_t h;
+    tase_port_t p = {&write_only_ops, &x->port};
+    uint8_t reply[8];
+    assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_OK);
+    assert_int_equal(tase_host_service(&h, 10), TASE_EUNSUPPORTED);
+    assert_int_equal(tase_host_transact(&h, 0x48, 0x00, NULL, 0, reply, sizeof reply, 100, 1),
+                     TASE_EUNSUPPORTED);
+    assert_int_equal(x->port.nout, 0); /* the request was not even sent */
+    assert_false(tase_host_busy(&h));
+    assert_int_equal(tase_host_service(NULL, 10), TASE_EARG);
+    assert_int_equal(tase_host_transact(NULL, 0x48, 0x00, NULL, 0, reply, 8, 100, 1), TASE_EARG);
+}
+
+static void transact_returns_a_start_error_without_leaving_a_request(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[8];
+    /* bad arguments and a port that refuses the first attempt */
+    assert_int_equal(tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, 8, 0, 1), TASE_EARG);
+    x->port.write_result = TASE_EDOWN;
+    assert_int_equal(tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, 8, 100, 1),
+                     TASE_EDOWN);
+    assert_false(tase_host_busy(&x->host));
+    assert_int_equal(x->host.stats.tx_errors, 1);
+    assert_int_equal(x->host.stats.requests, 0);
+}
+
+/* A port whose read fails: transact must give the error back and drop
+ * the request instead of spinning. */
+static int failing_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    (void)ctx, (void)buf, (void)cap, (void)timeout_ms;
+    return TASE_EIO;
+}
+
+static const tase_port_ops_t failing_read_ops = {fake_write, failing_read, fake_now};
+
+static void transact_gives_back_a_read_error_and_cancels_the_request(void **state)
+{
+    fix_t *x = *state;
+    tase_host_t h;
+    tase_port_t p = {&failing_read_ops, &x->port};
+    uint8_t reply[8];
+    assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_OK);
+    assert_int_equal(tase_host_transact(&h, 0x48, 0x01, NULL, 0, reply, sizeof reply, 100, 3),
+                     TASE_EIO);
+    assert_int_equal(fake_frames_out(&x->port), 1); /* one attempt, no retries */
+    assert_false(tase_host_busy(&h));
+    assert_int_equal(tase_host_poll(&h, 1000), TASE_ESTATE); /* nothing left to report */
+    assert_int_equal(tase_host_service(&h, 0), TASE_EIO);
+}
+
+static void send_counts_port_errors_but_not_argument_errors(void **state)
+{
+    fix_t *x = *state;
+    uint8_t d[TASE_DATA_MAX + 1];
+    memset(d, 0, sizeof d);
+    assert_int_equal(tase_host_send(NULL, 0x00, 0x80, d, 8), TASE_EARG);
+    assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, NULL, 8), TASE_EARG);
+    assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, d, sizeof d), TASE_ETOOLONG);
+    assert_int_equal(x->host.stats.tx_errors, 0);
+    x->port.write_result = TASE_EIO;
+    assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, d, 8), TASE_EIO);
+    assert_int_equal(x->host.stats.tx_errors, 1);
+    assert_int_equal(x->host.stats.frames_tx, 0);
+    x->port.write_result = 0;
+    assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, d, 8), 16);
+    assert_int_equal(x->host.stats.frames_tx, 1);
+    assert_int_equal(tase_host_cancel(NULL), TASE_EARG);
+}
+
+static void init_rejects_a_port_without_write(void **state)
+{
+    static const tase_port_ops_t no_write = {NULL, fake_read, fake_now};
+    fix_t *x = *state;
+    tase_host_t h;
+    tase_port_t p = {&no_write, &x->port};
+    memset(&h, 0x5A, sizeof h);
+    assert_int_equal(tase_host_init(&h, NULL, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_EARG);
+    assert_int_equal(h.state, 0x5A); /* untouched */
+}
+
+static void a_reply_without_a_buffer_reports_its_length_only(void **state)
+{
+    fix_t *x = *state;
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x04, NULL, 0, 100, 0, 0), TASE_OK);
+    /* the request must also be completed through handle_frame */
+    {
+        const uint8_t two[2] = {1, 0};
+        tase_frame_t f = {0, 0x48, 0x04, 2, two};
+        tase_frame_t nodata = {0, 0x48, 0x04, 2, NULL};
+        assert_int_equal(tase_host_handle_frame(&x->host, &nodata), TASE_EARG);
+        assert_int_equal(tase_host_handle_frame(&x->host, &f), 1);
+    }
+    assert_int_equal(tase_host_poll(&x->host, 1), 2);
+    assert_int_equal(x->others, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -338,6 +443,17 @@ int main(void)
                                         teardown),
         cmocka_unit_test_setup_teardown(transact_times_out_after_all_attempts, setup, teardown),
         cmocka_unit_test_setup_teardown(bad_arguments_are_rejected, setup, teardown),
+        cmocka_unit_test_setup_teardown(service_and_transact_need_a_readable_port_with_a_clock,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(transact_returns_a_start_error_without_leaving_a_request,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(transact_gives_back_a_read_error_and_cancels_the_request,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(send_counts_port_errors_but_not_argument_errors, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(init_rejects_a_port_without_write, setup, teardown),
+        cmocka_unit_test_setup_teardown(a_reply_without_a_buffer_reports_its_length_only, setup,
+                                        teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

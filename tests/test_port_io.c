@@ -107,6 +107,80 @@ static void send_frame_writes_one_encoded_frame(void **state)
     free(f);
 }
 
+static void write_all_rejects_incomplete_ports_and_lengths_beyond_int(void **state)
+{
+    static const tase_port_ops_t no_write = {NULL, NULL, NULL};
+    stingy_t s = {100, 0, 0};
+    tase_port_t p = {&stingy_ops, &s};
+    tase_port_t no_ops = {NULL, &s};
+    tase_port_t nw = {&no_write, &s};
+    (void)state;
+    assert_int_equal(tase_port_write_all(&no_ops, (const uint8_t *)"ab", 2), TASE_EARG);
+    assert_int_equal(tase_port_write_all(&nw, (const uint8_t *)"ab", 2), TASE_EARG);
+    /* the result could not be returned as an int: refused before writing */
+    assert_int_equal(tase_port_write_all(&p, (const uint8_t *)"ab", (size_t)0x80000000u),
+                     TASE_EARG);
+    assert_int_equal(tase_port_write_all(&p, (const uint8_t *)"ab", SIZE_MAX), TASE_EARG);
+    assert_int_equal(s.calls, 0);
+    /* zero bytes: nothing to do, NULL data allowed */
+    assert_int_equal(tase_port_write_all(&p, NULL, 0), 0);
+    assert_int_equal(s.calls, 0);
+}
+
+/* A port that returns a fixed value from every write. */
+typedef struct {
+    int ret;
+    unsigned calls;
+} fixed_t;
+
+static int fixed_write(void *ctx, const uint8_t *data, size_t n)
+{
+    fixed_t *x = ctx;
+    (void)data;
+    x->calls++;
+    return x->ret == 1 ? (int)n + 1 : x->ret; /* 1: claim one byte more */
+}
+
+static const tase_port_ops_t fixed_ops = {fixed_write, NULL, NULL};
+
+static void write_all_rejects_a_port_claiming_more_than_asked(void **state)
+{
+    fixed_t x = {1, 0};
+    tase_port_t p = {&fixed_ops, &x};
+    (void)state;
+    assert_int_equal(tase_port_write_all(&p, (const uint8_t *)"abc", 3), TASE_EIO);
+    assert_int_equal(x.calls, 1);
+}
+
+static void write_all_counts_zero_and_enobufs_as_no_progress(void **state)
+{
+    fixed_t zero = {0, 0}, full = {TASE_ENOBUFS, 0};
+    tase_port_t pz = {&fixed_ops, &zero}, pf = {&fixed_ops, &full};
+    (void)state;
+    /* a port that takes 0 bytes forever: EAGAIN (nothing sent), bounded */
+    assert_int_equal(tase_port_write_all(&pz, (const uint8_t *)"abc", 3), TASE_EAGAIN);
+    assert_int_equal(zero.calls, TASE_PORT_WRITE_TRIES);
+    /* a full queue keeps its own code */
+    assert_int_equal(tase_port_write_all(&pf, (const uint8_t *)"abc", 3), TASE_ENOBUFS);
+    assert_int_equal(full.calls, TASE_PORT_WRITE_TRIES);
+}
+
+static void send_frame_checks_the_frame_before_the_port(void **state)
+{
+    fake_port_t *f = new_fake();
+    tase_port_t p = {&fake_ops, f};
+    static const uint8_t big[300];
+    (void)state;
+    assert_int_equal(tase_port_send_frame(NULL, 0x48, 0x00, NULL, 0), TASE_EARG);
+    /* an encoder error wins over the missing port: nothing to send anyway */
+    assert_int_equal(tase_port_send_frame(NULL, 0x48, 0x00, big, sizeof big), TASE_ETOOLONG);
+    assert_int_equal(tase_port_send_frame(&p, 0x48, 0x00, NULL, 3), TASE_EARG);
+    assert_int_equal(f->nout, 0);
+    assert_int_equal(tase_port_send_frame(&p, 0x48, 0x00, NULL, 0), 8);
+    assert_int_equal(fake_frames_out(f), 1);
+    free(f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -115,6 +189,10 @@ int main(void)
         cmocka_unit_test(write_all_reports_eio_when_a_frame_was_cut),
         cmocka_unit_test(write_all_passes_hard_errors_on_at_once),
         cmocka_unit_test(send_frame_writes_one_encoded_frame),
+        cmocka_unit_test(write_all_rejects_incomplete_ports_and_lengths_beyond_int),
+        cmocka_unit_test(write_all_rejects_a_port_claiming_more_than_asked),
+        cmocka_unit_test(write_all_counts_zero_and_enobufs_as_no_progress),
+        cmocka_unit_test(send_frame_checks_the_frame_before_the_port),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

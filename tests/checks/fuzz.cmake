@@ -21,3 +21,6 @@ endfunction()
 
 tase_fuzz(rx_bytes 60)  # datalink receiver, arbitrary bytes in random splits
 tase_fuzz(rx_frames 30) # valid frames + noise + corruptions: zero collateral loss
+tase_fuzz(decode 20)    # every packet decoder + dispatcher, any (group, type) and length
+tase_fuzz(klv 20)       # KLV decoder (codes, round trip, first failure wins) + stream scanner
+tase_fuzz(can 20)       # CAN reassembly with lost/repeated/reordered/foreign frames; candump
