@@ -330,7 +330,8 @@ int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap);
  * fields beyond a short accepted length (query: all; CAMERA_CMD 1-byte
  * form: all but camera) stay zero, so check the return value.
  * Returns the data length decoded (>= 0), or
- *   TASE_EARG     f or msg is NULL (msg may be NULL for GYRO_ZERO_CMD);
+ *   TASE_EARG     f or msg is NULL (msg may be NULL for a zero-length frame:
+ *                 GYRO_ZERO_CMD or a query);
  *   TASE_EUNKNOWN the schema does not know (f->group, f->type);
  *   TASE_ELENGTH  f->len is not an accepted length for the packet.
  * On error msg is unchanged. O(length). */
