@@ -621,6 +621,7 @@ static void service_reads_every_port_feeds_it_and_polls(void **state)
     uint8_t g, t, d[TASE_DATA_MAX], noise[5000];
     (void)state;
     assert_non_null(x);
+    memset(d, 0, sizeof d); /* the GIMBAL_CMD pushed below carries d */
     app.user = x;
     ports[0].ops = &fake_ops;
     ports[0].ctx = &x->port[0];
