@@ -109,14 +109,7 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, size_t nports,
 /* Count the outcome of writing one frame; returns r. */
 static int gimbal_write(tase_gimbal_t *g, int r)
 {
-    if (r >= 0) {
-        g->stats.frames_tx++;
-    } else if (r != TASE_EARG && r != TASE_ETOOLONG) {
-        g->stats.tx_errors++;
-    } else {
-        /* the caller's mistake, not the link's */
-    }
-    return r;
+    return tase_port_count_tx(r, &g->stats.frames_tx, &g->stats.tx_errors);
 }
 
 int tase_gimbal_send(tase_gimbal_t *g, unsigned port, uint8_t group, uint8_t type,

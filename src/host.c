@@ -25,15 +25,8 @@ int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on
 
 static int host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len)
 {
-    int r = tase_port_send_frame(&h->port, group, type, data, len);
-    if (r >= 0) {
-        h->stats.frames_tx++;
-    } else if (r != TASE_EARG && r != TASE_ETOOLONG) {
-        h->stats.tx_errors++;
-    } else {
-        /* the caller's mistake, not the link's */
-    }
-    return r;
+    return tase_port_count_tx(tase_port_send_frame(&h->port, group, type, data, len),
+                              &h->stats.frames_tx, &h->stats.tx_errors);
 }
 
 int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len)

@@ -53,3 +53,19 @@ int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, c
     }
     return tase_port_write_all(port, buf, (size_t)n);
 }
+
+int tase_port_count_tx(int r, uint32_t *sent, uint32_t *errors)
+{
+    if (r >= 0) {
+        if (sent != NULL) {
+            (*sent)++;
+        }
+    } else if (r != TASE_EARG && r != TASE_ETOOLONG) {
+        if (errors != NULL) {
+            (*errors)++;
+        }
+    } else {
+        /* the caller's mistake, not the link's */
+    }
+    return r;
+}

@@ -181,9 +181,26 @@ static void send_frame_checks_the_frame_before_the_port(void **state)
     free(f);
 }
 
+static void count_tx_counts_link_failures_but_not_caller_mistakes(void **state)
+{
+    uint32_t sent = 0, errors = 0;
+    (void)state;
+    assert_int_equal(tase_port_count_tx(14, &sent, &errors), 14);
+    assert_int_equal(tase_port_count_tx(0, &sent, &errors), 0);
+    assert_int_equal(tase_port_count_tx(TASE_EIO, &sent, &errors), TASE_EIO);
+    assert_int_equal(tase_port_count_tx(TASE_EAGAIN, &sent, &errors), TASE_EAGAIN);
+    assert_int_equal(tase_port_count_tx(TASE_EARG, &sent, &errors), TASE_EARG);
+    assert_int_equal(tase_port_count_tx(TASE_ETOOLONG, &sent, &errors), TASE_ETOOLONG);
+    assert_int_equal(sent, 2);
+    assert_int_equal(errors, 2);
+    assert_int_equal(tase_port_count_tx(5, NULL, NULL), 5);
+    assert_int_equal(tase_port_count_tx(TASE_EIO, NULL, NULL), TASE_EIO);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(count_tx_counts_link_failures_but_not_caller_mistakes),
         cmocka_unit_test(write_all_reassembles_partial_writes),
         cmocka_unit_test(write_all_reports_eagain_when_nothing_went_out),
         cmocka_unit_test(write_all_reports_eio_when_a_frame_was_cut),

@@ -47,6 +47,13 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n);
 int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *data,
                          size_t len);
 
+/* Count the result r of a frame write (tase_port_send_frame() or
+ * tase_port_write_all()): a success in *sent, a failure of the link in
+ * *errors. Failures caused by the caller's arguments (TASE_EARG,
+ * TASE_ETOOLONG) are not the link's and count in neither. Either pointer
+ * may be NULL. Returns r unchanged. O(1), reentrant. */
+int tase_port_count_tx(int r, uint32_t *sent, uint32_t *errors);
+
 #ifdef __cplusplus
 }
 #endif
