@@ -444,8 +444,8 @@ def main():
         p("")
         p("The library has no static data: its RAM is the instances the application owns "
           "(two tase_rx_t of %d B, the host-side one only for the self-check; a "
-          "tase_gimbal_t of %d B, which carries three receivers of its own that this image "
-          "leaves unused because it feeds its own receiver through the dispatcher; a "
+          "tase_gimbal_t of %d B, initialised without receivers because this image feeds "
+          "its own receiver through the dispatcher and hands setup frames to the role; a "
           "tase_dispatch_t of %d B)." % (rxsz, types.get("tase_gimbal_t", 0),
                                          types.get("tase_dispatch_t", 0)))
         p("")

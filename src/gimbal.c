@@ -61,7 +61,7 @@ static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
     }
 }
 
-int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, size_t nports,
+int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, size_t nports,
                      const tase_gimbal_app_t *app, uint32_t now_ms)
 {
     /* Defaults the spec states. PACKET_RATE: 10, 10, 4 per port. SENSOR_FILTER:
@@ -95,8 +95,12 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, size_t nports,
     for (i = 0; i < nports; i++) {
         g->port[i] = ports[i];
     }
-    for (i = 0; i < TASE_GIMBAL_PORTS; i++) {
-        (void)tase_rx_init(&g->rx[i]);
+    if (rx != NULL) {
+        g->rx = rx;
+        g->nrx = (uint8_t)nports;
+        for (i = 0; i < nports; i++) {
+            (void)tase_rx_init(&rx[i]);
+        }
     }
     if (app != NULL) {
         g->app = *app;
@@ -228,7 +232,13 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
                      uint32_t now_ms)
 {
     feed_ctx_t c;
-    if (g == NULL || port >= TASE_GIMBAL_PORTS) {
+    if (g == NULL) {
+        return TASE_EARG;
+    }
+    if (g->rx == NULL) {
+        return TASE_ESTATE;
+    }
+    if (port >= g->nrx) {
         return TASE_EARG;
     }
     c.g = g;
@@ -328,6 +338,9 @@ int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
     for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
         if (!port_present(g, p) || g->port[p].ops->read == NULL) {
             continue;
+        }
+        if (g->rx == NULL) {
+            return TASE_ESTATE; /* nowhere to feed what it would read */
         }
         for (i = 0; i < SERVICE_READS; i++) {
             int n = g->port[p].ops->read(g->port[p].ctx, buf, sizeof buf, 0);

@@ -24,6 +24,7 @@
 typedef struct {
     tase_posix_uart_t uart;
     tase_gimbal_t g;
+    tase_rx_t rx[1];
     int stop;
     /* written by the gimbal thread, read after join */
     unsigned commands;
@@ -127,7 +128,7 @@ static void host_and_gimbal_talk_over_a_real_pty(void **state)
     assert_int_equal(tase_posix_uart_open(&gs.uart, name, 57600), TASE_OK);
     close(slave); /* the port has its own descriptor */
     gport = tase_posix_uart_port(&gs.uart);
-    assert_int_equal(tase_gimbal_init(&gs.g, &gport, 1, &app, tase_posix_now_ms()), TASE_OK);
+    assert_int_equal(tase_gimbal_init(&gs.g, &gport, gs.rx, 1, &app, tase_posix_now_ms()), TASE_OK);
     for (i = 0; i < sizeof version; i++) {
         version[i] = (uint8_t)(0xA0u + i);
     }
@@ -179,7 +180,7 @@ static void host_and_gimbal_talk_over_a_real_pty(void **state)
     assert_int_equal(host.stats.retries, 0);
     assert_int_equal(host.rx.stats.checksum_errors, 0);
     assert_int_equal(host.rx.stats.bytes_discarded, 0);
-    assert_int_equal(gs.g.rx[0].stats.checksum_errors, 0);
+    assert_int_equal(gs.rx[0].stats.checksum_errors, 0);
     assert_int_equal(gs.g.stats.setup_applied, 1);
     assert_int_equal(gs.g.stats.tx_errors, 0);
     tase_posix_uart_close(&hu);

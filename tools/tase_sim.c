@@ -44,6 +44,7 @@ typedef struct {
 
 typedef struct {
     tase_gimbal_t g;
+    tase_rx_t rx[1]; /* the receiver of the gimbal's one port */
     sim_model_t m;
     camera_t cam[NCAM];
     uint8_t active_cam;
@@ -540,7 +541,7 @@ int main(int argc, char **argv)
     app.user = &s;
     now = tase_posix_now_ms();
     s.t0 = now;
-    if (tase_gimbal_init(&s.g, &port, 1, &app, now) != TASE_OK) {
+    if (tase_gimbal_init(&s.g, &port, s.rx, 1, &app, now) != TASE_OK) {
         tk_die("internal error: gimbal role init failed");
     }
     set_version(&s, now);

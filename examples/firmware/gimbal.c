@@ -190,7 +190,7 @@ int gimbal_app_init(gimbal_app_t *app, const tase_port_t *port, tase_rx_stats_t 
     memset(&cb, 0, sizeof cb);
     cb.fill_telemetry = fill_telemetry; /* apply_setup NULL: accept every setting */
     cb.user = app;
-    r = tase_gimbal_init(&app->role, port, 1u, &cb, now_ms);
+    r = tase_gimbal_init(&app->role, port, NULL, 1u, &cb, now_ms);
     if (r < 0) {
         return r;
     }

@@ -114,13 +114,14 @@ typedef struct {
     uint8_t rate; /* packets per second, 0 = off */
 } tase_gimbal_sched_t;
 
-/* Gimbal instance (about 1.2 KiB). Treat every field except `stats` and
- * `rx[i].stats` as private. */
+/* Gimbal instance (about 270 bytes; the receivers are the caller's, see
+ * tase_gimbal_init()). Treat every field except `stats` as private. */
 typedef struct {
     tase_gimbal_stats_t stats;
     tase_gimbal_app_t app;
     tase_port_t port[TASE_GIMBAL_PORTS]; /* ops NULL: port absent */
-    tase_rx_t rx[TASE_GIMBAL_PORTS];
+    tase_rx_t *rx;                       /* caller's receivers, or NULL */
+    uint8_t nrx;                         /* how many */
     tase_gimbal_sched_t sched[TASE_GIMBAL_PORTS][TASE_GIMBAL_STREAMS];
     uint8_t setup[TASE_GIMBAL_SETUP_BYTES];
 } tase_gimbal_t;
@@ -129,14 +130,20 @@ typedef struct {
  * is NULL leaves that port absent: nothing is sent there), app is copied
  * (NULL: no callbacks), setup packets take their defaults and every
  * stream is anchored at now_ms (first packets one period later).
- * Returns TASE_OK, or TASE_EARG (g NULL, ports NULL with nports > 0,
- * nports > 3, a present port without write). O(1). */
-int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, size_t nports,
+ * rx is the caller's array of nports receivers (328 bytes each), one per
+ * port, used by tase_gimbal_feed() and tase_gimbal_service(); init
+ * initialises them and the gimbal keeps the pointer. Pass NULL when the
+ * application runs its own receiver and hands frames over with
+ * tase_gimbal_handle_frame() (firmware that dispatches every frame
+ * itself saves the RAM). Returns TASE_OK, or TASE_EARG (g NULL, ports
+ * NULL with nports > 0, nports > 3, a present port without write). O(1). */
+int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, size_t nports,
                      const tase_gimbal_app_t *app, uint32_t now_ms);
 
-/* Feed bytes received on port index `port`. Answers setup packets and
- * calls on_frame for the rest. Returns frames received (>= 0) or
- * TASE_EARG (g NULL, port >= 3, bytes NULL with n > 0).
+/* Feed bytes received on port index `port` into that port's receiver.
+ * Answers setup packets and calls on_frame for the rest. Returns frames
+ * received (>= 0), TASE_EARG (g NULL, port >= nports, bytes NULL with
+ * n > 0) or TASE_ESTATE (initialised without receivers).
  * Worst case O(n * TASE_FRAME_MAX). */
 int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
                      uint32_t now_ms);
@@ -153,7 +160,9 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
 
 /* Read whatever each present port has ready (timeout 0, ports with a
  * read function), feed it, then tase_gimbal_poll(). Returns the poll
- * result or TASE_EARG. A port read error is skipped (the port may
+ * result, TASE_EARG, or TASE_ESTATE when a port has a read function but
+ * the gimbal was initialised without receivers. A port read error is
+ * skipped (the port may
  * recover), counted nowhere else: check the port. Uses 64 bytes of stack
  * plus a bounded number of reads (at most 64 per port per call). */
 int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms);
