@@ -9,6 +9,10 @@ Outputs (next to this script):
   decode_noisy.bin / decode_noisy.jsonl        raw serial bytes with noise
   decode_candump.log / decode_candump.jsonl    the same kind of traffic as a
                                                candump log, both directions
+  klv_noisy.bin / klv_noisy.jsonl              KLV packets (spec table 31, built
+                                               here) with noise, a corrupted and
+                                               a cut packet; the expected lines
+                                               hold offset and raw fields
 """
 import json
 import os
@@ -210,6 +214,64 @@ def candump(rng):
     return "\n".join(lines) + "\n", expect
 
 
+# KLV (spec section 6, table 31): key, BER length, tag/length/value items.
+KLV_KEY = bytes([0x06, 0x0E, 0x2B, 0x34, 0x02, 0x03, 0x01, 0x01] + [0] * 8)
+KLV_ITEMS = [("utc", 8, False), ("lat", 4, True), ("lon", 4, True), ("alt", 2, False),
+             ("pan", 2, False), ("tilt", 2, True), ("heading", 2, False),
+             ("pitch", 2, True), ("roll", 2, True), ("vnorth", 2, True),
+             ("veast", 2, True), ("hfov", 2, False), ("vfov", 2, False),
+             ("gps_status", 2, False)]
+
+
+def klv_packet(values, declared=70):
+    body = b""
+    for tag, (name, width, signed) in enumerate(KLV_ITEMS, start=1):
+        body += bytes([tag, width]) + values[name].to_bytes(width, "big", signed=signed)
+    check = sum(body) & 0xFFFF  # every local-set byte before the checksum item
+    body += bytes([15, 2]) + check.to_bytes(2, "big")
+    assert len(body) == 70
+    return KLV_KEY + bytes([declared]) + body
+
+
+def klv_values(rng):
+    v = {}
+    for name, width, signed in KLV_ITEMS:
+        bits = 8 * width
+        if signed:
+            v[name] = rng.randint(-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+        else:
+            v[name] = rng.randint(0, (1 << bits) - 1)
+    return v
+
+
+def klv_capture(rng):
+    buf = bytearray()
+    expect = []
+
+    def good(declared=70):
+        v = klv_values(rng)
+        expect.append({"offset": len(buf), "fields": v})
+        buf.extend(klv_packet(v, declared))
+
+    for i in range(12):
+        kind = i % 6
+        if kind == 1:  # noise, with stray key bytes and a partial key
+            buf.extend(bytes(rng.randint(0, 255) for _ in range(rng.randint(1, 40))))
+            buf.extend(KLV_KEY[:rng.randint(1, 15)])
+        elif kind == 2:  # a packet with one value byte flipped: rejected
+            bad = bytearray(klv_packet(klv_values(rng)))
+            bad[17 + 2 + rng.randint(0, 7)] ^= 0x10
+            buf.extend(bad)
+        elif kind == 3:  # a packet cut short, the next one follows at once
+            buf.extend(klv_packet(klv_values(rng))[:rng.randint(17, 80)])
+        elif kind == 4:  # the spec's own declared length
+            good(69)
+            continue
+        good()
+    buf.extend(b"\x06\x0e\x2b")  # an unfinished key at the end
+    return bytes(buf), expect
+
+
 def dump(path, objs):
     with open(path, "w") as f:
         for o in objs:
@@ -229,6 +291,10 @@ def main():
     with open(os.path.join(HERE, "decode_candump.log"), "w") as f:
         f.write(log)
     dump(os.path.join(HERE, "decode_candump.jsonl"), expect)
+    klv, expect = klv_capture(random.Random(7))
+    with open(os.path.join(HERE, "klv_noisy.bin"), "wb") as f:
+        f.write(klv)
+    dump(os.path.join(HERE, "klv_noisy.jsonl"), expect)
 
 
 if __name__ == "__main__":
