@@ -25,6 +25,9 @@ check() {
     if "$@"; then ok "$name"; else bad "$name"; fi
 }
 
+# quiet CMD...: run CMD, its output to the log only
+quiet() { "$@" >>"$dir/quiet.log" 2>&1; }
+
 # json_int LINE KEY: the integer value of "KEY": in a JSON line
 json_int() { sed -n "s/.*\"$2\":\(-\{0,1\}[0-9][0-9]*\).*/\1/p" <<<"$1"; }
 
@@ -102,11 +105,12 @@ check "AXIS_SETTING 0xFF fields kept their values (tilt no-go 90/60)" \
     test "$(json_int "$ax" tilt_nogo_center)/$(json_int "$ax" tilt_nogo_range)" = 9000/6000
 
 # ---- SPOI: host at 0/0, 100 m up, heading north; target 100 m east on the ground ----
-"$TASE" send HOST_GPS_DATA lat=0 lon=0 height=10000 valid=1 "${L[@]}" >/dev/null
-"$TASE" send HOST_ATTITUDE roll=0 pitch=0 yaw=0 "${L[@]}" >/dev/null
-"$TASE" send AXIS_SETTING pan_nogo_range=0 "${L[@]}" >/dev/null
+# (each step is checked, so a failure names its cause, not just the angle)
+check "HOST_GPS_DATA sent" quiet "$TASE" send HOST_GPS_DATA lat=0 lon=0 height=10000 valid=1 "${L[@]}"
+check "HOST_ATTITUDE sent" quiet "$TASE" send HOST_ATTITUDE roll=0 pitch=0 yaw=0 "${L[@]}"
+check "AXIS_SETTING pan no-go range 0 echoed" quiet "$TASE" send AXIS_SETTING pan_nogo_range=0 "${L[@]}"
 # 100 m east at the equator = 100 / 6371000 rad = 3237.58 mas
-"$TASE" send SPOI_CMD lat=0 lon=3238 height=0 flags=0x80 "${L[@]}" >"$dir/spoi"
+check "SPOI_CMD echoed" quiet "$TASE" send SPOI_CMD lat=0 lon=3238 height=0 flags=0x80 "${L[@]}"
 sleep 2
 last=$("$TASE" monitor "${L[@]}" --json --count 40 | grep '"GIMBAL_ANGLE"' | tail -1)
 check "SPOI points at 90 deg pan, -45 deg tilt ($last)" \
