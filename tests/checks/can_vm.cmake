@@ -28,5 +28,7 @@ if(TARGET tase_port AND CMAKE_SYSTEM_NAME STREQUAL "Linux")
            COMMAND ${PROJECT_SOURCE_DIR}/scripts/can-vm/run.sh
                    $<TARGET_FILE:tase_can_vm_agent> ${CMAKE_BINARY_DIR}/can-vm
                    ${TASE_CAN_VM_TOOLS})
-  set_tests_properties(can_vm PROPERTIES LABELS check TIMEOUT 600 SKIP_RETURN_CODE 77)
+  # RUN_SERIAL: the guest runs the bench tools on its real (emulated) clock and
+  # counts telemetry rates; parallel fuzzers must not starve it.
+  set_tests_properties(can_vm PROPERTIES LABELS check TIMEOUT 600 SKIP_RETURN_CODE 77 RUN_SERIAL TRUE)
 endif()
