@@ -442,8 +442,7 @@ static void codec_api_rejects_bad_arguments(void **state)
     assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, &cmd, NULL, sizeof out), TASE_EARG);
     assert_int_equal(tase_packet_encode(TASE_ID(0x28u, 0u), &cmd, NULL, sizeof out), TASE_EARG);
     assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, NULL, out, sizeof out), TASE_EARG);
-    assert_int_equal(tase_packet_encode(TASE_ID(0x28u, 0u), &cmd, out, sizeof out),
-                     TASE_EUNKNOWN);
+    assert_int_equal(tase_packet_encode(TASE_ID(0x28u, 0u), &cmd, out, sizeof out), TASE_EUNKNOWN);
     assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, &cmd, out, 0), TASE_ENOSPC);
     assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, &cmd, out, 15), TASE_ENOSPC);
     assert_int_equal(tase_packet_encode_len(TASE_ID_GIMBAL_CMD, &cmd, SIZE_MAX, out, SIZE_MAX),
