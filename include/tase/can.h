@@ -107,8 +107,9 @@ int tase_can_split_next(tase_can_split_t *s, tase_can_frame_t *out);
 /* Split data[0..n) into out[0..cap) in one call. Returns the number of
  * frames written ((n + 7) / 8), or TASE_EARG (out NULL with n > 0, data
  * NULL with n > 0, unknown role) or TASE_ENOSPC (cap too small, 0
- * included, or more than INT16_MAX frames needed; nothing written). TASE_CAN_FRAMES_MAX frames hold any single datalink frame.
- * O(n), reentrant, ISR-safe. */
+ * included, or more than INT16_MAX frames needed; nothing written).
+ * TASE_CAN_FRAMES_MAX frames hold any single datalink frame. O(n),
+ * reentrant, ISR-safe. */
 int tase_can_split(tase_can_role_t sender, const uint8_t *data, size_t n, tase_can_frame_t *out,
                    size_t cap);
 
