@@ -127,9 +127,10 @@ typedef struct {
 
 /* Encode one packet (TASE_KLV_PACKET_LEN bytes, declared set length 70)
  * into out[0..cap). Returns TASE_KLV_PACKET_LEN, or TASE_EARG (klv or out
- * NULL) or TASE_ENOSPC (cap < 87, 0 included); on error nothing is written. To imitate
- * a gimbal that follows the spec literally, overwrite out[16] with
- * TASE_KLV_SET_LEN_SPEC afterwards: the checksum does not cover that byte.
+ * NULL) or TASE_ENOSPC (cap < 87, 0 included); on error nothing is
+ * written. To imitate a gimbal that follows the spec literally, overwrite
+ * out[16] with TASE_KLV_SET_LEN_SPEC afterwards: the checksum does not
+ * cover that byte.
  * O(1), reentrant, ISR-safe. */
 int tase_klv_encode(const tase_klv_t *klv, uint8_t *out, size_t cap);
 
