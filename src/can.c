@@ -56,6 +56,9 @@ int tase_can_split_next(tase_can_split_t *s, tase_can_frame_t *out)
     if (s->pos >= s->len) {
         return 0;
     }
+    if (s->data == NULL) {
+        return TASE_EARG; /* never initialised or corrupted: bytes left, no data */
+    }
     chunk = s->len - s->pos;
     if (chunk > TASE_CAN_DLC_MAX) {
         chunk = TASE_CAN_DLC_MAX;

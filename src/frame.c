@@ -426,13 +426,23 @@ static void finish_event(tase_rx_t *rx, bool got, tase_frame_t *out, tase_rx_han
     }
 }
 
+/* Invariants every entry point relies on, checked so that a corrupted or
+ * never-initialised instance gives TASE_EARG instead of indexing outside
+ * buf: held bytes fit, the scan is within them, the candidate count fits,
+ * and with no candidate at most a partial sync (2 bytes) is held. */
+static bool rx_sane(const tase_rx_t *rx)
+{
+    return rx->len <= RX_CAP && rx->scan <= rx->len && rx->ncand <= TASE_RX_CANDIDATES &&
+           (rx->ncand != 0u || rx->len < 3u);
+}
+
 int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
                  void *user)
 {
     size_t i = 0;
     uint32_t before;
     tase_frame_t frame;
-    if (rx == NULL || (data == NULL && n > 0u)) {
+    if (rx == NULL || (data == NULL && n > 0u) || !rx_sane(rx)) {
         return TASE_EARG;
     }
     before = rx->stats.frames_ok;
@@ -569,6 +579,9 @@ int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *
         rx->stats.bytes_in++;
         return 0;
     }
+    if (!rx_sane(rx)) {
+        return TASE_EARG;
+    }
     if (rx->ncand == 0u) {
         hunt_byte(rx, byte);
         return 0;
@@ -580,7 +593,7 @@ int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
 {
     uint32_t before;
     tase_frame_t frame;
-    if (rx == NULL) {
+    if (rx == NULL || !rx_sane(rx)) {
         return TASE_EARG;
     }
     before = rx->stats.frames_ok;

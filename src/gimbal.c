@@ -344,7 +344,8 @@ int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
         }
         for (i = 0; i < SERVICE_READS; i++) {
             int n = g->port[p].ops->read(g->port[p].ctx, buf, sizeof buf, 0);
-            if (n <= 0) {
+            /* More than asked: a broken port; skipped like a read error. */
+            if (n <= 0 || n > (int)sizeof buf) {
                 break;
             }
             (void)tase_gimbal_feed(g, p, buf, (size_t)n, now_ms);

@@ -170,13 +170,16 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms)
     uint8_t buf[HOST_SERVICE_CHUNK];
     int n;
 
-    if (h == NULL) {
+    if (h == NULL || h->port.ops == NULL) {
         return TASE_EARG;
     }
     if (h->port.ops->read == NULL || h->port.ops->now_ms == NULL) {
         return TASE_EUNSUPPORTED;
     }
     n = h->port.ops->read(h->port.ctx, buf, sizeof buf, wait_ms);
+    if (n > (int)sizeof buf) {
+        return TASE_EIO; /* a port claiming more than asked is broken */
+    }
     if (n > 0) {
         (void)tase_host_feed(h, buf, (size_t)n, h->port.ops->now_ms(h->port.ctx));
     }
@@ -188,7 +191,7 @@ int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_
 {
     int r;
 
-    if (h == NULL) {
+    if (h == NULL || h->port.ops == NULL) {
         return TASE_EARG;
     }
     if (h->port.ops->read == NULL || h->port.ops->now_ms == NULL) {

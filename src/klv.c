@@ -305,7 +305,9 @@ int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n, tase_klv_
 {
     int delivered = 0;
     size_t done = 0;
-    if (rx == NULL || (data == NULL && n > 0u)) {
+    /* A held length beyond the window (corrupted or never initialised)
+     * would make `take` wrap. */
+    if (rx == NULL || (data == NULL && n > 0u) || rx->len > TASE_KLV_PACKET_MAX) {
         return TASE_EARG;
     }
     while (done < n) {
@@ -327,7 +329,7 @@ int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n, tase_klv_
 int tase_klv_rx_flush(tase_klv_rx_t *rx, tase_klv_handler_t on_packet,
                       tase_klv_error_handler_t on_error, void *user)
 {
-    if (rx == NULL) {
+    if (rx == NULL || rx->len > TASE_KLV_PACKET_MAX) {
         return TASE_EARG;
     }
     return rx_scan(rx, 1, on_packet, on_error, user);

@@ -143,7 +143,9 @@ const tase_packet_desc_t *tase_schema_at(size_t i)
 
 const tase_field_t *tase_schema_field(const tase_packet_desc_t *p, size_t i)
 {
-    if (p == NULL || i >= p->nfields) {
+    /* The second bound only matters for a descriptor that is not one of
+     * the table's (a corrupted copy): it keeps the index inside fields[]. */
+    if (p == NULL || i >= p->nfields || (size_t)p->first_field + i >= (size_t)FIELD_TOTAL) {
         return NULL;
     }
     return &fields[p->first_field + i];

@@ -67,7 +67,10 @@ int tase_schema_field_index(const tase_packet_desc_t *p, const char *name)
         return TASE_EARG;
     }
     for (i = 0; i < p->nfields; i++) {
-        if (strcmp(tase_schema_field_name(p, i), name) == 0) {
+        /* NULL only for a corrupted descriptor whose fields run off the
+         * table: never compared. */
+        const char *fname = tase_schema_field_name(p, i);
+        if (fname != NULL && strcmp(fname, name) == 0) {
             return (int)i;
         }
     }

@@ -375,9 +375,68 @@ static void main_loop_poll_delivers_every_frame_the_isr_received(void **state)
     assert_int_equal(tase_bm_uart_poll(NULL, &rx, count_frame, &c), TASE_EARG);
 }
 
+/* Bad arguments of the ring and the bare-metal UART template give their
+ * documented results and change nothing: NULL, a never-initialised ring
+ * or UART (no storage, no hooks), bad capacities. */
+static void baremetal_api_rejects_bad_arguments(void **state)
+{
+    static uint8_t storage[8];
+    tase_ring_t r;
+    tase_ring_t rcopy;
+    tase_bm_uart_t u;
+    tase_bm_uart_t ucopy;
+    uint8_t out[4];
+    uint8_t before[sizeof out];
+    (void)state;
+
+    memset(out, 0xA5, sizeof out);
+    memcpy(before, out, sizeof out);
+    memset(&r, 0, sizeof r); /* never initialised: no storage */
+    memcpy(&rcopy, &r, sizeof r);
+    assert_false(tase_ring_put(NULL, 1));
+    assert_false(tase_ring_put(&r, 1));
+    assert_int_equal(tase_ring_get(&r, out, sizeof out), 0);
+    assert_int_equal(tase_ring_get(NULL, out, sizeof out), 0);
+    assert_memory_equal(&r, &rcopy, sizeof r);
+    assert_int_equal(tase_ring_init(&r, storage, 0), TASE_EARG);
+    assert_int_equal(tase_ring_init(&r, storage, 3), TASE_EARG);
+    assert_int_equal(tase_ring_init(&r, storage, SIZE_MAX), TASE_EARG);
+    assert_int_equal(tase_ring_init(&r, NULL, 8), TASE_EARG);
+    assert_int_equal(tase_ring_init(NULL, storage, 8), TASE_EARG);
+    assert_memory_equal(&r, &rcopy, sizeof r);
+    assert_int_equal(tase_ring_init(&r, storage, sizeof storage), TASE_OK);
+    assert_true(tase_ring_put(&r, 0x42));
+    memcpy(&rcopy, &r, sizeof r);
+    assert_int_equal(tase_ring_get(&r, NULL, 4), 0);
+    assert_int_equal(tase_ring_get(&r, out, 0), 0);
+    assert_memory_equal(&r, &rcopy, sizeof r);
+    assert_memory_equal(out, before, sizeof out);
+    assert_int_equal(tase_ring_count(NULL), 0);
+    assert_int_equal(tase_ring_overflows(NULL), 0);
+    assert_int_equal(tase_ring_capacity(NULL), 0);
+
+    memset(&u, 0, sizeof u); /* never initialised: no hooks */
+    memcpy(&ucopy, &u, sizeof u);
+    tase_bm_uart_rx_isr(NULL, 1);
+    tase_bm_uart_rx_isr(&u, 1);
+    assert_int_equal(tase_bm_uart_ops.write(&u, out, 1), TASE_EARG);
+    assert_int_equal(tase_bm_uart_ops.write(NULL, out, 1), TASE_EARG);
+    assert_int_equal(tase_bm_uart_ops.read(&u, out, sizeof out, 0), TASE_EARG);
+    assert_int_equal(tase_bm_uart_ops.read(NULL, out, sizeof out, 0), TASE_EARG);
+    assert_int_equal(tase_bm_uart_ops.now_ms(&u), 0);
+    assert_int_equal(tase_bm_uart_ops.now_ms(NULL), 0);
+    assert_int_equal(tase_bm_uart_poll(NULL, NULL, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_bm_uart_init(&u, storage, 3, &fake_hooks, NULL), TASE_EARG);
+    assert_int_equal(tase_bm_uart_init(&u, NULL, 8, &fake_hooks, NULL), TASE_EARG);
+    assert_int_equal(tase_bm_uart_init(&u, storage, 8, NULL, NULL), TASE_EARG);
+    assert_memory_equal(&u, &ucopy, sizeof u);
+    assert_memory_equal(out, before, sizeof out);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(baremetal_api_rejects_bad_arguments),
         cmocka_unit_test(init_rejects_sizes_that_are_not_a_power_of_two),
         cmocka_unit_test(a_full_ring_drops_and_counts_every_extra_byte),
         cmocka_unit_test(order_survives_many_wrap_arounds),

@@ -449,9 +449,69 @@ static void null_and_unknown_roles_are_rejected_without_counting(void **state)
     assert_int_equal(m.command, TASE_3AX_RETRACT);
 }
 
+/* Bad arguments of can.h give their documented codes and change nothing,
+ * including a never-initialised splitter and a receiver whose role field
+ * is corrupted. */
+static void can_api_rejects_bad_arguments(void **state)
+{
+    static const uint8_t data[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+    tase_can_split_t s;
+    tase_can_split_t scopy;
+    tase_can_frame_t f;
+    tase_can_frame_t fcopy;
+    tase_can_frame_t frames[2];
+    tase_can_frame_t fbefore[2];
+    tase_can_rx_t crx;
+    tase_can_rx_t ccopy;
+    uint32_t tx = 7;
+    uint32_t rxid = 7;
+    (void)state;
+
+    memset(&f, 0x77, sizeof f);
+    memcpy(&fcopy, &f, sizeof f);
+    memset(&s, 0, sizeof s);
+    s.len = 5; /* bytes left but no data: never initialised */
+    memcpy(&scopy, &s, sizeof s);
+    assert_int_equal(tase_can_split_next(&s, &f), TASE_EARG);
+    assert_int_equal(tase_can_split_next(NULL, &f), TASE_EARG);
+    assert_int_equal(tase_can_split_next(&s, NULL), TASE_EARG);
+    assert_memory_equal(&s, &scopy, sizeof s);
+    assert_memory_equal(&f, &fcopy, sizeof f);
+    assert_int_equal(tase_can_split_init(&s, (tase_can_role_t)2, data, 1), TASE_EARG);
+    assert_int_equal(tase_can_split_init(&s, TASE_CAN_ROLE_HOST, NULL, SIZE_MAX), TASE_EARG);
+    assert_memory_equal(&s, &scopy, sizeof s);
+
+    assert_int_equal(tase_can_role_ids((tase_can_role_t)2, &tx, &rxid), TASE_EARG);
+    assert_int_equal(tx, 7);
+    assert_int_equal(rxid, 7);
+
+    memset(frames, 0x55, sizeof frames);
+    memcpy(fbefore, frames, sizeof frames);
+    assert_int_equal(tase_can_split(TASE_CAN_ROLE_HOST, data, sizeof data, frames, 1), TASE_ENOSPC);
+    assert_int_equal(tase_can_split(TASE_CAN_ROLE_HOST, data, sizeof data, frames, 0), TASE_ENOSPC);
+    assert_int_equal(tase_can_split(TASE_CAN_ROLE_HOST, NULL, SIZE_MAX, frames, SIZE_MAX),
+                     TASE_EARG);
+    assert_int_equal(tase_can_split(TASE_CAN_ROLE_HOST, data, sizeof data, NULL, 2), TASE_EARG);
+    assert_int_equal(tase_can_split((tase_can_role_t)9, data, sizeof data, frames, 2), TASE_EARG);
+    assert_memory_equal(frames, fbefore, sizeof frames);
+
+    assert_int_equal(tase_can_accept((tase_can_role_t)9, &f), TASE_EARG);
+    assert_int_equal(tase_can_accept(TASE_CAN_ROLE_HOST, NULL), TASE_EARG);
+    assert_int_equal(tase_can_rx_init(&crx, TASE_CAN_ROLE_HOST), TASE_OK);
+    assert_int_equal(tase_can_split(TASE_CAN_ROLE_GIMBAL, data, 8, frames, 2), 1);
+    crx.role = (tase_can_role_t)5;
+    memcpy(&ccopy, &crx, sizeof crx);
+    assert_int_equal(tase_can_rx_feed(&crx, &frames[0], NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_can_rx_feed(&crx, NULL, NULL, NULL), TASE_EARG);
+    assert_memory_equal(&crx, &ccopy, sizeof crx);
+    assert_int_equal(tase_can_rx_init(&crx, (tase_can_role_t)5), TASE_EARG);
+    assert_memory_equal(&crx, &ccopy, sizeof crx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(can_api_rejects_bad_arguments),
         cmocka_unit_test(split_refuses_counts_an_int_result_cannot_carry),
         cmocka_unit_test(null_and_unknown_roles_are_rejected_without_counting),
         cmocka_unit_test(role_ids_follow_the_spec),

@@ -173,9 +173,49 @@ static void longest_line_fits_the_documented_maximum_and_round_trips(void **stat
     assert_memory_equal(back.frame.data, r.frame.data, 8);
 }
 
+/* Bad arguments of candump.h give their documented codes and leave the
+ * record and the output unchanged. */
+static void candump_api_rejects_bad_arguments(void **state)
+{
+    static const char line[] = "(1.000000) can0 123#11\n";
+    tase_candump_rec_t rec;
+    tase_candump_rec_t copy;
+    char out[TASE_CANDUMP_LINE_MAX];
+    char before[sizeof out];
+    (void)state;
+
+    memset(&rec, 0x33, sizeof rec);
+    memcpy(&copy, &rec, sizeof rec);
+    assert_int_equal(tase_candump_parse(NULL, SIZE_MAX, &rec), TASE_EARG);
+    assert_int_equal(tase_candump_parse(line, sizeof line - 1u, NULL), TASE_EARG);
+    assert_int_equal(tase_candump_parse(line, 0, &rec), TASE_EFORMAT);
+    assert_int_equal(tase_candump_parse(line, 5, &rec), TASE_EFORMAT);
+    assert_memory_equal(&rec, &copy, sizeof rec);
+
+    assert_int_equal(tase_candump_parse(line, sizeof line - 1u, &rec), TASE_OK);
+    memset(out, 'x', sizeof out);
+    memcpy(before, out, sizeof out);
+    assert_int_equal(tase_candump_format(NULL, out, sizeof out), TASE_EARG);
+    assert_int_equal(tase_candump_format(&rec, NULL, sizeof out), TASE_EARG);
+    assert_int_equal(tase_candump_format(&rec, out, 0), TASE_ENOSPC);
+    assert_int_equal(tase_candump_format(&rec, out, 5), TASE_ENOSPC);
+    rec.usec = 1000000u;
+    assert_int_equal(tase_candump_format(&rec, out, sizeof out), TASE_EARG);
+    rec.usec = 0;
+    memset(rec.ifname, 'a', sizeof rec.ifname); /* no terminating NUL */
+    assert_int_equal(tase_candump_format(&rec, out, sizeof out), TASE_EARG);
+    rec.ifname[0] = '\0'; /* empty */
+    assert_int_equal(tase_candump_format(&rec, out, sizeof out), TASE_EARG);
+    strcpy(rec.ifname, "can0");
+    rec.frame.dlc = 9;
+    assert_int_equal(tase_candump_format(&rec, out, sizeof out), TASE_EARG);
+    assert_memory_equal(out, before, sizeof out);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(candump_api_rejects_bad_arguments),
         cmocka_unit_test(extended_line_parses_into_fields),
         cmocka_unit_test(standard_and_empty_frames_parse),
         cmocka_unit_test(malformed_lines_are_rejected_and_leave_output_alone),

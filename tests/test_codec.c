@@ -423,9 +423,76 @@ static void unknown_ids_and_missing_structs_are_told_apart_from_missing_buffers(
     assert_int_equal(cp.camera, 1); /* untouched */
 }
 
+/* Bad arguments of codec.h give their documented codes; neither the output
+ * buffer nor the decoded struct changes on any of them. */
+static void codec_api_rejects_bad_arguments(void **state)
+{
+    tase_gimbal_cmd_t cmd;
+    tase_camera_pass_t cp;
+    uint8_t out[TASE_FRAME_MAX];
+    uint8_t before[sizeof out];
+    tase_packet_msg_t msg;
+    tase_packet_msg_t mcopy;
+    tase_frame_t f;
+    (void)state;
+
+    memset(&cmd, 0, sizeof cmd);
+    memset(out, 0xA5, sizeof out);
+    memcpy(before, out, sizeof out);
+    assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, &cmd, NULL, sizeof out), TASE_EARG);
+    assert_int_equal(tase_packet_encode(TASE_ID(0x28u, 0u), &cmd, NULL, sizeof out), TASE_EARG);
+    assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, NULL, out, sizeof out), TASE_EARG);
+    assert_int_equal(tase_packet_encode(TASE_ID(0x28u, 0u), &cmd, out, sizeof out), TASE_EUNKNOWN);
+    assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, &cmd, out, 0), TASE_ENOSPC);
+    assert_int_equal(tase_packet_encode(TASE_ID_GIMBAL_CMD, &cmd, out, 15), TASE_ENOSPC);
+    assert_int_equal(tase_packet_encode_len(TASE_ID_GIMBAL_CMD, &cmd, SIZE_MAX, out, SIZE_MAX),
+                     TASE_ELENGTH);
+    assert_int_equal(tase_packet_encode_len(TASE_ID_GIMBAL_CMD, &cmd, 9, out, sizeof out),
+                     TASE_ELENGTH);
+    assert_int_equal(tase_packet_encode_len(TASE_ID_GIMBAL_CMD, &cmd, 0, out, sizeof out),
+                     TASE_ELENGTH);
+    cp.camera = 0;
+    cp.baud = 0;
+    cp.len = (uint8_t)(TASE_CAMERA_PASS_MAX + 1u);
+    cp.data = before;
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof out), TASE_ETOOLONG);
+    cp.len = 3;
+    cp.data = NULL;
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof out), TASE_EARG);
+    cp.data = before;
+    assert_int_equal(tase_packet_encode_len(TASE_ID_CAMERA_PASS, &cp, SIZE_MAX, out, sizeof out),
+                     TASE_ELENGTH);
+    assert_int_equal(tase_packet_encode_len(TASE_ID_CAMERA_PASS, &cp, 8, out, sizeof out),
+                     TASE_ELENGTH);
+    assert_int_equal(tase_packet_encode_query(TASE_ID_GIMBAL_CMD, out, sizeof out), TASE_ELENGTH);
+    assert_int_equal(tase_packet_encode_query(TASE_ID_PACKET_RATE, NULL, 8), TASE_EARG);
+    assert_int_equal(tase_packet_encode_query(TASE_ID_PACKET_RATE, out, 7), TASE_ENOSPC);
+    assert_memory_equal(out, before, sizeof out);
+
+    memset(&msg, 0x5A, sizeof msg);
+    memcpy(&mcopy, &msg, sizeof msg);
+    f.offset = 0;
+    f.group = 0x00;
+    f.type = 0x80; /* GIMBAL_CMD */
+    f.len = 8;
+    f.data = NULL;
+    assert_int_equal(tase_packet_decode(NULL, &msg), TASE_EARG);
+    assert_int_equal(tase_packet_decode(&f, &msg), TASE_EARG);
+    f.data = before;
+    assert_int_equal(tase_packet_decode(&f, NULL), TASE_EARG);
+    f.len = 7;
+    assert_int_equal(tase_packet_decode(&f, &msg), TASE_ELENGTH);
+    f.len = 255;
+    assert_int_equal(tase_packet_decode(&f, &msg), TASE_ELENGTH);
+    f.group = 0x28;
+    assert_int_equal(tase_packet_decode(&f, &msg), TASE_EUNKNOWN);
+    assert_memory_equal(&msg, &mcopy, sizeof msg);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(codec_api_rejects_bad_arguments),
         cmocka_unit_test(unknown_ids_and_missing_structs_are_told_apart_from_missing_buffers),
         cmocka_unit_test(gimbal_cmd_extremes_encode_to_hand_computed_frame),
         cmocka_unit_test(gyro_zero_and_camera_short_forms_encode_to_hand_computed_frames),

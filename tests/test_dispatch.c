@@ -245,9 +245,42 @@ static void null_hooks_and_stats_are_allowed(void **state)
     assert_int_equal(rx.stats.bad_length, 0);
 }
 
+static unsigned bad_arg_calls;
+
+static void count_default(void *user, const tase_frame_t *frame)
+{
+    (void)user;
+    (void)frame;
+    bad_arg_calls++;
+}
+
+/* tase_dispatch_init(NULL) is refused; tase_dispatch_frame() with a NULL
+ * dispatcher or frame runs no callback and counts nothing. */
+static void dispatch_api_rejects_bad_arguments(void **state)
+{
+    tase_dispatch_t d;
+    tase_dispatch_t copy;
+    tase_rx_stats_t stats;
+    tase_rx_stats_t scopy;
+    (void)state;
+
+    memset(&stats, 0, sizeof stats);
+    assert_int_equal(tase_dispatch_init(NULL, NULL, count_default, NULL, NULL, &stats), TASE_EARG);
+    assert_int_equal(tase_dispatch_init(&d, NULL, count_default, NULL, NULL, &stats), TASE_OK);
+    memcpy(&copy, &d, sizeof d);
+    memcpy(&scopy, &stats, sizeof stats);
+    bad_arg_calls = 0;
+    tase_dispatch_frame(&d, NULL);
+    tase_dispatch_frame(NULL, NULL);
+    assert_int_equal(bad_arg_calls, 0);
+    assert_memory_equal(&d, &copy, sizeof d);
+    assert_memory_equal(&stats, &scopy, sizeof stats);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(dispatch_api_rejects_bad_arguments),
         cmocka_unit_test(each_packet_reaches_its_typed_handler_decoded),
         cmocka_unit_test(queries_and_short_forms_reach_the_typed_handler),
         cmocka_unit_test(unknown_packets_pass_through_intact_and_are_counted),

@@ -809,9 +809,61 @@ static void push_one_byte_at_a_time_equals_feeding_one_buffer(void **state)
     free(rb);
 }
 
+/* Every bad argument of frame.h gives its documented code, and a receiver
+ * that is visibly corrupted (indices out of range) is refused by every
+ * entry point without being changed or read outside its window. */
+static void frame_api_rejects_bad_arguments(void **state)
+{
+    static const uint8_t bytes[4] = {0x00, 0xFF, 0x5A, 0x04};
+    uint8_t out[TASE_FRAME_MAX + 1u];
+    uint8_t before[sizeof out];
+    tase_rx_t rx;
+    tase_rx_t bad;
+    tase_rx_t copy;
+    int k;
+    (void)state;
+
+    memset(out, 0xA5, sizeof out);
+    memcpy(before, out, sizeof out);
+    assert_int_equal(tase_frame_encode(NULL, sizeof out, 0, 0, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_frame_encode(out, sizeof out, 0, 0, NULL, 1), TASE_EARG);
+    assert_int_equal(tase_frame_encode(out, sizeof out, 0, 0, NULL, SIZE_MAX), TASE_EARG);
+    assert_int_equal(tase_frame_encode(out, sizeof out, 0, 0, bytes, TASE_DATA_MAX + 1u),
+                     TASE_ETOOLONG);
+    assert_int_equal(tase_frame_encode(out, sizeof out, 0, 0, bytes, SIZE_MAX), TASE_ETOOLONG);
+    assert_int_equal(tase_frame_encode(out, 0, 0, 0, NULL, 0), TASE_ENOSPC);
+    assert_int_equal(tase_frame_encode(out, 11, 0, 0, bytes, 4), TASE_ENOSPC);
+    assert_memory_equal(out, before, sizeof out);
+    assert_int_equal(tase_checksum(0x1234u, NULL, SIZE_MAX), 0x1234u);
+
+    assert_int_equal(tase_rx_init(&rx), TASE_OK);
+    assert_int_equal(tase_rx_feed(&rx, bytes, 3, NULL, NULL), 0); /* a candidate pending */
+    memcpy(&copy, &rx, sizeof rx);
+    assert_int_equal(tase_rx_feed(&rx, NULL, SIZE_MAX, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_rx_feed(&rx, NULL, 0, NULL, NULL), 0);
+    assert_memory_equal(&rx, &copy, sizeof rx);
+
+    for (k = 0; k < 5; k++) {
+        memcpy(&bad, &rx, sizeof rx);
+        switch (k) {
+        case 0: bad.len = (uint16_t)(TASE_FRAME_MAX + 1u); break;
+        case 1: bad.len = 0xFFFFu; break;
+        case 2: bad.scan = (uint16_t)(bad.len + 1u); break;
+        case 3: bad.ncand = (uint8_t)(TASE_RX_CANDIDATES + 1); break;
+        default: bad.ncand = 0; break; /* 3 sync bytes held, no candidate */
+        }
+        memcpy(&copy, &bad, sizeof bad);
+        assert_int_equal(tase_rx_feed(&bad, bytes, sizeof bytes, NULL, NULL), TASE_EARG);
+        assert_int_equal(tase_rx_push(&bad, 0x5A, NULL, NULL), TASE_EARG);
+        assert_int_equal(tase_rx_flush(&bad, NULL, NULL), TASE_EARG);
+        assert_memory_equal(&bad, &copy, sizeof bad);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(frame_api_rejects_bad_arguments),
         cmocka_unit_test(encode_zero_length_frame_matches_hand_computed_bytes),
         cmocka_unit_test(encode_with_data_matches_hand_computed_bytes),
         cmocka_unit_test(encode_checksum_wraps_modulo_65536),

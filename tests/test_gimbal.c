@@ -660,9 +660,103 @@ static void service_reads_every_port_feeds_it_and_polls(void **state)
     free(x);
 }
 
+/* A port whose read() claims one byte more than it was given room for. */
+static int overclaiming_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    (void)ctx;
+    (void)timeout_ms;
+    memset(buf, 0x00, cap);
+    return (int)cap + 1;
+}
+
+/* Bad arguments of gimbal.h (NULL, port index and setup type out of range,
+ * zero and SIZE_MAX lengths, too small buffers) give their documented
+ * codes and leave the gimbal, the output and the wire unchanged; a read()
+ * that over-claims is not fed. */
+static void gimbal_api_rejects_bad_arguments(void **state)
+{
+    static fake_port_t fp;
+    static tase_gimbal_t g;
+    static tase_gimbal_t copy;
+    static tase_rx_t rx[TASE_GIMBAL_PORTS];
+    static const tase_port_ops_t liar_ops = {fake_write, overclaiming_read, fake_now};
+    tase_port_ops_t no_write = {NULL, fake_read, fake_now};
+    tase_port_t ports[TASE_GIMBAL_PORTS + 1u];
+    uint8_t data[TASE_GIMBAL_SETUP_BYTES];
+    uint8_t out[16];
+    uint8_t before[sizeof out];
+    tase_frame_t f;
+    size_t i;
+    (void)state;
+
+    memset(&fp, 0, sizeof fp);
+    for (i = 0; i < TASE_GIMBAL_PORTS + 1u; i++) {
+        ports[i].ops = &fake_ops;
+        ports[i].ctx = &fp;
+    }
+    memset(&g, 0xC3, sizeof g);
+    memcpy(&copy, &g, sizeof g);
+    assert_int_equal(tase_gimbal_init(NULL, ports, rx, 1, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(&g, NULL, rx, 1, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(&g, ports, rx, TASE_GIMBAL_PORTS + 1u, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(&g, ports, rx, SIZE_MAX, NULL, 0), TASE_EARG);
+    ports[1].ops = &no_write;
+    assert_int_equal(tase_gimbal_init(&g, ports, rx, 2, NULL, 0), TASE_EARG);
+    ports[1].ops = &fake_ops;
+    assert_memory_equal(&g, &copy, sizeof g);
+
+    assert_int_equal(tase_gimbal_init(&g, ports, rx, 1, NULL, 0), TASE_OK);
+    memcpy(&copy, &g, sizeof g);
+    memset(data, 0, sizeof data);
+    f.offset = 0;
+    f.group = 0x48;
+    f.type = 0;
+    f.len = 0;
+    f.data = NULL;
+    assert_int_equal(tase_gimbal_feed(&g, 1, data, 1, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_feed(&g, UINT32_MAX, data, 1, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_feed(&g, 0, NULL, SIZE_MAX, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_feed(NULL, 0, data, 1, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_handle_frame(&g, 0, &f, 0), TASE_EARG); /* data NULL */
+    f.data = data;
+    assert_int_equal(tase_gimbal_handle_frame(&g, TASE_GIMBAL_PORTS, &f, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_handle_frame(&g, 0, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_send(&g, 1, 0, 0, NULL, 0), TASE_EARG); /* absent */
+    assert_int_equal(tase_gimbal_send(&g, TASE_GIMBAL_PORTS, 0, 0, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_send(&g, 0, 0, 0, NULL, 1), TASE_EARG);
+    assert_int_equal(tase_gimbal_send(&g, 0, 0, 0, data, SIZE_MAX), TASE_ETOOLONG);
+    assert_int_equal(tase_gimbal_setup_set(&g, 0, data, 0, 0), TASE_ELENGTH);
+    assert_int_equal(tase_gimbal_setup_set(&g, 0, data, SIZE_MAX, 0), TASE_ELENGTH);
+    assert_int_equal(tase_gimbal_setup_set(&g, 0, NULL, 16, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_set(&g, TASE_GIMBAL_SETUP_TYPES, data, 16, 0),
+                     TASE_EUNKNOWN);
+    assert_int_equal(tase_gimbal_setup_set(&g, 0xFF, data, 16, 0), TASE_EUNKNOWN);
+    assert_memory_equal(&g, &copy, sizeof g);
+    assert_int_equal(fp.nout, 0);
+
+    memset(out, 0xA5, sizeof out);
+    memcpy(before, out, sizeof out);
+    assert_int_equal(tase_gimbal_setup_get(&g, 0, out, 15), TASE_ENOSPC);
+    assert_int_equal(tase_gimbal_setup_get(&g, 0, out, 0), TASE_ENOSPC);
+    assert_int_equal(tase_gimbal_setup_get(&g, 8, out, sizeof out), TASE_EUNKNOWN);
+    assert_int_equal(tase_gimbal_setup_get(NULL, 0, out, sizeof out), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_get(&g, 0, NULL, sizeof out), TASE_EARG);
+    assert_memory_equal(out, before, sizeof out);
+    assert_int_equal(tase_gimbal_setup_len(TASE_GIMBAL_SETUP_TYPES), TASE_EUNKNOWN);
+    assert_int_equal(tase_gimbal_setup_len(0xFF), TASE_EUNKNOWN);
+    assert_int_equal(tase_gimbal_poll(NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_service(NULL, 0), TASE_EARG);
+
+    ports[0].ops = &liar_ops;
+    assert_int_equal(tase_gimbal_init(&g, ports, rx, 1, NULL, 0), TASE_OK);
+    assert_int_equal(tase_gimbal_service(&g, 0), 0);
+    assert_int_equal(rx[0].stats.bytes_in, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(gimbal_api_rejects_bad_arguments),
         cmocka_unit_test(a_zero_length_query_is_answered_with_the_defaults_on_its_port),
         cmocka_unit_test(a_setup_packet_is_applied_and_the_applied_bytes_echoed),
         cmocka_unit_test(a_refused_setup_echoes_the_settings_still_in_force),

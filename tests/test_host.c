@@ -421,9 +421,76 @@ static void a_reply_without_a_buffer_reports_its_length_only(void **state)
     assert_int_equal(x->others, 0);
 }
 
+/* A port whose read() claims one byte more than it was given room for. */
+static int overclaiming_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    (void)ctx;
+    (void)timeout_ms;
+    memset(buf, 0x00, cap);
+    return (int)cap + 1;
+}
+
+/* Bad arguments of host.h give their documented codes and leave the host
+ * and the wire unchanged; a never-initialised host (no port ops) is
+ * refused by service/transact; a read() that over-claims is TASE_EIO and
+ * nothing is fed. */
+static void host_api_rejects_bad_arguments(void **state)
+{
+    static fake_port_t fp;
+    static const tase_port_ops_t liar_ops = {fake_write, overclaiming_read, fake_now};
+    static tase_host_t h;
+    static tase_host_t copy;
+    static const uint8_t req[4] = {1, 2, 3, 4};
+    uint8_t reply[8];
+    tase_port_t port = {&fake_ops, &fp};
+    tase_port_t no_write = {&liar_ops, &fp};
+    tase_port_ops_t ops_no_write = {NULL, fake_read, fake_now};
+    (void)state;
+
+    memset(&fp, 0, sizeof fp);
+    memset(&h, 0, sizeof h); /* never initialised */
+    memcpy(&copy, &h, sizeof h);
+    assert_int_equal(tase_host_service(&h, 0), TASE_EARG);
+    assert_int_equal(tase_host_transact(&h, 0x48, 0, NULL, 0, NULL, 0, 10, 0), TASE_EARG);
+    assert_memory_equal(&h, &copy, sizeof h);
+
+    no_write.ops = &ops_no_write;
+    assert_int_equal(tase_host_init(&h, &no_write, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_host_init(&h, NULL, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_host_init(NULL, &port, NULL, NULL), TASE_EARG);
+    assert_memory_equal(&h, &copy, sizeof h);
+
+    assert_int_equal(tase_host_init(&h, &port, NULL, NULL), TASE_OK);
+    memcpy(&copy, &h, sizeof h);
+    assert_int_equal(tase_host_send(&h, 0, 0, NULL, 1), TASE_EARG);
+    assert_int_equal(tase_host_send(&h, 0, 0, req, SIZE_MAX), TASE_ETOOLONG);
+    assert_int_equal(tase_host_request_start(&h, 0x48, 0, NULL, 1, reply, sizeof reply, 10, 0, 0),
+                     TASE_EARG);
+    assert_int_equal(tase_host_request_start(&h, 0x48, 0, req, 4, NULL, 1, 10, 0, 0), TASE_EARG);
+    assert_int_equal(tase_host_request_start(&h, 0x48, 0, req, 4, reply, 8, 0, 0, 0), TASE_EARG);
+    assert_int_equal(tase_host_request_start(&h, 0x48, 0, req, 4, reply, 8, 0x80000001u, 0, 0),
+                     TASE_EARG);
+    assert_int_equal(tase_host_request_start(&h, 0x48, 0, req, SIZE_MAX, reply, 8, 10, 0, 0),
+                     TASE_ETOOLONG);
+    assert_int_equal(tase_host_feed(&h, NULL, SIZE_MAX, 0), TASE_EARG);
+    assert_int_equal(tase_host_handle_frame(&h, NULL), TASE_EARG);
+    assert_int_equal(tase_host_poll(&h, 0), TASE_ESTATE);
+    assert_memory_equal(&h, &copy, sizeof h);
+    assert_int_equal(fp.nout, 0);
+    assert_int_equal(tase_host_poll(NULL, 0), TASE_EARG);
+    assert_int_equal(tase_host_cancel(NULL), TASE_EARG);
+    assert_false(tase_host_busy(NULL));
+
+    port.ops = &liar_ops;
+    assert_int_equal(tase_host_init(&h, &port, NULL, NULL), TASE_OK);
+    assert_int_equal(tase_host_service(&h, 0), TASE_EIO);
+    assert_int_equal(h.rx.stats.bytes_in, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(host_api_rejects_bad_arguments),
         cmocka_unit_test_setup_teardown(a_query_is_a_zero_length_frame_completed_by_the_echo, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(an_echo_of_another_type_does_not_complete_the_query, setup,

@@ -782,9 +782,67 @@ static void gps_status_uses_msb_first_bit_numbers(void **state)
     assert_int_equal(tase_klv_gps_status(15, 7, 0), 0xE006);
 }
 
+/* Bad arguments of klv.h give their documented codes and change nothing;
+ * a scanner whose held length exceeds its window is refused; the units
+ * helpers are total (NaN, infinities, huge values give defined results). */
+static void klv_api_rejects_bad_arguments(void **state)
+{
+    tase_klv_t k;
+    tase_klv_t kcopy;
+    uint8_t out[TASE_KLV_PACKET_LEN];
+    uint8_t before[sizeof out];
+    tase_klv_rx_t rx;
+    tase_klv_rx_t copy;
+    uint16_t st;
+    (void)state;
+
+    memset(&k, 0x3C, sizeof k);
+    memcpy(&kcopy, &k, sizeof k);
+    memset(out, 0xA5, sizeof out);
+    memcpy(before, out, sizeof out);
+    assert_int_equal(tase_klv_encode(NULL, out, sizeof out), TASE_EARG);
+    assert_int_equal(tase_klv_encode(&k, NULL, sizeof out), TASE_EARG);
+    assert_int_equal(tase_klv_encode(&k, out, 0), TASE_ENOSPC);
+    assert_int_equal(tase_klv_encode(&k, out, TASE_KLV_PACKET_LEN - 1u), TASE_ENOSPC);
+    assert_memory_equal(out, before, sizeof out);
+    assert_int_equal(tase_klv_decode(NULL, SIZE_MAX, &k), TASE_EARG);
+    assert_int_equal(tase_klv_decode(out, sizeof out, NULL), TASE_EARG);
+    assert_int_equal(tase_klv_decode(out, 0, &k), TASE_ETRUNC);
+    assert_memory_equal(&k, &kcopy, sizeof k);
+
+    assert_int_equal(tase_klv_rx_init(NULL), TASE_EARG);
+    assert_int_equal(tase_klv_rx_feed(NULL, out, 1, NULL, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_klv_rx_flush(NULL, NULL, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_klv_rx_stats_reset(NULL), TASE_EARG);
+    assert_int_equal(tase_klv_rx_init(&rx), TASE_OK);
+    assert_int_equal(tase_klv_rx_feed(&rx, out, 5, NULL, NULL, NULL), 0);
+    memcpy(&copy, &rx, sizeof rx);
+    assert_int_equal(tase_klv_rx_feed(&rx, NULL, SIZE_MAX, NULL, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_klv_rx_feed(&rx, NULL, 0, NULL, NULL, NULL), 0);
+    assert_memory_equal(&rx, &copy, sizeof rx);
+    rx.len = (uint8_t)(TASE_KLV_PACKET_MAX + 1u);
+    memcpy(&copy, &rx, sizeof rx);
+    assert_int_equal(tase_klv_rx_feed(&rx, out, sizeof out, NULL, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_klv_rx_flush(&rx, NULL, NULL, NULL), TASE_EARG);
+    assert_memory_equal(&rx, &copy, sizeof rx);
+
+    assert_int_equal(tase_klv_lat_raw(NAN), 0);
+    assert_int_equal(tase_klv_lon_raw(INFINITY), 0);
+    assert_int_equal(tase_klv_angle_raw(-INFINITY), 0);
+    assert_int_equal(tase_klv_pitch_raw(1e300), INT16_MAX);
+    assert_int_equal(tase_klv_roll_raw(-1e300), INT16_MIN);
+    assert_int_equal(tase_klv_fov_raw(-1e300), 0);
+    assert_int_equal(tase_klv_alt_raw(1e300), UINT16_MAX);
+    st = tase_klv_gps_status(UINT32_MAX, UINT32_MAX, 0xFFFFu);
+    assert_int_equal(tase_klv_gps_fix(st), 7);
+    assert_int_equal(tase_klv_gps_antenna(st), 3);
+    assert_int_equal(st & 0x0401u, 0); /* reserved bits 5 and 15 stay clear */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(klv_api_rejects_bad_arguments),
         cmocka_unit_test(encode_matches_hand_built_packet),
         cmocka_unit_test(decode_of_hand_built_packet_gives_hand_values),
         cmocka_unit_test(round_trip_keeps_random_and_extreme_values),

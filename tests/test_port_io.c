@@ -197,9 +197,41 @@ static void count_tx_counts_link_failures_but_not_caller_mistakes(void **state)
     assert_int_equal(tase_port_count_tx(TASE_EIO, NULL, NULL), TASE_EIO);
 }
 
+/* Bad arguments of port_io.h give TASE_EARG / TASE_ETOOLONG and put
+ * nothing on the wire: NULL port, ops or write, data NULL with n > 0, a
+ * count that does not fit the int result, an over-long frame. */
+static void port_io_api_rejects_bad_arguments(void **state)
+{
+    static fake_port_t fp;
+    static const uint8_t data[4] = {1, 2, 3, 4};
+    static const tase_port_ops_t no_write = {NULL, fake_read, fake_now};
+    tase_port_t port = {&fake_ops, &fp};
+    tase_port_t no_ops = {NULL, &fp};
+    tase_port_t bad_ops = {&no_write, &fp};
+    (void)state;
+
+    memset(&fp, 0, sizeof fp);
+    assert_int_equal(tase_port_write_all(NULL, data, 4), TASE_EARG);
+    assert_int_equal(tase_port_write_all(&no_ops, data, 4), TASE_EARG);
+    assert_int_equal(tase_port_write_all(&bad_ops, data, 4), TASE_EARG);
+    assert_int_equal(tase_port_write_all(&port, NULL, 1), TASE_EARG);
+    assert_int_equal(tase_port_write_all(&port, NULL, SIZE_MAX), TASE_EARG);
+    assert_int_equal(tase_port_write_all(&port, data, (size_t)INT32_MAX + 1u), TASE_EARG);
+    assert_int_equal(tase_port_write_all(&port, data, SIZE_MAX), TASE_EARG);
+    assert_int_equal(tase_port_send_frame(NULL, 0, 0, data, 4), TASE_EARG);
+    assert_int_equal(tase_port_send_frame(&no_ops, 0, 0, data, 4), TASE_EARG);
+    assert_int_equal(tase_port_send_frame(&port, 0, 0, NULL, 1), TASE_EARG);
+    assert_int_equal(tase_port_send_frame(&port, 0, 0, data, TASE_DATA_MAX + 1u), TASE_ETOOLONG);
+    assert_int_equal(tase_port_send_frame(&port, 0, 0, data, SIZE_MAX), TASE_ETOOLONG);
+    assert_int_equal(fp.nout, 0);
+    assert_int_equal(fp.writes, 0);
+    assert_int_equal(tase_port_write_all(&port, NULL, 0), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(port_io_api_rejects_bad_arguments),
         cmocka_unit_test(count_tx_counts_link_failures_but_not_caller_mistakes),
         cmocka_unit_test(write_all_reassembles_partial_writes),
         cmocka_unit_test(write_all_reports_eagain_when_nothing_went_out),

@@ -370,9 +370,39 @@ static void bad_arguments_are_rejected(void **state)
     assert_int_equal(tase_posix_uart_ops.write(&a, b, sizeof b), TASE_EARG);
 }
 
+/* Bad arguments of the POSIX UART port give TASE_EARG (or false): NULL and
+ * closed instances, NULL buffers, zero and over-long counts, a bad fd. */
+static void posix_uart_api_rejects_bad_arguments(void **state)
+{
+    tase_posix_uart_t u;
+    tase_posix_uart_t copy;
+    tase_port_t p;
+    uint8_t buf[4] = {1, 2, 3, 4};
+    (void)state;
+
+    memset(&u, 0, sizeof u);
+    u.fd = -1;
+    memcpy(&copy, &u, sizeof u);
+    p = tase_posix_uart_port(&u);
+    assert_int_equal(p.ops->write(p.ctx, buf, sizeof buf), TASE_EARG);
+    assert_int_equal(p.ops->read(p.ctx, buf, sizeof buf, 0), TASE_EARG);
+    p = tase_posix_uart_port(NULL);
+    assert_int_equal(p.ops->write(p.ctx, buf, sizeof buf), TASE_EARG);
+    assert_int_equal(p.ops->read(p.ctx, buf, sizeof buf, 0), TASE_EARG);
+    assert_int_equal(tase_posix_uart_open(NULL, "/dev/null", 9600), TASE_EARG);
+    assert_int_equal(tase_posix_uart_open(&u, NULL, 9600), TASE_EARG);
+    assert_int_equal(tase_posix_uart_attach(NULL, 0, 9600), TASE_EARG);
+    assert_int_equal(tase_posix_uart_attach(&u, -1, 9600), TASE_EARG);
+    assert_int_equal(tase_posix_uart_close(NULL), TASE_EARG);
+    assert_false(tase_posix_uart_baud_supported(0));
+    assert_false(tase_posix_uart_baud_supported(UINT32_MAX));
+    assert_memory_equal(&u, &copy, sizeof u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(posix_uart_api_rejects_bad_arguments),
         cmocka_unit_test(bytes_cross_the_pty_unchanged_in_both_directions),
         cmocka_unit_test(read_waits_for_the_timeout_and_no_longer),
         cmocka_unit_test(read_returns_as_soon_as_bytes_arrive),

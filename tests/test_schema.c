@@ -308,9 +308,60 @@ static void names_resolve_both_ways_and_reject_unknown(void **state)
     assert_null(tase_schema_field(NULL, 0));
 }
 
+/* Bad arguments of schema.h give NULL / false / their documented codes,
+ * and a corrupted copy of a descriptor (fields running off the table, an
+ * index out of range) is never used to index the ROM tables. */
+static void schema_api_rejects_bad_arguments(void **state)
+{
+    const tase_packet_desc_t *p = tase_schema_at(TASE_PKT_COUNT - 1u);
+    tase_packet_desc_t forged;
+    uint8_t data[TASE_DATA_MAX] = {0};
+    int64_t v = 77;
+    (void)state;
+
+    assert_non_null(p);
+    assert_null(tase_schema_at(TASE_PKT_COUNT));
+    assert_null(tase_schema_at(SIZE_MAX));
+    assert_null(tase_schema_field(NULL, 0));
+    assert_null(tase_schema_field(p, p->nfields));
+    assert_null(tase_schema_field(p, SIZE_MAX));
+    assert_false(tase_schema_length_ok(NULL, 0));
+    assert_false(tase_schema_length_ok(p, SIZE_MAX));
+    assert_false(tase_schema_is_query(NULL, 0));
+    assert_int_equal(tase_field_get(NULL, 0, data, sizeof data, &v), TASE_EARG);
+    assert_int_equal(tase_field_get(p, p->nfields, data, sizeof data, &v), TASE_EARG);
+    assert_int_equal(tase_field_get(p, SIZE_MAX, data, sizeof data, &v), TASE_EARG);
+    assert_int_equal(tase_field_get(p, 0, NULL, SIZE_MAX, &v), TASE_EARG);
+    assert_int_equal(tase_field_get(p, 0, data, sizeof data, NULL), TASE_EARG);
+    assert_int_equal(tase_field_get(p, 0, NULL, 0, &v), TASE_ETRUNC);
+    assert_int_equal(tase_field_get(p, 0, data, 1, &v), TASE_ETRUNC);
+    assert_int_equal(v, 77);
+
+    assert_null(tase_schema_packet_name(NULL));
+    assert_null(tase_schema_field_name(NULL, 0));
+    assert_null(tase_schema_field_name(p, SIZE_MAX));
+    assert_null(tase_schema_find_name(NULL));
+    assert_null(tase_schema_find_name(""));
+    assert_int_equal(tase_schema_field_index(NULL, "pan"), TASE_EARG);
+    assert_int_equal(tase_schema_field_index(p, NULL), TASE_EARG);
+    assert_int_equal(tase_schema_field_index(p, "no_such_field"), TASE_EUNKNOWN);
+
+    forged = *p;
+    forged.first_field = 255; /* the table has fewer than 256 fields */
+    forged.nfields = 200;
+    assert_null(tase_schema_field(&forged, 0));
+    assert_null(tase_schema_field_name(&forged, 0));
+    assert_int_equal(tase_schema_field_index(&forged, "zoom_1"), TASE_EUNKNOWN);
+    assert_int_equal(tase_field_get(&forged, 0, data, sizeof data, &v), TASE_EARG);
+    assert_int_equal(v, 77);
+    forged.index = 200;
+    assert_null(tase_schema_packet_name(&forged));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(schema_api_rejects_bad_arguments),
         cmocka_unit_test(schema_matches_spec_transcription),
         cmocka_unit_test(fields_are_in_range_ordered_disjoint_and_cover_all_but_reserved),
         cmocka_unit_test(struct_members_match_field_width_sign_and_offset),

@@ -343,9 +343,71 @@ static void port_table_moves_bytes_both_ways(void **state)
     close_pair(&p);
 }
 
+/* Bad arguments of socketcan.h give TASE_EARG and touch nothing: NULL,
+ * closed and corrupted instances (role or private queue indices out of
+ * range), NULL buffers, counts that do not fit the int result. */
+static void socketcan_api_rejects_bad_arguments(void **state)
+{
+    static const uint8_t data[4] = {1, 2, 3, 4};
+    pair_t p;
+    tase_socketcan_t copy;
+    tase_can_frame_t f;
+    uint8_t buf[16];
+    int k;
+    (void)state;
+
+    memset(&f, 0, sizeof f);
+    f.id = TASE_CAN_ID_TO_GIMBAL;
+    f.extended = true;
+    f.dlc = 1;
+    assert_int_equal(tase_socketcan_write(NULL, data, 4), TASE_EARG);
+    assert_int_equal(tase_socketcan_read(NULL, buf, sizeof buf, 0), TASE_EARG);
+    assert_int_equal(tase_socketcan_send_frame(NULL, &f), TASE_EARG);
+    assert_int_equal(tase_socketcan_recv_frame(NULL, &f, 0), TASE_EARG);
+    tase_socketcan_close(NULL);
+
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    memcpy(&copy, &p.s, sizeof p.s);
+    assert_int_equal(tase_socketcan_write(&p.s, NULL, 1), TASE_EARG);
+    assert_int_equal(tase_socketcan_write(&p.s, data, (size_t)INT32_MAX + 1u), TASE_EARG);
+    assert_int_equal(tase_socketcan_read(&p.s, NULL, 1, 0), TASE_EARG);
+    assert_int_equal(tase_socketcan_read(&p.s, buf, SIZE_MAX, 0), TASE_EARG);
+    assert_int_equal(tase_socketcan_read(&p.s, buf, 0, 0), 0);
+    assert_int_equal(tase_socketcan_recv_frame(&p.s, NULL, 0), TASE_EARG);
+    f.dlc = 9;
+    assert_int_equal(tase_socketcan_send_frame(&p.s, &f), TASE_EARG);
+    assert_int_equal(tase_socketcan_send_frame(&p.s, NULL), TASE_EARG);
+    f.dlc = 1;
+    assert_memory_equal(&p.s, &copy, sizeof p.s);
+
+    for (k = 0; k < 5; k++) {
+        tase_socketcan_t bad;
+        memcpy(&bad, &copy, sizeof bad);
+        switch (k) {
+        case 0: bad.role = (tase_can_role_t)7; break;
+        case 1: bad.pend_len = 9; break;
+        case 2: bad.pend_pos = (uint8_t)(bad.pend_len + 1u); break;
+        case 3: bad.side_head = TASE_SOCKETCAN_SIDEQ; break;
+        default: bad.side_count = TASE_SOCKETCAN_SIDEQ + 1u; break;
+        }
+        p.s = bad;
+        assert_int_equal(tase_socketcan_write(&p.s, data, 4), TASE_EARG);
+        assert_int_equal(tase_socketcan_read(&p.s, buf, sizeof buf, 0), TASE_EARG);
+        assert_int_equal(tase_socketcan_send_frame(&p.s, &f), TASE_EARG);
+        assert_int_equal(tase_socketcan_recv_frame(&p.s, &f, 0), TASE_EARG);
+        assert_memory_equal(&p.s, &bad, sizeof bad);
+    }
+    p.s = copy;
+    assert_int_equal(p.s.stats.frames_tx, 0); /* nothing was sent */
+    close_pair(&p);
+    assert_int_equal(tase_socketcan_write(&p.s, data, 4), TASE_EARG); /* closed */
+    assert_int_equal(tase_socketcan_read(&p.s, buf, sizeof buf, 0), TASE_EARG);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(socketcan_api_rejects_bad_arguments),
         cmocka_unit_test(write_splits_a_max_frame_into_33_frames_of_the_host_id),
         cmocka_unit_test(gimbal_writes_with_its_own_id),
         cmocka_unit_test(gimbal_reads_a_max_packet_in_one_call),

@@ -100,14 +100,16 @@ int tase_can_split_init(tase_can_split_t *s, tase_can_role_t sender, const uint8
 
 /* Next frame: 8 bytes while at least 8 remain, then the 1..7 left over.
  * Returns the frame's dlc (1..8), 0 when every byte has been handed out
- * (out untouched), or TASE_EARG (NULL argument). O(1), reentrant. */
+ * (out untouched), or TASE_EARG (NULL argument, or s not initialised:
+ * bytes left but no data pointer; s and out untouched). O(1), reentrant. */
 int tase_can_split_next(tase_can_split_t *s, tase_can_frame_t *out);
 
 /* Split data[0..n) into out[0..cap) in one call. Returns the number of
  * frames written ((n + 7) / 8), or TASE_EARG (out NULL with n > 0, data
- * NULL with n > 0, unknown role) or TASE_ENOSPC (cap too small; nothing
- * written). TASE_CAN_FRAMES_MAX frames hold any single datalink frame.
- * O(n), reentrant, ISR-safe. */
+ * NULL with n > 0, unknown role) or TASE_ENOSPC (cap too small, 0
+ * included, or more than INT16_MAX frames needed; nothing written).
+ * TASE_CAN_FRAMES_MAX frames hold any single datalink frame. O(n),
+ * reentrant, ISR-safe. */
 int tase_can_split(tase_can_role_t sender, const uint8_t *data, size_t n, tase_can_frame_t *out,
                    size_t cap);
 
@@ -150,7 +152,8 @@ int tase_can_rx_init(tase_can_rx_t *crx, tase_can_role_t role);
  * counted and dropped, and the return code says why: TASE_EUNKNOWN (not
  * ours: normal on a shared bus) or TASE_ELENGTH (our ID, bad dlc). These
  * two are the only "errors" that still change the instance (a counter).
- * TASE_EARG: crx or f NULL (nothing counted). Not reentrant per instance;
+ * TASE_EARG: crx or f NULL, or crx->role not a role (corrupted instance;
+ * nothing counted). Not reentrant per instance;
  * O(dlc) plus the datalink receiver's cost. */
 int tase_can_rx_feed(tase_can_rx_t *crx, const tase_can_frame_t *f, tase_rx_handler_t on_frame,
                      void *user);

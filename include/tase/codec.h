@@ -306,7 +306,8 @@ typedef union {
  *                 CAMERA_PASS data is NULL with len > 0;
  *   TASE_EUNKNOWN id is not in the schema;
  *   TASE_ETOOLONG CAMERA_PASS len > TASE_CAMERA_PASS_MAX;
- *   TASE_ENOSPC   cap is too small.
+ *   TASE_ENOSPC   cap is too small (0 included).
+ * Checked in this order, except that out NULL gives TASE_EARG first.
  * The payload is built in place at out + TASE_FRAME_HEADER (no copy; msg
  * data may even lie in out). O(length). */
 int tase_packet_encode(uint16_t id, const void *msg, uint8_t *out, size_t cap);
@@ -316,13 +317,14 @@ int tase_packet_encode(uint16_t id, const void *msg, uint8_t *out, size_t cap);
  * 0 for a query (msg may be NULL), 1 for CAMERA_CMD "change active camera
  * only" (only msg->camera is sent). For CAMERA_PASS len must be
  * 4 + msg->len. Returns as tase_packet_encode(), plus TASE_ELENGTH when
- * len is not accepted. */
+ * len is not accepted (any size_t up to SIZE_MAX; compared without
+ * overflow). */
 int tase_packet_encode_len(uint16_t id, const void *msg, size_t len, uint8_t *out, size_t cap);
 
 /* Encode the zero-length form of packet `id`: the query of a setup
  * packet, SPOI_CMD or SYSTEM_VERSION, and the GYRO_ZERO_CMD command.
- * Returns 8 (the frame length) or TASE_EARG / TASE_EUNKNOWN / TASE_ELENGTH
- * (packet has no zero-length form) / TASE_ENOSPC. */
+ * Returns 8 (the frame length) or TASE_EARG (out NULL) / TASE_EUNKNOWN /
+ * TASE_ELENGTH (packet has no zero-length form) / TASE_ENOSPC (cap < 8). */
 int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap);
 
 /* Decode frame f into the typed struct of its packet at msg (which must
@@ -330,8 +332,9 @@ int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap);
  * fields beyond a short accepted length (query: all; CAMERA_CMD 1-byte
  * form: all but camera) stay zero, so check the return value.
  * Returns the data length decoded (>= 0), or
- *   TASE_EARG     f or msg is NULL (msg may be NULL for a zero-length frame:
- *                 GYRO_ZERO_CMD or a query);
+ *   TASE_EARG     f NULL, f->data NULL with f->len > 0, or msg NULL for a
+ *                 known packet of accepted length > 0 (msg may be NULL for
+ *                 a zero-length frame: GYRO_ZERO_CMD or a query);
  *   TASE_EUNKNOWN the schema does not know (f->group, f->type);
  *   TASE_ELENGTH  f->len is not an accepted length for the packet.
  * On error msg is unchanged. O(length). */

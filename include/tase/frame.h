@@ -152,7 +152,7 @@ typedef struct {
 typedef void (*tase_rx_handler_t)(void *user, const tase_frame_t *frame);
 
 /* 16-bit additive checksum: `seed` plus the sum of n bytes, modulo 2^16.
- * p may be NULL only when n == 0. O(n), reentrant. */
+ * p == NULL (any n) returns seed without reading. O(n), reentrant. */
 uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n);
 
 /* Encode one frame into out[0..cap).
@@ -173,7 +173,9 @@ int tase_rx_init(tase_rx_t *rx);
 /* Feed n bytes. Each valid frame completed by them is passed to
  * on_frame(user, frame) before this returns; on_frame may be NULL (frames
  * are then only counted). Returns the number of frames delivered (>= 0),
- * or TASE_EARG if rx is NULL or data is NULL with n > 0 (nothing consumed).
+ * or TASE_EARG if rx is NULL or data is NULL with n > 0 (any n up to
+ * SIZE_MAX), or rx is visibly not an initialised receiver (held length,
+ * scan position or candidate count out of range); nothing is consumed.
  * Feeding a stream one byte at a time or in any split gives the same
  * frames and counters. Not reentrant per receiver; different receivers
  * are independent. Call from one context (e.g. the main loop draining an
@@ -184,7 +186,8 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
 /* Feed one byte: the same as tase_rx_feed(rx, &byte, 1, on_frame, user),
  * with a shorter path for the common bytes (inside a frame, or noise while
  * hunting for a sync), for callers that get one byte at a time. Returns
- * the number of frames delivered (0 or more) or TASE_EARG if rx is NULL.
+ * the number of frames delivered (0 or more) or TASE_EARG if rx is NULL
+ * or visibly corrupted (as tase_rx_feed(); receiver unchanged).
  * Same context rules as tase_rx_feed(). */
 int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user);
 
@@ -192,10 +195,12 @@ int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *
  * candidate. Frames that can still be completed from the bytes held are
  * delivered; incomplete ones are released and counted in bytes_discarded.
  * Afterwards the receiver is empty (counters kept) and ready for a new
- * stream. Returns frames delivered (>= 0) or TASE_EARG if rx is NULL. */
+ * stream. Returns frames delivered (>= 0) or TASE_EARG if rx is NULL or
+ * visibly corrupted (as tase_rx_feed(); receiver unchanged). */
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user);
 
-/* Zero every counter, nothing else. Returns TASE_OK or TASE_EARG. */
+/* Zero every counter, nothing else. Returns TASE_OK or TASE_EARG (rx
+ * NULL). */
 int tase_rx_stats_reset(tase_rx_t *rx);
 
 #ifdef __cplusplus

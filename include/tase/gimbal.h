@@ -149,21 +149,24 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
                      uint32_t now_ms);
 
 /* Hand over one frame received on `port` some other way (e.g. CAN
- * reassembly). Returns TASE_OK or TASE_EARG. O(len). */
+ * reassembly). Returns TASE_OK or TASE_EARG (g, frame or frame->data
+ * NULL, port >= 3; nothing counted). A setup frame for an absent port is
+ * counted but not answered. O(len). */
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
                              uint32_t now_ms);
 
 /* Send every telemetry packet that is due at now_ms (at most one per
  * stream, see SCHEDULE). Returns the number of frames written (>= 0) or
- * TASE_EARG. O(ports * streams) plus the callbacks and writes. */
+ * TASE_EARG (g NULL). O(ports * streams) plus the callbacks and writes. */
 int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
 
 /* Read whatever each present port has ready (timeout 0, ports with a
  * read function), feed it, then tase_gimbal_poll(). Returns the poll
- * result, TASE_EARG, or TASE_ESTATE when a port has a read function but
+ * result, TASE_EARG (g NULL), or TASE_ESTATE when a port has a read function but
  * the gimbal was initialised without receivers. A port read error is
  * skipped (the port may
- * recover), counted nowhere else: check the port. Uses 64 bytes of stack
+ * recover), counted nowhere else: check the port; so is a read() that
+ * claims more bytes than asked (none of them is fed). Uses 64 bytes of stack
  * plus a bounded number of reads (at most 64 per port per call). */
 int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms);
 
@@ -173,7 +176,8 @@ int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms);
 int tase_gimbal_send(tase_gimbal_t *g, unsigned port, uint8_t group, uint8_t type,
                      const uint8_t *data, size_t len);
 
-/* Data length of setup packet `type` (0..7), or TASE_EUNKNOWN. O(1). */
+/* Data length of setup packet `type` (0..7), or TASE_EUNKNOWN (type > 7).
+ * O(1). */
 int tase_gimbal_setup_len(uint8_t type);
 
 /* Copy the stored bytes of setup packet `type` into out[0..cap).
@@ -185,7 +189,8 @@ int tase_gimbal_setup_get(const tase_gimbal_t *g, uint8_t type, uint8_t *out, si
  * settings at start-up, or set SYSTEM_VERSION. A PACKET_RATE change
  * reschedules as described above, anchored at now_ms. Returns TASE_OK,
  * TASE_EARG (g NULL, data NULL), TASE_EUNKNOWN (type > 7), TASE_ELENGTH
- * (len is not the type's length). O(len). */
+ * (len is not the type's length, 0 and SIZE_MAX included); g unchanged on
+ * error. O(len). */
 int tase_gimbal_setup_set(tase_gimbal_t *g, uint8_t type, const uint8_t *data, size_t len,
                           uint32_t now_ms);
 

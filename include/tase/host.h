@@ -151,7 +151,7 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame);
 int tase_host_poll(tase_host_t *h, uint32_t now_ms);
 
 /* Forget the pending request (its outcome will not be reported).
- * Returns TASE_OK, or TASE_EARG. O(1). */
+ * Returns TASE_OK, or TASE_EARG (h NULL). O(1). */
 int tase_host_cancel(tase_host_t *h);
 
 /* True while a request waits for its reply (false for NULL). O(1). */
@@ -159,8 +159,10 @@ bool tase_host_busy(const tase_host_t *h);
 
 /* Read once from the port, waiting at most wait_ms, and feed what
  * arrived (time from port->ops->now_ms). Returns bytes read (>= 0), a
- * port error, TASE_EUNSUPPORTED (port has no read or now_ms) or
- * TASE_EARG. Uses 64 bytes of stack. */
+ * port error, TASE_EIO (the port's read() claimed more bytes than asked;
+ * nothing fed), TASE_EUNSUPPORTED (port has no read or now_ms) or
+ * TASE_EARG (h NULL, or never initialised: no port ops). Uses 64 bytes of
+ * stack. */
 int tase_host_service(tase_host_t *h, uint32_t wait_ms);
 
 /* Blocking convenience for tools: start a request, then service the port
@@ -168,7 +170,8 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms);
  * tase_host_request_start() + tase_host_poll(): returns the reply length
  * or a negative code (TASE_ETIMEOUT after 1 + retries attempts). Waits at
  * most about (1 + retries) * timeout_ms. Frames that arrive meanwhile go
- * to on_frame. */
+ * to on_frame. TASE_EARG also for h without port ops (never initialised),
+ * TASE_EUNSUPPORTED for a port without read or now_ms (nothing sent). */
 int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len,
                        uint8_t *reply, size_t reply_cap, uint32_t timeout_ms, uint8_t retries);
 

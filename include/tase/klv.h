@@ -127,9 +127,10 @@ typedef struct {
 
 /* Encode one packet (TASE_KLV_PACKET_LEN bytes, declared set length 70)
  * into out[0..cap). Returns TASE_KLV_PACKET_LEN, or TASE_EARG (klv or out
- * NULL) or TASE_ENOSPC (cap < 87); on error nothing is written. To imitate
- * a gimbal that follows the spec literally, overwrite out[16] with
- * TASE_KLV_SET_LEN_SPEC afterwards: the checksum does not cover that byte.
+ * NULL) or TASE_ENOSPC (cap < 87, 0 included); on error nothing is
+ * written. To imitate a gimbal that follows the spec literally, overwrite
+ * out[16] with TASE_KLV_SET_LEN_SPEC afterwards: the checksum does not
+ * cover that byte.
  * O(1), reentrant, ISR-safe. */
 int tase_klv_encode(const tase_klv_t *klv, uint8_t *out, size_t cap);
 
@@ -190,7 +191,9 @@ int tase_klv_rx_init(tase_klv_rx_t *rx);
 /* Feed n bytes. Each packet they complete goes to on_packet(user, ...),
  * each failed candidate to on_error(user, ...), before this returns;
  * either handler may be NULL. Returns the number of packets delivered, or
- * TASE_EARG if rx is NULL or data is NULL with n > 0 (nothing consumed).
+ * TASE_EARG if rx is NULL, data is NULL with n > 0 (any n up to
+ * SIZE_MAX), or rx's held length exceeds its window (corrupted or never
+ * initialised); nothing is consumed.
  * Any split of the stream into calls gives the same packets, offsets and
  * counters. Not reentrant per scanner; scanners are independent.
  * Worst case O(n * TASE_KLV_PACKET_MAX) (a stream of near-miss
@@ -203,14 +206,18 @@ int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n, tase_klv_
  * completed is counted as truncated (reported with TASE_ETRUNC) and the
  * bytes after its first byte are scanned again. Afterwards the window is
  * empty (offset and counters kept). Returns packets delivered (>= 0) or
- * TASE_EARG if rx is NULL. */
+ * TASE_EARG if rx is NULL or corrupted as for tase_klv_rx_feed() (rx
+ * unchanged). */
 int tase_klv_rx_flush(tase_klv_rx_t *rx, tase_klv_handler_t on_packet,
                       tase_klv_error_handler_t on_error, void *user);
 
-/* Zero every counter, nothing else. Returns TASE_OK or TASE_EARG. */
+/* Zero every counter, nothing else. Returns TASE_OK or TASE_EARG (rx
+ * NULL). */
 int tase_klv_rx_stats_reset(tase_klv_rx_t *rx);
 
-/* ---- units (corrected formulas; reentrant, ISR-safe, no libm) --------- */
+/* ---- units (corrected formulas; reentrant, ISR-safe, no libm) ---------
+ * Total functions: every input gives a defined result (see UNITS above for
+ * NaN, infinities and out-of-range values); none can fail. */
 
 double tase_klv_lat_deg(int32_t v);    /* v * 180 / 2^32 */
 double tase_klv_lon_deg(int32_t v);    /* v * 360 / 2^32 */
@@ -266,7 +273,8 @@ uint16_t tase_klv_fov_raw(double deg);   /* [0, 180) */
 #define TASE_KLV_GPS_ANTENNA_UNDERCURRENT 2u
 #define TASE_KLV_GPS_ANTENNA_NO_POWER 3u
 
-/* Fix type (0..7) and antenna state (0..3) of a status word. */
+/* Fix type (0..7) and antenna state (0..3) of a status word (any word;
+ * the other bits are ignored). */
 unsigned tase_klv_gps_fix(uint16_t status);
 unsigned tase_klv_gps_antenna(uint16_t status);
 

@@ -29,12 +29,14 @@ extern "C" {
 
 /* Write all n bytes of data to the port.
  * Returns n, or
- *   TASE_EARG    port/ops/write NULL, or data NULL with n > 0;
+ *   TASE_EARG    port/ops/write NULL, data NULL with n > 0, or
+ *                n > INT32_MAX (the count must fit the int result);
  *   TASE_EAGAIN / TASE_ENOBUFS  the port took nothing at all (retry later;
  *                nothing was sent);
  *   TASE_EIO     the port stopped taking bytes part-way (some bytes were
  *                sent; a receiver will discard the cut frame by its
- *                checksum);
+ *                checksum), also when write() claims more than it was
+ *                given (a broken port);
  *   any other negative code the port's write() returned.
  * O(n) plus the port's cost. Reentrant if the port's write is; not
  * ISR-safe unless the port's write is. */
@@ -42,8 +44,9 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n);
 
 /* Encode one frame (tase_frame_encode) into a stack buffer of
  * TASE_FRAME_MAX bytes and write it with tase_port_write_all().
- * Returns the frame length, an encoder error (TASE_EARG, TASE_ETOOLONG:
- * nothing sent) or a tase_port_write_all() error. Uses 261 bytes of stack. */
+ * Returns the frame length, an encoder error (TASE_EARG: data NULL with
+ * len > 0; TASE_ETOOLONG: len > 253; checked first, nothing sent),
+ * TASE_EARG for port NULL, or a tase_port_write_all() error. Uses 261 bytes of stack. */
 int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *data,
                          size_t len);
 

@@ -101,7 +101,8 @@ typedef struct {
 } tase_packet_desc_t;
 
 /* The descriptor of packet (group, type), or NULL if the schema does not
- * know it (group 0x28 STATUS has no packets in spec v1.0.0). O(1). */
+ * know it (group 0x28 STATUS has no packets in spec v1.0.0; any byte
+ * values may be passed). O(1). */
 const tase_packet_desc_t *tase_schema_find(uint8_t group, uint8_t type);
 
 /* The descriptor of TASE_PKT_* index i (0..TASE_PKT_COUNT-1), or NULL
@@ -109,7 +110,8 @@ const tase_packet_desc_t *tase_schema_find(uint8_t group, uint8_t type);
 const tase_packet_desc_t *tase_schema_at(size_t i);
 
 /* Field i (0..nfields-1) of packet p, or NULL if p is NULL or i is out of
- * range. O(1). */
+ * range (any size_t; also when a corrupted descriptor would index past
+ * the field table). O(1). */
 const tase_field_t *tase_schema_field(const tase_packet_desc_t *p, size_t i);
 
 /* True when `len` data bytes are a valid form of packet p: its table
@@ -119,7 +121,7 @@ bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len);
 
 /* True when a frame of packet p with `len` data bytes is a query (zero
  * length and p has a query form). GYRO_ZERO_CMD is always zero length and
- * is a command, not a query. O(1). */
+ * is a command, not a query. False when p is NULL. O(1). */
 bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len);
 
 /* Read the integer value of field i of packet p from data[0..len): big-
@@ -135,14 +137,16 @@ int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, s
 /* ---- names (src/schema_names.c; not linked unless used) ----------- */
 
 /* The spec name of packet p ("GIMBAL_CMD", "GIMBAL_RATE" for 0x08/0x40,
- * ...), or NULL if p is NULL. */
+ * ...), or NULL if p is NULL or its index is out of range (not a
+ * descriptor of the table). */
 const char *tase_schema_packet_name(const tase_packet_desc_t *p);
 
 /* The JSON name of field i of packet p ("pan", "impulse_time"), or NULL if
  * p is NULL or i is out of range. */
 const char *tase_schema_field_name(const tase_packet_desc_t *p, size_t i);
 
-/* The packet named `name` (exact, case-sensitive spec name), or NULL.
+/* The packet named `name` (exact, case-sensitive spec name), or NULL
+ * (also for name NULL).
  * O(TASE_PKT_COUNT) string compares: for tools, not for receive paths. */
 const tase_packet_desc_t *tase_schema_find_name(const char *name);
 

@@ -19,7 +19,9 @@ int tase_bm_uart_init(tase_bm_uart_t *u, uint8_t *rx_buf, size_t cap,
 
 void tase_bm_uart_rx_isr(tase_bm_uart_t *u, uint8_t byte)
 {
-    (void)tase_ring_put(&u->rx, byte);
+    if (u != NULL) {
+        (void)tase_ring_put(&u->rx, byte);
+    }
 }
 
 int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
@@ -52,7 +54,7 @@ static int bm_write(void *ctx, const uint8_t *data, size_t n)
 {
     tase_bm_uart_t *u = ctx;
     int r;
-    if (u == NULL || (data == NULL && n > 0) || n > 0x7FFFFFFFu) {
+    if (u == NULL || u->hooks == NULL || (data == NULL && n > 0) || n > 0x7FFFFFFFu) {
         return TASE_EARG;
     }
     r = u->hooks->tx(u->hw, data, n);
@@ -64,7 +66,7 @@ static int bm_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
     tase_bm_uart_t *u = ctx;
     uint32_t start;
 
-    if (u == NULL || buf == NULL || cap == 0) {
+    if (u == NULL || u->hooks == NULL || buf == NULL || cap == 0) {
         return TASE_EARG;
     }
     if (cap > 0x7FFFFFFFu) {
@@ -88,7 +90,7 @@ static int bm_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
 static uint32_t bm_now_ms(void *ctx)
 {
     tase_bm_uart_t *u = ctx;
-    return u->hooks->millis(u->hw);
+    return (u == NULL || u->hooks == NULL) ? 0u : u->hooks->millis(u->hw);
 }
 
 const tase_port_ops_t tase_bm_uart_ops = {bm_write, bm_read, bm_now_ms};

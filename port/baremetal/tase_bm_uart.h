@@ -30,12 +30,16 @@
  * The port functions (tase_bm_uart_ops):
  *  write   calls hooks->tx(hw, data, n), which must send all bytes
  *          (blocking on the TX-empty flag, or queue them to a TX ring/DMA)
- *          and return 0, or a negative TASE_E* code (passed on). Returns n.
+ *          and return 0, or a negative TASE_E* code (passed on). Returns n,
+ *          or TASE_EARG (ctx NULL or not initialised, data NULL with
+ *          n > 0, n > INT32_MAX; the hook is not called).
  *  read    takes what the ring holds; if empty, waits until bytes arrive
  *          or timeout_ms passes on hooks->millis(), calling hooks->idle()
  *          (e.g. __WFI(): the RX interrupt wakes the core) between checks,
- *          or spinning if idle is NULL. Returns the count (0: timeout).
- *  now_ms  hooks->millis(hw) (a SysTick millisecond counter).
+ *          or spinning if idle is NULL. Returns the count (0: timeout),
+ *          or TASE_EARG (ctx NULL or not initialised, buf NULL, cap 0).
+ *  now_ms  hooks->millis(hw) (a SysTick millisecond counter); 0 for ctx
+ *          NULL or not initialised.
  */
 #ifndef TASE_BM_UART_H
 #define TASE_BM_UART_H
@@ -73,12 +77,12 @@ int tase_bm_uart_init(tase_bm_uart_t *u, uint8_t *rx_buf, size_t cap,
                       const tase_bm_uart_hooks_t *hooks, void *hw);
 
 /* RX INTERRUPT ONLY: one received byte. Drops and counts it when the ring
- * is full (tase_ring_overflows(&u->rx)). O(1). */
+ * is full (tase_ring_overflows(&u->rx)); ignored for u NULL. O(1). */
 void tase_bm_uart_rx_isr(tase_bm_uart_t *u, uint8_t byte);
 
 /* MAIN LOOP: drain everything the ring holds into a frame receiver, in
  * chunks of 32 bytes. Returns the number of frames delivered (>= 0) or
- * TASE_EARG. Bounded: stops after one ring capacity's worth of bytes even
+ * TASE_EARG (u or rx NULL). Bounded: stops after one ring capacity's worth of bytes even
  * if the ISR keeps adding, so the main loop cannot be starved. */
 int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_frame, void *user);
 

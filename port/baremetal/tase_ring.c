@@ -27,9 +27,14 @@ int tase_ring_init(tase_ring_t *r, uint8_t *buf, size_t cap)
 
 bool tase_ring_put(tase_ring_t *r, uint8_t byte)
 {
-    uint32_t head = r->head; /* ours: no one else changes it */
-    uint32_t tail = r->tail;
+    uint32_t head;
+    uint32_t tail;
 
+    if (r == NULL || r->buf == NULL) {
+        return false; /* two compares: cheap enough for the ISR path */
+    }
+    head = r->head; /* ours: no one else changes it */
+    tail = r->tail;
     if (head - tail > r->mask) {
         r->overflow = r->overflow + 1u;
         return false;
@@ -48,7 +53,7 @@ size_t tase_ring_get(tase_ring_t *r, uint8_t *out, size_t cap)
 {
     uint32_t tail, avail, i;
 
-    if (r == NULL || out == NULL) {
+    if (r == NULL || out == NULL || r->buf == NULL) {
         return 0;
     }
     tail = r->tail;

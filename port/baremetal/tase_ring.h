@@ -94,13 +94,15 @@ typedef struct {
 int tase_ring_init(tase_ring_t *r, uint8_t *buf, size_t cap);
 
 /* PRODUCER ONLY (the RX ISR). Append one byte. Returns true if stored,
- * false if the ring was full (the byte is dropped and counted). r must be
- * a ring initialised by tase_ring_init() (not checked: this is the ISR
- * fast path). O(1), ISR-safe, lock-free, wait-free. */
+ * false if the ring was full (the byte is dropped and counted) or r is
+ * NULL or has no storage (never initialised; nothing changes). Other
+ * corruption is not checked: this is the ISR fast path. O(1), ISR-safe,
+ * lock-free, wait-free. */
 bool tase_ring_put(tase_ring_t *r, uint8_t byte);
 
 /* CONSUMER ONLY (the main loop). Move up to cap bytes, oldest first, into
- * out. Returns the number moved (0 when empty, or when r/out is NULL).
+ * out. Returns the number moved (0 when empty, cap 0, r/out NULL or r
+ * without storage; nothing changes then).
  * O(returned). Lock-free; safe while the producer interrupts it. */
 size_t tase_ring_get(tase_ring_t *r, uint8_t *out, size_t cap);
 

@@ -15,11 +15,14 @@
  *          (default 1000 ms) while the kernel's output queue is full.
  *          Returns n, the count written when the timeout expired part-way,
  *          TASE_EAGAIN when nothing could be written in time, TASE_EIO on
- *          an OS error.
+ *          an OS error, TASE_EARG (ctx NULL or closed, data NULL with
+ *          n > 0, n > INT32_MAX; nothing written).
  *  read    returns what is available now, or waits up to timeout_ms for
  *          the first bytes (EINTR restarts the wait with the time left).
- *          Returns the count (0 = nothing within the timeout) or TASE_EIO
- *          (OS error, or the other end hung up).
+ *          Returns the count (0 = nothing within the timeout), TASE_EIO
+ *          (OS error, or the other end hung up) or TASE_EARG (ctx NULL or
+ *          closed, buf NULL, cap 0). A cap above INT32_MAX reads at most
+ *          INT32_MAX bytes.
  *  now_ms  CLOCK_MONOTONIC in milliseconds, modulo 2^32.
  * One instance is used from one thread at a time; separate instances are
  * independent.
@@ -65,10 +68,12 @@ int tase_posix_uart_attach(tase_posix_uart_t *u, int fd, uint32_t baud);
  * if u is NULL, TASE_EIO if close() failed (the fd is gone anyway). */
 int tase_posix_uart_close(tase_posix_uart_t *u);
 
-/* The tase_port_t of an open instance: {&tase_posix_uart_ops, u}. */
+/* The tase_port_t of an open instance: {&tase_posix_uart_ops, u}. With u
+ * NULL or closed its write/read return TASE_EARG. */
 tase_port_t tase_posix_uart_port(tase_posix_uart_t *u);
 
-/* True if `baud` is a rate tase_posix_uart_open() accepts. */
+/* True if `baud` is a rate tase_posix_uart_open() accepts (any value may
+ * be asked). */
 bool tase_posix_uart_baud_supported(uint32_t baud);
 
 /* CLOCK_MONOTONIC milliseconds modulo 2^32 (the ops' now_ms). */

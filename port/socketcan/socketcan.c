@@ -204,6 +204,16 @@ void tase_socketcan_close(tase_socketcan_t *s)
     s->fd = -1;
 }
 
+/* An open instance whose private indices are in range: a corrupted or
+ * never-initialised one gives TASE_EARG instead of indexing outside pend[]
+ * or side[]. */
+static bool usable(const tase_socketcan_t *s)
+{
+    return s != NULL && s->fd >= 0 && tase_can_role_ids(s->role, NULL, NULL) == TASE_OK &&
+           s->pend_len <= sizeof s->pend && s->pend_pos <= s->pend_len &&
+           s->side_head < TASE_SOCKETCAN_SIDEQ && s->side_count <= TASE_SOCKETCAN_SIDEQ;
+}
+
 /* ---- frames --------------------------------------------------------- */
 
 static void to_linux(const tase_can_frame_t *f, struct can_frame *cf)
@@ -269,7 +279,7 @@ static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, uint32_t d
 
 int tase_socketcan_send_frame(tase_socketcan_t *s, const tase_can_frame_t *f)
 {
-    if (s == NULL || s->fd < 0 || tase_can_frame_check(f) != TASE_OK) {
+    if (!usable(s) || tase_can_frame_check(f) != TASE_OK) {
         return TASE_EARG;
     }
     return send_until(s, f, tase_socketcan_now_ms(NULL) + s->tx_timeout_ms);
@@ -280,7 +290,7 @@ int tase_socketcan_write(tase_socketcan_t *s, const uint8_t *data, size_t n)
     tase_can_split_t sp;
     tase_can_frame_t f;
     uint32_t deadline;
-    if (s == NULL || s->fd < 0 || n > (size_t)0x7FFFFFFF ||
+    if (!usable(s) || n > (size_t)0x7FFFFFFF ||
         tase_can_split_init(&sp, s->role, data, n) != TASE_OK) {
         return TASE_EARG;
     }
@@ -381,7 +391,7 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
     tase_can_frame_t f;
     uint32_t deadline;
     size_t got;
-    if (s == NULL || s->fd < 0 || buf == NULL || cap > (size_t)0x7FFFFFFF) {
+    if (!usable(s) || buf == NULL || cap > (size_t)0x7FFFFFFF) {
         return TASE_EARG;
     }
     deadline = tase_socketcan_now_ms(NULL) + timeout_ms;
@@ -412,7 +422,7 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
 
 int tase_socketcan_recv_frame(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_ms)
 {
-    if (s == NULL || s->fd < 0 || f == NULL) {
+    if (!usable(s) || f == NULL) {
         return TASE_EARG;
     }
     if (s->side_count > 0u) {

@@ -103,24 +103,28 @@ int tase_socketcan_open(tase_socketcan_t *s, const char *ifname, tase_can_role_t
  * setsockopt failed; s untouched, fd not closed). */
 int tase_socketcan_adopt(tase_socketcan_t *s, int fd, tase_can_role_t role, unsigned flags);
 
-/* Close the descriptor if owned. Safe to call twice. */
+/* Close the descriptor if owned. Safe to call twice; s NULL is ignored. */
 void tase_socketcan_close(tase_socketcan_t *s);
 
 /* The port view: ops = &tase_socketcan_ops, ctx = s. */
 tase_port_t tase_socketcan_port(tase_socketcan_t *s);
 extern const tase_port_ops_t tase_socketcan_ops;
 
-/* Byte stream (the tase_port_ops_t contract, see tase/port.h). */
+/* Byte stream (the tase_port_ops_t contract, see tase/port.h). Both
+ * return TASE_EARG, touching nothing, for s NULL, closed or corrupted
+ * (role or private queue indices out of range), n or cap > INT32_MAX,
+ * data NULL with n > 0, buf NULL. read() with cap 0 returns 0. */
 int tase_socketcan_write(tase_socketcan_t *s, const uint8_t *data, size_t n);
 int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t timeout_ms);
 
 /* Send one frame (validated with tase_can_frame_check()). Returns TASE_OK,
- * TASE_EARG, TASE_ENOBUFS (queue still full after tx_timeout_ms) or
+ * TASE_EARG (s as for write(), f NULL or failing the check; nothing
+ * sent), TASE_ENOBUFS (queue still full after tx_timeout_ms) or
  * TASE_EIO. */
 int tase_socketcan_send_frame(tase_socketcan_t *s, const tase_can_frame_t *f);
 
 /* Receive one frame, waiting at most timeout_ms. Returns 1 (*f filled),
- * 0 (none in time), TASE_EARG or TASE_EIO. Frames the filters let through
+ * 0 (none in time), TASE_EARG (s as for read(), f NULL) or TASE_EIO. Frames the filters let through
  * but that are not data frames (remote, error, wrong size) are counted in
  * stats.bad_frames and skipped. */
 int tase_socketcan_recv_frame(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_ms);
