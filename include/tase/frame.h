@@ -55,7 +55,7 @@
  * in it) is checked and delivered straight from the caller's buffer. Other
  * bytes are copied in runs (memchr/memcpy) between sync bytes and frame
  * ends. On x86-64 (gcc -O2, callgrind) a clean telemetry stream costs
- * about 9 instructions per byte fed in 4 KB buffers and about 47 fed one
+ * about 9 instructions per byte fed in 4 KB buffers and about 51 fed one
  * byte at a time through tase_rx_push(); a stream made only of false syncs
  * claiming 253 data bytes is the worst case, about 240 (300 byte at a
  * time). docs/PERFORMANCE.md has the measured numbers.
