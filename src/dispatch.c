@@ -2,6 +2,8 @@
  * contract described in include/tase/dispatch.h. */
 #include "tase/dispatch.h"
 
+#include <string.h>
+
 int tase_dispatch_init(tase_dispatch_t *d, const tase_packet_handler_t *handlers,
                        tase_rx_handler_t on_default, tase_dispatch_error_t on_error, void *user,
                        tase_rx_stats_t *stats)
@@ -9,6 +11,7 @@ int tase_dispatch_init(tase_dispatch_t *d, const tase_packet_handler_t *handlers
     if (d == NULL) {
         return TASE_EARG;
     }
+    (void)memset(d, 0, sizeof *d); /* the decode buffer too: no undefined bytes */
     d->handlers = handlers;
     d->on_default = on_default;
     d->on_error = on_error;
