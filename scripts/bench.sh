@@ -132,7 +132,7 @@ status=$(awk -v a="$tele" 'BEGIN {print (a <= 10) ? "met" : "**missed**"}')
     echo "  what the ring holds in one call (port/baremetal tase_bm_uart_poll() feeds 32-byte"
     echo "  chunks) to get close to the chunk-4096 figure."
     echo "- Where the telemetry stream's instructions go (chunk 4096, exclusive cost per"
-    echo "  function; static functions of src/frame.c that gcc inlined are counted in their"
+    echo "  function; static functions of src/tase_frame.c that gcc inlined are counted in their"
     echo "  caller; per-line detail: \`callgrind_annotate --auto=yes callgrind.out\` after"
     echo "  \`valgrind --tool=callgrind --toggle-collect=tase_rx_feed"
     echo "  --callgrind-out-file=callgrind.out bench_rx telemetry 4096 once\`):"

@@ -13,8 +13,8 @@ flags=(-std=c99 -mcpu="$cpu" -mthumb -Os -ffunction-sections -fdata-sections
        -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wshadow -Werror
        -I"$TASE_ROOT/include" -I"$TASE_ROOT/port/baremetal")
 objs=()
-for src in "$TASE_ROOT"/port/baremetal/*.c "$TASE_ROOT"/src/host.c "$TASE_ROOT"/src/gimbal.c \
-           "$TASE_ROOT"/src/port_io.c; do
+for src in "$TASE_ROOT"/port/baremetal/*.c "$TASE_ROOT"/src/tase_host.c "$TASE_ROOT"/src/tase_gimbal.c \
+           "$TASE_ROOT"/src/tase_port_io.c; do
     obj="$out/$(basename "$src" .c).o"
     arm-none-eabi-gcc "${flags[@]}" -c "$src" -o "$obj"
     objs+=("$obj")

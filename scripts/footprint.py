@@ -7,8 +7,8 @@ Run through scripts/footprint.sh, which installs what it needs.
 
 Works on whatever src/*.c exist: modules are found by object file, the
 receive path is framing (tase_rx_*) plus every public function of
-src/dispatch.c when that module exists, and optional name strings are
-src/*names*.c and src/strerror.c."""
+src/tase_dispatch.c when that module exists, and optional name strings are
+src/*names*.c and src/tase_strerror.c."""
 import argparse
 import glob
 import os
@@ -53,7 +53,8 @@ def build(cpu, out):
          "-DCMAKE_TOOLCHAIN_FILE=" + os.path.join(ROOT, "cmake", "arm-none-eabi.cmake")], env=env)
     run(["cmake", "--build", bdir, "-j2"])
     objs = sorted(glob.glob(os.path.join(bdir, "CMakeFiles", "tase.dir", "src", "*.c.obj")))
-    return bdir, {os.path.basename(o)[:-len(".c.obj")]: o for o in objs}
+    # Module names drop the files' "tase_" prefix (tase_frame.c -> frame).
+    return bdir, {os.path.basename(o)[:-len(".c.obj")].replace("tase_", "", 1): o for o in objs}
 
 
 def berkeley(path):
@@ -307,7 +308,7 @@ def main():
     p("## Targets")
     p("")
     dispatch = res[CPUS[0]]["dispatch"]
-    rxname = "framing + dispatch" if dispatch else "framing only (no src/dispatch.c yet)"
+    rxname = "framing + dispatch" if dispatch else "framing only (no src/tase_dispatch.c yet)"
     p("Linked sizes: only what the named entry points pull in after `--gc-sections`; libc's "
       "`memcpy`/`memmove`/`memchr`/`memset` are not counted (every firmware links them).")
     p("")
@@ -375,8 +376,8 @@ def main():
       "single-state parser would be smaller but loses the frames behind a corrupted Size "
       "or re-scans after each failure; we chose zero latency and ~9 instructions per byte "
       "(docs/PERFORMANCE.md) over the 1 KB. Dispatch adds %d B: the generic decoder of the "
-      "codec (largest symbols of codec.c: %s) and the schema's ROM tables and lookup "
-      "(schema.c: %s), which describe every packet of the spec once." % (
+      "codec (largest symbols of tase_codec.c: %s) and the schema's ROM tables and lookup "
+      "(tase_schema.c: %s), which describe every packet of the spec once." % (
           m4["rx"][0], "met" if rx_gap <= 0 else "+%d" % rx_gap, m4["rx_frame"][0],
           biggest("frame", 3), m4["rx"][0] - m4["rx_frame"][0], biggest("codec"),
           biggest("schema")))

@@ -12,8 +12,8 @@
 #include <cmocka.h>
 
 #include "tase/frame.h"
-#include "tase_bm_uart.h"
-#include "tase_ring.h"
+#include "tase/bm_uart.h"
+#include "tase/ring.h"
 
 /* Byte number i of the test stream: not periodic in 256, so a lost,
  * repeated or reordered byte changes the sequence. */

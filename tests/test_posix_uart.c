@@ -21,7 +21,7 @@
 
 #include <cmocka.h>
 
-#include "tase_posix_uart.h"
+#include "tase/posix_uart.h"
 
 typedef struct {
     int master, slave;

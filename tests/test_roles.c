@@ -19,7 +19,7 @@
 #include "tase/gimbal.h"
 #include "tase/host.h"
 #include "tase/ids.h"
-#include "tase_posix_uart.h"
+#include "tase/posix_uart.h"
 
 typedef struct {
     tase_posix_uart_t uart;

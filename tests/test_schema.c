@@ -164,7 +164,7 @@ static void struct_members_match_field_width_sign_and_offset(void **state)
 #define E(N)                                                                                       \
     assert_int_equal(k, p->nfields);                                                               \
     }
-#include "../src/schema_def.h"
+#include "../src/tase_schema_def.h"
 #undef P
 #undef F
 #undef E

@@ -21,7 +21,7 @@
 #include "tase/port.h"
 #include "tase/schema.h"
 #include "tase/socketcan.h"
-#include "tase_posix_uart.h"
+#include "tase/posix_uart.h"
 
 /* ---- errors and arguments ---- */
 

@@ -29,7 +29,7 @@
 #include "board.h"
 #include "gimbal.h"
 #include "stream.h"
-#include "tase_bm_uart.h"
+#include "tase/bm_uart.h"
 
 #define CPU_HZ 25000000u /* mps2-an385 */
 #define TICK_HZ 1000u    /* one simulated millisecond per SysTick */

@@ -7,7 +7,7 @@ The stream mixes clean host->gimbal frames with line noise and corruption
 truncated frame, false 00 FF 5A syncs in garbage, a bad checksum, an
 incomplete frame at the end). The expected results come from an
 independent reference model of the receiver rules in include/tase/frame.h,
-written here in Python and sharing no code with src/frame.c, and are
+written here in Python and sharing no code with src/tase_frame.c, and are
 cross-checked against what the generator meant to put in the stream.
 
 Run from this directory: python3 mkstream.py > stream.h (stream.h is

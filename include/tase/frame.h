@@ -143,7 +143,7 @@ typedef struct {
 } tase_rx_t;
 
 /* Upper bound on sizeof(tase_rx_t) (the same on 32- and 64-bit targets:
- * the instance holds no pointers), enforced at compile time in frame.c. */
+ * the instance holds no pointers), enforced at compile time in tase_frame.c. */
 #define TASE_RX_SIZE_BUDGET (328u + 6u * ((unsigned)TASE_RX_CANDIDATES - 4u))
 
 /* Called once per valid frame, in stream order of the frames' last bytes

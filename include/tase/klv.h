@@ -170,7 +170,7 @@ typedef struct {
     uint8_t buf[TASE_KLV_PACKET_MAX];
 } tase_klv_rx_t;
 
-/* Enforced at compile time in klv.c. */
+/* Enforced at compile time in tase_klv.c. */
 #define TASE_KLV_RX_SIZE_BUDGET 128u
 
 /* Called once per valid packet, in stream order. `offset` is the stream

@@ -22,7 +22,7 @@
  *
  * NAMES. Packet names ("GIMBAL_CMD", ...) and field names (the JSON keys
  * "pan", "impulse_time", ...) live in a separate translation unit
- * (src/schema_names.c): firmware that never calls the *_name functions
+ * (src/tase_schema_names.c): firmware that never calls the *_name functions
  * does not link the strings. Field names are a public contract: the
  * snake_case form of the spec's Name column without byte suffixes, equal
  * to the member names of the typed structs. See docs/PROTOCOL-NOTES.md.
@@ -134,7 +134,7 @@ bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len);
 int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
                    int64_t *value);
 
-/* ---- names (src/schema_names.c; not linked unless used) ----------- */
+/* ---- names (src/tase_schema_names.c; not linked unless used) ----------- */
 
 /* The spec name of packet p ("GIMBAL_CMD", "GIMBAL_RATE" for 0x08/0x40,
  * ...), or NULL if p is NULL or its index is out of range (not a

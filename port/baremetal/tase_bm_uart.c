@@ -1,5 +1,5 @@
-/* Bare-metal UART port template; see tase_bm_uart.h. */
-#include "tase_bm_uart.h"
+/* Bare-metal UART port template; see tase/bm_uart.h. */
+#include "tase/bm_uart.h"
 
 #define DRAIN_CHUNK 32u
 

@@ -1,6 +1,6 @@
 /* SPSC byte ring for ISR -> main loop; the ordering argument is in
- * tase_ring.h. */
-#include "tase_ring.h"
+ * tase/ring.h. */
+#include "tase/ring.h"
 
 /* Optional port configuration header (e.g. -DTASE_RING_CONFIG='"cfg.h"')
  * that may define TASE_RING_BARRIER(). */

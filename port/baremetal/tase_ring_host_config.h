@@ -1,6 +1,6 @@
 /* Ring configuration for the hosted (Linux) build, where the test's
  * "interrupt" is a thread on another CPU core: a full hardware + compiler
- * barrier (GCC/Clang builtin). See tase_ring.h, "the hook". */
+ * barrier (GCC/Clang builtin). See tase/ring.h, "the hook". */
 #ifndef TASE_RING_HOST_CONFIG_H
 #define TASE_RING_HOST_CONFIG_H
 #define TASE_RING_BARRIER() __sync_synchronize()

@@ -1,7 +1,7 @@
-/* POSIX termios serial port; see tase_posix_uart.h. */
+/* POSIX termios serial port; see tase/posix_uart.h. */
 #define _DEFAULT_SOURCE /* CRTSCTS, rates above B38400 with -std=c99 */
 
-#include "tase_posix_uart.h"
+#include "tase/posix_uart.h"
 
 #include <errno.h>
 #include <fcntl.h>

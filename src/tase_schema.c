@@ -1,7 +1,7 @@
 /*
  * The schema table. Descriptors are generated from the X-macro list in
- * schema_def.h so that each field is written once; the names are
- * generated from the same list in schema_names.c.
+ * tase_schema_def.h so that each field is written once; the names are
+ * generated from the same list in tase_schema_names.c.
  */
 #include "tase/schema.h"
 
@@ -16,7 +16,7 @@
  * purpose: that is how a marker takes no slot. */
 /* cppcheck-suppress misra-c2012-8.12 */
 enum {
-#include "schema_def.h"
+#include "tase_schema_def.h"
     FIELD_TOTAL
 };
 #undef P
@@ -28,7 +28,7 @@ enum {
 #define F(T, m, o, w, s)
 #define E(N)
 enum {
-#include "schema_def.h"
+#include "tase_schema_def.h"
     PKTIDX_COUNT
 };
 #undef P
@@ -43,7 +43,7 @@ enum {
 /* cppcheck-suppress misra-c2012-20.7 */
 #define F(T, m, o, w, s)                                                                           \
     typedef char chk_##T##_##m[(sizeof(((T *)0)->m) == (w) && offsetof(T, m) < 256u) ? 1 : -1];
-#include "schema_def.h"
+#include "tase_schema_def.h"
 #undef P
 #undef F
 #undef E
@@ -61,7 +61,7 @@ static const tase_field_t fields[FIELD_TOTAL] = {
 #define P(N, g, t, fl, l, sz)
 #define F(T, m, o, w, s) {o, offsetof(T, m), (w) | FMT_##s},
 #define E(N)
-#include "schema_def.h"
+#include "tase_schema_def.h"
 #undef P
 #undef F
 #undef E
@@ -72,7 +72,7 @@ static const tase_packet_desc_t packets[TASE_PKT_COUNT] = {
     {TASE_ID(g, t), l, fl, FIRST_##N, END_##N - FIRST_##N, sz, TASE_PKT_##N},
 #define F(T, m, o, w, s)
 #define E(N)
-#include "schema_def.h"
+#include "tase_schema_def.h"
 #undef P
 #undef F
 #undef E

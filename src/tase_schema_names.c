@@ -12,7 +12,7 @@ static const char *const packet_names[TASE_PKT_COUNT] = {
 #define P(N, g, t, fl, l, sz) #N,
 #define F(T, m, o, w, s)
 #define E(N)
-#include "schema_def.h"
+#include "tase_schema_def.h"
 #undef P
 #undef F
 #undef E
@@ -25,7 +25,7 @@ static const char *const field_names[] = {
 #define P(N, g, t, fl, l, sz)
 #define F(T, m, o, w, s) #m,
 #define E(N)
-#include "schema_def.h"
+#include "tase_schema_def.h"
 #undef P
 #undef F
 #undef E

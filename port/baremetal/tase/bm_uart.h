@@ -1,6 +1,6 @@
 /*
- * tase_bm_uart.h - bare-metal UART port TEMPLATE for microcontrollers:
- * an RX interrupt fills a tase_ring_t (tase_ring.h), the main loop drains
+ * tase/bm_uart.h - bare-metal UART port TEMPLATE for microcontrollers:
+ * an RX interrupt fills a tase_ring_t (tase/ring.h), the main loop drains
  * it, and transmission goes through a blocking TX hook. It implements
  * tase_port_ops_t (tase/port.h), so the host and gimbal roles run on it
  * unchanged. Copy it next to your UART driver, or use it as it is and
@@ -25,7 +25,7 @@
  * port's read/write/now_ms) is the consumer side: call it only from the
  * main loop (one context). tase_bm_uart_init() runs before the interrupt
  * is enabled. The ring's memory-ordering rules and the TASE_RING_BARRIER()
- * hook are explained in tase_ring.h.
+ * hook are explained in tase/ring.h.
  *
  * The port functions (tase_bm_uart_ops):
  *  write   calls hooks->tx(hw, data, n), which must send all bytes
@@ -46,7 +46,7 @@
 
 #include "tase/frame.h"
 #include "tase/port.h"
-#include "tase_ring.h"
+#include "tase/ring.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -1,5 +1,5 @@
 /*
- * tase_posix_uart.h - the POSIX serial port: a termios device (RS-232
+ * tase/posix_uart.h - the POSIX serial port: a termios device (RS-232
  * adapter, USB serial, pseudo-terminal) as a tase_port_t (tase/port.h).
  *
  * The device is opened in raw 8N1 mode at one of the standard rates

@@ -1,6 +1,6 @@
 /*
  * Private X-macro list: every packet of the spec and its fields, written
- * once. Included by schema.c (descriptors), schema_names.c (names) and the
+ * once. Included by tase_schema.c (descriptors), tase_schema_names.c (names) and the
  * white-box schema test. Before including it define
  *   P(NAME, group, type, flags, len, size)  start of packet TASE_PKT_NAME
  *   F(T, member, offset, width, sign)       one field; sign is U or S

@@ -1,5 +1,5 @@
 /*
- * tase_ring.h - single-producer single-consumer byte ring for a UART
+ * tase/ring.h - single-producer single-consumer byte ring for a UART
  * receive interrupt (producer) and the main loop (consumer).
  *
  * The caller gives the storage; its capacity must be a power of two
