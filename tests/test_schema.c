@@ -148,7 +148,7 @@ static void struct_members_match_field_width_sign_and_offset(void **state)
     {                                                                                              \
         const tase_packet_desc_t *p = tase_schema_at(TASE_PKT_##N);                                \
         size_t k = 0;
-#define F(T, m, o, w, s)                                                                           \
+#define F(T, m, o, w, s, keep)                                                                     \
     {                                                                                              \
         T x;                                                                                       \
         const tase_field_t *f = tase_schema_field(p, k++);                                         \
@@ -284,6 +284,123 @@ static void field_get_sign_extends_signed_fields_only(void **state)
     assert_true(v == 99);
 }
 
+/* Every "do not change" value of the spec, transcribed by hand from its
+ * sentences (4.1.3 tables 6, 4.1.4 table 7, 4.1.5 table 8, 4.4.3 and 4.4.6;
+ * see docs/PROTOCOL-NOTES.md K1). Every other field has none. */
+static const struct {
+    const char *packet;
+    const char *field;
+    int64_t keep;
+} keeps[] = {
+    {"CAMERA_CMD", "camera", 0xFF},
+    {"CAMERA_CMD", "hfov", -1}, /* "0xFFFF (-1) means do not change" */
+    {"CAMERA_CMD", "focus", 0xFFFF},
+    {"CAMERA_CMD", "exposure", 0xFF},
+    {"CAMERA_CMD", "shutter_speed", 0xFF},
+    {"CAMERA_CMD", "bright", 0xFF},
+    {"CAMERA_CMD", "flags", 0x80}, /* MSB: any value with it set */
+    {"LEGACY_CAMERA_CMD", "focus", 0xFFFF},
+    {"LEGACY_CAMERA_CMD", "shutter_speed", 0xFF},
+    {"CAMERA_PASS", "baud", 0},
+    {"AXIS_SETTING", "pan_nogo_center", -1},
+    {"AXIS_SETTING", "pan_nogo_range", 0xFFFF},
+    {"AXIS_SETTING", "tilt_nogo_center", -1},
+    {"AXIS_SETTING", "tilt_nogo_range", 0xFFFF},
+    {"AXIS_SETTING", "roll_nogo_center", -1},
+    {"AXIS_SETTING", "roll_nogo_range", 0xFFFF},
+    {"AXIS_SETTING", "pan_max_rate", 0xFF},
+    {"AXIS_SETTING", "tilt_max_rate", 0xFF},
+    {"AXIS_SETTING", "roll_max_rate", 0xFF},
+    {"AXIS_SETTING", "pan_max_accel", 0xFF},
+    {"AXIS_SETTING", "tilt_max_accel", 0xFF},
+    {"AXIS_SETTING", "roll_max_accel", 0xFF},
+    {"AXIS_SETTING", "pan_pos_gain", 0xFF},
+    {"AXIS_SETTING", "tilt_pos_gain", 0xFF},
+    {"AXIS_SETTING", "roll_pos_gain", 0xFF},
+    {"CAMERA_TYPE", "camera_a", 0},
+    {"CAMERA_TYPE", "camera_b", 0},
+    {"CAMERA_TYPE", "camera_c", 0},
+};
+
+static int keep_row(const char *packet, const char *field)
+{
+    size_t k;
+    for (k = 0; k < sizeof(keeps) / sizeof(keeps[0]); k++) {
+        if (strcmp(keeps[k].packet, packet) == 0 && strcmp(keeps[k].field, field) == 0) {
+            return (int)k;
+        }
+    }
+    return -1;
+}
+
+static void keep_values_are_exactly_the_specs(void **state)
+{
+    size_t i, k, found = 0;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        for (k = 0; k < p->nfields; k++) {
+            int row = keep_row(tase_schema_packet_name(p), tase_schema_field_name(p, k));
+            int64_t v = 12345;
+            if (row < 0) {
+                assert_int_equal(tase_field_keep(p, k, &v), TASE_EUNKNOWN);
+                assert_true(v == 12345);
+                assert_false(tase_field_is_keep(p, k, 0));
+                assert_false(tase_field_is_keep(p, k, -1));
+                assert_false(tase_field_is_keep(p, k, 0xFF));
+                assert_false(tase_field_is_keep(p, k, 0x80));
+                continue;
+            }
+            found++;
+            assert_int_equal(tase_field_keep(p, k, &v), TASE_OK);
+            assert_true(v == keeps[row].keep);
+            assert_true(tase_field_is_keep(p, k, v));
+            /* its neighbours are ordinary values (0x7F for the flags byte) */
+            assert_false(tase_field_is_keep(p, k, v - 1));
+            if (v != 0x80) {
+                assert_false(tase_field_is_keep(p, k, v + 1));
+            }
+        }
+    }
+    assert_int_equal(found, sizeof(keeps) / sizeof(keeps[0]));
+}
+
+static void camera_flags_with_the_msb_set_all_mean_no_change(void **state)
+{
+    const tase_packet_desc_t *p = tase_schema_find(0x00, 0x41);
+    int flags = tase_schema_field_index(p, "flags");
+    int64_t v;
+    (void)state;
+    assert_true(flags >= 0);
+    for (v = -300; v < 0x200; v++) {
+        assert_int_equal(tase_field_is_keep(p, (size_t)flags, v), v >= 0x80 && v <= 0xFF);
+    }
+    /* the other camera fields: only their one value */
+    assert_false(tase_field_is_keep(p, 0, 0x1FF)); /* camera: out of range */
+    assert_true(tase_field_is_keep(p, 0, 0xFF));
+    assert_false(tase_field_is_keep(p, 1, 0xFFFF)); /* hfov is signed: -1 */
+}
+
+static void keep_api_rejects_bad_arguments(void **state)
+{
+    const tase_packet_desc_t *p = tase_schema_find(0x48, 0x02);
+    tase_packet_desc_t forged;
+    int64_t v = 77;
+    (void)state;
+    assert_int_equal(tase_field_keep(NULL, 0, &v), TASE_EARG);
+    assert_int_equal(tase_field_keep(p, p->nfields, &v), TASE_EARG);
+    assert_int_equal(tase_field_keep(p, SIZE_MAX, &v), TASE_EARG);
+    assert_int_equal(tase_field_keep(p, 0, NULL), TASE_EARG);
+    assert_true(v == 77);
+    assert_false(tase_field_is_keep(NULL, 0, -1));
+    assert_false(tase_field_is_keep(p, p->nfields, 0xFF));
+    assert_false(tase_field_is_keep(p, SIZE_MAX, 0xFF));
+    forged = *p;
+    forged.first_field = 255;
+    assert_int_equal(tase_field_keep(&forged, 0, &v), TASE_EARG);
+    assert_false(tase_field_is_keep(&forged, 0, -1));
+}
+
 static void names_resolve_both_ways_and_reject_unknown(void **state)
 {
     size_t i, k;
@@ -369,6 +486,9 @@ int main(void)
         cmocka_unit_test(accepted_lengths_follow_the_spec_rules),
         cmocka_unit_test(field_get_sign_extends_signed_fields_only),
         cmocka_unit_test(names_resolve_both_ways_and_reject_unknown),
+        cmocka_unit_test(keep_values_are_exactly_the_specs),
+        cmocka_unit_test(camera_flags_with_the_msb_set_all_mean_no_change),
+        cmocka_unit_test(keep_api_rejects_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -78,16 +78,24 @@ enum {
 #define TASE_LEN_SHORT1 0x08u /* 1 byte: CAMERA_CMD "change camera only" */
 #define TASE_LEN_TAIL 0x10u   /* len + 0..(253-len) trailing bytes */
 
-/* Field format byte: width in bytes (1, 2, 4, 8) in bits 0-3 (LSB
- * numbering here: this is a C value, not a wire byte), signed in bit 4. */
+/* Field format byte (LSB numbering here: this is a C value, not a wire
+ * byte): width in bytes (1, 2, 4, 8) in bits 0-3, signed in bit 4, and in
+ * bits 5-6 the kind of the field's "do not change" value (the spec's value
+ * that leaves a setting as it is; read it with tase_field_keep()). */
 #define TASE_FIELD_SIGNED 0x10u
+#define TASE_FIELD_KEEP_NONE 0x00u /* the field has no such value */
+#define TASE_FIELD_KEEP_ONES 0x20u /* all bits set: 0xFF, 0xFFFF (-1 if signed) */
+#define TASE_FIELD_KEEP_ZERO 0x40u /* zero */
+#define TASE_FIELD_KEEP_MSB 0x60u  /* a flags byte whose MSB means "no change" */
+#define TASE_FIELD_KEEP_MASK 0x60u
 #define TASE_FIELD_WIDTH(f) ((unsigned)(f)->fmt & 0x0Fu)
 #define TASE_FIELD_IS_SIGNED(f) (((unsigned)(f)->fmt & TASE_FIELD_SIGNED) != 0u)
+#define TASE_FIELD_KEEP(f) ((unsigned)(f)->fmt & TASE_FIELD_KEEP_MASK)
 
 typedef struct {
     uint8_t offset; /* byte offset in the packet data */
     uint8_t member; /* offsetof() the member in the packet's typed struct */
-    uint8_t fmt;    /* width | TASE_FIELD_SIGNED */
+    uint8_t fmt;    /* width | TASE_FIELD_SIGNED | TASE_FIELD_KEEP_* */
 } tase_field_t;
 
 typedef struct {
@@ -133,6 +141,19 @@ bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len);
  * O(width), reentrant, ISR-safe. */
 int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
                    int64_t *value);
+
+/* The "do not change" value of field i of packet p (the spec's value that
+ * leaves a setting as it is, e.g. CAMERA_CMD camera 0xFF, hfov -1, focus
+ * 0xFFFF, flags 0x80; AXIS_SETTING 0xFF / 0xFFFF; CAMERA_TYPE 0): returns
+ * TASE_OK and sets *value to the wire integer (sign-extended for signed
+ * fields), TASE_EUNKNOWN if the field has none, TASE_EARG for NULL
+ * arguments or i out of range. O(1), reentrant, ISR-safe. */
+int tase_field_keep(const tase_packet_desc_t *p, size_t i, int64_t *value);
+
+/* True when `value` of field i of packet p means "do not change" (for a
+ * flags byte whose MSB means "no change", any value with that bit set).
+ * False when the field has none or p is NULL or i out of range. */
+bool tase_field_is_keep(const tase_packet_desc_t *p, size_t i, int64_t value);
 
 /* ---- names (src/tase_schema_names.c; not linked unless used) ----------- */
 
