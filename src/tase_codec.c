@@ -38,21 +38,23 @@ static void member_store(void *dst, unsigned w, uint64_t v)
     }
 }
 
-/* The fields of msg that lie within len bytes, big-endian into body. */
+/* The fields of msg that lie within len bytes, big-endian into body, at
+ * the offsets of the layout that len selects (AXIS_SETTING 22 or 23). */
 static void pack_fields(const tase_packet_desc_t *p, const void *msg, size_t len, uint8_t *body)
 {
     size_t i;
     for (i = 0; i < p->nfields; i++) {
         const tase_field_t *f = tase_schema_field(p, i);
         unsigned w = TASE_FIELD_WIDTH(f);
+        size_t at = (size_t)tase_field_offset(p, i, len);
         uint64_t v;
-        if ((size_t)f->offset + w > len) {
+        if (at + w > len) {
             continue; /* short form: CAMERA_CMD camera byte only */
         }
         v = member_load((const uint8_t *)msg + f->member, w);
         while (w > 0u) {
             w--;
-            body[f->offset + w] = (uint8_t)v;
+            body[at + w] = (uint8_t)v;
             v >>= 8;
         }
     }
@@ -130,20 +132,29 @@ int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap)
 /* The fields that lie within the frame's data, into msg. Only the wire
  * bits are needed (no sign extension: see the top of this file), and
  * reading them inline instead of through tase_field_get() keeps the
- * receive path's stack small. */
+ * receive path's stack small. A field a short form leaves out (CAMERA_CMD's
+ * 1-byte form) takes its "do not change" value, so a handler that ignores
+ * the length never acts on a zero it was not sent; fields without one stay
+ * zero. */
 static void unpack_fields(const tase_packet_desc_t *p, const tase_frame_t *f, void *msg)
 {
     size_t i;
     for (i = 0; i < p->nfields; i++) {
         const tase_field_t *fd = tase_schema_field(p, i);
         unsigned w = TASE_FIELD_WIDTH(fd);
+        size_t at = (size_t)tase_field_offset(p, i, f->len);
         unsigned k;
         uint64_t v = 0u;
-        if ((size_t)fd->offset + w > f->len) {
+        int64_t keep;
+        if (at + w > f->len) {
+            if (tase_field_keep(p, i, &keep) == TASE_OK) {
+                /* two's complement bits of the value, as stored below */
+                member_store((uint8_t *)msg + fd->member, w, (uint64_t)keep);
+            }
             continue;
         }
         for (k = 0; k < w; k++) {
-            v = (v << 8) | f->data[fd->offset + k];
+            v = (v << 8) | f->data[at + k];
         }
         member_store((uint8_t *)msg + fd->member, w, v);
     }
@@ -166,7 +177,7 @@ int tase_packet_decode(const tase_frame_t *f, void *msg)
         return f->len == 0u ? 0 : TASE_EARG;
     }
     (void)memset(msg, 0, p->size);
-    if (f->data != NULL) { /* else a query: no data */
+    if (f->len > 0u) { /* else a query: no data, every member zero */
         unpack_fields(p, f, msg);
     }
     if ((p->flags & TASE_LEN_TAIL) != 0u) {

@@ -57,6 +57,7 @@ typedef char chk_fields[(FIELD_TOTAL < 256) ? 1 : -1];
 #define ONES TASE_FIELD_KEEP_ONES
 #define ZERO TASE_FIELD_KEEP_ZERO
 #define MSB TASE_FIELD_KEEP_MSB
+#define SHIFT TASE_FIELD_SHIFT
 
 /* Generated from the list like its siblings here, so it stays at file
  * scope although only tase_schema_field() reads it. */
@@ -73,6 +74,7 @@ static const tase_field_t fields[FIELD_TOTAL] = {
 #undef ONES
 #undef ZERO
 #undef MSB
+#undef SHIFT
 
 static const tase_packet_desc_t packets[TASE_PKT_COUNT] = {
 #define P(N, g, t, fl, l, sz)                                                                      \
@@ -172,6 +174,9 @@ bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len)
     if (len == 1u) {
         return (p->flags & TASE_LEN_SHORT1) != 0u;
     }
+    if (len + 1u == p->len && (p->flags & TASE_LEN_SHORT) != 0u) {
+        return true;
+    }
     return (p->flags & TASE_LEN_TAIL) != 0u && len > p->len && len <= TASE_DATA_MAX;
 }
 
@@ -180,10 +185,26 @@ bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len)
     return p != NULL && len == 0u && (p->flags & TASE_LEN_QUERY) != 0u;
 }
 
+int tase_field_offset(const tase_packet_desc_t *p, size_t i, size_t len)
+{
+    const tase_field_t *f = tase_schema_field(p, i);
+    if (f == NULL) {
+        return TASE_EARG;
+    }
+    /* The short layout only exists for packets flagged for it; the field
+     * flag alone (a corrupted descriptor) never moves a field. */
+    if ((f->fmt & TASE_FIELD_SHIFT) != 0u && (p->flags & TASE_LEN_SHORT) != 0u &&
+        len + 1u == p->len && f->offset > 0u) {
+        return (int)f->offset - 1;
+    }
+    return (int)f->offset;
+}
+
 int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
                    int64_t *value)
 {
     const tase_field_t *f = tase_schema_field(p, i);
+    size_t at;
     unsigned w;
     unsigned k;
     uint64_t v = 0u;
@@ -191,15 +212,16 @@ int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, s
         return TASE_EARG;
     }
     w = TASE_FIELD_WIDTH(f);
+    at = (size_t)tase_field_offset(p, i, len); /* >= 0: f is valid */
     /* data is NULL only with len 0, where no field fits. */
-    if (data == NULL || (size_t)f->offset + w > len) {
+    if (data == NULL || at + w > len) {
         return TASE_ETRUNC;
     }
     for (k = 0; k < w; k++) {
-        v = (v << 8) | data[f->offset + k];
+        v = (v << 8) | data[at + k];
     }
     /* Big-endian: the sign bit is the top bit of the first byte. */
-    if (TASE_FIELD_IS_SIGNED(f) && (data[f->offset] & 0x80u) != 0u) {
+    if (TASE_FIELD_IS_SIGNED(f) && (data[at] & 0x80u) != 0u) {
         /* Two's complement by arithmetic, without an implementation-
          * defined conversion of an out-of-range unsigned value. */
         uint64_t mag = ~v;

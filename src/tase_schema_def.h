@@ -7,8 +7,10 @@
  *   E(NAME)                                 end of packet NAME
  * keep is the field's "do not change" value (docs/PROTOCOL-NOTES.md, K1):
  * 0 none, ONES all bits set (0xFF, 0xFFFF; -1 when signed), ZERO, or MSB
- * (a flags byte whose most significant bit means "no change"). Those names
- * are defined only where the argument is used (tase_schema.c).
+ * (a flags byte whose most significant bit means "no change"). A field
+ * that sits one byte earlier in its packet's short layout (TASE_LEN_SHORT,
+ * PROTOCOL-NOTES S2) adds SHIFT ("ONES | SHIFT", or SHIFT alone). Those
+ * names are defined only where the argument is used (tase_schema.c).
  * Fields are in table order; Reserved rows are omitted. The JSON name of
  * a field is its struct member name. No include guard: included several
  * times on purpose.
@@ -171,7 +173,7 @@ P(SENSOR_FILTER, 0x48, 0x01, TASE_Q, 2, sizeof(tase_sensor_filter_t))
 F(tase_sensor_filter_t, cutoff, 0, 1, U, 0)
 F(tase_sensor_filter_t, decimation, 1, 1, U, 0)
 E(SENSOR_FILTER)
-P(AXIS_SETTING, 0x48, 0x02, TASE_Q, 23, sizeof(tase_axis_setting_t))
+P(AXIS_SETTING, 0x48, 0x02, TASE_Q | TASE_LEN_SHORT, 23, sizeof(tase_axis_setting_t))
 F(tase_axis_setting_t, pan_nogo_center, 0, 2, S, ONES)
 F(tase_axis_setting_t, pan_nogo_range, 2, 2, U, ONES)
 F(tase_axis_setting_t, tilt_nogo_center, 4, 2, S, ONES)
@@ -179,15 +181,15 @@ F(tase_axis_setting_t, tilt_nogo_range, 6, 2, U, ONES)
 F(tase_axis_setting_t, roll_nogo_center, 8, 2, S, ONES)
 F(tase_axis_setting_t, roll_nogo_range, 10, 2, U, ONES)
 F(tase_axis_setting_t, pan_max_rate, 12, 1, U, ONES)
-F(tase_axis_setting_t, tilt_max_rate, 14, 1, U, ONES)
-F(tase_axis_setting_t, roll_max_rate, 15, 1, U, ONES)
-F(tase_axis_setting_t, pan_max_accel, 16, 1, U, ONES)
-F(tase_axis_setting_t, tilt_max_accel, 17, 1, U, ONES)
-F(tase_axis_setting_t, roll_max_accel, 18, 1, U, ONES)
-F(tase_axis_setting_t, pan_pos_gain, 19, 1, U, ONES)
-F(tase_axis_setting_t, tilt_pos_gain, 20, 1, U, ONES)
-F(tase_axis_setting_t, roll_pos_gain, 21, 1, U, ONES)
-F(tase_axis_setting_t, temporary, 22, 1, U, 0)
+F(tase_axis_setting_t, tilt_max_rate, 14, 1, U, ONES | SHIFT)
+F(tase_axis_setting_t, roll_max_rate, 15, 1, U, ONES | SHIFT)
+F(tase_axis_setting_t, pan_max_accel, 16, 1, U, ONES | SHIFT)
+F(tase_axis_setting_t, tilt_max_accel, 17, 1, U, ONES | SHIFT)
+F(tase_axis_setting_t, roll_max_accel, 18, 1, U, ONES | SHIFT)
+F(tase_axis_setting_t, pan_pos_gain, 19, 1, U, ONES | SHIFT)
+F(tase_axis_setting_t, tilt_pos_gain, 20, 1, U, ONES | SHIFT)
+F(tase_axis_setting_t, roll_pos_gain, 21, 1, U, ONES | SHIFT)
+F(tase_axis_setting_t, temporary, 22, 1, U, SHIFT)
 E(AXIS_SETTING)
 P(SYSTEM_VERSION, 0x48, 0x03, TASE_Q, 42, sizeof(tase_system_version_t))
 F(tase_system_version_t, major, 0, 1, U, 0)

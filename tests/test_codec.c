@@ -92,8 +92,15 @@ static void gyro_zero_and_camera_short_forms_encode_to_hand_computed_frames(void
     memset(&camb, 0x55, sizeof(camb));
     assert_int_equal(tase_packet_decode(&f, &camb), 1);
     assert_int_equal(camb.camera, 1);
-    assert_int_equal(camb.hfov, 0); /* not sent: zero */
-    assert_int_equal(camb.flags, 0);
+    /* Not sent: "do not change" (4.1.3), never a zero that is a command
+     * (focus 0 = auto-focus, exposure 0 = full auto, flags 0 = white hot,
+     * stabilisation and title off). */
+    assert_int_equal(camb.hfov, -1);
+    assert_int_equal(camb.focus, 0xFFFF);
+    assert_int_equal(camb.exposure, 0xFF);
+    assert_int_equal(camb.shutter_speed, 0xFF);
+    assert_int_equal(camb.bright, 0xFF);
+    assert_int_equal(camb.flags, TASE_CAMERA_FLAG_NO_CHANGE);
 
     assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), 14);
     assert_memory_equal(out, pass, sizeof(pass));
@@ -178,6 +185,54 @@ static void axis_setting_leaves_byte_13_reserved_zero(void **state)
     memset(out, 0xAA, sizeof(out)); /* reserved byte must be cleared */
     assert_int_equal(tase_packet_encode(TASE_ID_AXIS_SETTING, &m, out, sizeof(out)), 31);
     assert_memory_equal(out, want, sizeof(want));
+}
+
+/* Table 22 read as a row-numbering slip (no byte 13, 22 bytes): accepted
+ * and decoded by its own layout, and encoded when asked for (S2). */
+static void axis_setting_22_byte_layout_decodes_and_encodes_to_hand_computed_frames(void **state)
+{
+    /* The data of the test above without byte 13: ... 3C, 3C FF 32 32 FF
+     * 28 28 FF 01. Size 22 + 2 = 0x18. Sum: header FF+5A+18+48+02 = 443;
+     * data 2147; 2590 = 0x0A1E. */
+    static const uint8_t want22[] = {0x00, 0xFF, 0x5A, 0x18, 0x48, 0x02, 0xB9, 0xB0, 0xFF, 0xFF,
+                                     0x23, 0x28, 0x17, 0x70, 0x00, 0x00, 0x00, 0x00, 0x3C, 0x3C,
+                                     0xFF, 0x32, 0x32, 0xFF, 0x28, 0x28, 0xFF, 0x01, 0x0A, 0x1E};
+    /* The 23-byte frame with a non-zero byte 13 (ignored): sum + 0xAB. */
+    static const uint8_t in23[] = {0x00, 0xFF, 0x5A, 0x19, 0x48, 0x02, 0xB9, 0xB0, 0xFF, 0xFF, 0x23,
+                                   0x28, 0x17, 0x70, 0x00, 0x00, 0x00, 0x00, 0x3C, 0xAB, 0x3C, 0xFF,
+                                   0x32, 0x32, 0xFF, 0x28, 0x28, 0xFF, 0x01, 0x0A, 0xCA};
+    tase_axis_setting_t a22, a23;
+    uint8_t out[64];
+    tase_frame_t f;
+    (void)state;
+    f = frame_of(want22, sizeof(want22));
+    memset(&a22, 0x55, sizeof(a22));
+    assert_int_equal(tase_packet_decode(&f, &a22), 22);
+    assert_int_equal(a22.pan_nogo_center, -18000);
+    assert_int_equal(a22.pan_nogo_range, 0xFFFF);
+    assert_int_equal(a22.tilt_nogo_center, 9000);
+    assert_int_equal(a22.tilt_nogo_range, 6000);
+    assert_int_equal(a22.pan_max_rate, 60);    /* byte 12 */
+    assert_int_equal(a22.tilt_max_rate, 60);   /* byte 13 */
+    assert_int_equal(a22.roll_max_rate, 0xFF); /* 14 */
+    assert_int_equal(a22.pan_max_accel, 50);   /* 15 */
+    assert_int_equal(a22.tilt_max_accel, 50);  /* 16 */
+    assert_int_equal(a22.roll_max_accel, 0xFF);
+    assert_int_equal(a22.pan_pos_gain, 40); /* 18 */
+    assert_int_equal(a22.tilt_pos_gain, 40);
+    assert_int_equal(a22.roll_pos_gain, 0xFF);
+    assert_int_equal(a22.temporary, 1); /* 21 */
+    /* the same settings in the 23-byte layout decode to the same struct */
+    f = frame_of(in23, sizeof(in23));
+    memset(&a23, 0x33, sizeof(a23));
+    assert_int_equal(tase_packet_decode(&f, &a23), 23);
+    assert_memory_equal(&a22, &a23, sizeof(a22));
+    /* the encoder writes 23 unless asked for the short layout */
+    assert_int_equal(tase_packet_encode_len(TASE_ID_AXIS_SETTING, &a22, 22, out, sizeof(out)), 30);
+    assert_memory_equal(out, want22, sizeof(want22));
+    assert_int_equal(tase_packet_encode(TASE_ID_AXIS_SETTING, &a22, out, sizeof(out)), 31);
+    assert_int_equal(out[6 + 13], 0x00);
+    assert_int_equal(out[6 + 22], 0x01);
 }
 
 /* ---- every packet: round trips -------------------------------------- */
@@ -499,6 +554,7 @@ int main(void)
         cmocka_unit_test(gimbal_angle_encodes_to_hand_computed_frame),
         cmocka_unit_test(spoi_full_and_query_forms_encode_to_hand_computed_frames),
         cmocka_unit_test(axis_setting_leaves_byte_13_reserved_zero),
+        cmocka_unit_test(axis_setting_22_byte_layout_decodes_and_encodes_to_hand_computed_frames),
         cmocka_unit_test(every_packet_round_trips_random_and_extreme_values),
         cmocka_unit_test(every_query_capable_packet_encodes_an_eight_byte_query),
         cmocka_unit_test(every_wrong_length_is_rejected_on_decode_and_encode),

@@ -315,7 +315,8 @@ int tase_packet_encode(uint16_t id, const void *msg, uint8_t *out, size_t cap);
 /* Like tase_packet_encode() but with an explicit data length `len`, which
  * must be an accepted length of the packet (tase_schema_length_ok()):
  * 0 for a query (msg may be NULL), 1 for CAMERA_CMD "change active camera
- * only" (only msg->camera is sent). For CAMERA_PASS len must be
+ * only" (only msg->camera is sent), 22 for AXIS_SETTING's short layout
+ * (tase/schema.h TWO LAYOUTS). For CAMERA_PASS len must be
  * 4 + msg->len. Returns as tase_packet_encode(), plus TASE_ELENGTH when
  * len is not accepted (any size_t up to SIZE_MAX; compared without
  * overflow). */
@@ -328,9 +329,12 @@ int tase_packet_encode_len(uint16_t id, const void *msg, size_t len, uint8_t *ou
 int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap);
 
 /* Decode frame f into the typed struct of its packet at msg (which must
- * be that struct, or a tase_packet_msg_t). The struct is zeroed first;
- * fields beyond a short accepted length (query: all; CAMERA_CMD 1-byte
- * form: all but camera) stay zero, so check the return value.
+ * be that struct, or a tase_packet_msg_t), in the layout its length
+ * selects (AXIS_SETTING 22 or 23 bytes). A query (length 0) decodes to a
+ * zeroed struct. The fields a short form leaves out (CAMERA_CMD's 1-byte
+ * form: all but camera) take their "do not change" values
+ * (tase_field_keep(): hfov -1, focus 0xFFFF, flags 0x80, ...), never a
+ * zero that would be a command; the return value tells the forms apart.
  * Returns the data length decoded (>= 0), or
  *   TASE_EARG     f NULL, f->data NULL with f->len > 0, or msg NULL for a
  *                 known packet of accepted length > 0 (msg may be NULL for
