@@ -544,6 +544,126 @@ static void codec_api_rejects_bad_arguments(void **state)
     assert_memory_equal(&msg, &mcopy, sizeof msg);
 }
 
+/* ---- data bytes only ---------------------------------------------------- */
+
+/* For every packet and every accepted length, the data-only encoders write
+ * exactly the data bytes of the frame the frame encoders build, and the
+ * data-only decoders give exactly the struct tase_packet_decode() gives. */
+static void data_only_codec_matches_the_frame_codec_for_every_packet(void **state)
+{
+    size_t i, len, k;
+    int rep;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        for (len = 0; len <= TASE_DATA_MAX; len++) {
+            for (rep = 0; rep < 3 && tase_schema_length_ok(p, len); rep++) {
+                uint8_t data[TASE_DATA_MAX], wire[TASE_FRAME_MAX], only[TASE_DATA_MAX + 1];
+                tase_packet_msg_t by_frame, by_data, by_desc;
+                void *msg = p->size ? &by_frame : NULL;
+                tase_frame_t f;
+                int n;
+                for (k = 0; k < len; k++) {
+                    data[k] = (uint8_t)rnd();
+                }
+                n = tase_frame_encode(wire, sizeof wire, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id),
+                                      data, len);
+                f = frame_of(wire, n);
+                memset(&by_frame, 0x11, sizeof by_frame);
+                memset(&by_data, 0x22, sizeof by_data);
+                memset(&by_desc, 0x33, sizeof by_desc);
+                assert_int_equal(tase_packet_decode(&f, msg), (int)len);
+                assert_int_equal(
+                    tase_packet_decode_data(p->id, data, len, p->size ? &by_data : NULL), (int)len);
+                assert_int_equal(tase_packet_decode_desc(p, data, len, p->size ? &by_desc : NULL),
+                                 (int)len);
+                if (p->flags & TASE_LEN_TAIL) {
+                    /* the tail points into what was decoded */
+                    assert_ptr_equal(by_frame.camera_pass.data, f.data + 4);
+                    assert_ptr_equal(by_data.camera_pass.data, data + 4);
+                    assert_ptr_equal(by_desc.camera_pass.data, data + 4);
+                    by_data.camera_pass.data = by_frame.camera_pass.data;
+                    by_desc.camera_pass.data = by_frame.camera_pass.data;
+                }
+                assert_memory_equal(&by_data, &by_frame, p->size);
+                assert_memory_equal(&by_desc, &by_frame, p->size);
+                /* the struct back to data bytes: those of the frame encoder */
+                n = tase_packet_encode_len(p->id, msg, len, wire, sizeof wire);
+                assert_int_equal(n, (int)len + 8);
+                memset(only, 0xEE, sizeof only);
+                assert_int_equal(tase_packet_encode_data_len(p->id, msg, len, only, len), (int)len);
+                assert_memory_equal(only, wire + TASE_FRAME_HEADER, len);
+                assert_int_equal(only[len], 0xEE); /* nothing past the data */
+                if (len == (size_t)p->len || (p->flags & TASE_LEN_TAIL)) {
+                    n = tase_packet_encode(p->id, msg, wire, sizeof wire);
+                    memset(only, 0xEE, sizeof only);
+                    assert_int_equal(tase_packet_encode_data(p->id, msg, only, sizeof only), n - 8);
+                    assert_memory_equal(only, wire + TASE_FRAME_HEADER, (size_t)n - 8u);
+                }
+            }
+        }
+    }
+}
+
+/* Bad arguments of the data-only functions give their documented codes
+ * and write nothing. */
+static void data_only_codec_rejects_bad_arguments(void **state)
+{
+    tase_gimbal_cmd_t cmd = {1, 2, 3, 4, 5};
+    tase_camera_pass_t cp = {0, 0, 250, (const uint8_t *)"x"};
+    tase_packet_desc_t fake;
+    uint8_t out[TASE_DATA_MAX], before[TASE_DATA_MAX], in[8] = {0};
+    tase_packet_msg_t msg, mcopy;
+    size_t cap;
+    (void)state;
+
+    memset(out, 0xA5, sizeof out);
+    memcpy(before, out, sizeof out);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &cmd, NULL, 8), TASE_EARG);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_GYRO_ZERO_CMD, NULL, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_packet_encode_data(TASE_ID(0x28u, 0u), &cmd, NULL, 8), TASE_EARG);
+    assert_int_equal(tase_packet_encode_data(TASE_ID(0x28u, 0u), &cmd, out, 8), TASE_EUNKNOWN);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, NULL, out, 8), TASE_EARG);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, out, sizeof out),
+                     TASE_ETOOLONG);
+    cp.len = 3;
+    cp.data = NULL;
+    assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, out, sizeof out), TASE_EARG);
+    for (cap = 0; cap < 8; cap++) {
+        assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &cmd, out, cap), TASE_ENOSPC);
+    }
+    assert_int_equal(tase_packet_encode_data_len(TASE_ID_GIMBAL_CMD, &cmd, 0, out, 8),
+                     TASE_ELENGTH);
+    assert_int_equal(tase_packet_encode_data_len(TASE_ID_GIMBAL_CMD, &cmd, SIZE_MAX, out, SIZE_MAX),
+                     TASE_ELENGTH);
+    assert_memory_equal(out, before, sizeof out);
+    /* the forms without data need a buffer but no room */
+    assert_int_equal(tase_packet_encode_data(TASE_ID_GYRO_ZERO_CMD, NULL, out, 0), 0);
+    assert_int_equal(tase_packet_encode_data_len(TASE_ID_PACKET_RATE, NULL, 0, out, 0), 0);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &cmd, out, 8), 8);
+    assert_int_equal(out[1], 1);
+
+    memset(&msg, 0x5A, sizeof msg);
+    memcpy(&mcopy, &msg, sizeof msg);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GIMBAL_CMD, NULL, 8, &msg), TASE_EARG);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GIMBAL_CMD, in, 8, NULL), TASE_EARG);
+    assert_int_equal(tase_packet_decode_data(TASE_ID(0x28u, 0u), in, 8, &msg), TASE_EUNKNOWN);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GIMBAL_CMD, in, 7, &msg), TASE_ELENGTH);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GIMBAL_CMD, in, SIZE_MAX, &msg), TASE_ELENGTH);
+    assert_int_equal(tase_packet_decode_desc(NULL, in, 8, &msg), TASE_EUNKNOWN);
+    assert_int_equal(tase_packet_decode_desc(NULL, NULL, 8, &msg), TASE_EARG);
+    /* a copy of a real descriptor is not one of the table: its size could
+     * be anything, so it is refused before msg is written */
+    fake = *tase_schema_find(0x00, 0x80);
+    fake.size = 255;
+    assert_int_equal(tase_packet_decode_desc(&fake, in, 8, &msg), TASE_EARG);
+    assert_memory_equal(&msg, &mcopy, sizeof msg);
+    /* queries and GYRO_ZERO_CMD decode without data or struct */
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GYRO_ZERO_CMD, NULL, 0, NULL), 0);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_PACKET_RATE, NULL, 0, &msg), 0);
+    assert_int_equal(msg.packet_rate.angle_1, 0); /* zeroed */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -560,6 +680,8 @@ int main(void)
         cmocka_unit_test(every_wrong_length_is_rejected_on_decode_and_encode),
         cmocka_unit_test(argument_errors_are_reported_and_write_nothing),
         cmocka_unit_test(camera_pass_carries_249_bytes_and_may_be_encoded_in_place),
+        cmocka_unit_test(data_only_codec_matches_the_frame_codec_for_every_packet),
+        cmocka_unit_test(data_only_codec_rejects_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
