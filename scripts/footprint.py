@@ -213,7 +213,7 @@ def firmware_image(out):
                      line)
         if m and (m.group(1) or pending):
             path = m.group(4)
-            a = re.search(r"(libtase(?:_bm)?\.a)\((\w+)\.c\.obj\)", path)
+            a = re.search(r"(libtase(?:_baremetal)?\.a)\((\w+)\.c\.obj\)", path)
             if a:
                 key = "%s %s" % (a.group(1), a.group(2))
             elif "tase_gimbal.elf.dir" in path:
@@ -431,12 +431,12 @@ def main():
         p("| part | flash | static RAM |")
         p("|---|---:|---:|")
         lib = [k for k in img["share"] if k.startswith("libtase.a")]
-        port = [k for k in img["share"] if k.startswith("libtase_bm.a")]
+        port = [k for k in img["share"] if k.startswith("libtase_baremetal.a")]
         for k in sorted(lib) + sorted(port):
             p("| %s | %d | %d |" % (k, img["share"][k]["flash"], img["share"][k]["ram"]))
         p("| **library total (libtase.a)** | %d | %d |" % (
             sum(img["share"][k]["flash"] for k in lib), sum(img["share"][k]["ram"] for k in lib)))
-        p("| **bare-metal port total (libtase_bm.a)** | %d | %d |" % (
+        p("| **bare-metal port total (libtase_baremetal.a)** | %d | %d |" % (
             sum(img["share"][k]["flash"] for k in port),
             sum(img["share"][k]["ram"] for k in port)))
         for k in sorted(img["share"]):

@@ -19,13 +19,11 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "tase/version.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-#define TASE_VERSION_MAJOR 0
-#define TASE_VERSION_MINOR 1
-#define TASE_VERSION_PATCH 0
 
 /* Error codes. Stable: values never change meaning once released. */
 #define TASE_OK 0
