@@ -16,6 +16,10 @@ install(TARGETS ${TASE_LIBS} EXPORT tase-targets
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/tase
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT dev)
+if(TASE_CONFIG_HEADER) # cmake/tase-config-header.cmake
+  install(FILES ${PROJECT_BINARY_DIR}/tase-user-config/tase/user_config.h
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tase COMPONENT dev)
+endif()
 # Each port's headers (port/<name>/tase/*.h) go beside the core's.
 foreach(lib ${TASE_LIBS})
   if(lib MATCHES "^tase_(.+)$")

@@ -71,6 +71,17 @@ def globals_of(obj):
     return syms
 
 
+def link_name(objs, name):
+    """The symbol a function links as: the initialisers guarded by
+    tase/config.h carry the configuration (tase_rx_init ->
+    tase_rx_init_rx_candidates_4)."""
+    for o in objs.values():
+        for s in globals_of(o):
+            if s == name or re.fullmatch(re.escape(name) + r"_rx_candidates_\d+", s):
+                return s
+    return name
+
+
 def linked_size(cpu, objs, roots, out):
     """Flash of what `roots` pull in, after --gc-sections. libc (memcpy,
     memchr, ...) is left unresolved: a firmware links it anyway."""
@@ -249,7 +260,8 @@ def main():
     for cpu in CPUS:
         bdir, objs = build(cpu, args.build)
         mods = {m: berkeley(o) for m, o in objs.items()}
-        rx_roots = ["tase_rx_feed", "tase_rx_init", "tase_rx_flush"]
+        rx_init = link_name(objs, "tase_rx_init")
+        rx_roots = ["tase_rx_feed", rx_init, "tase_rx_flush"]
         has_dispatch = "dispatch" in objs
         if has_dispatch:
             rx_roots += globals_of(objs["dispatch"])
@@ -262,7 +274,7 @@ def main():
             "mods": mods,
             "rx": linked_size(cpu, objs.values(), rx_roots, args.build),
             "rx_frame": linked_size(cpu, objs.values(),
-                                    ["tase_rx_init", "tase_rx_feed", "tase_rx_flush"], args.build),
+                                    [rx_init, "tase_rx_feed", "tase_rx_flush"], args.build),
             "core": linked_size(cpu, core, roots_core, args.build),
             "core_float": linked_size(cpu, core, roots_all, args.build),
             "rest": linked_size(cpu, list(objs.values()), roots_rest, args.build)

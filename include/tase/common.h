@@ -19,6 +19,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "tase/config.h" /* TASE_CONFIG_HEADER and the defaults */
 #include "tase/version.h"
 
 #ifdef __cplusplus
