@@ -26,6 +26,15 @@
 extern "C" {
 #endif
 
+/* Private: an explicit conversion for code in the public headers (static
+ * inline functions, macros) that compiles cleanly as C and as C++ (no
+ * old-style cast there: clang++ -Wold-style-cast). */
+#ifdef __cplusplus
+#define TASE_CAST_(type, value) (static_cast<type>(value))
+#else
+#define TASE_CAST_(type, value) ((type)(value))
+#endif
+
 /* Error codes. Stable: values never change meaning once released. */
 #define TASE_OK 0
 #define TASE_EARG (-1)          /* NULL pointer or out-of-range argument */
