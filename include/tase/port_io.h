@@ -21,11 +21,9 @@
 extern "C" {
 #endif
 
-/* Consecutive calls to write() that took nothing (TASE_EAGAIN,
- * TASE_ENOBUFS or 0) after which tase_port_write_all() gives up. */
-#ifndef TASE_PORT_WRITE_TRIES
-#define TASE_PORT_WRITE_TRIES 64u
-#endif
+/* TASE_PORT_WRITE_TRIES (tase/config.h, default 64): consecutive calls
+ * to write() that took nothing (TASE_EAGAIN, TASE_ENOBUFS or 0) after
+ * which tase_port_write_all() gives up. */
 
 /* Write all n bytes of data to the port.
  * Returns n, or
