@@ -28,9 +28,12 @@
  *   TASE_RX_CANDIDATES (1..16, default 4)   ABI: changes sizeof(tase_rx_t),
  *       so also of tase_host_t and tase_can_rx_t, and the stride of the
  *       receiver array given to tase_gimbal_init(). See tase/frame.h.
+ *   TASE_PORT_WRITE_TIMEOUT_MS (default 100)  the deadline of one frame
+ *       write by tase_port_write_all() (tase/port_io.h).
  *   TASE_PORT_WRITE_TRIES (default 64)  tase_port_write_all()'s give-up
- *       count (tase/port_io.h). Used only inside the library: the value
- *       the library was built with is the one that applies.
+ *       count for a port whose clock does not move (tase/port_io.h).
+ *       Both are used only inside the library: the values the library
+ *       was built with are the ones that apply.
  *   TASE_RING_BARRIER()  the bare-metal ring's barrier hook (tase/ring.h),
  *       used only inside port/baremetal/tase_ring.c.
  * No other macro changes a type's size or a function's signature.
@@ -66,6 +69,9 @@
 #error "TASE_RX_CANDIDATES must be 1..16"
 #endif
 
+#ifndef TASE_PORT_WRITE_TIMEOUT_MS
+#define TASE_PORT_WRITE_TIMEOUT_MS 100u
+#endif
 #ifndef TASE_PORT_WRITE_TRIES
 #define TASE_PORT_WRITE_TRIES 64u
 #endif
