@@ -101,7 +101,10 @@
 #define TASE_CAMERA_FLAG_STAB TASE_BIT8(6)
 #define TASE_CAMERA_FLAG_TITLE TASE_BIT8(7)
 
-/* ---- RETRACT_DEPLOY_CMD (4.1.6); note 5.3.1 uses the opposite sense -- */
+/* ---- RETRACT_DEPLOY_CMD (4.1.6) --------------------------------------- */
+/* The `deploy` byte: non-zero deploys, zero retracts. The 3AX CAN move
+ * frame (5.3.1) has the opposite byte sense; tase/can.h hides it behind
+ * TASE_3AX_MOVE_DEPLOY / _RETRACT, which have these same values. */
 #define TASE_RETRACT 0u
 #define TASE_DEPLOY 1u /* any non-zero value deploys */
 
