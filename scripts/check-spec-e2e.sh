@@ -4,8 +4,8 @@
 #    (table 22 read as a numbering slip) and of 23 bytes, the same values;
 #  - a running tase-sim echoes a PACKET_RATE whose reserved bytes 4, 9, 14
 #    were 0xAA/0xBB/0xCC with zeros there, answers a SPOI_CMD echo request
-#    with its own flags (SPOI mode in bits 3-7) and reports NavHealth with
-#    filter mode "normal" and no reserved bit.
+#    with its own flags (SPOI mode in bits 3-7), reports NavHealth with
+#    filter mode "normal" and no reserved bit, and CAMERA_TYPE its cameras.
 # Frames are built here byte by byte (checksums computed by this script)
 # and written to the simulator's pty raw, as a host of any make would.
 # Usage: scripts/check-spec-e2e.sh TASE TASE_SIM (tests/checks/spec.cmake)
@@ -101,6 +101,10 @@ geo=$(grep '"name":"GEOREFERENCE_DATA"' <<<"$dec" | tail -1)
 h=$(json_int "$geo" nav_health)
 check "NavHealth: filter mode normal (bits 12-15 = 3), reserved bits 2-5 and 11 clear ($h)" \
     eval '[ -n "$h" ] && [ $((h & 0xF)) -eq 3 ] && [ $((h & 0x3C10)) -eq 0 ]'
+
+ct=$("$TASE" query CAMERA_TYPE --serial "$dir/gimbal" --json)
+check "CAMERA_TYPE reports the simulated cameras, not \"do not change\" ($ct)" \
+    test "$(json_int "$ct" camera_a)/$(json_int "$ct" camera_b)/$(json_int "$ct" camera_c)" = 68/97/255
 
 echo "$fails failure(s)"
 [ "$fails" -eq 0 ]

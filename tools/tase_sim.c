@@ -203,6 +203,13 @@ static void set_version(sim_t *s, uint32_t now)
                                        now) != TASE_OK) {
         tk_die("internal error: cannot store SYSTEM_VERSION");
     }
+    /* CAMERA_TYPE reports the same cameras (the role starts at "none") */
+    data[0] = s->cam[0].type;
+    data[1] = s->cam[1].type;
+    data[2] = s->cam[2].type;
+    if (tase_gimbal_setup_set(&s->g, TASE_ID_TYPE(TASE_ID_CAMERA_TYPE), data, 3, now) != TASE_OK) {
+        tk_die("internal error: cannot store CAMERA_TYPE");
+    }
 }
 
 /* ---- telemetry ---- */
