@@ -197,7 +197,7 @@ static void threeax_move_goes_out_and_status_comes_back(void **state)
     static const uint8_t pkt_part[4] = {0x00, 0xFF, 0x5A, 0x02};
     (void)state;
     open_pair(&p, TASE_CAN_ROLE_GIMBAL);
-    m.command = TASE_3AX_RETRACT;
+    m.command = TASE_3AX_MOVE_RETRACT;
     assert_int_equal(tase_can_3ax_move_encode(&m, &f), TASE_OK);
     assert_int_equal(tase_socketcan_send_frame(&p.s, &f), TASE_OK);
     assert_int_equal(recv(p.peer, &cf, sizeof(cf), MSG_DONTWAIT), (ssize_t)sizeof(cf));
