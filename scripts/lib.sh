@@ -33,3 +33,17 @@ tase_all_lists() {
         basename "$f" .txt
     done
 }
+
+# tase_version: the library's MAJOR.MINOR.PATCH, from include/tase/version.h.
+tase_version() {
+    sed -n 's/^#define TASE_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\)$/\2/p' \
+        "$TASE_ROOT/include/tase/version.h" | paste -sd.
+}
+
+# Progress and failure lines of the longer check scripts:
+# tase_step TEXT prints TEXT with the seconds since the script started.
+tase_step() { echo "== [${SECONDS} s] $*"; }
+tase_fail() {
+    echo "FAIL: $*"
+    exit 1
+}

@@ -19,6 +19,9 @@
 #if defined(APP_BAREMETAL)
 #include "tase/bm_uart.h"
 #endif
+#if defined(APP_SOCKETCAN)
+#include "tase/socketcan.h"
+#endif
 
 static int pan_seen = -1;
 
@@ -81,6 +84,17 @@ int main(void)
         tase_posix_uart_t u;
         if (!tase_posix_uart_baud_supported(115200u) ||
             tase_posix_uart_open(&u, "/nonexistent/tty", 115200u) != TASE_ENODEV) {
+            fails++;
+        }
+    }
+#endif
+#if defined(APP_SOCKETCAN)
+    {
+        /* No such interface: a clear error (which one depends on whether
+         * the kernel has CAN at all), never TASE_EARG or success. */
+        tase_socketcan_t s;
+        int r = tase_socketcan_open(&s, "tasenosuch0", TASE_CAN_ROLE_HOST);
+        if (r >= 0 || r == TASE_EARG) {
             fails++;
         }
     }
