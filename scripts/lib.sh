@@ -4,7 +4,8 @@
 TASE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # tase_need LIST...: install the Debian packages named in
-# scripts/packages.d/LIST.txt (one per line, # comments) that are missing.
+# scripts/packages.d/LIST.txt (one per line, # comments; NAME:ARCH for
+# another architecture's package) that are missing.
 # Runs apt-get update once, only when something is missing.
 tase_need() {
     local list pkgs=() missing=() p
@@ -19,9 +20,19 @@ tase_need() {
     done
     [ ${#missing[@]} -eq 0 ] && return 0
     echo "== installing: ${missing[*]}"
-    local sudo=""
+    local sudo="" arch
     [ "$(id -u)" -ne 0 ] && sudo=sudo
     export DEBIAN_FRONTEND=noninteractive
+    # A package of another architecture (libcmocka-dev:s390x): Debian
+    # multiarch, which the following update then indexes.
+    for p in "${missing[@]}"; do
+        case $p in
+        *:*)
+            arch=${p#*:}
+            dpkg --print-foreign-architectures | grep -qx "$arch" || $sudo dpkg --add-architecture "$arch"
+            ;;
+        esac
+    done
     $sudo apt-get -o DPkg::Lock::Timeout=600 update -qq
     $sudo apt-get -o DPkg::Lock::Timeout=600 install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
