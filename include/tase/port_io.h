@@ -28,7 +28,8 @@ extern "C" {
 /* Write all n bytes of data to the port.
  * Returns n, or
  *   TASE_EARG    port/ops/write NULL, data NULL with n > 0, or
- *                n > INT32_MAX (the count must fit the int result);
+ *                n > INT_MAX (the count must fit the int result;
+ *                32767 where int is 16 bits);
  *   TASE_EAGAIN / TASE_ENOBUFS  the port took nothing at all (retry later;
  *                nothing was sent);
  *   TASE_EIO     the port stopped taking bytes part-way (some bytes were
