@@ -60,7 +60,8 @@ for f in usr/include/tase/frame.h usr/include/tase/config.h usr/include/tase/ver
     "usr/lib/$triplet/libtase_socketcan.a" "usr/lib/$triplet/libtase_baremetal.a" \
     "usr/lib/$triplet/cmake/tase/tase-config.cmake" "usr/lib/$triplet/cmake/tase/tase-config-version.cmake" \
     "usr/lib/$triplet/cmake/tase/tase-targets.cmake" "usr/lib/$triplet/pkgconfig/tase.pc" \
-    "usr/lib/$triplet/pkgconfig/tase-socketcan.pc" usr/share/doc/libtase-dev/copyright; do
+    "usr/lib/$triplet/pkgconfig/tase-socketcan.pc" usr/share/doc/libtase-dev/copyright \
+    usr/share/doc/libtase-dev/CHANGELOG.md; do
     grep -qx "$f" "$out/dev.list" || tase_fail "libtase-dev lacks /$f"
 done
 for f in usr/bin/tase usr/bin/tase-sim usr/share/doc/tase-tools/copyright; do
@@ -70,6 +71,8 @@ if grep -q '^usr/bin/' "$out/dev.list" || grep -q '^usr/include/' "$out/tools.li
     tase_fail "a file is in the wrong package"
 fi
 echo "   libtase-dev: $(grep -c '[^/]$' "$out/dev.list") files; tase-tools: $(grep -c '[^/]$' "$out/tools.list") files"
+
+grep -q "^## \[$version\]" "$TASE_ROOT/CHANGELOG.md" || tase_fail "CHANGELOG.md has no section for $version"
 
 tase_step "unpack both and build consumers from the unpacked tree"
 root="$out/root"
