@@ -1,6 +1,8 @@
 /* Helpers over the port boundary: write-all and frame send. */
 #include "tase/port_io.h"
 
+#include <limits.h>
+
 #include "tase/codec.h"
 #include "tase/frame.h"
 
@@ -21,7 +23,7 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n)
     if (port == NULL || port->ops == NULL || port->ops->write == NULL || (data == NULL && n > 0)) {
         return TASE_EARG;
     }
-    if (n > (size_t)0x7FFFFFFF) {
+    if (n > (size_t)INT_MAX) {
         return TASE_EARG; /* the result must fit the int return */
     }
     clock = port->ops->now_ms != NULL;

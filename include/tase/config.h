@@ -113,19 +113,21 @@
 #define TASE_CONFIG_TAG_ rx_candidates_16
 #endif
 
-#define TASE_CONFIG_PASTE_(name, tag) name##_##tag
-#define TASE_CONFIG_NAME_(name, tag) TASE_CONFIG_PASTE_(name, tag)
-/* name -> name_<configuration tag>, the link name of an ABI-guarded
- * function. */
-#define TASE_CONFIG_LINK_NAME(name) TASE_CONFIG_NAME_(name, TASE_CONFIG_TAG_)
+#define TASE_CONFIG_PASTE_(stem, tag) stem##tag
+#define TASE_CONFIG_NAME_(stem, tag) TASE_CONFIG_PASTE_(stem, tag)
+/* stem -> stem<configuration tag>: the link name of an ABI-guarded
+ * function is its name, "_", and the tag. (The stem is spelled with the
+ * trailing "_" so that no macro expands to its own name: clang
+ * -Wdisabled-macro-expansion.) */
+#define TASE_CONFIG_LINK_NAME(stem) TASE_CONFIG_NAME_(stem, TASE_CONFIG_TAG_)
 
 /* The ABI-guarded functions: the initialisers of tase_rx_t (frame.h),
  * tase_can_rx_t (can.h), tase_host_t (host.h) and of tase_gimbal_t with
  * its receiver array (gimbal.h). A new type that embeds a tase_rx_t, or
  * takes an array of them, adds its initialiser here. */
-#define tase_rx_init TASE_CONFIG_LINK_NAME(tase_rx_init)
-#define tase_can_rx_init TASE_CONFIG_LINK_NAME(tase_can_rx_init)
-#define tase_host_init TASE_CONFIG_LINK_NAME(tase_host_init)
-#define tase_gimbal_init TASE_CONFIG_LINK_NAME(tase_gimbal_init)
+#define tase_rx_init TASE_CONFIG_LINK_NAME(tase_rx_init_)
+#define tase_can_rx_init TASE_CONFIG_LINK_NAME(tase_can_rx_init_)
+#define tase_host_init TASE_CONFIG_LINK_NAME(tase_host_init_)
+#define tase_gimbal_init TASE_CONFIG_LINK_NAME(tase_gimbal_init_)
 
 #endif /* TASE_CONFIG_H */

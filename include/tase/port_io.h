@@ -51,7 +51,8 @@ uint32_t tase_port_elapsed_ms(uint32_t now_ms, uint32_t since_ms);
 /* Write all n bytes of data to the port within the frame deadline (see
  * LONGEST BLOCK). Returns n, or
  *   TASE_EARG    port/ops/write NULL, data NULL with n > 0, or
- *                n > INT32_MAX (the count must fit the int result);
+ *                n > INT_MAX (the count must fit the int result;
+ *                32767 where int is 16 bits);
  *   TASE_EAGAIN / TASE_ENOBUFS  the port took nothing before the deadline
  *                (retry later; nothing was sent);
  *   TASE_EIO     the deadline passed part-way (some bytes were sent; a
