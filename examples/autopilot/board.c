@@ -18,6 +18,12 @@
 #define INT_RX 0x2u
 #define UART0_RX_IRQ 0u /* NVIC line; the TX interrupt is line 1 */
 
+#define TIMER0_CTRL (*(volatile uint32_t *)0x40000000u)
+#define TIMER0_VALUE (*(volatile uint32_t *)0x40000004u)
+#define TIMER0_RELOAD (*(volatile uint32_t *)0x40000008u)
+#define TIMER_EN 0x1u
+#define TIMER_HZ BOARD_CPU_HZ
+
 #define NVIC_ISER0 (*(volatile uint32_t *)0xE000E100u)
 #define NVIC_ICER0 (*(volatile uint32_t *)0xE000E180u)
 #define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
@@ -25,12 +31,15 @@
 #define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
 
 static tase_bm_uart_t *rx_uart;
-static volatile uint32_t ticks;
 static volatile board_stats_t stats;
+static volatile uint32_t woken; /* an interrupt since the last board_sleep */
+static uint32_t clock_last;     /* TIMER0 value at the last board_millis */
+static uint64_t clock_cycles;   /* timer cycles since board_init */
 
 void SysTick_Handler(void)
 {
-    ticks++;
+    stats.ticks++;
+    woken = 1u;
 }
 
 /* Receive interrupt: the UART holds one byte. Clear the interrupt first,
@@ -40,6 +49,7 @@ void UART0_RX_Handler(void)
 {
     uint32_t state;
     stats.rx_irqs++;
+    woken = 1u;
     UART_INTSTATUS = INT_RX;
     while (((state = UART_STATE) & STATE_RXFULL) != 0u) {
         if ((state & STATE_RXOVERRUN) != 0u) {
@@ -53,6 +63,10 @@ void UART0_RX_Handler(void)
 void board_init(tase_bm_uart_t *uart)
 {
     rx_uart = uart;
+    TIMER0_RELOAD = 0xFFFFFFFFu;
+    TIMER0_VALUE = 0xFFFFFFFFu;
+    TIMER0_CTRL = TIMER_EN;
+    clock_last = TIMER0_VALUE;
     SYST_RVR = BOARD_CPU_HZ / 1000u - 1u;
     SYST_CVR = 0u;
     SYST_CSR = 7u; /* processor clock, interrupt, enable */
@@ -70,8 +84,11 @@ void board_stop(void)
 
 uint32_t board_millis(void *hw)
 {
+    uint32_t v = TIMER0_VALUE;
     (void)hw;
-    return ticks;
+    clock_cycles += (uint32_t)(clock_last - v); /* it counts down */
+    clock_last = v;
+    return (uint32_t)(clock_cycles / (TIMER_HZ / 1000u));
 }
 
 int board_uart_tx(void *hw, const uint8_t *data, size_t n)
@@ -79,9 +96,9 @@ int board_uart_tx(void *hw, const uint8_t *data, size_t n)
     size_t i;
     (void)hw;
     for (i = 0; i < n; i++) {
-        uint32_t start = ticks;
+        uint32_t start = board_millis(hw);
         while ((UART_STATE & STATE_TXFULL) != 0u) {
-            if ((uint32_t)(ticks - start) >= BOARD_TX_TIMEOUT_MS) {
+            if ((uint32_t)(board_millis(hw) - start) >= BOARD_TX_TIMEOUT_MS) {
                 stats.tx_timeouts++;
                 return TASE_EIO;
             }
@@ -91,18 +108,20 @@ int board_uart_tx(void *hw, const uint8_t *data, size_t n)
     return 0;
 }
 
-void board_wait_tick(uint32_t last)
+void board_sleep(void)
 {
     __asm__ volatile("cpsid i" ::: "memory");
-    if (ticks == last) {
+    if (woken == 0u) {
         __asm__ volatile("wfi"); /* a pending interrupt wakes it even masked */
     }
+    woken = 0u;
     __asm__ volatile("cpsie i" ::: "memory");
 }
 
 board_stats_t board_stats(void)
 {
     board_stats_t s;
+    s.ticks = stats.ticks;
     s.rx_irqs = stats.rx_irqs;
     s.rx_overruns = stats.rx_overruns;
     s.tx_timeouts = stats.tx_timeouts;

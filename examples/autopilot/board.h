@@ -1,8 +1,17 @@
 /*
  * board.h - the autopilot example's board layer for QEMU's mps2-an386
  * (Cortex-M4F at 25 MHz): UART0 (an ARM CMSDK APB UART) with its receive
- * interrupt feeding the library's bare-metal ring, SysTick as the
- * millisecond clock, and the stack high-water mark.
+ * interrupt feeding the library's bare-metal ring, a millisecond clock,
+ * a 1 kHz SysTick wake-up, and the stack high-water mark.
+ *
+ * CLOCK. SysTick interrupts every millisecond to wake the main loop, but
+ * the clock is not a count of them: under QEMU without -icount, a busy
+ * host delays the timer and QEMU then raises one SysTick interrupt for
+ * several periods (measured: 11.0 s of ticks in 17.5 s of run with three
+ * busy loops on two cores). The milliseconds come from TIMER0, a CMSDK
+ * APB timer counting the 25 MHz clock down from 0xFFFFFFFF, whose value
+ * QEMU computes from the host clock when it is read; board_millis()
+ * extends it past its 171 s wrap. On real hardware either would do.
  *
  * The UART is the link to the gimbal. Under QEMU it is wired to tase-sim's
  * pseudo-terminal (-chardev serial,path=<link> -serial chardev:...), so the
@@ -22,17 +31,20 @@
 
 /* Board counters, written by the interrupts and the TX hook. */
 typedef struct {
+    uint32_t ticks;       /* SysTick interrupts taken */
     uint32_t rx_irqs;     /* UART0 receive interrupts taken */
     uint32_t rx_overruns; /* bytes the UART lost (RX overrun flag) */
     uint32_t tx_timeouts; /* writes abandoned: TX stayed full too long */
 } board_stats_t;
 
-/* Start SysTick (1 kHz) and UART0 (115200 8N1, receive interrupt), and
+/* Start TIMER0 (the clock), SysTick (1 kHz) and UART0 (115200 8N1, receive interrupt), and
  * route every received byte to tase_bm_uart_rx_isr(uart, byte). uart must
  * be initialised (tase_bm_uart_init) and outlive the program. */
 void board_init(tase_bm_uart_t *uart);
 
-/* Milliseconds since board_init (SysTick count). The bm_uart millis hook. */
+/* Milliseconds since board_init, from TIMER0. Main loop only (it keeps
+ * the extension's state); call it at least every 171 s. The bm_uart
+ * millis hook. */
 uint32_t board_millis(void *hw);
 
 /* Send n bytes on UART0, waiting on the TX-full flag before each byte;
@@ -40,10 +52,11 @@ uint32_t board_millis(void *hw);
  * bm_uart tx hook: returns 0 or TASE_EIO. */
 int board_uart_tx(void *hw, const uint8_t *data, size_t n);
 
-/* Sleep until the millisecond counter differs from `last` (or any
- * interrupt arrives), without the lost-wakeup race: interrupts are masked
- * while the condition is checked, and WFI wakes on a pending one. */
-void board_wait_tick(uint32_t last);
+/* Sleep until an interrupt (SysTick or UART0 receive) has been taken
+ * since the previous call, without the lost-wakeup race: the flag the
+ * handlers set is tested with interrupts masked, and WFI wakes on a
+ * pending interrupt even then. */
+void board_sleep(void);
 
 /* The counters above (a snapshot). */
 board_stats_t board_stats(void);

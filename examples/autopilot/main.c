@@ -15,10 +15,11 @@
  *     flight model (flight.c: a circle at constant height);
  *  4. after WARMUP_MS, command a SPOI at a ground point with echo
  *     requested and check the echo;
- *  5. for TRACK_MS consume GIMBAL_ANGLE, GIMBAL_RATE and GEOREFERENCE_DATA
- *     through the library's dispatcher: the camera line of sight that
- *     GEOREFERENCE_DATA reports must come within TOLERANCE_DEG of the SPOI
- *     within SETTLE_MS and stay there; the gimbal must report SPOI mode
+ *  5. from the command until TRACK_MS after its echo, consume GIMBAL_ANGLE,
+ *     GIMBAL_RATE and GEOREFERENCE_DATA through the library's dispatcher:
+ *     the camera line of sight that GEOREFERENCE_DATA reports must come
+ *     within TOLERANCE_DEG of the SPOI within SETTLE_MS of the command and
+ *     stay there; the gimbal must report SPOI mode
  *     and echo our host position and attitude;
  *  6. query SPOI_CMD: the gimbal still holds our point;
  * then print a summary (with its own flash/RAM/stack numbers) through
@@ -111,11 +112,12 @@ typedef struct {
     uint32_t after;         /* samples after convergence */
     uint32_t outside;       /* of them, beyond the tolerance */
     float err_max, err_sum; /* over `after` */
-    uint32_t steady;        /* samples from SETTLE_MS after the echo on */
+    uint32_t steady;        /* of them, from SETTLE_MS after the command on */
     float steady_max, steady_sum;
     uint32_t position_bad; /* host position/attitude not echoed */
     float pos_max_m;       /* largest distance of an echoed position from the circle */
-    uint32_t spoi_at;      /* when the echo came */
+    uint32_t spoi_at;      /* when the SPOI command was sent */
+    uint32_t track_ms;     /* from then to the end of tracking */
     uint32_t now;
     /* checks */
     unsigned checks, failures;
@@ -388,6 +390,10 @@ static void run_step(mission_t *m)
         if (m->now - m->step_at >= WARMUP_MS) {
             flight_spoi(&plan, SPOI_NORTH_M, SPOI_EAST_M, SPOI_HEIGHT_M, (uint8_t)TASE_SPOI_ECHO,
                         &m->spoi_req);
+            /* From here on a GEOREFERENCE may reflect the command (it is
+             * sent on the next pass): none counts as "before" any more. */
+            m->spoi_at = m->now;
+            m->tracking = true;
             next_step(m, STEP_SPOI);
         }
         return;
@@ -401,14 +407,13 @@ static void run_step(mission_t *m)
                 return;
             }
             m->spoi_echo_ms = m->now - m->step_at;
-            m->spoi_at = m->now;
-            m->tracking = true;
             next_step(m, STEP_TRACK);
         }
         return;
     case STEP_TRACK:
         if (m->now - m->step_at >= TRACK_MS) {
             m->tracking = false;
+            m->track_ms = m->now - m->spoi_at;
             next_step(m, STEP_SPOI_GET);
         }
         return;
@@ -449,7 +454,8 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
     const tase_host_stats_t *hs = &m->link.host.stats;
     const tase_rx_stats_t *rs = &m->link.host.rx.stats;
     board_stats_t bs = board_stats();
-    uint32_t track_ms = TRACK_MS;
+    uint32_t track_ms = m->track_ms;
+    uint32_t steady_ms = track_ms > SETTLE_MS ? track_ms - SETTLE_MS : 0u;
 
     if (m->step > STEP_VERSION) {
         report_version(&m->version);
@@ -477,19 +483,21 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
            (unsigned long)hs->timeouts, (unsigned long)hs->tx_errors, (unsigned long)m->host_late);
     printf("rx: %lu bytes, %lu frames, %lu checksum errors, %lu bytes discarded (%lu before the "
            "first reply), %lu bad length, %lu unknown; UART %lu interrupts, %lu overruns, ring "
-           "overflows %lu\n",
+           "overflows %lu; SysTick %lu interrupts in %lu ms\n",
            (unsigned long)rs->bytes_in, (unsigned long)rs->frames_ok,
            (unsigned long)rs->checksum_errors, (unsigned long)rs->bytes_discarded,
            (unsigned long)m->rx_mark.bytes_discarded, (unsigned long)rs->bad_length,
            (unsigned long)rs->unknown, (unsigned long)bs.rx_irqs, (unsigned long)bs.rx_overruns,
-           (unsigned long)tase_ring_overflows(&uart->rx));
+           (unsigned long)tase_ring_overflows(&uart->rx), (unsigned long)bs.ticks,
+           (unsigned long)m->now);
     printf("telemetry while tracking (%lu ms): GIMBAL_ANGLE %lu (%.1f/s), GIMBAL_RATE %lu "
            "(%.1f/s, %lu in SPOI mode), GEOREFERENCE_DATA %lu (%.1f/s); %lu other frames\n",
            (unsigned long)track_ms, (unsigned long)m->angles, per_s(m->angles, track_ms),
            (unsigned long)m->rates, per_s(m->rates, track_ms), (unsigned long)m->spoi_mode_rates,
            (unsigned long)m->georefs, per_s(m->georefs, track_ms), (unsigned long)m->other);
-    printf("pointing: error %.2f deg before the SPOI, %.2f at the first GEOREFERENCE after it; "
-           "within %.1f deg after %lu ms; then %lu samples, mean %.3f, max %.3f deg, %lu outside; "
+    printf("pointing: error %.2f deg before the SPOI command, %.2f at the first GEOREFERENCE after "
+           "it; within %.1f deg %lu ms after it; then %lu samples, mean %.3f, max %.3f deg, %lu "
+           "outside; "
            "from %lu ms on: %lu samples, mean %.3f, max %.3f deg; host position echoed within "
            "%.2f m of the circle\n",
            (double)m->err_before, (double)m->err_first, (double)TOLERANCE_DEG,
@@ -529,9 +537,9 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
           (long)(m->err_before * 100.0f), (long)(500.0f * TOLERANCE_DEG));
     check(m, m->converged_ms > 0u && m->converged_ms <= SETTLE_MS,
           "line of sight within tolerance after (ms)", (long)m->converged_ms, SETTLE_MS);
-    check(m, m->after * 10u >= GEO_HZ * (TRACK_MS - SETTLE_MS) / 1000u * 5u,
-          "GEOREFERENCE samples after convergence", (long)m->after,
-          (long)(GEO_HZ * (TRACK_MS - SETTLE_MS) / 1000u));
+    check(m, m->steady * 10u >= GEO_HZ * steady_ms / 1000u * 5u,
+          "GEOREFERENCE samples after the settling time", (long)m->steady,
+          (long)(GEO_HZ * steady_ms / 1000u));
     check(m, m->outside == 0u, "samples beyond the tolerance after convergence", (long)m->outside,
           0);
     check(m, m->position_bad == 0u, "GEOREFERENCE host position/attitude not what we sent",
@@ -569,7 +577,7 @@ int main(void)
     next_step(&m, STEP_VERSION);
 
     while (m.step != STEP_DONE) {
-        board_wait_tick(last); /* a millisecond, or a UART interrupt */
+        board_sleep(); /* until SysTick or a received byte */
         m.now = board_millis(NULL);
         r = link_service(&m.link, READS_PER_WAKE);
         if (r < 0) {
