@@ -6,7 +6,8 @@
  * port (port/baremetal: tase_bm_uart_rx_isr() into a tase_ring_t); the
  * main loop wakes on every SysTick millisecond or UART interrupt, feeds
  * what arrived to the library's host role (tase_host_service() reading
- * the bm_uart port), and runs the mission (link.c wraps the role calls):
+ * the bm_uart port, link.c), and runs the mission with the role's typed
+ * calls (tase_host_send_msg(), tase_host_request_msg_start()):
  *
  *  1. query SYSTEM_VERSION and report the gimbal's software and cameras;
  *  2. query PACKET_RATE, set port 1 to ANGLE_HZ/RATE_HZ/GEO_HZ and confirm
@@ -19,8 +20,8 @@
  *     GIMBAL_RATE and GEOREFERENCE_DATA through the library's dispatcher:
  *     the camera line of sight that GEOREFERENCE_DATA reports must come
  *     within TOLERANCE_DEG of the SPOI within SETTLE_MS of the command and
- *     stay there; the gimbal must report SPOI mode
- *     and echo our host position and attitude;
+ *     stay there; the gimbal must report SPOI mode and echo our host
+ *     position and attitude;
  *  6. query SPOI_CMD: the gimbal still holds our point;
  * then print a summary (with its own flash/RAM/stack numbers) through
  * semihosting and exit 0 on success, 1 on any failure.
@@ -46,6 +47,9 @@
 /* Host data streamed to the gimbal. */
 #define ATT_HZ 50u
 #define GPS_HZ 10u
+
+#define REQUEST_TIMEOUT_MS 300u /* per attempt */
+#define REQUEST_RETRIES 3u      /* re-sends after a timeout */
 
 #define WARMUP_MS 1000u   /* host data streamed before the SPOI command */
 #define TRACK_MS 10000u   /* tracking observed after the SPOI echo */
@@ -259,10 +263,11 @@ static bool answered(mission_t *m, uint16_t id, const void *msg, int len, const 
 {
     int r;
     if (!m->requesting) {
-        r = link_request(&m->link, id, msg, m->now);
+        r = tase_host_request_msg_start(&m->link.host, id, msg, &m->reply, REQUEST_TIMEOUT_MS,
+                                        REQUEST_RETRIES, m->now);
         m->requesting = r == TASE_OK;
     } else {
-        r = link_poll(&m->link, m->now, &m->reply);
+        r = tase_host_poll(&m->link.host, m->now);
         m->requesting = r == TASE_EAGAIN;
     }
     if (r == len) {
@@ -307,7 +312,7 @@ static void report_version(const tase_system_version_t *v)
  * than a period is skipped (counted), never sent in a burst. */
 static void send_host(mission_t *m, uint16_t id, const void *msg, uint32_t *next, uint32_t hz)
 {
-    m->send_errors += link_send(&m->link, id, msg) < 0 ? 1u : 0u;
+    m->send_errors += tase_host_send_msg(&m->link.host, id, msg) < 0 ? 1u : 0u;
     *next += 1000u / hz;
     if ((int32_t)(m->now - *next) >= 0) {
         m->host_late++;
