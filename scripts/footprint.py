@@ -540,6 +540,11 @@ def main():
               types.get("tase_host_t", 0), rxsz, types.get("tase_dispatch_t", 0),
               " of %d B" % apimg["bm_uart"] if apimg["bm_uart"] is not None else ""))
         p("")
+        p("The stack high-water mark depends on where the interrupts happen to land in the "
+          "deepest call chain (an exception frame with floating-point context is 104 B), so it "
+          "varies by up to about 120 B from run to run; `scripts/check-autopilot.sh` prints it "
+          "with every run.")
+        p("")
     p("## sizeof of the public types")
     p("")
     p("| header | type | " + " | ".join(CPUS) + " |")
