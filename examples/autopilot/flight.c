@@ -23,14 +23,29 @@ void flight_at(const flight_plan_t *p, uint32_t t_ms, flight_state_t *s)
     uint32_t lap_ms = (uint32_t)(2.0f * PI_F * p->radius_m / p->speed_mps * 1000.0f);
     float th = 2.0f * PI_F * (float)(t_ms % lap_ms) / (float)lap_ms;
     float c = cosf(th), sn = sinf(th);
-    float yaw = th * (180.0f / PI_F) + 90.0f;
 
     s->north_m = p->radius_m * c;
     s->east_m = p->radius_m * sn;
     s->vnorth_mps = -p->speed_mps * sn;
     s->veast_mps = p->speed_mps * c;
     s->roll_deg = flight_bank_deg(p);
-    s->yaw_deg = yaw >= 180.0f ? yaw - 360.0f : yaw;
+    s->yaw_deg = flight_heading_deg(s->north_m, s->east_m);
+}
+
+float flight_angle_diff_deg(float a, float b)
+{
+    float d = fmodf(a - b, 360.0f);
+    if (d >= 180.0f) {
+        d -= 360.0f;
+    } else if (d < -180.0f) {
+        d += 360.0f;
+    }
+    return d;
+}
+
+float flight_heading_deg(float north_m, float east_m)
+{
+    return flight_angle_diff_deg(atan2f(east_m, north_m) * (180.0f / PI_F) + 90.0f, 0.0f);
 }
 
 static double lat_of(const flight_plan_t *p, float north_m)

@@ -65,4 +65,11 @@ float flight_pointing_error_deg(const flight_plan_t *p, const tase_georeference_
 /* The flight's bank angle in degrees. */
 float flight_bank_deg(const flight_plan_t *p);
 
+/* The heading in degrees (-180..180) of an aircraft on the circle at
+ * north_m/east_m from its centre: the tangent, turning clockwise. */
+float flight_heading_deg(float north_m, float east_m);
+
+/* a - b wrapped to -180..180 degrees. */
+float flight_angle_diff_deg(float a, float b);
+
 #endif /* AUTOPILOT_FLIGHT_H */

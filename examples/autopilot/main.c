@@ -56,6 +56,9 @@
 #define SETTLE_MS 5000u   /* the line of sight must converge within this */
 #define MISSION_MS 30000u /* hard limit of the whole run */
 #define TOLERANCE_DEG 1.0f
+/* Echoed yaw against the heading at the echoed position: the aircraft
+ * turns 360 * speed / (2 pi radius) = 2.1 deg/s, 0.2 deg per GPS period. */
+#define YAW_TOLERANCE_DEG 1.0f
 
 #define RING_SIZE 512u /* power of two; ~45 ms of 115200 baud */
 #define READS_PER_WAKE 8u
@@ -120,6 +123,7 @@ typedef struct {
     float steady_max, steady_sum;
     uint32_t position_bad; /* host position/attitude not echoed */
     float pos_max_m;       /* largest distance of an echoed position from the circle */
+    float yaw_max_deg;     /* largest echoed yaw off the heading at the echoed position */
     uint32_t spoi_at;      /* when the SPOI command was sent */
     uint32_t track_ms;     /* from then to the end of tracking */
     uint32_t now;
@@ -161,17 +165,22 @@ static void on_rate(void *user, const tase_frame_t *f, const void *msg)
     }
 }
 
-/* The echoed host position must be one we sent: on the circle, at our
- * height, with our bank and zero pitch. */
+/* The navigation data the gimbal reports must be ours: a position on the
+ * circle at our height, our bank and zero pitch, and a yaw that matches
+ * the heading at that position (within what the aircraft turns between
+ * two HOST_GPS_DATA: the attitude is sent more often). Only then does a
+ * line of sight on the SPOI in the gimbal's frame mean one in ours. */
 static void check_host_echo(mission_t *m, const tase_georeference_t *g)
 {
-    float n, e, off;
+    float n, e, off, dyaw;
     flight_offset(&plan, g->lat, g->lon, &n, &e);
     off = fabsf(sqrtf(n * n + e * e) - plan.radius_m);
-    if (off > m->pos_max_m) {
-        m->pos_max_m = off;
-    }
-    if (off > 0.5f || g->height != tase_units_m_to_cm((double)plan.height_m) ||
+    dyaw = fabsf(flight_angle_diff_deg((float)tase_units_cdeg_to_deg(g->mount_yaw),
+                                       flight_heading_deg(n, e)));
+    m->pos_max_m = off > m->pos_max_m ? off : m->pos_max_m;
+    m->yaw_max_deg = dyaw > m->yaw_max_deg ? dyaw : m->yaw_max_deg;
+    if (off > 0.5f || dyaw > YAW_TOLERANCE_DEG ||
+        g->height != tase_units_m_to_cm((double)plan.height_m) ||
         g->mount_roll != tase_units_deg_to_cdeg((double)flight_bank_deg(&plan)) ||
         g->mount_pitch != 0) {
         m->position_bad++;
@@ -504,13 +513,13 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
            "it; within %.1f deg %lu ms after it; then %lu samples, mean %.3f, max %.3f deg, %lu "
            "outside; "
            "from %lu ms on: %lu samples, mean %.3f, max %.3f deg; host position echoed within "
-           "%.2f m of the circle\n",
+           "%.2f m of the circle, yaw within %.2f deg of the heading there\n",
            (double)m->err_before, (double)m->err_first, (double)TOLERANCE_DEG,
            (unsigned long)m->converged_ms, (unsigned long)m->after,
            m->after > 0u ? (double)(m->err_sum / (float)m->after) : 0.0, (double)m->err_max,
            (unsigned long)m->outside, (unsigned long)SETTLE_MS, (unsigned long)m->steady,
            m->steady > 0u ? (double)(m->steady_sum / (float)m->steady) : 0.0, (double)m->steady_max,
-           (double)m->pos_max_m);
+           (double)m->pos_max_m, (double)m->yaw_max_deg);
 
     check(m, m->step == STEP_DONE && !m->requesting, "mission completed", (long)m->step, STEP_DONE);
     check(m, hs->timeouts == 0u, "requests timed out", (long)hs->timeouts, 0);
