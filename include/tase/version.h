@@ -19,14 +19,15 @@
 #define TASE_VERSION_PATCH 0
 
 /* MAJOR * 10000 + MINOR * 100 + PATCH (minor and patch stay below 100). */
-#define TASE_VERSION_NUMBER (TASE_VERSION_MAJOR * 10000 + TASE_VERSION_MINOR * 100 + TASE_VERSION_PATCH)
+#define TASE_VERSION_NUMBER                                                                        \
+    (TASE_VERSION_MAJOR * 10000 + TASE_VERSION_MINOR * 100 + TASE_VERSION_PATCH)
 
 /* "MAJOR.MINOR.PATCH", built from the three numbers above so that it can
  * never disagree with them. */
 #define TASE_VERSION_STR_(x) #x
 #define TASE_VERSION_XSTR_(x) TASE_VERSION_STR_(x)
-#define TASE_VERSION_STRING                                                                         \
-    TASE_VERSION_XSTR_(TASE_VERSION_MAJOR)                                                          \
+#define TASE_VERSION_STRING                                                                        \
+    TASE_VERSION_XSTR_(TASE_VERSION_MAJOR)                                                         \
     "." TASE_VERSION_XSTR_(TASE_VERSION_MINOR) "." TASE_VERSION_XSTR_(TASE_VERSION_PATCH)
 
 #endif /* TASE_VERSION_H */
