@@ -542,7 +542,7 @@ def main():
         p("")
         p("The stack high-water mark depends on where the interrupts happen to land in the "
           "deepest call chain (an exception frame with floating-point context is 104 B), so it "
-          "varies by up to about 120 B from run to run; `scripts/check-autopilot.sh` prints it "
+          "varies by up to about 150 B from run to run; `scripts/check-autopilot.sh` prints it "
           "with every run.")
         p("")
     p("## sizeof of the public types")
