@@ -574,7 +574,7 @@ int main(void)
 {
     static uint8_t ring_storage[RING_SIZE];
     static tase_bm_uart_t uart;
-    static const tase_bm_uart_hooks_t hooks = {board_uart_tx, board_millis, NULL};
+    static const tase_bm_uart_hooks_t hooks = {board_uart_tx, board_millis, NULL, NULL, NULL};
     static mission_t m;
     tase_port_t port;
     uint32_t last = 0;
