@@ -25,6 +25,15 @@
 
 #define RX_CAP ((uint16_t)TASE_FRAME_MAX)
 
+/* Keeps the byte events of tase_rx_push() out of line, so that its fast
+ * path (a byte inside a frame) needs no stack frame. GCC and clang only;
+ * another compiler may inline it, which costs speed, not correctness. */
+#if defined(__GNUC__)
+#define RX_NOINLINE __attribute__((noinline))
+#else
+#define RX_NOINLINE
+#endif
+
 /* C99 has no _Static_assert: a negative array size fails the build. */
 typedef char tase_rx_size_check[sizeof(tase_rx_t) <= TASE_RX_SIZE_BUDGET ? 1 : -1];
 typedef char tase_rx_cand_check[(TASE_RX_CANDIDATES >= 1 && TASE_RX_CANDIDATES <= 16) ? 1 : -1];
@@ -134,6 +143,8 @@ int tase_rx_stats_reset(tase_rx_t *rx)
     return TASE_OK;
 }
 
+static const uint8_t sync[3] = {TASE_SYNC1, TASE_SYNC2, TASE_SYNC3};
+
 /* What one call delivers to, and how many frames it has delivered. */
 typedef struct {
     tase_rx_handler_t on_frame;
@@ -141,21 +152,22 @@ typedef struct {
     uint32_t count;
 } rx_call_t;
 
-/* Hand on the valid frame f[0..Size+6) at stream offset `offset` (f is in
- * the window or in the caller's buffer). Returns false when the callback
- * re-initialised the receiver: the caller must then leave it alone. */
-static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, rx_call_t *c)
+/* Count and hand on the valid frame f[0..Size+6) at stream offset
+ * `offset` (f is in the window or in the caller's buffer). Returns false
+ * when the callback re-initialised the receiver: the caller must then
+ * leave it alone. */
+static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, tase_rx_handler_t on_frame,
+                    void *user)
 {
     tase_frame_t fr;
     rx->stats.frames_ok++;
-    c->count++;
-    if (c->on_frame != NULL) {
+    if (on_frame != NULL) {
         fr.offset = offset;
         fr.group = f[4];
         fr.type = f[5];
         fr.len = (uint8_t)(f[3] - 2u);
         fr.data = &f[TASE_FRAME_HEADER];
-        c->on_frame(c->user, &fr);
+        on_frame(user, &fr);
     }
     return rx->busy != 0u;
 }
@@ -172,7 +184,6 @@ static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, rx_call_t 
 static bool scan(tase_rx_t *rx, const uint8_t *src, size_t m, size_t counted_before, bool final,
                  rx_call_t *c)
 {
-    static const uint8_t sync[3] = {TASE_SYNC1, TASE_SYNC2, TASE_SYNC3};
     size_t p = 0;
     size_t held = 0;
     size_t counted = counted_before;
@@ -202,7 +213,9 @@ static bool scan(tase_rx_t *rx, const uint8_t *src, size_t m, size_t counted_bef
                         rx->stats.bytes_in += (uint32_t)(p + flen - counted);
                         counted = p + flen;
                     }
-                    if (!deliver(rx, s, rx->stats.bytes_in - (uint32_t)(counted - p), c)) {
+                    c->count++;
+                    if (!deliver(rx, s, rx->stats.bytes_in - (uint32_t)(counted - p), c->on_frame,
+                                 c->user)) {
                         return false;
                     }
                     p += flen;
@@ -242,13 +255,19 @@ static bool scan(tase_rx_t *rx, const uint8_t *src, size_t m, size_t counted_bef
 }
 
 /* The general path: feed data[0..n) (n may be 0), or settle everything at
- * end of input (`final`). While the window holds something, just enough
- * bytes to decide it are copied in and the window is scanned; once it is
- * empty, the rest of the input is scanned in place. */
-static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, rx_call_t *c)
+ * end of input (data NULL: tase_rx_flush()). While the window holds
+ * something, just enough bytes to decide it are copied in and the window is
+ * scanned; once it is empty, the rest of the input is scanned in place.
+ * (Five arguments, like the entry points: they can tail-call it.) */
+static int run(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame, void *user)
 {
+    rx_call_t c;
     size_t i = 0;
     bool live = true;
+    bool final = data == NULL;
+    c.on_frame = on_frame;
+    c.user = user;
+    c.count = 0u;
     rx->busy = 1u;
     rx->end = 0u;
     while (live) {
@@ -256,35 +275,72 @@ static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, rx_call
         size_t need;
         size_t k;
         bool short_of;
+        const uint8_t *src = rx->buf;
+        size_t m;
+        size_t counted;
         if (len == 0u) {
-            if (i < n) {
-                live = scan(rx, &data[i], n - i, 0u, final, c);
+            if (i == n) {
+                break;
             }
-            break;
+            /* the rest of the input, in place */
+            src = &data[i];
+            m = n - i;
+            counted = 0u;
+            i = n;
+        } else if (len < 4u) {
+            /* A partial sync: the input continues it into a header, or
+             * breaks it. Broken, its bytes are noise (00 FF 5A with a Size
+             * < 2 is a bad Size), and the byte that broke it is scanned in
+             * place like the rest of the input. */
+            while (len < 3u && i < n && data[i] == sync[len]) {
+                rx->buf[len] = data[i];
+                len++;
+                i++;
+                rx->stats.bytes_in++;
+            }
+            if (i == n && !final) {
+                rx->len = (uint16_t)len;
+                break;
+            }
+            if (len == 3u && i < n && data[i] >= 2u) {
+                rx->buf[3] = data[i];
+                len = 4u;
+                i++;
+                rx->stats.bytes_in++;
+            } else {
+                if (len == 3u && i < n) {
+                    rx->stats.bad_size++;
+                }
+                rx->stats.bytes_discarded += (uint32_t)len;
+                len = 0u;
+            }
+            rx->len = (uint16_t)len;
+            continue;
+        } else {
+            /* the rest of the held candidate (rx_sane: Size >= 2) */
+            need = (size_t)rx->buf[3] + 6u - len;
+            short_of = n - i < need;
+            k = short_of ? n - i : need;
+            if (k > 0u) {
+                (void)memcpy(&rx->buf[len], &data[i], k);
+                rx->len = (uint16_t)(len + k);
+                rx->stats.bytes_in += (uint32_t)k;
+                i += k;
+            }
+            if (short_of && !final) {
+                break; /* its last byte is still to come */
+            }
+            m = rx->len;
+            counted = m;
         }
-        /* the rest of the header, or of the held candidate */
-        need = (len < 4u) ? 4u - len : (size_t)rx->buf[3] + 6u - len;
-        short_of = n - i < need;
-        k = short_of ? n - i : need;
-        if (k > 0u) {
-            (void)memcpy(&rx->buf[len], &data[i], k);
-            rx->len = (uint16_t)(len + k);
-            rx->stats.bytes_in += (uint32_t)k;
-            i += k;
-        }
-        /* Scan unless nothing can be decided yet: no new byte, or a held
-         * candidate still short of its last byte. (A partial sync is
-         * decided by any byte that breaks it.) */
-        if (short_of && !final && (k == 0u || rx->len >= 4u)) {
-            break;
-        }
-        live = scan(rx, rx->buf, rx->len, rx->len, final, c);
+        /* one call site: scan() is inlined here, one stack frame for both */
+        live = scan(rx, src, m, counted, final, &c);
     }
     if (live) {
         rx->end = (rx->len >= 4u) ? (uint16_t)(rx->buf[3] + 5u) : 0u;
         rx->busy = 0u;
     }
-    return (c->count > (uint32_t)INT_MAX) ? INT_MAX : (int)c->count;
+    return (c.count > (uint32_t)INT_MAX) ? INT_MAX : (int)c.count;
 }
 
 /* What every entry point checks of an instance, so that a corrupted or
@@ -300,9 +356,9 @@ static bool rx_sane(const tase_rx_t *rx)
     return rx->buf[3] >= 2u && rx->end == (uint16_t)(rx->buf[3] + 5u) && len <= rx->end;
 }
 
-/* What every entry point checks (rx NULL, a call in progress, visibly
- * corrupted), and the context of the call. */
-static int rx_begin(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user, rx_call_t *c)
+/* What every entry point checks: rx NULL, a call in progress, visibly
+ * corrupted. */
+static int rx_check(const tase_rx_t *rx)
 {
     if (rx == NULL) {
         return TASE_EARG;
@@ -310,77 +366,40 @@ static int rx_begin(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user, rx_ca
     if (rx->busy != 0u) {
         return TASE_EBUSY;
     }
-    if (!rx_sane(rx)) {
+    return rx_sane(rx) ? TASE_OK : TASE_EARG;
+}
+
+/* tase_rx_push() for the last byte of a held candidate (and for a receiver
+ * that is busy or visibly corrupted). A valid frame is delivered from the
+ * window; a failed one leaves the byte in the window for the general path
+ * to scan on. */
+RX_NOINLINE static int push_event(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+{
+    uint16_t len = rx->len;
+    uint16_t want;
+    if (rx->busy != 0u) {
+        return TASE_EBUSY;
+    }
+    /* tase_rx_push() took every other byte of a sane receiver: held
+     * candidate (len >= 4) and len == end is what is left */
+    if (len < 4u || !rx_sane(rx)) {
         return TASE_EARG;
     }
-    c->on_frame = on_frame;
-    c->user = user;
-    c->count = 0u;
-    return TASE_OK;
-}
-
-int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
-                 void *user)
-{
-    rx_call_t c;
-    int r = (data == NULL && n > 0u) ? TASE_EARG : rx_begin(rx, on_frame, user, &c);
-    return (r != TASE_OK) ? r : run(rx, data, n, false, &c);
-}
-
-/* tase_rx_push() for every byte that is not simply stored: the byte state
- * machine of a classic parser (hunt the sync, take the Size, check the
- * last byte), and the general path only when a candidate fails. */
-static int push_event(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
-{
-    static const uint8_t sync[3] = {TASE_SYNC1, TASE_SYNC2, TASE_SYNC3};
-    uint16_t len = rx->len;
-    rx_call_t c;
-    int r = rx_begin(rx, on_frame, user, &c);
-    if (r != TASE_OK) {
-        return r;
+    rx->stats.bytes_in++;
+    want = (uint16_t)(((uint16_t)rx->buf[len - 1u] << 8) | b);
+    if (tase_checksum(0u, rx->buf, (size_t)len - 1u) == want) {
+        rx->len = 0u;
+        rx->end = 0u;
+        rx->busy = 1u;
+        (void)deliver(rx, rx->buf, rx->stats.bytes_in - (uint32_t)len - 1u, on_frame, user);
+        rx->busy = 0u; /* also right when the callback re-initialised rx */
+        return 1;
     }
-    if (len < 3u) {
-        rx->stats.bytes_in++;
-        if (b == sync[len]) {
-            rx->buf[len] = b;
-            rx->len = (uint16_t)(len + 1u);
-        } else {
-            /* a 00 may begin a sync: keep it (buf[0] is 00 already) */
-            uint16_t keep = 0u;
-            if (b == TASE_SYNC1) {
-                keep = 1u;
-            }
-            rx->stats.bytes_discarded += (uint32_t)(len + 1u - keep);
-            rx->len = keep;
-        }
-        return 0;
-    }
-    if (len == 3u && b >= 2u) {
-        rx->stats.bytes_in++;
-        rx->buf[3] = b;
-        rx->len = 4u;
-        rx->end = (uint16_t)(b + 5u);
-        return 0;
-    }
-    if (len > 3u && len == rx->end) { /* the held candidate's last byte */
-        uint16_t want = (uint16_t)(((uint16_t)rx->buf[len - 1u] << 8) | b);
-        rx->stats.bytes_in++;
-        if (tase_checksum(0u, rx->buf, (size_t)len - 1u) == want) {
-            rx->len = 0u;
-            rx->end = 0u;
-            rx->busy = 1u;
-            (void)deliver(rx, rx->buf, rx->stats.bytes_in - (uint32_t)len - 1u, &c);
-            rx->busy = 0u; /* also right when the callback re-initialised rx */
-            return 1;
-        }
-        rx->stats.checksum_errors++;
-        rx->buf[len] = b;
-        rx->len = (uint16_t)(len + 1u);
-        /* Judged: make its first byte noise for the scan of the rest. */
-        rx->buf[0] = TASE_SYNC2;
-        return run(rx, NULL, 0u, false, &c);
-    }
-    return run(rx, &b, 1u, false, &c); /* Size < 2 */
+    rx->stats.checksum_errors++;
+    rx->buf[len] = b;
+    rx->len = (uint16_t)(len + 1u);
+    rx->buf[0] = TASE_SYNC2;                     /* judged: its first byte is noise to the scan */
+    return run(rx, rx->buf, 0u, on_frame, user); /* no new byte, not the end */
 }
 
 int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user)
@@ -401,12 +420,46 @@ int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *
         rx->stats.bytes_in++;
         return 0;
     }
+    /* Hunting a sync, or its Size byte (nothing or a partial sync held, so
+     * end is 0). */
+    if (len < 4u && end == 0u && rx->busy == 0u) {
+        rx->stats.bytes_in++;
+        if ((len < 3u) ? (byte == sync[len]) : (byte >= 2u)) {
+            rx->buf[len] = byte;
+            rx->len = (uint16_t)(len + 1u);
+            if (len == 3u) {
+                rx->end = (uint16_t)(byte + 5u);
+            }
+        } else {
+            /* Broken (a Size < 2 is a bad Size): the bytes held are noise;
+             * a 00 may begin a sync, keep it (buf[0] is 00 already). */
+            uint16_t keep = 0u;
+            if (byte == TASE_SYNC1) {
+                keep = 1u;
+            }
+            if (len == 3u) {
+                rx->stats.bad_size++;
+            }
+            rx->stats.bytes_discarded += (uint32_t)(len + 1u - keep);
+            rx->len = keep;
+        }
+        return 0;
+    }
     return push_event(rx, byte, on_frame, user);
+}
+
+int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
+                 void *user)
+{
+    int r = (data == NULL && n > 0u) ? TASE_EARG : rx_check(rx);
+    if (r != TASE_OK) {
+        return r;
+    }
+    return run(rx, (data != NULL) ? data : rx->buf, n, on_frame, user); /* NULL: flush */
 }
 
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c;
-    int r = rx_begin(rx, on_frame, user, &c);
-    return (r != TASE_OK) ? r : run(rx, NULL, 0u, true, &c);
+    int r = rx_check(rx);
+    return (r != TASE_OK) ? r : run(rx, NULL, 0u, on_frame, user);
 }

@@ -659,6 +659,8 @@ enum { KRE_NONE, KRE_FEED, KRE_FLUSH, KRE_RESET, KRE_INIT };
 typedef struct {
     tase_klv_rx_t *rx;
     int action;
+    bool init_from_error; /* KRE_INIT: in the first error handler call, not the first call */
+    bool inited;
     size_t calls;   /* handler calls so far */
     size_t refused; /* nested feed/flush refused with TASE_EBUSY, rx unchanged */
 } klv_reenter_t;
@@ -666,7 +668,7 @@ typedef struct {
 static void klv_reenter_packet(void *user, uint32_t offset, const tase_klv_t *klv);
 static void klv_reenter_error(void *user, uint32_t offset, int err);
 
-static void klv_reenter_act(klv_reenter_t *e)
+static void klv_reenter_act(klv_reenter_t *e, bool from_error)
 {
     tase_klv_rx_t before;
     int r = TASE_OK;
@@ -679,7 +681,12 @@ static void klv_reenter_act(klv_reenter_t *e)
         break;
     case KRE_FLUSH: r = tase_klv_rx_flush(e->rx, klv_reenter_packet, klv_reenter_error, e); break;
     case KRE_RESET: r = tase_klv_rx_stats_reset(e->rx); break;
-    case KRE_INIT: r = (e->calls == 1u) ? tase_klv_rx_init(e->rx) : TASE_OK; break;
+    case KRE_INIT:
+        if (!e->inited && from_error == e->init_from_error) {
+            e->inited = true;
+            r = tase_klv_rx_init(e->rx);
+        }
+        break;
     default: break;
     }
     if (e->action == KRE_FEED || e->action == KRE_FLUSH) {
@@ -695,14 +702,14 @@ static void klv_reenter_packet(void *user, uint32_t offset, const tase_klv_t *kl
 {
     (void)offset;
     (void)klv;
-    klv_reenter_act(user);
+    klv_reenter_act(user, false);
 }
 
 static void klv_reenter_error(void *user, uint32_t offset, int err)
 {
     (void)offset;
     (void)err;
-    klv_reenter_act(user);
+    klv_reenter_act(user, true);
 }
 
 /* Feed s[0..n) (in one call or byte by byte) and flush; rets[] gets each
@@ -718,7 +725,7 @@ static size_t klv_reenter_run(klv_reenter_t *e, const uint8_t *s, size_t n, bool
         assert_true(rets[calls] >= 0);
         pos += k;
         calls++;
-        if (e->action == KRE_INIT && e->calls > 0u) {
+        if (e->inited) {
             return calls;
         }
     }
@@ -759,13 +766,19 @@ static void scanner_calls_from_inside_a_handler_are_refused_or_safe(void **state
         plain_calls = klv_reenter_run(&e, s, n, bytewise != 0, plain_rets);
         assert_int_equal(e.calls, 4); /* 2 packets, a checksum error, a cut */
         plain_stats = rx.stats;
-        for (action = KRE_FEED; action <= KRE_INIT; action++) {
+        for (action = KRE_FEED; action <= KRE_INIT + 1; action++) {
             memset(&e, 0, sizeof(e));
             e.rx = &rx;
-            e.action = action;
+            e.action = action > KRE_INIT ? KRE_INIT : action;
+            e.init_from_error = action > KRE_INIT;
             calls = klv_reenter_run(&e, s, n, bytewise != 0, rets);
-            if (action == KRE_INIT) {
-                assert_int_equal(rets[calls - 1u], 1);
+            if (e.action == KRE_INIT) {
+                /* from the packet handler (the first packet) or the error
+                 * handler (after the first packet): the call returns the
+                 * packets it delivered, the first one unless the stream
+                 * comes byte by byte and the error came in a later call */
+                assert_true(e.inited);
+                assert_int_equal(rets[calls - 1u], (bytewise && e.init_from_error) ? 0 : 1);
                 assert_memory_equal(&rx, &fresh, sizeof(rx));
                 e.action = KRE_NONE;
                 assert_int_equal(tase_klv_rx_feed(&rx, hand_packet, 87, klv_reenter_packet,

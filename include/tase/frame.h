@@ -51,19 +51,23 @@
  * COST. The receiver keeps only the earliest pending candidate (the bytes
  * after it are not examined until it is decided), so the scan position
  * never moves back: each byte is examined once, each candidate's checksum
- * is computed once. A byte inside a frame fed with tase_rx_push() is only
- * stored; a frame's checksum is summed once its last byte is in. A buffer
- * fed with tase_rx_feed() is scanned in place: idle bytes are skipped with
- * memchr, and a frame wholly inside the buffer is checked and delivered
- * straight from it. On x86-64 (gcc -O2, callgrind) a clean telemetry
- * stream costs about 6 instructions per byte fed in 4 KB buffers and about
- * 14 fed one byte at a time with tase_rx_push(); a stream made only of
- * false syncs claiming 253 data bytes is the worst case, about 80 (about
- * 90 byte at a time). docs/PERFORMANCE.md has the measured numbers, with
- * Cortex-M4 figures.
+ * is computed once. tase_rx_push() stores a byte inside a frame with one
+ * test; the sync bytes and the Size byte are handled next to it, and the
+ * last byte sums the frame once. A buffer fed with tase_rx_feed() is
+ * scanned in place: idle bytes are skipped with memchr, and a frame wholly
+ * inside the buffer is checked and delivered straight from it. On a clean
+ * telemetry stream (x86-64 gcc -O2, callgrind) that is about 6
+ * instructions per byte fed in 4 KB buffers and about 23 fed one byte at a
+ * time with tase_rx_push(), where the classic single-state parser of
+ * bench/ costs 24; on Cortex-M4 (-O2, QEMU) about 6 and 33 Thumb-2
+ * instructions per byte (classic: 32). A stream made only of false syncs
+ * claiming 253 data bytes is the worst case, about 160 (190 byte at a
+ * time): every candidate there fails and is summed. docs/PERFORMANCE.md
+ * has the measured numbers.
  *
  * RAM. sizeof(tase_rx_t) is TASE_FRAME_MAX window bytes + counters + 5
- * bytes of state; checked against TASE_RX_SIZE_BUDGET at compile time. See
+ * bytes of state (296 in all); checked against TASE_RX_SIZE_BUDGET at
+ * compile time. Stack: see docs/FOOTPRINT.md. See
  * docs/DESIGN.md for why the 272-byte target of the original brief cannot
  * hold with 32-bit counters in the instance.
  *
