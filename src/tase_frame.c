@@ -173,10 +173,11 @@ static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, tase_rx_ha
 }
 
 /* The greedy scan of src[0..m), with nothing pending before it. The first
- * `counted` bytes are already in stats.bytes_in (bytes of the window); the
- * others are counted as the scan passes them, so that a callback sees
- * bytes_in up to the frame's last byte. A complete candidate is judged
- * where it lies. The first incomplete one (a sync still arriving, or a
+ * `counted_before` bytes are already in stats.bytes_in (bytes of the
+ * window); the others are counted as the scan passes them, so that a
+ * callback sees bytes_in up to the byte that decided its frame (its last
+ * byte, or the last byte of a longer candidate before it that failed). A
+ * complete candidate is judged where it lies. The first incomplete one (a sync still arriving, or a
  * candidate whose last byte has not come) is moved with everything after
  * it to the window, unless `final` (end of input), where it fails like a
  * bad one: discard its first byte and scan on. Returns false when a

@@ -38,15 +38,17 @@
  *
  * LATENCY. A frame that does not lie inside a still-pending earlier
  * candidate is delivered from the call that feeds its last byte (zero
- * added latency). A frame that does lie inside a pending candidate (one
- * whose last byte has not arrived yet, e.g. after a Size byte corrupted
- * upwards) is held until that candidate is decided: if the candidate turns
- * out valid the frame was its data and is dropped; if it fails, the frame
- * is delivered from the call that feeds the candidate's last byte, late by
- * at most TASE_FRAME_MAX - 8 = 253 bytes (the candidate began before the
- * frame and spans at most TASE_FRAME_MAX bytes). tase_rx_flush() settles
- * whatever is pending at end of input: pending candidates can no longer
- * complete, so they fail and what they were hiding is scanned.
+ * added latency). One that does (a pending candidate is one whose last
+ * byte has not arrived yet, e.g. after a Size byte corrupted upwards) is
+ * held while it does: if such a candidate turns out valid, the frame was
+ * its data and is dropped; once every candidate that covered it has
+ * failed, it is delivered from the call that fed the last of their last
+ * bytes, late by at most TASE_FRAME_MAX - 8 = 253 bytes (each began before
+ * it and spans at most TASE_FRAME_MAX bytes). In the callback,
+ * stats.bytes_in counts the bytes up to that deciding byte, whatever the
+ * split of the stream into calls. tase_rx_flush() settles whatever is
+ * pending at end of input: pending candidates can no longer complete, so
+ * they fail and what they were hiding is scanned.
  *
  * COST. The receiver keeps only the earliest pending candidate (the bytes
  * after it are not examined until it is decided), so the scan position
