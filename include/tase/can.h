@@ -144,7 +144,8 @@ typedef struct {
 
 /* Initialise for `role` (the role of the node that receives): empty
  * datalink receiver, all counters zero. Returns TASE_OK or TASE_EARG
- * (crx NULL or unknown role; crx untouched). O(1). */
+ * (crx NULL or unknown role; crx untouched). O(1). Allowed from inside
+ * the instance's own frame callback (see tase_can_rx_feed()). */
 int tase_can_rx_init(tase_can_rx_t *crx, tase_can_role_t role);
 
 /* Feed one received CAN frame. If tase_can_accept() takes it, its payload
@@ -154,8 +155,13 @@ int tase_can_rx_init(tase_can_rx_t *crx, tase_can_role_t role);
  * ours: normal on a shared bus) or TASE_ELENGTH (our ID, bad dlc). These
  * two are the only "errors" that still change the instance (a counter).
  * TASE_EARG: crx or f NULL, or crx->role not a role (corrupted instance;
- * nothing counted). Not reentrant per instance;
- * O(dlc) plus the datalink receiver's cost. */
+ * nothing counted). TASE_EBUSY: called from inside on_frame of this
+ * instance (nothing counted, nothing changed). From inside on_frame,
+ * tase_can_rx_init() is allowed: it resets the instance and the call that
+ * made the callback returns as soon as it does (see frame.h, RE-ENTRANCY);
+ * reading or clearing the counters is allowed too. The returned count is
+ * never negative except for these codes. O(dlc) plus the datalink
+ * receiver's cost. */
 int tase_can_rx_feed(tase_can_rx_t *crx, const tase_can_frame_t *f, tase_rx_handler_t on_frame,
                      void *user);
 
