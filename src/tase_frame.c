@@ -365,7 +365,8 @@ static int rx_check(const tase_rx_t *rx)
         return TASE_EARG;
     }
     if (rx->busy != 0u) {
-        return TASE_EBUSY;
+        /* 1 while a callback runs; anything else is a corrupted instance */
+        return rx->busy == 1u ? TASE_EBUSY : TASE_EARG;
     }
     return rx_sane(rx) ? TASE_OK : TASE_EARG;
 }
@@ -379,7 +380,7 @@ RX_NOINLINE static int push_event(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on
     uint16_t len = rx->len;
     uint16_t want;
     if (rx->busy != 0u) {
-        return TASE_EBUSY;
+        return rx->busy == 1u ? TASE_EBUSY : TASE_EARG;
     }
     /* tase_rx_push() took every other byte of a sane receiver: held
      * candidate (len >= 4) and len == end is what is left */
