@@ -7,6 +7,7 @@
 #include "tase/candump.h"
 #include "tase/host.h"
 #include "tase/klv.h"
+#include "tk_capture.h"
 #include "toolkit.h"
 
 #define DEFAULT_BAUD 57600L
@@ -19,13 +20,18 @@ static const char usage_main[] =
     "  query    zero-length query of a setup packet, SPOI_CMD or SYSTEM_VERSION\n"
     "  decode   decode a raw serial capture or a candump log to JSON lines\n"
     "  klv      decode a KLV metadata byte stream to JSON lines\n"
+    "  record   record a serial line or a CAN bus to a pcap capture with timestamps\n"
+    "  replay   send a capture back to a serial device or CAN interface with its timing\n"
     "  list     list the packets and their field names\n";
 
 static const char usage_link[] =
     "link options:\n"
     "  --serial DEV   serial device or pty (e.g. /dev/ttyUSB0, the path tase-sim prints)\n"
     "  --baud N       serial rate, default 57600\n"
-    "  --can IFACE    CAN interface instead of a serial device (e.g. can0)\n";
+    "  --can IFACE    CAN interface instead of a serial device (e.g. can0)\n"
+    "  --record FILE  also record the session's bytes, both directions, to the pcap\n"
+    "                 capture FILE (appended to; serial links only: on CAN run\n"
+    "                 'tase record --can IFACE' beside it)\n";
 
 static const char usage_monitor[] =
     "usage: tase monitor (--serial DEV [--baud N] | --can IFACE) [--json] [--count N]\n"
@@ -65,6 +71,30 @@ static const char usage_klv[] =
     "JSON object per valid packet: {\"offset\":N,\"fields\":{raw values in tag order},\n"
     "\"units\":{engineering values}}. Noise and damaged packets are skipped.\n";
 
+static const char usage_record[] =
+    "usage: tase record (--serial DEV [--tap-in DEV2] [--baud N] | --can IFACE) -o FILE\n"
+    "                   [--seconds S]\n"
+    "Records what arrives to the pcap capture FILE (replaced), with a timestamp per\n"
+    "received chunk, until interrupted (Ctrl-C) or S seconds have passed.\n"
+    "  --serial DEV   one record per read, byte-exact, as sent by the gimbal\n"
+    "                 (link type USER0 with a direction byte; docs/TOOLS.md)\n"
+    "  --tap-in DEV2  a second device on the other line of a tap: its bytes are\n"
+    "                 recorded as sent to the gimbal\n"
+    "  --can IFACE    every frame on the bus, as SocketCAN records (LINKTYPE_CAN_SOCKETCAN)\n"
+    "'tase decode FILE' decodes it; Wireshark reads it (tools/wireshark/tase.lua).\n";
+
+static const char usage_replay[] =
+    "usage: tase replay FILE (--serial DEV [--baud N] | --can IFACE) [--speed X]\n"
+    "                   [--dir out|in|all]\n"
+    "Sends the records of the pcap capture FILE with their recorded timing (divided\n"
+    "by X, default 1; 0 sends without waiting).\n"
+    "  --dir out   what the gimbal sent (the default: plays the gimbal's side)\n"
+    "  --dir in    what was sent to the gimbal (commands: moves a real gimbal)\n"
+    "  --dir all   both; on CAN every recorded frame, whatever its ID\n"
+    "Serial bytes go to a CAN interface as frames of their direction's ID, and the\n"
+    "datalink bytes of CAN frames to a serial device; CAN FD, remote and error\n"
+    "frames are skipped.\n";
+
 static const char usage_list[] = "usage: tase list\nLists every packet: group, type, "
                                  "direction, data length and field names.\n";
 
@@ -81,6 +111,7 @@ typedef struct {
     const char *serial;
     const char *can;
     long baud;
+    const char *record; /* --record FILE, or NULL */
 } link_opts_t;
 
 /* If argv[i] is option `name` (with "--name V" or "--name=V" when has_arg),
@@ -127,7 +158,8 @@ static bool link_opt(args_t *a, link_opts_t *l)
 {
     const char *v;
     long long n;
-    if (opt(a, "--serial", true, &l->serial) || opt(a, "--can", true, &l->can)) {
+    if (opt(a, "--serial", true, &l->serial) || opt(a, "--can", true, &l->can) ||
+        opt(a, "--record", true, &l->record)) {
         return true;
     }
     if (opt(a, "--baud", true, &v)) {
@@ -158,6 +190,17 @@ static void bad_arg(const args_t *a)
     tk_usage_error("unexpected argument '%s' (see --help)", s);
 }
 
+/* The --record capture of this process's link (one link per run). */
+static tk_cap_writer_t session_capture;
+static tk_cap_tap_t session_tap;
+
+static void close_session_capture(void)
+{
+    if (session_capture.dumper != NULL) {
+        tk_cap_close(&session_capture);
+    }
+}
+
 static void open_link(const link_opts_t *lo, tk_link_t *l, tase_port_t *port)
 {
     if (lo->serial != NULL && lo->can != NULL) {
@@ -166,12 +209,22 @@ static void open_link(const link_opts_t *lo, tk_link_t *l, tase_port_t *port)
     if (lo->serial == NULL && lo->can == NULL) {
         tk_usage_error("no link given: use --serial DEV or --can IFACE");
     }
+    if (lo->record != NULL && lo->can != NULL) {
+        tk_usage_error("--record records serial links; on CAN run 'tase record --can %s -o FILE' "
+                       "beside this command",
+                       lo->can);
+    }
     if (lo->serial != NULL) {
         tk_link_serial(l, lo->serial, lo->baud);
     } else {
         tk_link_can(l, lo->can, false);
     }
     *port = tk_link_port(l);
+    if (lo->record != NULL) {
+        tk_cap_create(&session_capture, lo->record, TK_CAP_LINKTYPE_SERIAL, true);
+        atexit(close_session_capture);
+        *port = tk_cap_tap_port(&session_tap, *port, &session_capture);
+    }
 }
 
 /* ---- output of received frames ---- */
@@ -202,7 +255,7 @@ static void print_frame(void *user, const tase_frame_t *f)
 
 static int cmd_monitor(args_t *a)
 {
-    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD};
+    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
     printer_t pr = {false, 0, 0, NULL};
     double seconds = 0.0, t_end;
     const char *v;
@@ -295,7 +348,7 @@ static void print_reply(const tase_packet_desc_t *p, const uint8_t *reply, int l
 
 static int cmd_query(args_t *a)
 {
-    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD};
+    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
     req_opts_t r = {500, 2, false};
     const char *name = NULL;
     const tase_packet_desc_t *p;
@@ -355,7 +408,7 @@ static size_t parse_tail(const char *v, uint8_t *out, size_t cap)
 
 static int cmd_send(args_t *a)
 {
-    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD};
+    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
     req_opts_t r = {500, 2, false};
     const char *name = NULL, *v;
     const char *assign[64];
@@ -630,6 +683,129 @@ static int cmd_klv(args_t *a)
     return 0;
 }
 
+/* ---- record / replay (tk_capture.c) ---- */
+
+static int cmd_record(args_t *a)
+{
+    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
+    const char *out = NULL, *tap_in = NULL, *v;
+    double seconds = 0.0;
+    tk_cap_writer_t w;
+    while (a->i < a->argc) {
+        if (help_opt(a) || link_opt(a, &lo)) {
+            continue;
+        }
+        if (opt(a, "-o", true, &out) || opt(a, "--output", true, &out) ||
+            opt(a, "--tap-in", true, &tap_in)) {
+            continue;
+        }
+        if (opt(a, "--seconds", true, &v)) {
+            if (tk_parse_seconds(v, &seconds) != 0 || seconds <= 0.0) {
+                tk_usage_error("bad --seconds value '%s'", v);
+            }
+        } else {
+            bad_arg(a);
+        }
+    }
+    if (lo.record != NULL) {
+        tk_usage_error("record writes its capture with -o FILE (--record is for the other "
+                       "commands)");
+    }
+    if (out == NULL) {
+        tk_usage_error("record needs an output file: -o FILE");
+    }
+    if ((lo.serial != NULL) == (lo.can != NULL)) {
+        tk_usage_error("give either --serial DEV or --can IFACE");
+    }
+    if (tap_in != NULL && lo.serial == NULL) {
+        tk_usage_error("--tap-in is the second line of a serial tap: it needs --serial");
+    }
+    if (lo.serial != NULL) {
+        tk_cap_create(&w, out, TK_CAP_LINKTYPE_SERIAL, false);
+        tk_cap_record_serial(&w, lo.serial, tap_in, lo.baud, seconds);
+    } else {
+        tk_cap_create(&w, out, TK_CAP_LINKTYPE_CAN, false);
+        tk_cap_record_can(&w, lo.can, seconds);
+    }
+    return 0;
+}
+
+/* Open FILE (or standard input) and, when it is a pcap or pcapng capture,
+ * a reader over it; returns false (bytes read so far in head) otherwise. */
+static bool open_capture(FILE *in, const char *path, tk_cap_reader_t *r, uint8_t *head,
+                         size_t *nhead)
+{
+    *nhead = fread(head, 1, 4, in);
+    if (!tk_cap_is_capture(head, *nhead)) {
+        return false;
+    }
+    tk_cap_reader_open(r, in, head, *nhead, path);
+    return true;
+}
+
+static FILE *open_input(const char *path);
+
+static int cmd_replay(args_t *a)
+{
+    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
+    tk_replay_opts_t ro;
+    const char *path = NULL, *v;
+    tk_cap_reader_t r;
+    uint8_t head[4];
+    size_t nhead;
+    FILE *in;
+    memset(&ro, 0, sizeof(ro));
+    ro.speed = 1.0;
+    ro.dirs = TK_CAP_DIR_OUT;
+    while (a->i < a->argc) {
+        if (help_opt(a) || link_opt(a, &lo)) {
+            continue;
+        }
+        if (opt(a, "--speed", true, &v)) {
+            if (tk_parse_seconds(v, &ro.speed) != 0) {
+                tk_usage_error("bad --speed value '%s' (a factor: 1 recorded timing, 2 twice as "
+                               "fast, 0 no waiting)",
+                               v);
+            }
+        } else if (opt(a, "--dir", true, &v)) {
+            if (strcmp(v, "out") == 0) {
+                ro.dirs = TK_CAP_DIR_OUT;
+            } else if (strcmp(v, "in") == 0) {
+                ro.dirs = TK_CAP_DIR_IN;
+            } else if (strcmp(v, "all") == 0) {
+                ro.dirs = TK_CAP_DIR_ALL;
+            } else {
+                tk_usage_error("bad --dir value '%s' (out, in or all)", v);
+            }
+        } else if (path == NULL && a->argv[a->i][0] != '-') {
+            path = a->argv[a->i++];
+        } else {
+            bad_arg(a);
+        }
+    }
+    if (path == NULL) {
+        tk_usage_error("replay needs a capture file (written by 'tase record')");
+    }
+    if (lo.record != NULL) {
+        tk_usage_error("--record is not available with replay");
+    }
+    if ((lo.serial != NULL) == (lo.can != NULL)) {
+        tk_usage_error("give either --serial DEV or --can IFACE");
+    }
+    in = open_input(path);
+    if (!open_capture(in, path, &r, head, &nhead)) {
+        tk_die("%s is not a pcap or pcapng capture (candump logs: can-utils' canplayer "
+               "replays them)",
+               path);
+    }
+    ro.serial = lo.serial;
+    ro.baud = lo.baud;
+    ro.can = lo.can;
+    tk_cap_replay(&r, &ro);
+    tk_cap_reader_close(&r);
+    return 0;
+}
+
 /* ---- list ---- */
 
 static int cmd_list(args_t *a)
@@ -671,6 +847,8 @@ int main(int argc, char **argv)
         {"query", cmd_query, usage_query},
         {"decode", cmd_decode, usage_decode},
         {"klv", cmd_klv, usage_klv},
+        {"record", cmd_record, usage_record},
+        {"replay", cmd_replay, usage_replay},
         {"list", cmd_list, usage_list},
     };
     args_t a;
