@@ -234,6 +234,7 @@ typedef struct {
     long count; /* frames printed */
     long limit; /* 0: no limit */
     const char *dir;
+    char time[32]; /* JSON "time" of the record being fed ("": none) */
 } printer_t;
 
 static void print_frame(void *user, const tase_frame_t *f)
@@ -243,7 +244,7 @@ static void print_frame(void *user, const tase_frame_t *f)
         return;
     }
     if (pr->json) {
-        tk_json_frame(stdout, f, pr->dir);
+        tk_json_frame(stdout, f, pr->dir, pr->time[0] != '\0' ? pr->time : NULL);
     } else {
         tk_text_frame(stdout, f);
     }
@@ -256,7 +257,7 @@ static void print_frame(void *user, const tase_frame_t *f)
 static int cmd_monitor(args_t *a)
 {
     link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
-    printer_t pr = {false, 0, 0, NULL};
+    printer_t pr = {false, 0, 0, NULL, ""};
     double seconds = 0.0, t_end;
     const char *v;
     tk_link_t link;
@@ -337,7 +338,7 @@ static void print_reply(const tase_packet_desc_t *p, const uint8_t *reply, int l
                         const req_opts_t *r)
 {
     tase_frame_t f;
-    printer_t pr = {r->json, 0, 0, NULL};
+    printer_t pr = {r->json, 0, 0, NULL, ""};
     f.offset = 0;
     f.group = TASE_ID_GROUP(p->id);
     f.type = TASE_ID_TYPE(p->id);
@@ -542,12 +543,78 @@ static FILE *open_input(const char *path)
     return f;
 }
 
+/* When `in` is a pcap or pcapng capture, open a reader over it and return
+ * true; otherwise return false with the (up to 4) bytes read in head. */
+static bool open_capture(FILE *in, const char *path, tk_cap_reader_t *r, uint8_t *head,
+                         size_t *nhead)
+{
+    *nhead = fread(head, 1, 4, in);
+    if (!tk_cap_is_capture(head, *nhead)) {
+        return false;
+    }
+    tk_cap_reader_open(r, in, head, *nhead, path);
+    return true;
+}
+
+/* Feed a CAN frame of a capture to the receiver of its direction (other
+ * IDs are ignored), with the record's time for the JSON. */
+static void feed_can_frame(tase_can_rx_t *from_gimbal, tase_can_rx_t *to_gimbal, printer_t *out_pr,
+                           printer_t *in_pr, const tase_can_frame_t *f, const tk_time_t *t,
+                           unsigned digits)
+{
+    if (tase_can_accept(TASE_CAN_ROLE_HOST, f) > 0) {
+        tk_time_format(out_pr->time, sizeof(out_pr->time), t, digits);
+        (void)tase_can_rx_feed(from_gimbal, f, print_frame, out_pr);
+    } else if (tase_can_accept(TASE_CAN_ROLE_GIMBAL, f) > 0) {
+        tk_time_format(in_pr->time, sizeof(in_pr->time), t, digits);
+        (void)tase_can_rx_feed(to_gimbal, f, print_frame, in_pr);
+    }
+}
+
+/* A pcap/pcapng capture of tase record: serial records go to one receiver
+ * per direction, CAN records as in a candump log. Returns the number of
+ * malformed records (reported and skipped). */
+static unsigned long decode_capture(tk_cap_reader_t *r)
+{
+    tase_can_rx_t from_gimbal, to_gimbal;
+    tase_rx_t serial[2]; /* indexed by the direction byte */
+    printer_t out_pr = {true, 0, 0, "out", ""}, in_pr = {true, 0, 0, "in", ""};
+    printer_t *prs[2] = {&out_pr, &in_pr};
+    unsigned long bad = 0;
+    tk_cap_rec_t rec;
+    char why[160];
+    int rc;
+    tase_can_rx_init(&from_gimbal, TASE_CAN_ROLE_HOST);
+    tase_can_rx_init(&to_gimbal, TASE_CAN_ROLE_GIMBAL);
+    tase_rx_init(&serial[TK_CAP_FROM_GIMBAL]);
+    tase_rx_init(&serial[TK_CAP_TO_GIMBAL]);
+    while ((rc = tk_cap_next(r, &rec, why, sizeof(why))) != TK_CAP_END) {
+        if (rc == TK_CAP_BAD) {
+            fprintf(stderr, "%s: %s: record %lu skipped: %s\n", tk_prog, r->path, rec.index, why);
+            bad++;
+        } else if (r->linktype == TK_CAP_LINKTYPE_SERIAL) {
+            tk_time_format(prs[rec.dir]->time, sizeof(prs[rec.dir]->time), &rec.t, 9);
+            tase_rx_feed(&serial[rec.dir], rec.data, rec.len, print_frame, prs[rec.dir]);
+        } else if (rec.can_data) {
+            feed_can_frame(&from_gimbal, &to_gimbal, &out_pr, &in_pr, &rec.frame, &rec.t, 9);
+        }
+    }
+    if (r->linktype == TK_CAP_LINKTYPE_SERIAL) {
+        tase_rx_flush(&serial[TK_CAP_TO_GIMBAL], print_frame, &in_pr);
+        tase_rx_flush(&serial[TK_CAP_FROM_GIMBAL], print_frame, &out_pr);
+    } else {
+        tase_rx_flush(&to_gimbal.rx, print_frame, &in_pr);
+        tase_rx_flush(&from_gimbal.rx, print_frame, &out_pr);
+    }
+    return bad;
+}
+
 static void decode_candump(FILE *in, const char *path)
 {
     /* from the gimbal: what a host receives; to the gimbal: what a gimbal
      * receives */
     tase_can_rx_t from_gimbal, to_gimbal;
-    printer_t out_pr = {true, 0, 0, "out"}, in_pr = {true, 0, 0, "in"};
+    printer_t out_pr = {true, 0, 0, "out", ""}, in_pr = {true, 0, 0, "in", ""};
     char line[512];
     unsigned long lineno = 0;
     tase_can_rx_init(&from_gimbal, TASE_CAN_ROLE_HOST);
@@ -570,11 +637,8 @@ static void decode_candump(FILE *in, const char *path)
         if (rc != TASE_OK) {
             tk_die("%s:%lu: not a candump log line", path, lineno);
         }
-        if (tase_can_accept(TASE_CAN_ROLE_HOST, &rec.frame) > 0) {
-            (void)tase_can_rx_feed(&from_gimbal, &rec.frame, print_frame, &out_pr);
-        } else if (tase_can_accept(TASE_CAN_ROLE_GIMBAL, &rec.frame) > 0) {
-            (void)tase_can_rx_feed(&to_gimbal, &rec.frame, print_frame, &in_pr);
-        }
+        tk_time_t t = {(int64_t)rec.sec, rec.usec * 1000u};
+        feed_can_frame(&from_gimbal, &to_gimbal, &out_pr, &in_pr, &rec.frame, &t, 6);
     }
     if (ferror(in)) {
         tk_die("cannot read %s: %s", path, strerror(errno));
@@ -607,11 +671,21 @@ static int cmd_decode(args_t *a)
     if (candump) {
         decode_candump(in, path);
     } else {
-        printer_t pr = {true, 0, 0, NULL};
+        printer_t pr = {true, 0, 0, NULL, ""};
         tase_rx_t rx;
+        tk_cap_reader_t r;
         uint8_t buf[4096];
         size_t n;
+        if (open_capture(in, path, &r, buf, &n)) {
+            unsigned long bad = decode_capture(&r);
+            tk_cap_reader_close(&r);
+            if (bad > 0) {
+                tk_die("%s: %lu malformed record%s skipped", path, bad, bad == 1 ? "" : "s");
+            }
+            return 0;
+        }
         tase_rx_init(&rx);
+        tase_rx_feed(&rx, buf, n, print_frame, &pr); /* the bytes open_capture() looked at */
         while ((n = fread(buf, 1, sizeof(buf), in)) > 0) {
             tase_rx_feed(&rx, buf, n, print_frame, &pr);
         }
@@ -729,21 +803,6 @@ static int cmd_record(args_t *a)
     }
     return 0;
 }
-
-/* Open FILE (or standard input) and, when it is a pcap or pcapng capture,
- * a reader over it; returns false (bytes read so far in head) otherwise. */
-static bool open_capture(FILE *in, const char *path, tk_cap_reader_t *r, uint8_t *head,
-                         size_t *nhead)
-{
-    *nhead = fread(head, 1, 4, in);
-    if (!tk_cap_is_capture(head, *nhead)) {
-        return false;
-    }
-    tk_cap_reader_open(r, in, head, *nhead, path);
-    return true;
-}
-
-static FILE *open_input(const char *path);
 
 static int cmd_replay(args_t *a)
 {

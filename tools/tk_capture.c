@@ -34,12 +34,12 @@ void tk_time_now(tk_time_t *t)
     t->nsec = (uint32_t)ts.tv_nsec;
 }
 
-void tk_time_print(FILE *out, const tk_time_t *t, unsigned digits)
+void tk_time_format(char *buf, size_t cap, const tk_time_t *t, unsigned digits)
 {
     if (digits == 6u) {
-        fprintf(out, "%lld.%06u", (long long)t->sec, (unsigned)(t->nsec / 1000u));
+        snprintf(buf, cap, "%lld.%06u", (long long)t->sec, (unsigned)(t->nsec / 1000u));
     } else {
-        fprintf(out, "%lld.%09u", (long long)t->sec, (unsigned)t->nsec);
+        snprintf(buf, cap, "%lld.%09u", (long long)t->sec, (unsigned)t->nsec);
     }
 }
 

@@ -61,8 +61,9 @@ typedef struct {
 
 /* The wall clock now (CLOCK_REALTIME). */
 void tk_time_now(tk_time_t *t);
-/* Print t as a JSON number of seconds with `digits` (6 or 9) decimals. */
-void tk_time_print(FILE *out, const tk_time_t *t, unsigned digits);
+/* Format t into buf[0..cap) as a JSON number of seconds with `digits` (6
+ * or 9) decimals. */
+void tk_time_format(char *buf, size_t cap, const tk_time_t *t, unsigned digits);
 
 /* ---- writing ---- */
 

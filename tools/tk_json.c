@@ -76,11 +76,14 @@ static void json_bytes(FILE *out, const uint8_t *p, size_t n)
     fputc(']', out);
 }
 
-void tk_json_frame(FILE *out, const tase_frame_t *f, const char *dir)
+void tk_json_frame(FILE *out, const tase_frame_t *f, const char *dir, const char *time)
 {
     const tase_packet_desc_t *p = tase_schema_find(f->group, f->type);
     unsigned i;
     fprintf(out, "{\"offset\":%lu,", (unsigned long)f->offset);
+    if (time != NULL) {
+        fprintf(out, "\"time\":%s,", time);
+    }
     if (dir != NULL) {
         fprintf(out, "\"dir\":\"%s\",", dir);
     }

@@ -106,8 +106,9 @@ bool tk_packet_has_tail(const tase_packet_desc_t *p);
 /* ---- JSON ---- */
 
 /* One JSON object for a frame, with a newline. `dir` (NULL, "in", "out")
- * adds the CAN direction key. */
-void tk_json_frame(FILE *out, const tase_frame_t *f, const char *dir);
+ * adds the direction key; `time` (NULL or a JSON number of seconds) the
+ * capture time key. */
+void tk_json_frame(FILE *out, const tase_frame_t *f, const char *dir, const char *time);
 /* One human-readable line for a frame. */
 void tk_text_frame(FILE *out, const tase_frame_t *f);
 

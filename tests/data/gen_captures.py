@@ -205,7 +205,9 @@ def candump(rng):
             o = pending[which][0]
             if o["offset"] + sizes[which][0] > pos[which]:
                 break
-            expect.append(pending[which].pop(0))
+            o = pending[which].pop(0)
+            o["time"] = RawJson("%.6f" % t)  # the line that completed it, as logged
+            expect.append(o)
             sizes[which].pop(0)
         if rng.random() < 0.3:
             t += 0.0001
@@ -272,13 +274,22 @@ def klv_capture(rng):
     return bytes(buf), expect
 
 
+class RawJson(str):
+    """A JSON number written exactly as given (capture times keep their digits)."""
+
+
 def dump(path, objs):
+    first = ("offset", "time", "dir")  # the contract's key order
     with open(path, "w") as f:
         for o in objs:
-            if "dir" in o:  # put the direction right after the offset
-                o = {"offset": o["offset"], "dir": o["dir"],
-                     **{k: v for k, v in o.items() if k not in ("offset", "dir")}}
-            f.write(json.dumps(o, separators=(",", ":")) + "\n")
+            o = {**{k: o[k] for k in first if k in o},
+                 **{k: v for k, v in o.items() if k not in first}}
+            raw = {k: v for k, v in o.items() if isinstance(v, RawJson)}
+            text = json.dumps({k: ("@%s@" % k if k in raw else v) for k, v in o.items()},
+                              separators=(",", ":"))
+            for k, v in raw.items():
+                text = text.replace('"@%s@"' % k, v)
+            f.write(text + "\n")
 
 
 def main():

@@ -322,9 +322,8 @@ local function add_frame(tree, fr, dir)
             if f.offset + f.width > len then break end -- short forms: the fields that fit
             t:add(f.pf, ftvb(6 + f.offset, f.width))
         end
-        local tail = len - p.len
-        if p.flags:find("t", 1, true) and tail > 0 then
-            t:add(F.data, ftvb(6 + p.len, tail))
+        if p.flags:find("t", 1, true) then -- CAMERA_PASS: its camera bytes, maybe none
+            t:add(F.data, ftvb(6 + p.len, len - p.len))
         end
     end
     t:add(F.checksum, ftvb(6 + len, 2))
