@@ -4,9 +4,10 @@ scripts/check-wireshark.sh). Written from the format descriptions
 (docs/TOOLS.md "Captures", tcpdump.org's LINKTYPE_CAN_SOCKETCAN), not from
 the tools' code, so they check it rather than repeat it.
 
-  serial-pcap OUT SEED BIN:DIR...  a nanosecond pcap, link type 147, of the
-        raw byte streams BIN (DIR out = from the gimbal, in = to it) cut in
-        random 1..64-byte records, interleaved; prints the record times.
+  serial-pcap OUT SEED GAPS BIN:DIR...  a nanosecond pcap, link type 147,
+        of the raw byte streams BIN (DIR out = from the gimbal, in = to it)
+        cut in random 1..64-byte records, interleaved, GAPS ("LO-HI", in
+        milliseconds) apart.
   expect-serial PCAP JSONL:DIR...  the JSON lines `tase decode PCAP` must
         print, from each stream's expected lines (the generator's
         decode_noisy.jsonl): "time" and "dir" added, ordered by the record
@@ -22,6 +23,8 @@ the tools' code, so they check it rather than repeat it.
         order, data bytes, errors, directions, offsets and times.
   pdml-3ax PDML                    the 3AX frames the dissector showed, one
         "NAME position speed" line each ("error" for a wrong length).
+  records PCAP                     one line per record: time, then (serial)
+        the direction byte and the bytes in hex, or (CAN) id#data.
   timing PCAP_SENT PCAP_GOT DIR SPEED TOL  the bytes of direction DIR in
         PCAP_SENT arrived in PCAP_GOT (direction out) byte for byte, each
         within TOL seconds of its recorded time divided by SPEED.
@@ -79,8 +82,9 @@ def cut(data, rng):
     return out
 
 
-def serial_pcap(out, seed, specs):
+def serial_pcap(out, seed, gaps, specs):
     rng = random.Random(int(seed))
+    lo, hi = (int(Decimal(x) * 1000000) for x in gaps.split("-"))
     queues = []
     for spec in specs:
         path, d = spec.rsplit(":", 1)
@@ -90,7 +94,7 @@ def serial_pcap(out, seed, specs):
         f.write(pcap_header(LINKTYPE_SERIAL))
         while any(q for _, q in queues):
             d, q = rng.choice([x for x in queues if x[1]])
-            ns += rng.randint(1000, 3000000)
+            ns += rng.randint(lo, hi)
             f.write(pcap_record(T0 + ns // 10**9, ns % 10**9, bytes([d]) + q.pop(0)))
 
 
@@ -266,6 +270,16 @@ def pdml_3ax(pdml):
                 print(name, vals["tase.3ax_status.position"], vals["tase.3ax_status.speed"])
 
 
+def records(pcap):
+    linktype, recs = read_pcap(pcap)
+    for t, r in recs:
+        if linktype == LINKTYPE_SERIAL:
+            print(t, r[0], r[1:].hex().upper())
+        else:
+            can_id, n = struct.unpack(">IB", r[:5])
+            print(t, "%08X#%s" % (can_id, r[8:8 + n].hex().upper()))
+
+
 def timing(sent, got, d, speed, tol):
     want = DIRS[d]
     _, srecs = read_pcap(sent)
@@ -287,7 +301,7 @@ def timing(sent, got, d, speed, tol):
 def main(argv):
     cmd, args = argv[1], argv[2:]
     if cmd == "serial-pcap":
-        serial_pcap(args[0], args[1], args[2:])
+        serial_pcap(args[0], args[1], args[2], args[3:])
     elif cmd == "expect-serial":
         expect_serial(args[0], args[1:])
     elif cmd == "can-pcap":
@@ -300,6 +314,8 @@ def main(argv):
         return compare_pdml(args[0], args[1])
     elif cmd == "pdml-3ax":
         pdml_3ax(args[0])
+    elif cmd == "records":
+        records(args[0])
     elif cmd == "timing":
         return timing(*args)
     else:

@@ -384,6 +384,19 @@ static void print_recorded(const tk_cap_writer_t *w, unsigned long bytes, const 
            what, w->path);
 }
 
+static void print_recording(const tk_cap_writer_t *w, const char *what, const char *tap_in,
+                            double seconds)
+{
+    printf("recording %s%s%s to %s ", what, tap_in != NULL ? " and " : "",
+           tap_in != NULL ? tap_in : "", w->path);
+    if (seconds > 0.0) {
+        printf("for %g s\n", seconds);
+    } else {
+        printf("until interrupted (Ctrl-C)\n");
+    }
+    fflush(stdout);
+}
+
 static int ms_left(double t_end)
 {
     double left = t_end - tk_now_s();
@@ -408,6 +421,7 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_i
         tk_link_serial(&links[1], tap_in, baud);
     }
     catch_stop_signals();
+    print_recording(w, dev, tap_in, seconds);
     for (i = 0; i < n; i++) {
         ports[i] = tk_link_port(&links[i]);
         pfd[i].fd = links[i].uart.fd;
@@ -484,6 +498,7 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *iface, double seconds)
     double t_end = seconds > 0.0 ? tk_now_s() + seconds : 0.0;
     unsigned long frames = 0;
     catch_stop_signals();
+    print_recording(w, iface, NULL, seconds);
     while (!stop_requested) {
         struct pollfd pfd = {fd, POLLIN, 0};
         int timeout = ms_left(t_end), pr;

@@ -158,6 +158,10 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     until grep -q ' 7FF#03' /tmp/tools.log 2>/dev/null; do
         cansend vcan0 7FF#03; usleep 20000; i=$((i + 1)); [ $i -gt 200 ] && fail "candump never started (tools)"
     done
+    # tase record --can beside candump: the same session as a pcap capture
+    $T record --can vcan0 -o /tmp/tools.pcap > /tmp/rec.out 2>&1 &
+    trec=$!
+    wait_for /tmp/rec.out recording || { cat /tmp/rec.out; fail "tase record --can did not start"; }
     tase-sim --can vcan0 --seconds 40 > /tmp/sim.log 2>&1 &
     sim=$!
     wait_for /tmp/sim.log 'simulated gimbal on CAN interface vcan0' || { cat /tmp/sim.log; fail "tase-sim --can vcan0 did not start"; }
@@ -208,6 +212,8 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     cansend vcan0 7FF#04
     wait_for /tmp/tools.log ' 7FF#04' || fail "end marker not seen (tools)"
     kill $tdump
+    kill -INT $trec
+    wait $trec
 
     # candump's record, first raw, then decoded offline by the tool. The
     # SYSTEM_VERSION query framed by hand: 00 FF 5A, size 2, group 0x48,
@@ -240,6 +246,42 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     nd=$(grep -c '"dir":"out".*"name":"GIMBAL_ANGLE"' /tmp/dec.json)
     check "decoded: $nd GIMBAL_ANGLE out, at least the $na the 2 s monitor printed" [ "$nd" -ge "$na" ]
     check "decoded: no frame with a wrong length" eval '! grep -q "\"error\"" /tmp/dec.json'
+
+    # The capture of tase record --can: the same packets as candump's log,
+    # the same kernel receive times (to the microsecond candump keeps).
+    check "tase record --can: $(tail -1 /tmp/rec.out)" grep -q '^recorded [1-9][0-9]* records' /tmp/rec.out
+    $T decode /tmp/tools.pcap | sed 's/\("time":[0-9]*\.[0-9]\{6\}\)[0-9]\{3\}/\1/; s/"interface":"[^"]*",//' > /tmp/pcap.json
+    sed 's/"interface":"[^"]*",//' /tmp/dec.json > /tmp/dec.cmp
+    check "tase decode of the record --can capture: the candump log's $(wc -l < /tmp/dec.cmp) packets, times to the microsecond" \
+        cmp -s /tmp/pcap.json /tmp/dec.cmp
+    # tase replay --can of that capture, seen by candump: every frame, in
+    # order, at 4 times the recorded pace; then only the host's frames.
+    replay_seen() {
+        candump -L vcan0 > /tmp/replay.log &
+        rdump=$!
+        i=0
+        until grep -q ' 7FF#05' /tmp/replay.log 2>/dev/null; do
+            cansend vcan0 7FF#05; usleep 20000; i=$((i + 1)); [ $i -gt 200 ] && fail "candump never started (replay)"
+        done
+        $T replay /tmp/tools.pcap --can vcan0 "$@" > /tmp/replay.out 2>&1
+        cansend vcan0 7FF#06
+        wait_for /tmp/replay.log ' 7FF#06' || fail "end marker not seen (replay)"
+        kill $rdump
+        grep -v ' 7FF#0' /tmp/replay.log | cut -d' ' -f2- > /tmp/replayed.txt
+    }
+    grep -v ' 7FF#0' /tmp/tools.log | cut -d' ' -f2- > /tmp/recorded.txt
+    span=$(grep -v ' 7FF#0' /tmp/tools.log | sed -n '1s/^(\([0-9.]*\)).*/\1/p;$s/^(\([0-9.]*\)).*/\1/p' |
+        tr '\n' ' ' | awk '{ printf "%.3f", $2 - $1 }')
+    replay_seen --dir all --speed 4
+    took=$(sed -n 's/.* in \([0-9.]*\) s.*/\1/p' /tmp/replay.out)
+    check "replay --can --dir all --speed 4: candump saw the $(wc -l < /tmp/recorded.txt) recorded frames in order ($(cat /tmp/replay.out))" \
+        cmp -s /tmp/recorded.txt /tmp/replayed.txt
+    check "replay --speed 4 took $took s for a $span s session: a quarter, +-0.3 s" \
+        awk -v s="$span" -v t="$took" 'BEGIN { q = s / 4; exit !(t > q - 0.3 && t < q + 0.3) }'
+    replay_seen --dir in --speed 0
+    grep ' 11000000#' /tmp/recorded.txt > /tmp/recorded.in
+    check "replay --can --dir in: only the $(wc -l < /tmp/recorded.in) frames sent to the gimbal" \
+        cmp -s /tmp/recorded.in /tmp/replayed.txt
     [ $nfail -eq 0 ] || fail "$nfail bench tool check(s) over vcan0 failed"
 else
     step "bench tools over vcan0: SKIPPED (tase and tase-sim are not built)"
