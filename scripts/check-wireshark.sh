@@ -53,7 +53,7 @@ compare() {
     local tag=$1 name=$2 cap=$3
     shift 3
     if ! dissect "$cap" -T pdml >"$dir/$tag.pdml"; then
-        bad "$name: tshark failed: $(head -3 "$dir/tshark.err")"
+        bad "$name: tshark failed: $(grep -v "Running as user" "$dir/tshark.err" | head -3)"
         return
     fi
     if grep -q "Lua: Error" "$dir/tshark.err"; then

@@ -302,11 +302,12 @@ void tk_cap_reader_close(tk_cap_reader_t *r)
     }
 }
 
-static int parse_serial(const struct pcap_pkthdr *h, const uint8_t *d, tk_cap_rec_t *rec,
-                        char *why, size_t cap)
+static int parse_serial(const struct pcap_pkthdr *h, const uint8_t *d, tk_cap_rec_t *rec, char *why,
+                        size_t cap)
 {
     if (h->caplen < 2u) {
-        snprintf(why, cap, "%s bytes after the direction byte", h->caplen == 0 ? "no header, no" : "no");
+        snprintf(why, cap, "%s bytes after the direction byte",
+                 h->caplen == 0 ? "no header, no" : "no");
         return TK_CAP_BAD;
     }
     if (d[0] != TK_CAP_FROM_GIMBAL && d[0] != TK_CAP_TO_GIMBAL) {
@@ -478,7 +479,8 @@ static int open_can_recorder(const char *iface)
     if (fd < 0) {
         tk_die("cannot open CAN interface %s: %s", iface, strerror(errno));
     }
-    (void)setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof(on)); /* old kernels: classic only */
+    (void)setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on,
+                     sizeof(on)); /* old kernels: classic only */
     if (setsockopt(fd, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &errs, sizeof(errs)) != 0 ||
         setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof(on)) != 0) {
         tk_die("cannot set up CAN interface %s: %s", iface, strerror(errno));
@@ -616,9 +618,8 @@ static void send_bytes(replay_t *rp, const uint8_t *d, size_t n, unsigned dir)
     if (rp->o->can != NULL) { /* serial bytes onto CAN: frames of their direction's ID */
         tase_can_split_t s;
         tase_can_frame_t f;
-        (void)tase_can_split_init(&s, dir == TK_CAP_FROM_GIMBAL ? TASE_CAN_ROLE_GIMBAL
-                                                                : TASE_CAN_ROLE_HOST,
-                                  d, n);
+        (void)tase_can_split_init(
+            &s, dir == TK_CAP_FROM_GIMBAL ? TASE_CAN_ROLE_GIMBAL : TASE_CAN_ROLE_HOST, d, n);
         while (tase_can_split_next(&s, &f) == TASE_OK) {
             send_frame(rp, &f);
         }
@@ -699,7 +700,8 @@ void tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
             started = true;
         }
         if (o->speed > 0.0) {
-            double dt = (double)(rec.t.sec - t0.sec) + ((double)rec.t.nsec - (double)t0.nsec) * 1e-9;
+            double dt =
+                (double)(rec.t.sec - t0.sec) + ((double)rec.t.nsec - (double)t0.nsec) * 1e-9;
             if (!wait_until(start + (dt > 0.0 ? dt : 0.0) / o->speed)) {
                 break;
             }
@@ -707,8 +709,8 @@ void tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
         replay_send(&rp, r, &rec);
     }
     tk_link_close(&rp.link);
-    printf("replayed %lu of %lu records (%lu bytes) to %s in %.3f s%s", rp.sent, r->index,
-           rp.bytes, o->can != NULL ? o->can : o->serial, started ? tk_now_s() - start : 0.0,
+    printf("replayed %lu of %lu records (%lu bytes) to %s in %.3f s%s", rp.sent, r->index, rp.bytes,
+           o->can != NULL ? o->can : o->serial, started ? tk_now_s() - start : 0.0,
            stop_requested ? ", interrupted" : "");
     if (rp.skipped > 0) {
         printf("; %lu skipped (malformed, or CAN FD/remote/error frames)", rp.skipped);
