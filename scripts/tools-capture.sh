@@ -135,6 +135,9 @@ $U can-pcap "$dir/other.pcap" "$DATA/decode_candump.log"
 expect_error "--record appending to a capture of another link type" 1 "cannot write capture" \
     "$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/other.pcap"
 
+expect_error "record onto a full disk (/dev/full)" 1 "cannot write capture /dev/full: No space left on device" \
+    "$TASE" record --serial "$dir/gimbal" -o /dev/full --seconds 0.5
+
 # ---- tase record of the gimbal's line; SIGINT ends it cleanly ----
 "$TASE" record --serial "$dir/gimbal" -o "$dir/tele.pcap" >"$dir/rec.out" 2>&1 &
 rp=$!

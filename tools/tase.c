@@ -190,17 +190,6 @@ static void bad_arg(const args_t *a)
     tk_usage_error("unexpected argument '%s' (see --help)", s);
 }
 
-/* The --record capture of this process's link (one link per run). */
-static tk_cap_writer_t session_capture;
-static tk_cap_tap_t session_tap;
-
-static void close_session_capture(void)
-{
-    if (session_capture.dumper != NULL) {
-        tk_cap_close(&session_capture);
-    }
-}
-
 static void open_link(const link_opts_t *lo, tk_link_t *l, tase_port_t *port)
 {
     if (lo->serial != NULL && lo->can != NULL) {
@@ -221,9 +210,7 @@ static void open_link(const link_opts_t *lo, tk_link_t *l, tase_port_t *port)
     }
     *port = tk_link_port(l);
     if (lo->record != NULL) {
-        tk_cap_create(&session_capture, lo->record, TK_CAP_LINKTYPE_SERIAL, true);
-        atexit(close_session_capture);
-        *port = tk_cap_tap_port(&session_tap, *port, &session_capture);
+        *port = tk_cap_record_session(lo->record, *port);
     }
 }
 

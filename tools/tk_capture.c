@@ -140,16 +140,27 @@ void tk_cap_flush(tk_cap_writer_t *w)
     }
 }
 
-void tk_cap_close(tk_cap_writer_t *w)
+int tk_cap_finish(tk_cap_writer_t *w)
 {
     FILE *f = pcap_dump_file(w->dumper);
-    int bad = fflush(f) != 0 || ferror(f);
-    int e = errno;
+    int e = 0;
+    if (fflush(f) != 0 || ferror(f)) {
+        e = errno != 0 ? errno : EIO;
+    }
+    if (fsync(fileno(f)) != 0 && errno != EINVAL && e == 0) {
+        e = errno; /* a full or failing disk may only tell here */
+    }
     pcap_dump_close(w->dumper); /* fclose() */
     pcap_close(w->pcap);
     w->dumper = NULL;
     w->pcap = NULL;
-    if (bad) {
+    return e;
+}
+
+void tk_cap_close(tk_cap_writer_t *w)
+{
+    int e = tk_cap_finish(w);
+    if (e != 0) {
         tk_die("cannot write capture %s: %s", w->path, strerror(e));
     }
 }
@@ -196,6 +207,38 @@ tase_port_t tk_cap_tap_port(tk_cap_tap_t *tap, tase_port_t inner, tk_cap_writer_
     p.ops = &tap_ops;
     p.ctx = tap;
     return p;
+}
+
+/* The --record capture of this process (one link per run), closed at exit. */
+static tk_cap_writer_t session_capture;
+static tk_cap_tap_t session_tap;
+
+/* atexit: exit() must not be called again here */
+static void close_session_capture(void)
+{
+    int e;
+    if (session_capture.dumper == NULL) {
+        return;
+    }
+    e = tk_cap_finish(&session_capture);
+    if (e != 0) {
+        fflush(stdout);
+        fprintf(stderr, "%s: cannot write capture %s: %s\n", tk_prog, session_capture.path,
+                strerror(e));
+        _exit(TK_EXIT_FAIL);
+    }
+}
+
+tase_port_t tk_cap_record_session(const char *path, tase_port_t inner)
+{
+    if (session_capture.dumper != NULL) {
+        tk_die("only one link per run can be recorded");
+    }
+    tk_cap_create(&session_capture, path, TK_CAP_LINKTYPE_SERIAL, true);
+    if (atexit(close_session_capture) != 0) {
+        tk_die("cannot record %s: atexit failed", path);
+    }
+    return tk_cap_tap_port(&session_tap, inner, &session_capture);
 }
 
 /* ---- reading ---- */

@@ -90,6 +90,8 @@ void tk_cap_put_can(tk_cap_writer_t *w, const tk_time_t *t, const uint8_t *rec, 
 void tk_cap_flush(tk_cap_writer_t *w);
 /* Flush and close; dies on a write error. */
 void tk_cap_close(tk_cap_writer_t *w);
+/* The same without dying (for exit handlers): returns 0 or an errno. */
+int tk_cap_finish(tk_cap_writer_t *w);
 
 /* A port that records what passes through `inner` into `w` (reads as
  * TK_CAP_FROM_GIMBAL, accepted writes as TK_CAP_TO_GIMBAL) and is
@@ -99,6 +101,10 @@ typedef struct {
     tk_cap_writer_t *w;
 } tk_cap_tap_t;
 tase_port_t tk_cap_tap_port(tk_cap_tap_t *tap, tase_port_t inner, tk_cap_writer_t *w);
+/* --record FILE: append this process's serial session to FILE (a tap port
+ * over `inner`, the capture closed by an exit handler, which reports a
+ * write error on stderr and exits 1). Once per run. */
+tase_port_t tk_cap_record_session(const char *path, tase_port_t inner);
 
 /* ---- reading ---- */
 
