@@ -24,7 +24,7 @@ trap cleanup EXIT
 . "$(dirname "$0")/check-lib.sh"
 # Timing tolerances (seconds of replay jitter, ms for a --speed 0 run);
 # looser when scripts/check-valgrind.sh runs the programs under memcheck.
-tol=0.040 fast_ms=350
+tol=0.150 fast_ms=350
 [ -n "${TASE_UNDER_VALGRIND:-}" ] && tol=0.300 fast_ms=5000
 # json_int LINE KEY: the integer value of "KEY": in a JSON line
 json_int() { sed -n "s/.*\"$2\":\(-\{0,1\}[0-9][0-9]*\).*/\1/p" <<<"$1"; }
