@@ -176,9 +176,11 @@ quiet "$TASE" camera A --hfov 10 "${L[@]}"
 geo=$("$TASE" monitor "${L[@]}" --json --seconds 1.2 2>/dev/null | grep '"GEOREFERENCE_DATA"' | tail -1)
 check "tase camera A --hfov 10 shows in GEOREFERENCE_DATA" test "$(json_int "$geo" hfov)" = 1000
 quiet "$TASE" camera B "${L[@]}"
-"$TASE" send CAMERA_CMD hfov=1500 "${L[@]}" >/dev/null 2>&1
+out=$("$TASE" send CAMERA_CMD hfov=1500 "${L[@]}" --json 2>&1)
+check "send CAMERA_CMD hfov=1500: the fields left out go as \"do not change\" ($out)" \
+    grep -q '"fields":{"camera":255,"hfov":1500,"focus":65535,"exposure":255,"shutter_speed":255,"bright":255,"flags":128}' <<<"$out"
 geo=$("$TASE" monitor "${L[@]}" --json --seconds 1.2 2>/dev/null | grep '"GEOREFERENCE_DATA"' | tail -1)
-check "send CAMERA_CMD hfov=... does not switch back to camera A ($(json_int "$geo" camera))" \
+check "... and the gimbal stays on camera B ($(json_int "$geo" camera))" \
     test "$(json_int "$geo" camera)" = 1
 
 # ---- KLV output ----

@@ -93,10 +93,13 @@ static const char usage_send[] =
     "field values: decimal (leading zeros are decimal), 0x hex, an optional sign; a\n"
     "signed field also takes its hex bit pattern (hfov=0xFFFF is -1). CAMERA_PASS\n"
     "takes data=1,2,... . Each field at most once. Fields left out:\n"
-    "  - setup packets (group 0x48): the gimbal's current settings are queried\n"
-    "    first and kept;\n"
+    "  - a field with a \"do not change\" value in the spec takes it (CAMERA_CMD,\n"
+    "    AXIS_SETTING, CAMERA_TYPE, LEGACY_CAMERA_CMD focus and shutter_speed,\n"
+    "    CAMERA_PASS baud);\n"
+    "  - other fields of setup packets (group 0x48): the gimbal's current settings\n"
+    "    are queried first and kept;\n"
     "  - otherwise every field must be given (the error names the missing ones);\n"
-    "  - --zero: fields left out are 0 instead.\n"
+    "  - --zero: fields left out without such a value are 0 instead.\n"
     "GIMBAL_CMD always needs flags (its mode; or use 'tase point' / 'tase rate').\n"
     "Setup packets are echoed by the gimbal: the echo is awaited, printed and\n"
     "compared with what was sent; a field that differs (a value the gimbal refused\n"
@@ -391,16 +394,18 @@ static void print_packet(const tase_packet_desc_t *p, const uint8_t *data, size_
 
 typedef struct {
     const tase_packet_desc_t *p;
+    size_t len; /* the layout's length (fields move in AXIS_SETTING's 22) */
     uint8_t data[TASE_DATA_MAX];
-    bool given[32]; /* per field */
+    bool given[32]; /* per field: given, or filled in */
     size_t tail;    /* CAMERA_PASS data bytes */
     bool tail_given;
 } fields_t;
 
-static void fields_init(fields_t *fs, const tase_packet_desc_t *p)
+static void fields_init(fields_t *fs, const tase_packet_desc_t *p, size_t len)
 {
     memset(fs, 0, sizeof(*fs));
     fs->p = p;
+    fs->len = len;
 }
 
 static size_t parse_tail(const char *v, uint8_t *out, size_t cap)
@@ -473,7 +478,7 @@ static void fields_assign(fields_t *fs, const char *arg)
     if (fs->given[fi]) {
         tk_usage_error("%s.%s given twice", name, fname);
     }
-    tk_field(p, (unsigned)fi, &fd);
+    tk_field(p, (unsigned)fi, fs->len, &fd);
     tk_field_range(&fd, range, sizeof(range));
     rc = tk_field_parse(&fd, eq + 1, &val);
     if (eq[1] == '\0') {
@@ -494,7 +499,7 @@ static void fields_assign(fields_t *fs, const char *arg)
 static long long fields_value(const fields_t *fs, unsigned i)
 {
     long long v = 0;
-    (void)tk_field_get(fs->p, i, fs->data, TASE_DATA_MAX, &v);
+    (void)tk_field_get(fs->p, i, fs->data, fs->len, &v);
     return v;
 }
 
@@ -506,7 +511,7 @@ static void fields_set(fields_t *fs, const char *name, long long v)
     if (fi < 0) {
         tk_die("internal error: no field %s", name);
     }
-    tk_field(fs->p, (unsigned)fi, &fd);
+    tk_field(fs->p, (unsigned)fi, fs->len, &fd);
     if (tk_field_set(&fd, fs->data, v) != 0) {
         tk_die("internal error: %s=%lld does not fit", name, v);
     }
@@ -519,12 +524,25 @@ static unsigned fields_within(const tase_packet_desc_t *p, size_t len)
     unsigned i;
     for (i = 0; i < p->nfields; i++) {
         tk_field_t fd;
-        tk_field(p, i, &fd);
+        tk_field(p, i, len, &fd);
         if (fd.offset + fd.width > len) {
             break;
         }
     }
     return i;
+}
+
+/* Fields [0, n) left out that have a "do not change" value in the spec
+ * (the schema's, tase_field_keep()) take it. */
+static void fields_keep(fields_t *fs, unsigned n)
+{
+    unsigned i;
+    for (i = 0; i < n; i++) {
+        int64_t keep;
+        if (!fs->given[i] && tase_field_keep(fs->p, i, &keep) == TASE_OK) {
+            fields_set(fs, tase_schema_field_name(fs->p, i), (long long)keep);
+        }
+    }
 }
 
 /* A comma-separated list of the names of fields [0, n) not given. */
@@ -603,7 +621,8 @@ typedef struct {
 } send_opts_t;
 
 /* Compare the gimbal's echo with what was sent; exit 3 naming every field
- * that differs. `skip` names a field not to compare (or NULL). */
+ * that differs. Fields sent as "do not change" are not compared (the echo
+ * has the setting in force); `skip` names another one (or NULL). */
 static void confirm_echo(const fields_t *fs, size_t len, const uint8_t *echo, int elen,
                          const char *skip)
 {
@@ -620,7 +639,8 @@ static void confirm_echo(const fields_t *fs, size_t len, const uint8_t *echo, in
         long long sent = fields_value(fs, i), got = 0;
         const char *name = tase_schema_field_name(p, i);
         (void)tk_field_get(p, i, echo, (size_t)elen, &got);
-        if (got != sent && (skip == NULL || strcmp(skip, name) != 0)) {
+        if (got != sent && !tase_field_is_keep(p, i, sent) &&
+            (skip == NULL || strcmp(skip, name) != 0)) {
             int w = snprintf(diff + used, sizeof(diff) - used, "%s%s sent %lld, gimbal has %lld",
                              count ? "; " : "", name, sent, got);
             if (w > 0 && (size_t)w < sizeof(diff) - used) {
@@ -700,7 +720,7 @@ static int cmd_send(args_t *a)
         tk_usage_error("SYSTEM_VERSION is query-only: use 'tase query SYSTEM_VERSION'");
     }
     setup = TASE_ID_GROUP(p->id) == TASE_GROUP_SETUP;
-    fields_init(&fs, p);
+    fields_init(&fs, p, o.len >= 0 ? (size_t)o.len : p->len);
     for (i = 0; i < nassign; i++) {
         fields_assign(&fs, assign[i]);
     }
@@ -718,6 +738,7 @@ static int cmd_send(args_t *a)
             refuse_gimbal_cmd("flags is not a mode of the spec's table 5");
         }
     }
+    fields_keep(&fs, nf);
     if (!o.zero) {
         char missing[512];
         size_t nmiss = missing_list(&fs, nf, missing, sizeof(missing));
@@ -896,7 +917,7 @@ static int gimbal_verb(args_t *a, const gimbal_verb_t *gv)
     snprintf(what, sizeof(what), "tilt%s", gv->what);
     tilt = tase_units_deg_to_cdeg(real_arg(what, v.pos[1], gv->lo, gv->hi, gv->unit));
     flags = TASE_GIMBAL_FLAGS(gv->kind, v.stab == NULL || strcmp(v.stab, "on") == 0);
-    fields_init(&fs, p);
+    fields_init(&fs, p, p->len);
     fields_set(&fs, "pan", pan);
     fields_set(&fs, "tilt", tilt);
     fields_set(&fs, "roll", 0);
@@ -945,6 +966,7 @@ static int cmd_camera(args_t *a)
     session_t s;
     int cam = -1;
     long long hfov = 0;
+    size_t len;
     char what[96];
     verb_parse(a, &v, 1, "hfov zoom");
     check_link_opts(&v.lo);
@@ -971,18 +993,17 @@ static int cmd_camera(args_t *a)
         what[0] = '\0';
     }
     o = verb_opts(&v);
-    fields_init(&fs, p);
-    fields_set(&fs, "camera", cam >= 0 ? (long long)cam : (long long)TASE_CAMERA_NO_CHANGE);
-    if (v.hfov != NULL || v.zoom != NULL) {
-        fields_set(&fs, "hfov", hfov);
-        fields_set(&fs, "focus", TASE_FOCUS_NO_CHANGE);
-        fields_set(&fs, "exposure", TASE_EXPOSURE_NO_CHANGE);
-        fields_set(&fs, "shutter_speed", TASE_SHUTTER_NO_CHANGE);
-        fields_set(&fs, "bright", TASE_BRIGHT_NO_CHANGE);
-        fields_set(&fs, "flags", TASE_CAMERA_FLAG_NO_CHANGE);
+    len = v.hfov != NULL || v.zoom != NULL ? p->len : 1u;
+    fields_init(&fs, p, len);
+    if (cam >= 0) {
+        fields_set(&fs, "camera", cam);
     }
+    if (len > 1u) {
+        fields_set(&fs, "hfov", hfov);
+    }
+    fields_keep(&fs, fields_within(p, len)); /* everything else: "do not change" */
     session_open(&s, &v.lo, NULL, NULL);
-    send_fields(&s, &fs, v.hfov != NULL || v.zoom != NULL ? p->len : 1u, &o);
+    send_fields(&s, &fs, len, &o);
     if (!v.r.json) {
         char sel[32] = "active camera unchanged";
         if (cam >= 0) {
@@ -1083,7 +1104,7 @@ static int cmd_spoi(args_t *a)
     lat = real_arg("latitude", v.pos[0], -90.0, 90.0, "deg");
     lon = real_arg("longitude", v.pos[1], -180.0, 180.0, "deg");
     height = real_arg("height", v.pos[2], -21474836.48, 21474836.47, "m");
-    fields_init(&fs, p);
+    fields_init(&fs, p, p->len);
     fields_set(&fs, "lat", tase_units_deg_to_mas(lat));
     fields_set(&fs, "lon", tase_units_deg_to_mas(lon));
     fields_set(&fs, "height", tase_units_m_to_cm(height));
@@ -1491,7 +1512,7 @@ static int cmd_list(args_t *a)
                (p->flags & TASE_LEN_QUERY) ? " (query)" : "");
         for (j = 0; j < p->nfields; j++) {
             tk_field_t f;
-            tk_field(p, j, &f);
+            tk_field(p, j, p->len, &f);
             printf(" %s:%c%u", f.name, f.is_signed ? 's' : 'u', 8u * f.width);
         }
         printf("%s\n", tk_packet_has_tail(p) ? " data:bytes" : "");

@@ -10,11 +10,12 @@
 #include <strings.h>
 #include <time.h>
 
-void tk_field(const tase_packet_desc_t *p, unsigned i, tk_field_t *out)
+void tk_field(const tase_packet_desc_t *p, unsigned i, size_t len, tk_field_t *out)
 {
     const tase_field_t *f = tase_schema_field(p, i);
+    int off = tase_field_offset(p, i, len);
     out->name = tase_schema_field_name(p, i);
-    out->offset = f->offset;
+    out->offset = off >= 0 ? (unsigned)off : f->offset;
     out->width = TASE_FIELD_WIDTH(f);
     out->is_signed = TASE_FIELD_IS_SIGNED(f);
 }
@@ -433,7 +434,7 @@ static const pkt_text_t *text_of(const tase_packet_desc_t *p)
         (uint8_t)(n > 0 && (size_t)n < sizeof(t->full) - t->head_len ? t->head_len + n : 0);
     for (i = 0; i < p->nfields && i < MAX_FIELDS; i++) {
         tk_field_t fd;
-        tk_field(p, i, &fd);
+        tk_field(p, i, p->len, &fd);
         n = snprintf(t->f[i].key, sizeof(t->f[i].key), ",\"%s\":", fd.name);
         t->f[i].key_len = (uint8_t)(n > 0 && (size_t)n < sizeof(t->f[i].key) ? n : 0);
         t->f[i].offset = (uint8_t)fd.offset;
@@ -494,7 +495,7 @@ static void json_frame(sb_t *b, const tk_fmt_t *fmt, const tk_meta_t *m, const t
     }
     t = text_of(p);
     if (f->len == p->len) {
-        sb_mem(b, t->full, t->full_len);
+        sb_mem(b, t->full, t->full_len); /* ... "size":N,"fields":{ */
     } else {
         sb_mem(b, t->head, t->head_len);
         sb_u64(b, f->len);
@@ -505,14 +506,19 @@ static void json_frame(sb_t *b, const tk_fmt_t *fmt, const tk_meta_t *m, const t
         sb_mem(b, ",\"fields\":{", 11);
     }
     for (i = 0; i < p->nfields && i < MAX_FIELDS; i++) {
-        /* short accepted forms (queries, CAMERA_CMD's one byte) carry only
-         * the fields that fit */
-        if ((unsigned)t->f[i].offset + t->f[i].width > f->len) {
+        /* the first key without its leading comma */
+        const char *key = t->f[i].key + (i == 0u);
+        size_t key_len = (size_t)t->f[i].key_len - (i == 0u);
+        long long v;
+        if (f->len == p->len) { /* the table's layout: offsets known */
+            v = field_value(f->data + t->f[i].offset, t->f[i].width, t->f[i].is_signed);
+        } else if (!tk_field_get(p, i, f->data, f->len, &v)) {
+            /* short accepted forms (queries, CAMERA_CMD's one byte) carry
+             * only the fields that fit */
             break;
         }
-        /* the first key without its leading comma */
-        sb_mem(b, t->f[i].key + (i == 0u), (size_t)t->f[i].key_len - (i == 0u));
-        sb_i64(b, field_value(f->data + t->f[i].offset, t->f[i].width, t->f[i].is_signed));
+        sb_mem(b, key, key_len);
+        sb_i64(b, v);
     }
     sb_c(b, '}');
     if (tk_packet_has_tail(p)) {

@@ -33,13 +33,9 @@
 #include "tase/schema.h"
 #include "tase/socketcan.h"
 
-/* The version both programs print (the library's). */
+/* Stringify a number (usage texts). The version is TASE_VERSION_STRING. */
 #define TK_STR_(x) #x
 #define TK_STR(x) TK_STR_(x)
-#ifndef TASE_VERSION_STRING
-#define TASE_VERSION_STRING                                                                        \
-    TK_STR(TASE_VERSION_MAJOR) "." TK_STR(TASE_VERSION_MINOR) "." TK_STR(TASE_VERSION_PATCH)
-#endif
 
 /* ---- errors and exit status ---- */
 
@@ -162,13 +158,15 @@ int tk_pty_unread(int slave_fd);
 
 typedef struct {
     const char *name; /* JSON name */
-    unsigned offset;  /* byte offset in the data */
+    unsigned offset;  /* byte offset in the data (of the layout asked for) */
     unsigned width;   /* 1, 2, 4 or 8 bytes */
     bool is_signed;
 } tk_field_t;
 
-/* Field i of packet p (i < p->nfields). */
-void tk_field(const tase_packet_desc_t *p, unsigned i, tk_field_t *out);
+/* Field i of packet p (i < p->nfields) in a packet of `len` data bytes
+ * (the length selects the layout: AXIS_SETTING's 22-byte form moves
+ * fields, see tase_field_offset()). */
+void tk_field(const tase_packet_desc_t *p, unsigned i, size_t len, tk_field_t *out);
 /* Raw value of field i from data[0..len); false if it lies beyond len. */
 bool tk_field_get(const tase_packet_desc_t *p, unsigned i, const uint8_t *data, size_t len,
                   long long *v);
