@@ -10,8 +10,8 @@ the tools' code, so they check it rather than repeat it.
         milliseconds) apart.
   expect-serial PCAP JSONL:DIR...  the JSON lines `tase decode PCAP` must
         print, from each stream's expected lines (the generator's
-        decode_noisy.jsonl): "time" and "dir" added, ordered by the record
-        that completes each frame.
+        decode_noisy.jsonl): "time" (microseconds, truncated) and "dir"
+        added, ordered by the record that completes each frame.
   can-pcap OUT LOG                 a LINKTYPE_CAN_SOCKETCAN pcap of a candump
         log (nanosecond timestamps, big-endian identifiers with flags).
   bad-pcap OUT                     a serial pcap with a bad direction byte, a
@@ -38,7 +38,9 @@ import sys
 import termios
 import tty
 import xml.etree.ElementTree as ET
-from decimal import Decimal
+from decimal import ROUND_DOWN, Decimal
+
+USEC = Decimal("0.000001")
 
 LINKTYPE_SERIAL = 147
 LINKTYPE_CAN = 227
@@ -113,7 +115,7 @@ def expect_serial(pcap, specs):
             if o["offset"] + 8 + o["size"] > pos[d]:
                 break
             pending[d].pop(0)
-            o = {"offset": o["offset"], "time": "{:.9f}".format(t), "dir": name,
+            o = {"offset": o["offset"], "time": str(t.quantize(USEC, ROUND_DOWN)), "dir": name,
                  **{k: v for k, v in o.items() if k != "offset"}}
             text = json.dumps({k: ("@t@" if k == "time" else v) for k, v in o.items()},
                               separators=(",", ":"))
@@ -246,7 +248,7 @@ def compare_pdml(pdml, jsonl):
             print("packet %d differs:\n  dissector: %s\n  decode:    %s" % (i, json.dumps(g),
                                                                          json.dumps(e)))
             bad += 1
-        elif etime is not None and etime != t.quantize(etime):
+        elif etime is not None and etime != t.quantize(etime, ROUND_DOWN):
             print("packet %d: decode time %s, frame time %s" % (i, etime, t))
             bad += 1
     names = sorted({o["name"] for _, o in got})

@@ -117,9 +117,9 @@ L=(--serial "$dir/gimbal" --record "$dir/live.pcap")
 {
     "$TASE" query SYSTEM_VERSION "${L[@]}"
     "$TASE" send PACKET_RATE angle_1=20 rate_1=20 geo_ref_1=5 "${L[@]}"
-    "$TASE" send GIMBAL_CMD pan=1000 tilt=-500 flags=0xA0 "${L[@]}"
+    "$TASE" send GIMBAL_CMD pan=1000 tilt=-500 roll=0 flags=0xA0 impulse_time=0 "${L[@]}"
     "$TASE" send CAMERA_PASS camera=1 baud=8 data=1,2,3,250 "${L[@]}"
-    "$TASE" send HOST_GPS_DATA lat=162000000 lon=-442800000 height=10000 valid=1 "${L[@]}"
+    "$TASE" send HOST_GPS_DATA --zero lat=162000000 lon=-442800000 height=10000 valid=1 "${L[@]}"
     "$TASE" send CAMERA_CMD --len 1 camera=1 "${L[@]}"
     "$TASE" query AXIS_SETTING "${L[@]}"
     "$TASE" monitor "${L[@]}" --seconds 1

@@ -71,6 +71,17 @@ def globals_of(obj):
     return syms
 
 
+def link_name(objs, name):
+    """The symbol a function links as: the initialisers guarded by
+    tase/config.h carry the configuration (tase_rx_init ->
+    tase_rx_init_rx_candidates_4)."""
+    for o in objs.values():
+        for s in globals_of(o):
+            if s == name or re.fullmatch(re.escape(name) + r"_rx_candidates_\d+", s):
+                return s
+    return name
+
+
 def linked_size(cpu, objs, roots, out):
     """Flash of what `roots` pull in, after --gc-sections. libc (memcpy,
     memchr, ...) is left unresolved: a firmware links it anyway."""
@@ -213,7 +224,7 @@ def firmware_image(out):
                      line)
         if m and (m.group(1) or pending):
             path = m.group(4)
-            a = re.search(r"(libtase(?:_bm)?\.a)\((\w+)\.c\.obj\)", path)
+            a = re.search(r"(libtase(?:_baremetal)?\.a)\((\w+)\.c\.obj\)", path)
             if a:
                 key = "%s %s" % (a.group(1), a.group(2))
             elif "tase_gimbal.elf.dir" in path:
@@ -249,7 +260,8 @@ def main():
     for cpu in CPUS:
         bdir, objs = build(cpu, args.build)
         mods = {m: berkeley(o) for m, o in objs.items()}
-        rx_roots = ["tase_rx_feed", "tase_rx_init", "tase_rx_flush"]
+        rx_init = link_name(objs, "tase_rx_init")
+        rx_roots = ["tase_rx_feed", rx_init, "tase_rx_flush"]
         has_dispatch = "dispatch" in objs
         if has_dispatch:
             rx_roots += globals_of(objs["dispatch"])
@@ -262,7 +274,7 @@ def main():
             "mods": mods,
             "rx": linked_size(cpu, objs.values(), rx_roots, args.build),
             "rx_frame": linked_size(cpu, objs.values(),
-                                    ["tase_rx_init", "tase_rx_feed", "tase_rx_flush"], args.build),
+                                    [rx_init, "tase_rx_feed", "tase_rx_flush"], args.build),
             "core": linked_size(cpu, core, roots_core, args.build),
             "core_float": linked_size(cpu, core, roots_all, args.build),
             "rest": linked_size(cpu, list(objs.values()), roots_rest, args.build)
@@ -431,12 +443,12 @@ def main():
         p("| part | flash | static RAM |")
         p("|---|---:|---:|")
         lib = [k for k in img["share"] if k.startswith("libtase.a")]
-        port = [k for k in img["share"] if k.startswith("libtase_bm.a")]
+        port = [k for k in img["share"] if k.startswith("libtase_baremetal.a")]
         for k in sorted(lib) + sorted(port):
             p("| %s | %d | %d |" % (k, img["share"][k]["flash"], img["share"][k]["ram"]))
         p("| **library total (libtase.a)** | %d | %d |" % (
             sum(img["share"][k]["flash"] for k in lib), sum(img["share"][k]["ram"] for k in lib)))
-        p("| **bare-metal port total (libtase_bm.a)** | %d | %d |" % (
+        p("| **bare-metal port total (libtase_baremetal.a)** | %d | %d |" % (
             sum(img["share"][k]["flash"] for k in port),
             sum(img["share"][k]["ram"] for k in port)))
         for k in sorted(img["share"]):

@@ -38,33 +38,34 @@ static void member_store(void *dst, unsigned w, uint64_t v)
     }
 }
 
-/* The fields of msg that lie within len bytes, big-endian into body. */
+/* The fields of msg that lie within len bytes, big-endian into body, at
+ * the offsets of the layout that len selects (AXIS_SETTING 22 or 23). */
 static void pack_fields(const tase_packet_desc_t *p, const void *msg, size_t len, uint8_t *body)
 {
     size_t i;
     for (i = 0; i < p->nfields; i++) {
         const tase_field_t *f = tase_schema_field(p, i);
         unsigned w = TASE_FIELD_WIDTH(f);
+        size_t at = (size_t)tase_field_offset(p, i, len);
         uint64_t v;
-        if ((size_t)f->offset + w > len) {
+        if (at + w > len) {
             continue; /* short form: CAMERA_CMD camera byte only */
         }
         v = member_load((const uint8_t *)msg + f->member, w);
         while (w > 0u) {
             w--;
-            body[f->offset + w] = (uint8_t)v;
+            body[at + w] = (uint8_t)v;
             v >>= 8;
         }
     }
 }
 
-static int encode(const tase_packet_desc_t *p, const void *msg, size_t len, uint8_t *out,
-                  size_t cap)
+/* The checks both encoders make before writing, in the order codec.h
+ * documents (the output buffer and its capacity are the caller's). */
+static int encode_check(const tase_packet_desc_t *p, const void *msg, size_t len)
 {
     const tase_camera_pass_t *cp = msg;
-    uint8_t *body;
-    size_t fixed;
-    if (out == NULL || (msg == NULL && len > 0u)) {
+    if (msg == NULL && len > 0u) {
         return TASE_EARG;
     }
     if ((p->flags & TASE_LEN_TAIL) != 0u && len > 0u) {
@@ -78,16 +79,17 @@ static int encode(const tase_packet_desc_t *p, const void *msg, size_t len, uint
             return TASE_ELENGTH;
         }
     }
-    if (!tase_schema_length_ok(p, len)) {
-        return TASE_ELENGTH;
-    }
-    if (cap < len + TASE_FRAME_OVERHEAD) {
-        return TASE_ENOSPC;
-    }
-    body = out + TASE_FRAME_HEADER;
+    return tase_schema_length_ok(p, len) ? TASE_OK : TASE_ELENGTH;
+}
+
+/* The len data bytes of msg into body (checked by encode_check()). */
+static void encode_body(const tase_packet_desc_t *p, const void *msg, size_t len, uint8_t *body)
+{
+    const tase_camera_pass_t *cp = msg;
+    size_t fixed;
     if (len > p->len) {
         fixed = p->len;
-        /* The tail first: its source may lie anywhere in out. */
+        /* The tail first: its source may lie anywhere in the output. */
         (void)memmove(&body[fixed], cp->data, len - fixed);
     } else {
         fixed = len;
@@ -96,30 +98,71 @@ static int encode(const tase_packet_desc_t *p, const void *msg, size_t len, uint
     if (msg != NULL) {            /* else a query: no data */
         pack_fields(p, msg, len, body);
     }
-    return tase_frame_encode(out, cap, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), body, len);
 }
 
-int tase_packet_encode_len(uint16_t id, const void *msg, size_t len, uint8_t *out, size_t cap)
+/* The table length of p for msg (CAMERA_PASS: plus its tail). */
+static size_t table_len(const tase_packet_desc_t *p, const void *msg)
+{
+    size_t len = p->len;
+    if ((p->flags & TASE_LEN_TAIL) != 0u && msg != NULL) {
+        len += ((const tase_camera_pass_t *)msg)->len;
+    }
+    return len;
+}
+
+/* Every encoder: packet `id` from msg at data length *len (NULL: the table
+ * length) into out[0..cap), as a whole frame or as its data only. */
+static int encode(uint16_t id, const void *msg, const size_t *len, uint8_t *out, size_t cap,
+                  bool frame)
 {
     const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
-    if (p == NULL) {
-        return out == NULL ? TASE_EARG : TASE_EUNKNOWN;
+    size_t n;
+    size_t header = 0u;
+    size_t overhead = 0u;
+    int r;
+    if (out == NULL) {
+        return TASE_EARG;
     }
-    return encode(p, msg, len, out, cap);
+    if (p == NULL) {
+        return TASE_EUNKNOWN;
+    }
+    if (frame) {
+        header = TASE_FRAME_HEADER;
+        overhead = TASE_FRAME_OVERHEAD;
+    }
+    n = len != NULL ? *len : table_len(p, msg);
+    r = encode_check(p, msg, n);
+    if (r != TASE_OK) {
+        return r;
+    }
+    if (cap < n + overhead) {
+        return TASE_ENOSPC;
+    }
+    encode_body(p, msg, n, out + header);
+    if (!frame) {
+        return (int)n;
+    }
+    return tase_frame_encode(out, cap, TASE_ID_GROUP(id), TASE_ID_TYPE(id), out + header, n);
 }
 
 int tase_packet_encode(uint16_t id, const void *msg, uint8_t *out, size_t cap)
 {
-    const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
-    size_t len;
-    if (p == NULL) {
-        return out == NULL ? TASE_EARG : TASE_EUNKNOWN;
-    }
-    len = p->len;
-    if ((p->flags & TASE_LEN_TAIL) != 0u && msg != NULL) {
-        len += ((const tase_camera_pass_t *)msg)->len;
-    }
-    return encode(p, msg, len, out, cap);
+    return encode(id, msg, NULL, out, cap, true);
+}
+
+int tase_packet_encode_len(uint16_t id, const void *msg, size_t len, uint8_t *out, size_t cap)
+{
+    return encode(id, msg, &len, out, cap, true);
+}
+
+int tase_packet_encode_data(uint16_t id, const void *msg, uint8_t *data, size_t cap)
+{
+    return encode(id, msg, NULL, data, cap, false);
+}
+
+int tase_packet_encode_data_len(uint16_t id, const void *msg, size_t len, uint8_t *data, size_t cap)
+{
+    return encode(id, msg, &len, data, cap, false);
 }
 
 int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap)
@@ -130,49 +173,73 @@ int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap)
 /* The fields that lie within the frame's data, into msg. Only the wire
  * bits are needed (no sign extension: see the top of this file), and
  * reading them inline instead of through tase_field_get() keeps the
- * receive path's stack small. */
-static void unpack_fields(const tase_packet_desc_t *p, const tase_frame_t *f, void *msg)
+ * receive path's stack small. A field a short form leaves out (CAMERA_CMD's
+ * 1-byte form) takes its "do not change" value, so a handler that ignores
+ * the length never acts on a zero it was not sent; fields without one stay
+ * zero. */
+static void unpack_fields(const tase_packet_desc_t *p, const uint8_t *data, size_t len, void *msg)
 {
     size_t i;
     for (i = 0; i < p->nfields; i++) {
         const tase_field_t *fd = tase_schema_field(p, i);
         unsigned w = TASE_FIELD_WIDTH(fd);
+        size_t at = (size_t)tase_field_offset(p, i, len);
         unsigned k;
         uint64_t v = 0u;
-        if ((size_t)fd->offset + w > f->len) {
+        int64_t keep;
+        if (at + w > len) {
+            if (tase_field_keep(p, i, &keep) == TASE_OK) {
+                /* two's complement bits of the value, as stored below */
+                member_store((uint8_t *)msg + fd->member, w, (uint64_t)keep);
+            }
             continue;
         }
         for (k = 0; k < w; k++) {
-            v = (v << 8) | f->data[fd->offset + k];
+            v = (v << 8) | data[at + k];
         }
         member_store((uint8_t *)msg + fd->member, w, v);
     }
 }
 
-int tase_packet_decode(const tase_frame_t *f, void *msg)
+int tase_packet_decode_desc(const tase_packet_desc_t *p, const uint8_t *data, size_t len, void *msg)
 {
-    const tase_packet_desc_t *p;
-    if (f == NULL || (f->data == NULL && f->len > 0u)) {
+    if (data == NULL && len > 0u) {
         return TASE_EARG;
     }
-    p = tase_schema_find(f->group, f->type);
     if (p == NULL) {
         return TASE_EUNKNOWN;
     }
-    if (!tase_schema_length_ok(p, f->len)) {
+    if (tase_schema_at(p->index) != p) {
+        return TASE_EARG; /* not a descriptor of the table: its size is not to be trusted */
+    }
+    if (!tase_schema_length_ok(p, len)) {
         return TASE_ELENGTH;
     }
     if (msg == NULL) {
-        return f->len == 0u ? 0 : TASE_EARG;
+        return len == 0u ? 0 : TASE_EARG;
     }
     (void)memset(msg, 0, p->size);
-    if (f->data != NULL) { /* else a query: no data */
-        unpack_fields(p, f, msg);
+    if (len > 0u) { /* else a query: no data, every member zero */
+        unpack_fields(p, data, len, msg);
     }
     if ((p->flags & TASE_LEN_TAIL) != 0u) {
         tase_camera_pass_t *cp = msg;
-        cp->len = (uint8_t)(f->len - p->len);
-        cp->data = f->data + p->len;
+        cp->len = (uint8_t)(len - p->len);
+        cp->data = data + p->len;
     }
-    return f->len;
+    return (int)len;
+}
+
+int tase_packet_decode_data(uint16_t id, const uint8_t *data, size_t len, void *msg)
+{
+    return tase_packet_decode_desc(tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id)), data, len,
+                                   msg);
+}
+
+int tase_packet_decode(const tase_frame_t *f, void *msg)
+{
+    if (f == NULL) {
+        return TASE_EARG;
+    }
+    return tase_packet_decode_desc(tase_schema_find(f->group, f->type), f->data, f->len, msg);
 }

@@ -52,7 +52,8 @@ void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
         }
         return;
     }
-    /* Cannot fail: the packet is known and its length accepted. */
-    (void)tase_packet_decode(frame, p->size != 0u ? &d->msg : NULL);
+    /* Cannot fail: the packet is known and its length accepted. Decoded
+     * with the descriptor in hand, not looked up a second time. */
+    (void)tase_packet_decode_desc(p, frame->data, frame->len, p->size != 0u ? &d->msg : NULL);
     h(d->user, frame, p->size != 0u ? &d->msg : NULL);
 }

@@ -3,6 +3,7 @@
 
 #include <string.h>
 
+#include "tase/codec.h"
 #include "tase/ids.h"
 #include "tase/port_io.h"
 
@@ -10,6 +11,7 @@
 #define SETUP_PACKET_RATE 0x00u
 #define RATE_BYTES_PER_PORT 5u /* Angle, Rate, Geo-ref, Camera, Reserved */
 #define SETUP_APPLY_MAX 23u    /* longest writable setup packet: AXIS_SETTING */
+#define SETUP_LEN_MAX 42u      /* longest setup packet: SYSTEM_VERSION */
 #define SERVICE_CHUNK 64u
 #define SERVICE_READS 64u
 
@@ -86,6 +88,10 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
     if (g == NULL || (ports == NULL && nports > 0) || nports > TASE_GIMBAL_PORTS) {
         return TASE_EARG;
     }
+    if (app != NULL && ((app->fill_telemetry != NULL && app->fill_telemetry_msg != NULL) ||
+                        (app->apply_setup != NULL && app->apply_setup_msg != NULL))) {
+        return TASE_EARG; /* which one would be meant? */
+    }
     for (i = 0; i < nports; i++) {
         if (ports[i].ops != NULL && ports[i].ops->write == NULL) {
             return TASE_EARG;
@@ -123,6 +129,14 @@ int tase_gimbal_send(tase_gimbal_t *g, unsigned port, uint8_t group, uint8_t typ
         return TASE_EARG;
     }
     return gimbal_write(g, tase_port_send_frame(&g->port[port], group, type, data, len));
+}
+
+int tase_gimbal_send_msg(tase_gimbal_t *g, unsigned port, uint16_t id, const void *msg)
+{
+    if (g == NULL || !port_present(g, port)) {
+        return TASE_EARG;
+    }
+    return gimbal_write(g, tase_port_send_msg(&g->port[port], id, msg));
 }
 
 int tase_gimbal_setup_len(uint8_t type)
@@ -172,6 +186,67 @@ int tase_gimbal_setup_set(tase_gimbal_t *g, uint8_t type, const uint8_t *data, s
     return TASE_OK;
 }
 
+/* The setup type of packet id, or TASE_EUNKNOWN when it is not one. */
+static int setup_type(uint16_t id)
+{
+    if (TASE_ID_GROUP(id) != TASE_GROUP_SETUP || TASE_ID_TYPE(id) >= TASE_GIMBAL_SETUP_TYPES) {
+        return TASE_EUNKNOWN;
+    }
+    return TASE_ID_TYPE(id);
+}
+
+int tase_gimbal_setup_set_msg(tase_gimbal_t *g, uint16_t id, const void *msg, uint32_t now_ms)
+{
+    uint8_t data[SETUP_LEN_MAX];
+    int type = setup_type(id);
+    int n;
+    if (g == NULL || msg == NULL) {
+        return TASE_EARG;
+    }
+    if (type < 0) {
+        return type;
+    }
+    n = tase_packet_encode_data(id, msg, data, sizeof data);
+    if (n < 0) {
+        return n;
+    }
+    return tase_gimbal_setup_set(g, (uint8_t)type, data, (size_t)n, now_ms);
+}
+
+int tase_gimbal_setup_get_msg(const tase_gimbal_t *g, uint16_t id, void *msg)
+{
+    int type = setup_type(id);
+    if (g == NULL || msg == NULL) {
+        return TASE_EARG;
+    }
+    if (type < 0) {
+        return type;
+    }
+    return tase_packet_decode_data(id, &g->setup[setup_off[type]], setup_len[type], msg);
+}
+
+/* Offer a received setting to the application (typed or as bytes); the
+ * bytes it leaves in data are what will be stored. >= 0 accepts. */
+static int apply_setup(tase_gimbal_t *g, unsigned port, uint8_t type, uint8_t *data, size_t len)
+{
+    uint16_t id = TASE_ID(TASE_GROUP_SETUP, type);
+    tase_packet_msg_t m;
+    int r;
+    if (g->app.apply_setup != NULL) {
+        return g->app.apply_setup(g->app.user, port, type, data, len);
+    }
+    if (g->app.apply_setup_msg == NULL) {
+        return 0;
+    }
+    /* Cannot fail: a known setup packet of its full length. */
+    (void)tase_packet_decode_data(id, data, len, &m);
+    r = g->app.apply_setup_msg(g->app.user, port, id, &m);
+    if (r >= 0) {
+        (void)tase_packet_encode_data(id, &m, data, len);
+    }
+    return r;
+}
+
 static void handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f, uint32_t now_ms)
 {
     uint8_t type = f->type;
@@ -184,8 +259,7 @@ static void handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f,
         return;
     } else {
         (void)memcpy(tmp, f->data, f->len);
-        if (g->app.apply_setup == NULL ||
-            g->app.apply_setup(g->app.user, port, type, tmp, f->len) >= 0) {
+        if (apply_setup(g, port, type, tmp, f->len) >= 0) {
             setup_store(g, type, tmp, now_ms);
             g->stats.setup_applied++;
         } else {
@@ -266,13 +340,34 @@ static void sched_catch_up(tase_gimbal_t *g, tase_gimbal_sched_t *s, uint32_t no
     s->k = (uint16_t)k;
 }
 
+/* Ask the application for telemetry packet id and frame it in
+ * frame[0..TASE_FRAME_MAX): the frame length, or < 0 to skip the slot. */
+static int telemetry_frame(tase_gimbal_t *g, unsigned port, uint16_t id, uint8_t *frame,
+                           uint32_t now_ms)
+{
+    int n;
+    if (g->app.fill_telemetry_msg != NULL) {
+        tase_packet_msg_t m;
+        (void)memset(&m, 0, sizeof m);
+        n = g->app.fill_telemetry_msg(g->app.user, port, id, &m, now_ms);
+        return n < 0 ? n : tase_packet_encode(id, &m, frame, TASE_FRAME_MAX);
+    }
+    /* The application writes the data where the frame will carry it, and
+     * the frame is encoded around it in place: one buffer, not two. */
+    n = g->app.fill_telemetry(g->app.user, port, id, frame + TASE_FRAME_HEADER, TASE_DATA_MAX,
+                              now_ms);
+    if (n < 0 || n > (int)TASE_DATA_MAX) {
+        return TASE_ERANGE;
+    }
+    return tase_frame_encode(frame, TASE_FRAME_MAX, TASE_ID_GROUP(id), TASE_ID_TYPE(id),
+                             frame + TASE_FRAME_HEADER, (size_t)n);
+}
+
 static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_t now_ms)
 {
     static const uint16_t stream_id[TASE_GIMBAL_STREAMS] = {
         TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE, TASE_ID_GEOREFERENCE_DATA};
     tase_gimbal_sched_t *s = &g->sched[port][stream];
-    /* The application writes the data where the frame will carry it, and
-     * the frame is encoded around it in place: one buffer, not two. */
     uint8_t frame[TASE_FRAME_MAX];
     uint16_t id = stream_id[stream];
     int n;
@@ -281,17 +376,14 @@ static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_
     if (s->rate == 0 || !reached(now_ms, s->t0 + slot_ms(s->k, s->rate))) {
         return 0;
     }
-    n = g->app.fill_telemetry(g->app.user, port, id, frame + TASE_FRAME_HEADER, TASE_DATA_MAX,
-                              now_ms);
-    if (n < 0 || n > (int)TASE_DATA_MAX) {
+    n = telemetry_frame(g, port, id, frame, now_ms);
+    if (n < 0) {
         g->stats.telemetry_skipped++;
+    } else if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >= 0) {
+        g->stats.telemetry_tx++;
+        sent = 1;
     } else {
-        n = tase_frame_encode(frame, sizeof frame, TASE_ID_GROUP(id), TASE_ID_TYPE(id),
-                              frame + TASE_FRAME_HEADER, (size_t)n);
-        if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >= 0) {
-            g->stats.telemetry_tx++;
-            sent = 1;
-        }
+        /* counted in tx_errors */
     }
     if (++s->k >= s->rate) {
         s->k = 0;
@@ -312,7 +404,7 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
     if (g == NULL) {
         return TASE_EARG;
     }
-    if (g->app.fill_telemetry == NULL) {
+    if (g->app.fill_telemetry == NULL && g->app.fill_telemetry_msg == NULL) {
         return 0;
     }
     for (p = 0; p < TASE_GIMBAL_PORTS; p++) {

@@ -3,6 +3,7 @@
 
 #include <string.h>
 
+#include "tase/codec.h"
 #include "tase/port_io.h"
 
 enum { HOST_IDLE = 0, HOST_WAITING = 1, HOST_COMPLETE = 2 };
@@ -37,28 +38,23 @@ int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *d
     return host_send(h, group, type, data, len);
 }
 
-int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
-                            size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
-                            uint8_t retries, uint32_t now_ms)
+int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg)
 {
-    int r;
-
-    if (h == NULL || (data == NULL && len > 0) || (reply == NULL && reply_cap > 0) ||
-        timeout_ms == 0 || timeout_ms > 0x80000000u) {
+    if (h == NULL) {
         return TASE_EARG;
     }
-    if (len > TASE_DATA_MAX) {
-        return TASE_ETOOLONG;
-    }
-    if (h->state != HOST_IDLE) {
-        return TASE_EBUSY;
-    }
-    r = host_send(h, group, type, data, len);
+    return tase_port_count_tx(tase_port_send_msg(&h->port, id, msg), &h->stats.frames_tx,
+                              &h->stats.tx_errors);
+}
+
+/* Send the request whose data is already in h->req and make it pending.
+ * Nothing is pending if the first attempt cannot be sent. */
+static int request_send(tase_host_t *h, uint8_t group, uint8_t type, size_t len, uint8_t *reply,
+                        size_t reply_cap, uint32_t timeout_ms, uint8_t retries, uint32_t now_ms)
+{
+    int r = host_send(h, group, type, h->req, len);
     if (r < 0) {
         return r;
-    }
-    if (len > 0) {
-        (void)memcpy(h->req, data, len);
     }
     h->req_len = (uint8_t)len;
     h->group = group;
@@ -74,11 +70,74 @@ int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const u
     return TASE_OK;
 }
 
+static bool timeout_ok(uint32_t timeout_ms)
+{
+    return timeout_ms > 0u && timeout_ms <= 0x80000000u;
+}
+
+int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
+                            size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
+                            uint8_t retries, uint32_t now_ms)
+{
+    if (h == NULL || (data == NULL && len > 0) || (reply == NULL && reply_cap > 0) ||
+        !timeout_ok(timeout_ms)) {
+        return TASE_EARG;
+    }
+    if (len > TASE_DATA_MAX) {
+        return TASE_ETOOLONG;
+    }
+    if (h->state != HOST_IDLE) {
+        return TASE_EBUSY;
+    }
+    if (len > 0) {
+        (void)memmove(h->req, data, len); /* data may be a former reply in h->req */
+    }
+    h->typed = false;
+    return request_send(h, group, type, len, reply, reply_cap, timeout_ms, retries, now_ms);
+}
+
+int tase_host_request_msg_start(tase_host_t *h, uint16_t id, const void *msg, void *reply_msg,
+                                uint32_t timeout_ms, uint8_t retries, uint32_t now_ms)
+{
+    int n;
+    if (h == NULL || !timeout_ok(timeout_ms)) {
+        return TASE_EARG;
+    }
+    if (h->state != HOST_IDLE) {
+        return TASE_EBUSY;
+    }
+    /* The request's data goes where re-sends take it from; the reply will
+     * land in the same buffer once no re-send is due any more. */
+    n = msg != NULL ? tase_packet_encode_data(id, msg, h->req, sizeof h->req)
+                    : tase_packet_encode_data_len(id, NULL, 0u, h->req, sizeof h->req);
+    if (n < 0) {
+        return n;
+    }
+    h->typed = true;
+    h->reply_msg = reply_msg;
+    return request_send(h, TASE_ID_GROUP(id), TASE_ID_TYPE(id), (size_t)n, h->req, sizeof h->req,
+                        timeout_ms, retries, now_ms);
+}
+
 int tase_host_query_start(tase_host_t *h, uint8_t group, uint8_t type, uint8_t *reply,
                           size_t reply_cap, uint32_t timeout_ms, uint8_t retries, uint32_t now_ms)
 {
     return tase_host_request_start(h, group, type, NULL, 0, reply, reply_cap, timeout_ms, retries,
                                    now_ms);
+}
+
+/* A typed request's reply, already copied into h->req, into the caller's
+ * struct; its data length, or TASE_ELENGTH (the struct is not touched). */
+static int decode_reply(tase_host_t *h, size_t len)
+{
+    const tase_packet_desc_t *p = tase_schema_find(h->group, h->type);
+    if (!tase_schema_length_ok(p, len)) {
+        return TASE_ELENGTH;
+    }
+    if (h->reply_msg == NULL) {
+        return (int)len;
+    }
+    return tase_packet_decode_desc(p, h->req, len, h->reply_msg);
 }
 
 int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
@@ -99,6 +158,9 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
             (void)memcpy(h->reply, frame->data, frame->len);
             h->result = (int)frame->len;
         }
+        if (h->typed) {
+            h->result = decode_reply(h, frame->len);
+        }
         h->state = HOST_COMPLETE;
         h->stats.replies++;
         return 1;
@@ -107,6 +169,16 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
         h->on_frame(h->user, frame);
     }
     return 0;
+}
+
+/* Milliseconds from `since` to `now`, across the 2^32 wrap of the clock.
+ * A sample taken before `since` (a clock read earlier and handed in late,
+ * or a clock that stepped back) gives a "negative" difference, 2^31 or
+ * more as unsigned: that is no time at all, not 49 days. */
+static uint32_t elapsed(uint32_t now_ms, uint32_t since)
+{
+    uint32_t d = now_ms - since;
+    return d >= 0x80000000u ? 0u : d;
 }
 
 static void host_rx(void *user, const tase_frame_t *frame)
@@ -135,8 +207,7 @@ int tase_host_poll(tase_host_t *h, uint32_t now_ms)
     if (h->state != HOST_WAITING) {
         return TASE_ESTATE;
     }
-    /* Unsigned difference: correct across the 2^32 wrap of the clock. */
-    if ((uint32_t)(now_ms - h->sent_at) < h->timeout_ms) {
+    if (elapsed(now_ms, h->sent_at) < h->timeout_ms) {
         return TASE_EAGAIN;
     }
     if (h->retries_left == 0) {
@@ -186,34 +257,57 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms)
     return n;
 }
 
-int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len,
-                       uint8_t *reply, size_t reply_cap, uint32_t timeout_ms, uint8_t retries)
+/* Service the port and poll until the pending request completes. */
+static int transact_wait(tase_host_t *h)
 {
-    int r;
-
-    if (h == NULL || h->port.ops == NULL) {
-        return TASE_EARG;
-    }
-    if (h->port.ops->read == NULL || h->port.ops->now_ms == NULL) {
-        return TASE_EUNSUPPORTED;
-    }
-    r = tase_host_request_start(h, group, type, data, len, reply, reply_cap, timeout_ms, retries,
-                                h->port.ops->now_ms(h->port.ctx));
-    if (r < 0) {
-        return r;
-    }
     for (;;) {
         uint32_t now = h->port.ops->now_ms(h->port.ctx);
         uint32_t waited;
-        r = tase_host_poll(h, now);
+        int r = tase_host_poll(h, now);
         if (r != TASE_EAGAIN) {
             return r;
         }
-        waited = (uint32_t)(now - h->sent_at);
+        waited = elapsed(now, h->sent_at);
         r = tase_host_service(h, waited < h->timeout_ms ? h->timeout_ms - waited : 0u);
         if (r < 0) {
             (void)tase_host_cancel(h);
             return r;
         }
     }
+}
+
+/* The port checks of the blocking calls: TASE_OK when it can be used. */
+static int transact_port_ok(const tase_host_t *h)
+{
+    if (h == NULL || h->port.ops == NULL) {
+        return TASE_EARG;
+    }
+    if (h->port.ops->read == NULL || h->port.ops->now_ms == NULL) {
+        return TASE_EUNSUPPORTED;
+    }
+    return TASE_OK;
+}
+
+int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len,
+                       uint8_t *reply, size_t reply_cap, uint32_t timeout_ms, uint8_t retries)
+{
+    int r = transact_port_ok(h);
+    if (r != TASE_OK) {
+        return r;
+    }
+    r = tase_host_request_start(h, group, type, data, len, reply, reply_cap, timeout_ms, retries,
+                                h->port.ops->now_ms(h->port.ctx));
+    return r < 0 ? r : transact_wait(h);
+}
+
+int tase_host_transact_msg(tase_host_t *h, uint16_t id, const void *msg, void *reply_msg,
+                           uint32_t timeout_ms, uint8_t retries)
+{
+    int r = transact_port_ok(h);
+    if (r != TASE_OK) {
+        return r;
+    }
+    r = tase_host_request_msg_start(h, id, msg, reply_msg, timeout_ms, retries,
+                                    h->port.ops->now_ms(h->port.ctx));
+    return r < 0 ? r : transact_wait(h);
 }

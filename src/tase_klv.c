@@ -395,8 +395,8 @@ double tase_klv_utc_s(uint64_t v)
  * (every range here contains 0). */
 static int64_t nearest_sat(double x, int64_t lo, int64_t hi)
 {
-    if (x != x) {
-        return 0;
+    if (!(x < 0.0) && !(x >= 0.0)) {
+        return 0; /* NaN: every comparison is false */
     }
     if (x <= (double)lo) {
         return lo;

@@ -1,6 +1,7 @@
 /* Helpers over the port boundary: write-all and frame send. */
 #include "tase/port_io.h"
 
+#include "tase/codec.h"
 #include "tase/frame.h"
 
 int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n)
@@ -54,13 +55,28 @@ int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, c
     return tase_port_write_all(port, buf, (size_t)n);
 }
 
+int tase_port_send_msg(const tase_port_t *port, uint16_t id, const void *msg)
+{
+    uint8_t buf[TASE_FRAME_MAX];
+    int n = msg != NULL ? tase_packet_encode(id, msg, buf, sizeof buf)
+                        : tase_packet_encode_len(id, NULL, 0u, buf, sizeof buf);
+
+    if (n < 0) {
+        return n;
+    }
+    if (port == NULL) {
+        return TASE_EARG;
+    }
+    return tase_port_write_all(port, buf, (size_t)n);
+}
+
 int tase_port_count_tx(int r, uint32_t *sent, uint32_t *errors)
 {
     if (r >= 0) {
         if (sent != NULL) {
             (*sent)++;
         }
-    } else if (r != TASE_EARG && r != TASE_ETOOLONG) {
+    } else if (r != TASE_EARG && r != TASE_ETOOLONG && r != TASE_ELENGTH && r != TASE_EUNKNOWN) {
         if (errors != NULL) {
             (*errors)++;
         }

@@ -10,7 +10,7 @@
 /* Field index bookkeeping: FIRST_x / END_x are the flat field indices of
  * packet x. Each marker rewinds the counter so it takes no slot. */
 #define P(N, g, t, fl, l, sz) FIRST_##N, FIRST_##N##_ = FIRST_##N - 1,
-#define F(T, m, o, w, s) FLD_##T##_##m,
+#define F(T, m, o, w, s, k) FLD_##T##_##m,
 #define E(N) END_##N, END_##N##_ = END_##N - 1,
 /* The rewinding markers give the next constant its marker's value on
  * purpose: that is how a marker takes no slot. */
@@ -25,7 +25,7 @@ enum {
 
 /* Packet positions in the list, to check the enumeration in schema.h. */
 #define P(N, g, t, fl, l, sz) PKTIDX_##N,
-#define F(T, m, o, w, s)
+#define F(T, m, o, w, s, k)
 #define E(N)
 enum {
 #include "tase_schema_def.h"
@@ -41,7 +41,7 @@ enum {
     typedef char chk_idx_##N[((int)TASE_PKT_##N == (int)PKTIDX_##N) ? 1 : -1];
 /* T is a type and m a member name: neither can be parenthesised. */
 /* cppcheck-suppress misra-c2012-20.7 */
-#define F(T, m, o, w, s)                                                                           \
+#define F(T, m, o, w, s, k)                                                                        \
     typedef char chk_##T##_##m[(sizeof(((T *)0)->m) == (w) && offsetof(T, m) < 256u) ? 1 : -1];
 #include "tase_schema_def.h"
 #undef P
@@ -53,24 +53,33 @@ typedef char chk_fields[(FIELD_TOTAL < 256) ? 1 : -1];
 
 #define FMT_U 0u
 #define FMT_S TASE_FIELD_SIGNED
+/* The list's names for a field's "do not change" value. */
+#define ONES TASE_FIELD_KEEP_ONES
+#define ZERO TASE_FIELD_KEEP_ZERO
+#define MSB TASE_FIELD_KEEP_MSB
+#define SHIFT TASE_FIELD_SHIFT
 
 /* Generated from the list like its siblings here, so it stays at file
  * scope although only tase_schema_field() reads it. */
 /* cppcheck-suppress misra-c2012-8.9 */
 static const tase_field_t fields[FIELD_TOTAL] = {
 #define P(N, g, t, fl, l, sz)
-#define F(T, m, o, w, s) {o, offsetof(T, m), (w) | FMT_##s},
+#define F(T, m, o, w, s, k) {o, offsetof(T, m), (w) | FMT_##s | (k)},
 #define E(N)
 #include "tase_schema_def.h"
 #undef P
 #undef F
 #undef E
 };
+#undef ONES
+#undef ZERO
+#undef MSB
+#undef SHIFT
 
 static const tase_packet_desc_t packets[TASE_PKT_COUNT] = {
 #define P(N, g, t, fl, l, sz)                                                                      \
     {TASE_ID(g, t), l, fl, FIRST_##N, END_##N - FIRST_##N, sz, TASE_PKT_##N},
-#define F(T, m, o, w, s)
+#define F(T, m, o, w, s, k)
 #define E(N)
 #include "tase_schema_def.h"
 #undef P
@@ -165,6 +174,9 @@ bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len)
     if (len == 1u) {
         return (p->flags & TASE_LEN_SHORT1) != 0u;
     }
+    if (len + 1u == p->len && (p->flags & TASE_LEN_SHORT) != 0u) {
+        return true;
+    }
     return (p->flags & TASE_LEN_TAIL) != 0u && len > p->len && len <= TASE_DATA_MAX;
 }
 
@@ -173,10 +185,26 @@ bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len)
     return p != NULL && len == 0u && (p->flags & TASE_LEN_QUERY) != 0u;
 }
 
+int tase_field_offset(const tase_packet_desc_t *p, size_t i, size_t len)
+{
+    const tase_field_t *f = tase_schema_field(p, i);
+    if (f == NULL) {
+        return TASE_EARG;
+    }
+    /* The short layout only exists for packets flagged for it; the field
+     * flag alone (a corrupted descriptor) never moves a field. */
+    if ((f->fmt & TASE_FIELD_SHIFT) != 0u && (p->flags & TASE_LEN_SHORT) != 0u &&
+        len + 1u == p->len && f->offset > 0u) {
+        return (int)f->offset - 1;
+    }
+    return (int)f->offset;
+}
+
 int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
                    int64_t *value)
 {
     const tase_field_t *f = tase_schema_field(p, i);
+    size_t at;
     unsigned w;
     unsigned k;
     uint64_t v = 0u;
@@ -184,15 +212,16 @@ int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, s
         return TASE_EARG;
     }
     w = TASE_FIELD_WIDTH(f);
+    at = (size_t)tase_field_offset(p, i, len); /* >= 0: f is valid */
     /* data is NULL only with len 0, where no field fits. */
-    if (data == NULL || (size_t)f->offset + w > len) {
+    if (data == NULL || at + w > len) {
         return TASE_ETRUNC;
     }
     for (k = 0; k < w; k++) {
-        v = (v << 8) | data[f->offset + k];
+        v = (v << 8) | data[at + k];
     }
     /* Big-endian: the sign bit is the top bit of the first byte. */
-    if (TASE_FIELD_IS_SIGNED(f) && (data[f->offset] & 0x80u) != 0u) {
+    if (TASE_FIELD_IS_SIGNED(f) && (data[at] & 0x80u) != 0u) {
         /* Two's complement by arithmetic, without an implementation-
          * defined conversion of an out-of-range unsigned value. */
         uint64_t mag = ~v;
@@ -206,4 +235,56 @@ int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, s
         *value = (int64_t)v;
     }
     return TASE_OK;
+}
+
+/* Value of a `w`-byte field whose bits from the top down to `low` are set
+ * (low 0: all of them), as tase_field_get() reads it: negative when signed
+ * and the top bit is set. The spec has no 8-byte field with such a value;
+ * one would read as -1 either way (see tase_field_get()). */
+static int64_t top_bits(unsigned w, unsigned low, bool is_signed)
+{
+    unsigned bits = 8u * w;
+    uint64_t mask;
+    uint64_t v;
+    if (w >= 8u) {
+        return -1;
+    }
+    mask = ((uint64_t)1u << bits) - 1u;
+    v = mask & ~(((uint64_t)1u << low) - 1u);
+    return is_signed ? -(int64_t)(mask - v) - 1 : (int64_t)v;
+}
+
+int tase_field_keep(const tase_packet_desc_t *p, size_t i, int64_t *value)
+{
+    const tase_field_t *f = tase_schema_field(p, i);
+    unsigned w;
+    if (f == NULL || value == NULL) {
+        return TASE_EARG;
+    }
+    w = TASE_FIELD_WIDTH(f);
+    switch (TASE_FIELD_KEEP(f)) {
+    case TASE_FIELD_KEEP_ONES: *value = top_bits(w, 0u, TASE_FIELD_IS_SIGNED(f)); break;
+    case TASE_FIELD_KEEP_ZERO: *value = 0; break;
+    case TASE_FIELD_KEEP_MSB: *value = top_bits(w, 8u * w - 1u, TASE_FIELD_IS_SIGNED(f)); break;
+    default: return TASE_EUNKNOWN;
+    }
+    return TASE_OK;
+}
+
+bool tase_field_is_keep(const tase_packet_desc_t *p, size_t i, int64_t value)
+{
+    const tase_field_t *f = tase_schema_field(p, i);
+    int64_t keep;
+    if (tase_field_keep(p, i, &keep) != TASE_OK) {
+        return false;
+    }
+    if (TASE_FIELD_KEEP(f) != TASE_FIELD_KEEP_MSB) {
+        return value == keep;
+    }
+    /* Any value of the field with its most significant bit set: keep is
+     * the least of them (unsigned) or the most negative (signed). */
+    if (TASE_FIELD_IS_SIGNED(f)) {
+        return value >= keep && value < 0;
+    }
+    return value >= keep && value <= top_bits(TASE_FIELD_WIDTH(f), 0u, false);
 }

@@ -10,7 +10,7 @@
 
 static const char *const packet_names[TASE_PKT_COUNT] = {
 #define P(N, g, t, fl, l, sz) #N,
-#define F(T, m, o, w, s)
+#define F(T, m, o, w, s, k)
 #define E(N)
 #include "tase_schema_def.h"
 #undef P
@@ -23,7 +23,7 @@ static const char *const packet_names[TASE_PKT_COUNT] = {
 /* cppcheck-suppress misra-c2012-8.9 */
 static const char *const field_names[] = {
 #define P(N, g, t, fl, l, sz)
-#define F(T, m, o, w, s) #m,
+#define F(T, m, o, w, s, k) #m,
 #define E(N)
 #include "tase_schema_def.h"
 #undef P

@@ -92,8 +92,15 @@ static void gyro_zero_and_camera_short_forms_encode_to_hand_computed_frames(void
     memset(&camb, 0x55, sizeof(camb));
     assert_int_equal(tase_packet_decode(&f, &camb), 1);
     assert_int_equal(camb.camera, 1);
-    assert_int_equal(camb.hfov, 0); /* not sent: zero */
-    assert_int_equal(camb.flags, 0);
+    /* Not sent: "do not change" (4.1.3), never a zero that is a command
+     * (focus 0 = auto-focus, exposure 0 = full auto, flags 0 = white hot,
+     * stabilisation and title off). */
+    assert_int_equal(camb.hfov, -1);
+    assert_int_equal(camb.focus, 0xFFFF);
+    assert_int_equal(camb.exposure, 0xFF);
+    assert_int_equal(camb.shutter_speed, 0xFF);
+    assert_int_equal(camb.bright, 0xFF);
+    assert_int_equal(camb.flags, TASE_CAMERA_FLAG_NO_CHANGE);
 
     assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), 14);
     assert_memory_equal(out, pass, sizeof(pass));
@@ -178,6 +185,54 @@ static void axis_setting_leaves_byte_13_reserved_zero(void **state)
     memset(out, 0xAA, sizeof(out)); /* reserved byte must be cleared */
     assert_int_equal(tase_packet_encode(TASE_ID_AXIS_SETTING, &m, out, sizeof(out)), 31);
     assert_memory_equal(out, want, sizeof(want));
+}
+
+/* Table 22 read as a row-numbering slip (no byte 13, 22 bytes): accepted
+ * and decoded by its own layout, and encoded when asked for (S2). */
+static void axis_setting_22_byte_layout_decodes_and_encodes_to_hand_computed_frames(void **state)
+{
+    /* The data of the test above without byte 13: ... 3C, 3C FF 32 32 FF
+     * 28 28 FF 01. Size 22 + 2 = 0x18. Sum: header FF+5A+18+48+02 = 443;
+     * data 2147; 2590 = 0x0A1E. */
+    static const uint8_t want22[] = {0x00, 0xFF, 0x5A, 0x18, 0x48, 0x02, 0xB9, 0xB0, 0xFF, 0xFF,
+                                     0x23, 0x28, 0x17, 0x70, 0x00, 0x00, 0x00, 0x00, 0x3C, 0x3C,
+                                     0xFF, 0x32, 0x32, 0xFF, 0x28, 0x28, 0xFF, 0x01, 0x0A, 0x1E};
+    /* The 23-byte frame with a non-zero byte 13 (ignored): sum + 0xAB. */
+    static const uint8_t in23[] = {0x00, 0xFF, 0x5A, 0x19, 0x48, 0x02, 0xB9, 0xB0, 0xFF, 0xFF, 0x23,
+                                   0x28, 0x17, 0x70, 0x00, 0x00, 0x00, 0x00, 0x3C, 0xAB, 0x3C, 0xFF,
+                                   0x32, 0x32, 0xFF, 0x28, 0x28, 0xFF, 0x01, 0x0A, 0xCA};
+    tase_axis_setting_t a22, a23;
+    uint8_t out[64];
+    tase_frame_t f;
+    (void)state;
+    f = frame_of(want22, sizeof(want22));
+    memset(&a22, 0x55, sizeof(a22));
+    assert_int_equal(tase_packet_decode(&f, &a22), 22);
+    assert_int_equal(a22.pan_nogo_center, -18000);
+    assert_int_equal(a22.pan_nogo_range, 0xFFFF);
+    assert_int_equal(a22.tilt_nogo_center, 9000);
+    assert_int_equal(a22.tilt_nogo_range, 6000);
+    assert_int_equal(a22.pan_max_rate, 60);    /* byte 12 */
+    assert_int_equal(a22.tilt_max_rate, 60);   /* byte 13 */
+    assert_int_equal(a22.roll_max_rate, 0xFF); /* 14 */
+    assert_int_equal(a22.pan_max_accel, 50);   /* 15 */
+    assert_int_equal(a22.tilt_max_accel, 50);  /* 16 */
+    assert_int_equal(a22.roll_max_accel, 0xFF);
+    assert_int_equal(a22.pan_pos_gain, 40); /* 18 */
+    assert_int_equal(a22.tilt_pos_gain, 40);
+    assert_int_equal(a22.roll_pos_gain, 0xFF);
+    assert_int_equal(a22.temporary, 1); /* 21 */
+    /* the same settings in the 23-byte layout decode to the same struct */
+    f = frame_of(in23, sizeof(in23));
+    memset(&a23, 0x33, sizeof(a23));
+    assert_int_equal(tase_packet_decode(&f, &a23), 23);
+    assert_memory_equal(&a22, &a23, sizeof(a22));
+    /* the encoder writes 23 unless asked for the short layout */
+    assert_int_equal(tase_packet_encode_len(TASE_ID_AXIS_SETTING, &a22, 22, out, sizeof(out)), 30);
+    assert_memory_equal(out, want22, sizeof(want22));
+    assert_int_equal(tase_packet_encode(TASE_ID_AXIS_SETTING, &a22, out, sizeof(out)), 31);
+    assert_int_equal(out[6 + 13], 0x00);
+    assert_int_equal(out[6 + 22], 0x01);
 }
 
 /* ---- every packet: round trips -------------------------------------- */
@@ -489,6 +544,126 @@ static void codec_api_rejects_bad_arguments(void **state)
     assert_memory_equal(&msg, &mcopy, sizeof msg);
 }
 
+/* ---- data bytes only ---------------------------------------------------- */
+
+/* For every packet and every accepted length, the data-only encoders write
+ * exactly the data bytes of the frame the frame encoders build, and the
+ * data-only decoders give exactly the struct tase_packet_decode() gives. */
+static void data_only_codec_matches_the_frame_codec_for_every_packet(void **state)
+{
+    size_t i, len, k;
+    int rep;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        for (len = 0; len <= TASE_DATA_MAX; len++) {
+            for (rep = 0; rep < 3 && tase_schema_length_ok(p, len); rep++) {
+                uint8_t data[TASE_DATA_MAX], wire[TASE_FRAME_MAX], only[TASE_DATA_MAX + 1];
+                tase_packet_msg_t by_frame, by_data, by_desc;
+                void *msg = p->size ? &by_frame : NULL;
+                tase_frame_t f;
+                int n;
+                for (k = 0; k < len; k++) {
+                    data[k] = (uint8_t)rnd();
+                }
+                n = tase_frame_encode(wire, sizeof wire, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id),
+                                      data, len);
+                f = frame_of(wire, n);
+                memset(&by_frame, 0x11, sizeof by_frame);
+                memset(&by_data, 0x22, sizeof by_data);
+                memset(&by_desc, 0x33, sizeof by_desc);
+                assert_int_equal(tase_packet_decode(&f, msg), (int)len);
+                assert_int_equal(
+                    tase_packet_decode_data(p->id, data, len, p->size ? &by_data : NULL), (int)len);
+                assert_int_equal(tase_packet_decode_desc(p, data, len, p->size ? &by_desc : NULL),
+                                 (int)len);
+                if (p->flags & TASE_LEN_TAIL) {
+                    /* the tail points into what was decoded */
+                    assert_ptr_equal(by_frame.camera_pass.data, f.data + 4);
+                    assert_ptr_equal(by_data.camera_pass.data, data + 4);
+                    assert_ptr_equal(by_desc.camera_pass.data, data + 4);
+                    by_data.camera_pass.data = by_frame.camera_pass.data;
+                    by_desc.camera_pass.data = by_frame.camera_pass.data;
+                }
+                assert_memory_equal(&by_data, &by_frame, p->size);
+                assert_memory_equal(&by_desc, &by_frame, p->size);
+                /* the struct back to data bytes: those of the frame encoder */
+                n = tase_packet_encode_len(p->id, msg, len, wire, sizeof wire);
+                assert_int_equal(n, (int)len + 8);
+                memset(only, 0xEE, sizeof only);
+                assert_int_equal(tase_packet_encode_data_len(p->id, msg, len, only, len), (int)len);
+                assert_memory_equal(only, wire + TASE_FRAME_HEADER, len);
+                assert_int_equal(only[len], 0xEE); /* nothing past the data */
+                if (len == (size_t)p->len || (p->flags & TASE_LEN_TAIL)) {
+                    n = tase_packet_encode(p->id, msg, wire, sizeof wire);
+                    memset(only, 0xEE, sizeof only);
+                    assert_int_equal(tase_packet_encode_data(p->id, msg, only, sizeof only), n - 8);
+                    assert_memory_equal(only, wire + TASE_FRAME_HEADER, (size_t)n - 8u);
+                }
+            }
+        }
+    }
+}
+
+/* Bad arguments of the data-only functions give their documented codes
+ * and write nothing. */
+static void data_only_codec_rejects_bad_arguments(void **state)
+{
+    tase_gimbal_cmd_t cmd = {1, 2, 3, 4, 5};
+    tase_camera_pass_t cp = {0, 0, 250, (const uint8_t *)"x"};
+    tase_packet_desc_t fake;
+    uint8_t out[TASE_DATA_MAX], before[TASE_DATA_MAX], in[8] = {0};
+    tase_packet_msg_t msg, mcopy;
+    size_t cap;
+    (void)state;
+
+    memset(out, 0xA5, sizeof out);
+    memcpy(before, out, sizeof out);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &cmd, NULL, 8), TASE_EARG);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_GYRO_ZERO_CMD, NULL, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_packet_encode_data(TASE_ID(0x28u, 0u), &cmd, NULL, 8), TASE_EARG);
+    assert_int_equal(tase_packet_encode_data(TASE_ID(0x28u, 0u), &cmd, out, 8), TASE_EUNKNOWN);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, NULL, out, 8), TASE_EARG);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, out, sizeof out),
+                     TASE_ETOOLONG);
+    cp.len = 3;
+    cp.data = NULL;
+    assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, out, sizeof out), TASE_EARG);
+    for (cap = 0; cap < 8; cap++) {
+        assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &cmd, out, cap), TASE_ENOSPC);
+    }
+    assert_int_equal(tase_packet_encode_data_len(TASE_ID_GIMBAL_CMD, &cmd, 0, out, 8),
+                     TASE_ELENGTH);
+    assert_int_equal(tase_packet_encode_data_len(TASE_ID_GIMBAL_CMD, &cmd, SIZE_MAX, out, SIZE_MAX),
+                     TASE_ELENGTH);
+    assert_memory_equal(out, before, sizeof out);
+    /* the forms without data need a buffer but no room */
+    assert_int_equal(tase_packet_encode_data(TASE_ID_GYRO_ZERO_CMD, NULL, out, 0), 0);
+    assert_int_equal(tase_packet_encode_data_len(TASE_ID_PACKET_RATE, NULL, 0, out, 0), 0);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &cmd, out, 8), 8);
+    assert_int_equal(out[1], 1);
+
+    memset(&msg, 0x5A, sizeof msg);
+    memcpy(&mcopy, &msg, sizeof msg);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GIMBAL_CMD, NULL, 8, &msg), TASE_EARG);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GIMBAL_CMD, in, 8, NULL), TASE_EARG);
+    assert_int_equal(tase_packet_decode_data(TASE_ID(0x28u, 0u), in, 8, &msg), TASE_EUNKNOWN);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GIMBAL_CMD, in, 7, &msg), TASE_ELENGTH);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GIMBAL_CMD, in, SIZE_MAX, &msg), TASE_ELENGTH);
+    assert_int_equal(tase_packet_decode_desc(NULL, in, 8, &msg), TASE_EUNKNOWN);
+    assert_int_equal(tase_packet_decode_desc(NULL, NULL, 8, &msg), TASE_EARG);
+    /* a copy of a real descriptor is not one of the table: its size could
+     * be anything, so it is refused before msg is written */
+    fake = *tase_schema_find(0x00, 0x80);
+    fake.size = 255;
+    assert_int_equal(tase_packet_decode_desc(&fake, in, 8, &msg), TASE_EARG);
+    assert_memory_equal(&msg, &mcopy, sizeof msg);
+    /* queries and GYRO_ZERO_CMD decode without data or struct */
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GYRO_ZERO_CMD, NULL, 0, NULL), 0);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_PACKET_RATE, NULL, 0, &msg), 0);
+    assert_int_equal(msg.packet_rate.angle_1, 0); /* zeroed */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -499,11 +674,14 @@ int main(void)
         cmocka_unit_test(gimbal_angle_encodes_to_hand_computed_frame),
         cmocka_unit_test(spoi_full_and_query_forms_encode_to_hand_computed_frames),
         cmocka_unit_test(axis_setting_leaves_byte_13_reserved_zero),
+        cmocka_unit_test(axis_setting_22_byte_layout_decodes_and_encodes_to_hand_computed_frames),
         cmocka_unit_test(every_packet_round_trips_random_and_extreme_values),
         cmocka_unit_test(every_query_capable_packet_encodes_an_eight_byte_query),
         cmocka_unit_test(every_wrong_length_is_rejected_on_decode_and_encode),
         cmocka_unit_test(argument_errors_are_reported_and_write_nothing),
         cmocka_unit_test(camera_pass_carries_249_bytes_and_may_be_encoded_in_place),
+        cmocka_unit_test(data_only_codec_matches_the_frame_codec_for_every_packet),
+        cmocka_unit_test(data_only_codec_rejects_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include "fake_port.h"
+#include "tase/codec.h"
 #include "tase/gimbal.h"
 #include "tase/ids.h"
 
@@ -109,7 +110,7 @@ static fix_t *make(uint32_t now, unsigned nports, bool with_fill)
 {
     fix_t *x = calloc(1, sizeof *x);
     tase_port_t ports[3];
-    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL};
+    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL, NULL, NULL};
     unsigned i;
     assert_non_null(x);
     app.user = x;
@@ -621,7 +622,7 @@ static void service_reads_every_port_feeds_it_and_polls(void **state)
     static const tase_port_ops_t broken = {fake_write, broken_read, fake_now};
     fix_t *x = calloc(1, sizeof *x);
     tase_port_t ports[3];
-    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL};
+    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL, NULL, NULL};
     uint8_t g, t, d[TASE_DATA_MAX], noise[5000];
     (void)state;
     assert_non_null(x);
@@ -753,6 +754,219 @@ static void gimbal_api_rejects_bad_arguments(void **state)
     assert_int_equal(rx[0].stats.bytes_in, 0);
 }
 
+/* ---- typed API ------------------------------------------------------- */
+
+typedef struct {
+    unsigned fills, applies;
+    uint16_t last_id;
+    unsigned last_port;
+    int refuse;
+} typed_app_t;
+
+static int typed_fill(void *user, unsigned port, uint16_t id, void *msg, uint32_t now)
+{
+    typed_app_t *a = user;
+    a->fills++;
+    a->last_id = id;
+    a->last_port = port;
+    if (id == TASE_ID_GIMBAL_ANGLE) {
+        tase_gimbal_angle_t *m = msg;
+        assert_int_equal(m->pan, 0); /* zeroed for us */
+        m->pan = (int16_t)-17999;
+        m->tilt = (int16_t)(now % 1000u);
+    } else if (id == TASE_ID_GIMBAL_RATE) {
+        tase_gimbal_rate_t *m = msg;
+        m->time = now;
+        m->mode = 0x21;
+    } else {
+        tase_georeference_t *m = msg;
+        m->time = now;
+        m->lat = -123456789;
+        m->camera = 2;
+    }
+    return 0;
+}
+
+/* SENSOR_FILTER cutoffs above 20 Hz are clamped; NAV_SOURCE is refused. */
+static int typed_apply(void *user, unsigned port, uint16_t id, void *msg)
+{
+    typed_app_t *a = user;
+    a->applies++;
+    a->last_id = id;
+    a->last_port = port;
+    if (id == TASE_ID_SENSOR_FILTER) {
+        tase_sensor_filter_t *m = msg;
+        if (m->cutoff > 200) {
+            m->cutoff = 200;
+        }
+    }
+    return id == TASE_ID_NAV_SOURCE ? -1 : 0;
+}
+
+typedef struct {
+    fake_port_t fp;
+    tase_gimbal_t g;
+    tase_rx_t rx;
+    typed_app_t a;
+} typed_fix_t;
+
+/* A gimbal on one fake port with the typed callbacks (free() it). */
+static typed_fix_t *make_typed(void)
+{
+    typed_fix_t *x = calloc(1, sizeof *x);
+    tase_port_t port;
+    tase_gimbal_app_t app;
+    assert_non_null(x);
+    port.ops = &fake_ops;
+    port.ctx = &x->fp;
+    memset(&app, 0, sizeof app);
+    app.fill_telemetry_msg = typed_fill;
+    app.apply_setup_msg = typed_apply;
+    app.user = &x->a;
+    assert_int_equal(tase_gimbal_init(&x->g, &port, &x->rx, 1, &app, 0), TASE_OK);
+    return x;
+}
+
+static void typed_telemetry_is_encoded_from_the_filled_structs(void **state)
+{
+    typed_fix_t *x = make_typed();
+    uint8_t want[TASE_FRAME_MAX];
+    tase_gimbal_angle_t ang;
+    tase_georeference_t geo;
+    int n;
+    (void)state;
+    /* at 100 ms the 10/s angle and rate slots are due, in that order */
+    assert_int_equal(tase_gimbal_poll(&x->g, 99), 0);
+    assert_int_equal(tase_gimbal_poll(&x->g, 100), 2);
+    memset(&ang, 0, sizeof ang);
+    ang.pan = -17999;
+    ang.tilt = 100;
+    n = tase_packet_encode(TASE_ID_GIMBAL_ANGLE, &ang, want, sizeof want);
+    assert_memory_equal(x->fp.out, want, (size_t)n);
+    assert_int_equal(x->a.last_id, TASE_ID_GIMBAL_RATE);
+    x->fp.nout = 0;
+    /* at 250 ms the 4/s GEOREFERENCE_DATA slot too */
+    assert_int_equal(tase_gimbal_poll(&x->g, 250), 3);
+    assert_int_equal(x->a.last_id, TASE_ID_GEOREFERENCE_DATA);
+    memset(&geo, 0, sizeof geo);
+    geo.time = 250;
+    geo.lat = -123456789;
+    geo.camera = 2;
+    n = tase_packet_encode(TASE_ID_GEOREFERENCE_DATA, &geo, want, sizeof want);
+    assert_true(x->fp.nout > (size_t)n);
+    assert_memory_equal(x->fp.out + x->fp.nout - (size_t)n, want, (size_t)n);
+    assert_int_equal(fake_frames_out(&x->fp), 3);
+    assert_int_equal(x->g.stats.telemetry_tx, 5);
+}
+
+static void a_typed_setting_is_decoded_applied_stored_and_echoed(void **state)
+{
+    typed_fix_t *x = make_typed();
+    uint8_t fr[TASE_FRAME_MAX], grp, typ, d[TASE_DATA_MAX];
+    tase_sensor_filter_t sf;
+    tase_nav_source_t ns;
+    int n;
+    (void)state;
+    n = tase_frame_encode(fr, sizeof fr, 0x48, 0x01, (const uint8_t *)"\xFA\x07", 2);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, fr, (size_t)n, 5), 1);
+    assert_int_equal(x->a.applies, 1);
+    assert_int_equal(x->a.last_id, TASE_ID_SENSOR_FILTER);
+    assert_int_equal(only_frame(&x->fp, &grp, &typ, d), 2);
+    assert_int_equal(d[0], 200); /* clamped by the application */
+    assert_int_equal(d[1], 7);
+    assert_int_equal(tase_gimbal_setup_get_msg(&x->g, TASE_ID_SENSOR_FILTER, &sf), 2);
+    assert_int_equal(sf.cutoff, 200);
+    assert_int_equal(sf.decimation, 7);
+    /* a refused setting echoes what is in force */
+    n = tase_frame_encode(fr, sizeof fr, 0x48, 0x04, (const uint8_t *)"\x01\x01", 2);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, fr, (size_t)n, 6), 1);
+    assert_int_equal(only_frame(&x->fp, &grp, &typ, d), 2);
+    assert_int_equal(d[0], 0);
+    assert_int_equal(tase_gimbal_setup_get_msg(&x->g, TASE_ID_NAV_SOURCE, &ns), 2);
+    assert_int_equal(ns.external_gps, 0);
+    assert_int_equal(x->g.stats.setup_refused, 1);
+    free(x);
+}
+
+static void typed_setup_set_and_send_msg(void **state)
+{
+    typed_fix_t *x = make_typed();
+    tase_system_version_t v, back;
+    tase_packet_rate_t pr;
+    tase_spoi_cmd_t spoi = {1, 2, 3, 4, 5, 6, 7};
+    uint8_t want[TASE_FRAME_MAX], grp, typ, d[TASE_DATA_MAX];
+    int n;
+    (void)state;
+    memset(&v, 0, sizeof v);
+    v.major = 3;
+    v.board_sn = 77;
+    v.camera_b = 0xFF;
+    assert_int_equal(tase_gimbal_setup_set_msg(&x->g, TASE_ID_SYSTEM_VERSION, &v, 0), TASE_OK);
+    memset(&back, 0x5A, sizeof back);
+    assert_int_equal(tase_gimbal_setup_get_msg(&x->g, TASE_ID_SYSTEM_VERSION, &back), 42);
+    assert_memory_equal(&back, &v, sizeof v);
+    /* a PACKET_RATE set this way reschedules like the byte form */
+    assert_int_equal(tase_gimbal_setup_get_msg(&x->g, TASE_ID_PACKET_RATE, &pr), 16);
+    assert_int_equal(pr.angle_1, 10);
+    pr.angle_1 = 0;
+    pr.rate_1 = 0;
+    pr.geo_ref_1 = 1;
+    assert_int_equal(tase_gimbal_setup_set_msg(&x->g, TASE_ID_PACKET_RATE, &pr, 0), TASE_OK);
+    assert_int_equal(tase_gimbal_poll(&x->g, 999), 0);
+    assert_int_equal(tase_gimbal_poll(&x->g, 1000), 1);
+    assert_int_equal(x->a.last_id, TASE_ID_GEOREFERENCE_DATA);
+    x->fp.nout = 0;
+    /* send_msg: the codec's frame, and the zero-length form */
+    n = tase_packet_encode(TASE_ID_SPOI_CMD, &spoi, want, sizeof want);
+    assert_int_equal(tase_gimbal_send_msg(&x->g, 0, TASE_ID_SPOI_CMD, &spoi), n);
+    assert_memory_equal(x->fp.out, want, (size_t)n);
+    x->fp.nout = 0;
+    assert_int_equal(tase_gimbal_send_msg(&x->g, 0, TASE_ID_SPOI_CMD, NULL), 8);
+    assert_int_equal(only_frame(&x->fp, &grp, &typ, d), 0);
+    /* errors: nothing stored, nothing sent */
+    assert_int_equal(tase_gimbal_send_msg(&x->g, 1, TASE_ID_SPOI_CMD, &spoi), TASE_EARG);
+    assert_int_equal(tase_gimbal_send_msg(NULL, 0, TASE_ID_SPOI_CMD, &spoi), TASE_EARG);
+    assert_int_equal(tase_gimbal_send_msg(&x->g, 0, TASE_ID_GIMBAL_ANGLE, NULL), TASE_ELENGTH);
+    assert_int_equal(tase_gimbal_send_msg(&x->g, 0, TASE_ID(0x28, 1), &spoi), TASE_EUNKNOWN);
+    assert_int_equal(x->fp.nout, 0);
+    assert_int_equal(x->g.stats.tx_errors, 0);
+    assert_int_equal(tase_gimbal_setup_set_msg(&x->g, TASE_ID_GIMBAL_CMD, &pr, 0), TASE_EUNKNOWN);
+    assert_int_equal(tase_gimbal_setup_set_msg(&x->g, TASE_ID(0x48, 0x08), &pr, 0), TASE_EUNKNOWN);
+    assert_int_equal(tase_gimbal_setup_set_msg(&x->g, TASE_ID_PACKET_RATE, NULL, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_set_msg(NULL, TASE_ID_PACKET_RATE, &pr, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_get_msg(&x->g, TASE_ID_SPOI_CMD, &pr), TASE_EUNKNOWN);
+    assert_int_equal(tase_gimbal_setup_get_msg(&x->g, TASE_ID_PACKET_RATE, NULL), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_get_msg(NULL, TASE_ID_PACKET_RATE, &pr), TASE_EARG);
+    free(x);
+}
+
+static int bytes_fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
+                      uint32_t now)
+{
+    (void)user, (void)port, (void)id, (void)data, (void)cap, (void)now;
+    return 0;
+}
+
+static void init_refuses_both_forms_of_a_callback(void **state)
+{
+    static tase_gimbal_t g;
+    fake_port_t *fp = calloc(1, sizeof *fp);
+    tase_port_t port = {&fake_ops, fp};
+    tase_gimbal_app_t app;
+    (void)state;
+    memset(&app, 0, sizeof app);
+    app.fill_telemetry = bytes_fill;
+    app.fill_telemetry_msg = typed_fill;
+    assert_int_equal(tase_gimbal_init(&g, &port, NULL, 1, &app, 0), TASE_EARG);
+    app.fill_telemetry = NULL;
+    app.apply_setup = app_apply;
+    app.apply_setup_msg = typed_apply;
+    assert_int_equal(tase_gimbal_init(&g, &port, NULL, 1, &app, 0), TASE_EARG);
+    app.apply_setup_msg = NULL;
+    assert_int_equal(tase_gimbal_init(&g, &port, NULL, 1, &app, 0), TASE_OK);
+    free(fp);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -776,6 +990,10 @@ int main(void)
         cmocka_unit_test(every_function_rejects_null_and_out_of_range_arguments),
         cmocka_unit_test(frames_from_absent_ports_and_without_callbacks_are_only_counted),
         cmocka_unit_test(service_reads_every_port_feeds_it_and_polls),
+        cmocka_unit_test(typed_telemetry_is_encoded_from_the_filled_structs),
+        cmocka_unit_test(a_typed_setting_is_decoded_applied_stored_and_echoed),
+        cmocka_unit_test(typed_setup_set_and_send_msg),
+        cmocka_unit_test(init_refuses_both_forms_of_a_callback),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

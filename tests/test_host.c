@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "fake_port.h"
+#include "tase/codec.h"
 #include "tase/host.h"
 #include "tase/ids.h"
 
@@ -487,6 +488,222 @@ static void host_api_rejects_bad_arguments(void **state)
     assert_int_equal(h.rx.stats.bytes_in, 0);
 }
 
+/* ---- typed API ------------------------------------------------------- */
+
+static void send_msg_writes_the_frame_the_codec_builds(void **state)
+{
+    fix_t *x = *state;
+    tase_gimbal_cmd_t cmd = {-12345, 4500, 0, 0x21, 7};
+    tase_camera_pass_t cp = {1, 8, 3, (const uint8_t *)"abc"};
+    uint8_t want[TASE_FRAME_MAX];
+    int n;
+
+    n = tase_packet_encode(TASE_ID_GIMBAL_CMD, &cmd, want, sizeof want);
+    assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_GIMBAL_CMD, &cmd), n);
+    assert_int_equal(x->port.nout, (size_t)n);
+    assert_memory_equal(x->port.out, want, (size_t)n);
+    /* the zero-length forms: a command and a query */
+    x->port.nout = 0;
+    assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_GYRO_ZERO_CMD, NULL), 8);
+    assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_SPOI_CMD, NULL), 8);
+    assert_int_equal(x->port.out[3], 2);
+    assert_int_equal(x->port.out[5], 0x40);
+    assert_int_equal(x->port.out[8 + 4], 0x10);
+    /* a tail of camera bytes */
+    x->port.nout = 0;
+    assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_CAMERA_PASS, &cp), 15);
+    assert_memory_equal(&x->port.out[6],
+                        "\x01\x08\x00\x00"
+                        "abc",
+                        7);
+    assert_int_equal(x->host.stats.frames_tx, 4);
+    /* the caller's mistakes: nothing sent, no link error counted */
+    x->port.nout = 0;
+    assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_GIMBAL_CMD, NULL), TASE_ELENGTH);
+    assert_int_equal(tase_host_send_msg(&x->host, TASE_ID(0x28, 0x00), &cmd), TASE_EUNKNOWN);
+    cp.len = 250;
+    assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_CAMERA_PASS, &cp), TASE_ETOOLONG);
+    assert_int_equal(tase_host_send_msg(NULL, TASE_ID_GIMBAL_CMD, &cmd), TASE_EARG);
+    assert_int_equal(x->port.nout, 0);
+    assert_int_equal(x->host.stats.tx_errors, 0);
+    x->port.write_result = TASE_EIO;
+    assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_GIMBAL_CMD, &cmd), TASE_EIO);
+    assert_int_equal(x->host.stats.tx_errors, 1);
+}
+
+static void a_typed_query_returns_the_decoded_reply(void **state)
+{
+    fix_t *x = *state;
+    tase_packet_rate_t pr;
+    uint8_t d[TASE_DATA_MAX];
+    tase_frame_t f;
+
+    memset(&pr, 0xCC, sizeof pr);
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_PACKET_RATE, NULL, &pr, 100, 1, 1000),
+        TASE_OK);
+    f = written_frame(x, 0, d);
+    assert_int_equal(f.group, 0x48);
+    assert_int_equal(f.type, 0x00);
+    assert_int_equal(f.len, 0);
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_PACKET_RATE, NULL, &pr, 100, 1, 1000),
+        TASE_EBUSY);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 1010);
+    assert_int_equal(tase_host_poll(&x->host, 1010), 16);
+    /* rates[] = 10,10,4,0,0, 20,5,1,0,0, 0,0,0,0,0, 1 */
+    assert_int_equal(pr.angle_1, 10);
+    assert_int_equal(pr.geo_ref_1, 4);
+    assert_int_equal(pr.angle_2, 20);
+    assert_int_equal(pr.rate_2, 5);
+    assert_int_equal(pr.geo_ref_2, 1);
+    assert_int_equal(pr.angle_3, 0);
+    assert_int_equal(pr.temporary, 1);
+    assert_int_equal(x->others, 0);
+}
+
+static void a_typed_set_is_resent_as_encoded_and_confirmed_by_its_echo(void **state)
+{
+    fix_t *x = *state;
+    tase_sensor_filter_t set = {55, 3};
+    tase_sensor_filter_t back = {0, 0};
+    uint8_t d[TASE_DATA_MAX];
+    tase_frame_t f;
+    unsigned i;
+
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_SENSOR_FILTER, &set, &back, 50, 2, 0),
+        TASE_OK);
+    assert_int_equal(tase_host_poll(&x->host, 50), TASE_EAGAIN);  /* retry 1 */
+    assert_int_equal(tase_host_poll(&x->host, 100), TASE_EAGAIN); /* retry 2 */
+    for (i = 0; i < 3; i++) {
+        f = written_frame(x, i, d);
+        assert_int_equal(f.type, 0x01);
+        assert_int_equal(f.len, 2);
+        assert_int_equal(d[0], 55);
+        assert_int_equal(d[1], 3);
+    }
+    /* the gimbal clamps and echoes what is in force */
+    feed_frame(x, 0x48, 0x01, (const uint8_t *)"\x32\x03", 2, 120);
+    assert_int_equal(tase_host_poll(&x->host, 120), 2);
+    assert_int_equal(back.cutoff, 50);
+    assert_int_equal(back.decimation, 3);
+}
+
+static void a_typed_reply_of_a_wrong_length_is_elength_and_writes_nothing(void **state)
+{
+    fix_t *x = *state;
+    tase_packet_rate_t pr;
+    tase_packet_rate_t before;
+
+    memset(&pr, 0xCC, sizeof pr);
+    before = pr;
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_PACKET_RATE, NULL, &pr, 100, 1, 0), TASE_OK);
+    feed_frame(x, 0x48, 0x00, rates, 15, 10);
+    assert_int_equal(tase_host_poll(&x->host, 10), TASE_ELENGTH);
+    assert_memory_equal(&pr, &before, sizeof pr);
+    assert_false(tase_host_busy(&x->host));
+    /* without a struct the length is still checked */
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_PACKET_RATE, NULL, NULL, 100, 1, 20),
+        TASE_OK);
+    feed_frame(x, 0x48, 0x00, rates, 16, 30);
+    assert_int_equal(tase_host_poll(&x->host, 30), 16);
+}
+
+static void typed_request_errors_send_nothing_and_leave_the_host_idle(void **state)
+{
+    fix_t *x = *state;
+    tase_gimbal_cmd_t cmd = {0, 0, 0, 0, 0};
+    tase_packet_msg_t m;
+    assert_int_equal(tase_host_request_msg_start(NULL, TASE_ID_PACKET_RATE, NULL, &m, 10, 0, 0),
+                     TASE_EARG);
+    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID_PACKET_RATE, NULL, &m, 0, 0, 0),
+                     TASE_EARG);
+    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID_GIMBAL_CMD, NULL, &m, 10, 0, 0),
+                     TASE_ELENGTH); /* no query form */
+    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID(0x28, 0), &cmd, &m, 10, 0, 0),
+                     TASE_EUNKNOWN);
+    assert_int_equal(tase_host_transact_msg(NULL, TASE_ID_PACKET_RATE, NULL, &m, 10, 0), TASE_EARG);
+    assert_int_equal(x->port.nout, 0);
+    assert_false(tase_host_busy(&x->host));
+    assert_int_equal(x->host.stats.requests, 0);
+}
+
+static void transact_msg_decodes_the_scripted_gimbal_answer(void **state)
+{
+    fix_t *x = *state;
+    tase_system_version_t v, want;
+    uint8_t data[42];
+    int n;
+
+    memset(&want, 0, sizeof want);
+    want.major = 2;
+    want.minor = 7;
+    want.soft_year = 2024;
+    want.board_sn = 0x01020304u;
+    want.camera_a = 3;
+    want.max_hfov_a = 4000;
+    want.camera_b = 0xFF;
+    assert_int_equal(tase_packet_encode_data(TASE_ID_SYSTEM_VERSION, &want, data, sizeof data), 42);
+    x->port.reply_after = 2; /* the second attempt is answered */
+    x->port.nreply = (size_t)tase_frame_encode(x->port.reply, sizeof x->port.reply, 0x48, 0x03,
+                                               data, sizeof data);
+    memset(&v, 0xAB, sizeof v);
+    n = tase_host_transact_msg(&x->host, TASE_ID_SYSTEM_VERSION, NULL, &v, 100, 3);
+    assert_int_equal(n, 42);
+    assert_memory_equal(&v, &want, sizeof v);
+    assert_int_equal(fake_frames_out(&x->port), 2);
+}
+
+static void a_typed_camera_pass_reply_stays_readable_after_the_poll(void **state)
+{
+    fix_t *x = *state;
+    tase_camera_pass_t q = {0, 0, 2, (const uint8_t *)"\x81\x09"};
+    tase_camera_pass_t back;
+    const uint8_t answer[7] = {0, 0, 3, 0, 0x90, 0x50, 0xFF};
+
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_CAMERA_PASS, &q, &back, 100, 0, 0), TASE_OK);
+    feed_frame(x, 0x00, 0x42, answer, sizeof answer, 5);
+    assert_int_equal(tase_host_poll(&x->host, 5), 7);
+    assert_int_equal(back.len, 3);
+    assert_memory_equal(back.data, "\x90\x50\xFF", 3);
+    /* more traffic does not move it: it lives in the host until the next request */
+    feed_frame(x, 0x00, 0x42, rates, 7, 6);
+    assert_memory_equal(back.data, "\x90\x50\xFF", 3);
+}
+
+/* ---- clock edges ----------------------------------------------------- */
+
+/* A time sample older than the request start (read before the request was
+ * sent, handed in after) is no time at all: no timeout, no duplicate. */
+static void a_sample_older_than_the_request_start_is_not_a_timeout(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    const uint32_t starts[3] = {1000u, 0u, 0xFFFFF000u};
+    unsigned i;
+
+    for (i = 0; i < 3; i++) {
+        uint32_t t0 = starts[i];
+        x->port.nout = 0;
+        assert_int_equal(
+            tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1, t0), TASE_OK);
+        assert_int_equal(tase_host_poll(&x->host, t0 - 1u), TASE_EAGAIN);
+        assert_int_equal(tase_host_poll(&x->host, t0 - 50u), TASE_EAGAIN);
+        assert_int_equal(fake_frames_out(&x->port), 1); /* no duplicate */
+        assert_int_equal(tase_host_poll(&x->host, t0 + 99u), TASE_EAGAIN);
+        assert_int_equal(fake_frames_out(&x->port), 1);
+        assert_int_equal(tase_host_poll(&x->host, t0 + 100u), TASE_EAGAIN); /* the retry */
+        assert_int_equal(fake_frames_out(&x->port), 2);
+        assert_int_equal(tase_host_poll(&x->host, t0 + 99u), TASE_EAGAIN); /* stale again */
+        assert_int_equal(tase_host_poll(&x->host, t0 + 200u), TASE_ETIMEOUT);
+    }
+    assert_int_equal(x->host.stats.retries, 3);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -521,6 +738,21 @@ int main(void)
         cmocka_unit_test_setup_teardown(init_rejects_a_port_without_write, setup, teardown),
         cmocka_unit_test_setup_teardown(a_reply_without_a_buffer_reports_its_length_only, setup,
                                         teardown),
+        cmocka_unit_test_setup_teardown(send_msg_writes_the_frame_the_codec_builds, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(a_typed_query_returns_the_decoded_reply, setup, teardown),
+        cmocka_unit_test_setup_teardown(a_typed_set_is_resent_as_encoded_and_confirmed_by_its_echo,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(
+            a_typed_reply_of_a_wrong_length_is_elength_and_writes_nothing, setup, teardown),
+        cmocka_unit_test_setup_teardown(typed_request_errors_send_nothing_and_leave_the_host_idle,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(transact_msg_decodes_the_scripted_gimbal_answer, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(a_typed_camera_pass_reply_stays_readable_after_the_poll,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(a_sample_older_than_the_request_start_is_not_a_timeout,
+                                        setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -17,7 +17,8 @@
 /* The spec, transcribed by hand from section 4 (not from the code):
  * "NAME group type dir len forms : field@offset<s|u><width> ...".
  * dir: I(n), O(ut), B(oth). forms: - none, Q zero-length query, 1 the
- * one-byte form, T trailing bytes. Reserved rows are not listed. */
+ * one-byte form, T trailing bytes, S the short layout (one byte less).
+ * Reserved rows are not listed; offsets are the table's. */
 static const char *const spec[] = {
     "GIMBAL_CMD 00 80 I 8 - : pan@0s2 tilt@2s2 roll@4s2 flags@6u1 impulse_time@7u1",
     "GYRO_ZERO_CMD 00 40 I 0 - :",
@@ -49,7 +50,7 @@ static const char *const spec[] = {
     "angle_2@5u1 rate_2@6u1 geo_ref_2@7u1 camera_2@8u1 angle_3@10u1 rate_3@11u1 "
     "geo_ref_3@12u1 camera_3@13u1 temporary@15u1",
     "SENSOR_FILTER 48 01 B 2 Q : cutoff@0u1 decimation@1u1",
-    "AXIS_SETTING 48 02 B 23 Q : pan_nogo_center@0s2 pan_nogo_range@2u2 "
+    "AXIS_SETTING 48 02 B 23 QS : pan_nogo_center@0s2 pan_nogo_range@2u2 "
     "tilt_nogo_center@4s2 tilt_nogo_range@6u2 roll_nogo_center@8s2 "
     "roll_nogo_range@10u2 pan_max_rate@12u1 tilt_max_rate@14u1 roll_max_rate@15u1 "
     "pan_max_accel@16u1 tilt_max_accel@17u1 roll_max_accel@18u1 pan_pos_gain@19u1 "
@@ -90,10 +91,14 @@ static void schema_matches_spec_transcription(void **state)
         assert_int_equal(p->id, TASE_ID(g, t));
         assert_int_equal(p->len, len);
         want_flags = dir[0] == 'I' ? TASE_DIR_IN : dir[0] == 'O' ? TASE_DIR_OUT : TASE_DIR_BOTH;
-        want_flags |= forms[0] == 'Q'   ? TASE_LEN_QUERY
-                      : forms[0] == '1' ? TASE_LEN_SHORT1
-                      : forms[0] == 'T' ? TASE_LEN_TAIL
-                                        : 0u;
+        for (nf = 0; forms[nf] != '\0'; nf++) {
+            want_flags |= forms[nf] == 'Q'   ? TASE_LEN_QUERY
+                          : forms[nf] == '1' ? TASE_LEN_SHORT1
+                          : forms[nf] == 'T' ? TASE_LEN_TAIL
+                          : forms[nf] == 'S' ? TASE_LEN_SHORT
+                                             : 0u;
+        }
+        nf = 0;
         assert_int_equal(p->flags, want_flags);
         rest = spec[i] + used;
         while (*rest != '\0') {
@@ -148,7 +153,7 @@ static void struct_members_match_field_width_sign_and_offset(void **state)
     {                                                                                              \
         const tase_packet_desc_t *p = tase_schema_at(TASE_PKT_##N);                                \
         size_t k = 0;
-#define F(T, m, o, w, s)                                                                           \
+#define F(T, m, o, w, s, keep)                                                                     \
     {                                                                                              \
         T x;                                                                                       \
         const tase_field_t *f = tase_schema_field(p, k++);                                         \
@@ -219,6 +224,9 @@ static void accepted_lengths_follow_the_spec_rules(void **state)
             if (strcmp(name, "CAMERA_CMD") == 0 && len == 1) {
                 want = 1;
             }
+            if (strcmp(name, "AXIS_SETTING") == 0 && len == 22) {
+                want = 1; /* table 22 read as a numbering slip (S2) */
+            }
             if (strcmp(name, "CAMERA_PASS") == 0) {
                 want = len >= 4 && len <= 4 + 249;
             }
@@ -229,6 +237,62 @@ static void accepted_lengths_follow_the_spec_rules(void **state)
     }
     assert_false(tase_schema_length_ok(NULL, 0));
     assert_false(tase_schema_is_query(NULL, 0));
+}
+
+/* Table 22 read with row "14" as byte 13 and every later row one less:
+ * transcribed by hand, not from the code. */
+static const char *const axis22 =
+    "pan_nogo_center@0 pan_nogo_range@2 tilt_nogo_center@4 tilt_nogo_range@6 "
+    "roll_nogo_center@8 roll_nogo_range@10 pan_max_rate@12 tilt_max_rate@13 "
+    "roll_max_rate@14 pan_max_accel@15 tilt_max_accel@16 roll_max_accel@17 "
+    "pan_pos_gain@18 tilt_pos_gain@19 roll_pos_gain@20 temporary@21";
+
+static void only_axis_setting_has_a_short_layout_and_its_offsets_are_table_22s(void **state)
+{
+    size_t i, k;
+    const char *rest = axis22;
+    const tase_packet_desc_t *axis = tase_schema_find(0x48, 0x02);
+    uint8_t d[23];
+    int64_t v;
+    (void)state;
+    for (k = 0; *rest != '\0'; k++) {
+        char fname[32];
+        unsigned off;
+        int n = 0;
+        assert_int_equal(sscanf(rest, " %31[a-z_]@%u%n", fname, &off, &n), 2);
+        assert_string_equal(tase_schema_field_name(axis, k), fname);
+        assert_int_equal(tase_field_offset(axis, k, 22), (int)off);
+        assert_int_equal(tase_field_offset(axis, k, 23), tase_schema_field(axis, k)->offset);
+        rest += n;
+    }
+    assert_int_equal(k, axis->nfields);
+    /* every other packet has one layout whatever the length */
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        size_t len;
+        if (p == axis) {
+            continue;
+        }
+        assert_int_equal(p->flags & TASE_LEN_SHORT, 0);
+        for (k = 0; k < p->nfields; k++) {
+            for (len = 0; len <= TASE_DATA_MAX; len++) {
+                assert_int_equal(tase_field_offset(p, k, len), tase_schema_field(p, k)->offset);
+            }
+        }
+    }
+    /* tase_field_get reads the layout the length selects */
+    memset(d, 0, sizeof(d));
+    d[13] = 0x3C;
+    d[21] = 0x01;
+    assert_int_equal(tase_field_get(axis, 7, d, 22, &v), TASE_OK); /* tilt_max_rate */
+    assert_true(v == 0x3C);
+    assert_int_equal(tase_field_get(axis, 15, d, 22, &v), TASE_OK); /* temporary */
+    assert_true(v == 1);
+    assert_int_equal(tase_field_get(axis, 7, d, 23, &v), TASE_OK); /* byte 14 */
+    assert_true(v == 0);
+    assert_int_equal(tase_field_offset(NULL, 0, 22), TASE_EARG);
+    assert_int_equal(tase_field_offset(axis, axis->nfields, 22), TASE_EARG);
+    assert_int_equal(tase_field_offset(axis, SIZE_MAX, 22), TASE_EARG);
 }
 
 static void field_get_sign_extends_signed_fields_only(void **state)
@@ -282,6 +346,123 @@ static void field_get_sign_extends_signed_fields_only(void **state)
     assert_int_equal(tase_field_get(gps, 0, NULL, 32, &v), TASE_EARG);
     assert_int_equal(tase_field_get(gps, 0, d, 32, NULL), TASE_EARG);
     assert_true(v == 99);
+}
+
+/* Every "do not change" value of the spec, transcribed by hand from its
+ * sentences (4.1.3 tables 6, 4.1.4 table 7, 4.1.5 table 8, 4.4.3 and 4.4.6;
+ * see docs/PROTOCOL-NOTES.md K1). Every other field has none. */
+static const struct {
+    const char *packet;
+    const char *field;
+    int64_t keep;
+} keeps[] = {
+    {"CAMERA_CMD", "camera", 0xFF},
+    {"CAMERA_CMD", "hfov", -1}, /* "0xFFFF (-1) means do not change" */
+    {"CAMERA_CMD", "focus", 0xFFFF},
+    {"CAMERA_CMD", "exposure", 0xFF},
+    {"CAMERA_CMD", "shutter_speed", 0xFF},
+    {"CAMERA_CMD", "bright", 0xFF},
+    {"CAMERA_CMD", "flags", 0x80}, /* MSB: any value with it set */
+    {"LEGACY_CAMERA_CMD", "focus", 0xFFFF},
+    {"LEGACY_CAMERA_CMD", "shutter_speed", 0xFF},
+    {"CAMERA_PASS", "baud", 0},
+    {"AXIS_SETTING", "pan_nogo_center", -1},
+    {"AXIS_SETTING", "pan_nogo_range", 0xFFFF},
+    {"AXIS_SETTING", "tilt_nogo_center", -1},
+    {"AXIS_SETTING", "tilt_nogo_range", 0xFFFF},
+    {"AXIS_SETTING", "roll_nogo_center", -1},
+    {"AXIS_SETTING", "roll_nogo_range", 0xFFFF},
+    {"AXIS_SETTING", "pan_max_rate", 0xFF},
+    {"AXIS_SETTING", "tilt_max_rate", 0xFF},
+    {"AXIS_SETTING", "roll_max_rate", 0xFF},
+    {"AXIS_SETTING", "pan_max_accel", 0xFF},
+    {"AXIS_SETTING", "tilt_max_accel", 0xFF},
+    {"AXIS_SETTING", "roll_max_accel", 0xFF},
+    {"AXIS_SETTING", "pan_pos_gain", 0xFF},
+    {"AXIS_SETTING", "tilt_pos_gain", 0xFF},
+    {"AXIS_SETTING", "roll_pos_gain", 0xFF},
+    {"CAMERA_TYPE", "camera_a", 0},
+    {"CAMERA_TYPE", "camera_b", 0},
+    {"CAMERA_TYPE", "camera_c", 0},
+};
+
+static int keep_row(const char *packet, const char *field)
+{
+    size_t k;
+    for (k = 0; k < sizeof(keeps) / sizeof(keeps[0]); k++) {
+        if (strcmp(keeps[k].packet, packet) == 0 && strcmp(keeps[k].field, field) == 0) {
+            return (int)k;
+        }
+    }
+    return -1;
+}
+
+static void keep_values_are_exactly_the_specs(void **state)
+{
+    size_t i, k, found = 0;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        for (k = 0; k < p->nfields; k++) {
+            int row = keep_row(tase_schema_packet_name(p), tase_schema_field_name(p, k));
+            int64_t v = 12345;
+            if (row < 0) {
+                assert_int_equal(tase_field_keep(p, k, &v), TASE_EUNKNOWN);
+                assert_true(v == 12345);
+                assert_false(tase_field_is_keep(p, k, 0));
+                assert_false(tase_field_is_keep(p, k, -1));
+                assert_false(tase_field_is_keep(p, k, 0xFF));
+                assert_false(tase_field_is_keep(p, k, 0x80));
+                continue;
+            }
+            found++;
+            assert_int_equal(tase_field_keep(p, k, &v), TASE_OK);
+            assert_true(v == keeps[row].keep);
+            assert_true(tase_field_is_keep(p, k, v));
+            /* its neighbours are ordinary values (0x7F for the flags byte) */
+            assert_false(tase_field_is_keep(p, k, v - 1));
+            if (v != 0x80) {
+                assert_false(tase_field_is_keep(p, k, v + 1));
+            }
+        }
+    }
+    assert_int_equal(found, sizeof(keeps) / sizeof(keeps[0]));
+}
+
+static void camera_flags_with_the_msb_set_all_mean_no_change(void **state)
+{
+    const tase_packet_desc_t *p = tase_schema_find(0x00, 0x41);
+    int flags = tase_schema_field_index(p, "flags");
+    int64_t v;
+    (void)state;
+    assert_true(flags >= 0);
+    for (v = -300; v < 0x200; v++) {
+        assert_int_equal(tase_field_is_keep(p, (size_t)flags, v), v >= 0x80 && v <= 0xFF);
+    }
+    /* the other camera fields: only their one value */
+    assert_false(tase_field_is_keep(p, 0, 0x1FF)); /* camera: out of range */
+    assert_true(tase_field_is_keep(p, 0, 0xFF));
+    assert_false(tase_field_is_keep(p, 1, 0xFFFF)); /* hfov is signed: -1 */
+}
+
+static void keep_api_rejects_bad_arguments(void **state)
+{
+    const tase_packet_desc_t *p = tase_schema_find(0x48, 0x02);
+    tase_packet_desc_t forged;
+    int64_t v = 77;
+    (void)state;
+    assert_int_equal(tase_field_keep(NULL, 0, &v), TASE_EARG);
+    assert_int_equal(tase_field_keep(p, p->nfields, &v), TASE_EARG);
+    assert_int_equal(tase_field_keep(p, SIZE_MAX, &v), TASE_EARG);
+    assert_int_equal(tase_field_keep(p, 0, NULL), TASE_EARG);
+    assert_true(v == 77);
+    assert_false(tase_field_is_keep(NULL, 0, -1));
+    assert_false(tase_field_is_keep(p, p->nfields, 0xFF));
+    assert_false(tase_field_is_keep(p, SIZE_MAX, 0xFF));
+    forged = *p;
+    forged.first_field = 255;
+    assert_int_equal(tase_field_keep(&forged, 0, &v), TASE_EARG);
+    assert_false(tase_field_is_keep(&forged, 0, -1));
 }
 
 static void names_resolve_both_ways_and_reject_unknown(void **state)
@@ -368,7 +549,11 @@ int main(void)
         cmocka_unit_test(lookup_finds_exactly_the_spec_packets_among_all_65536_ids),
         cmocka_unit_test(accepted_lengths_follow_the_spec_rules),
         cmocka_unit_test(field_get_sign_extends_signed_fields_only),
+        cmocka_unit_test(only_axis_setting_has_a_short_layout_and_its_offsets_are_table_22s),
         cmocka_unit_test(names_resolve_both_ways_and_reject_unknown),
+        cmocka_unit_test(keep_values_are_exactly_the_specs),
+        cmocka_unit_test(camera_flags_with_the_msb_set_all_mean_no_change),
+        cmocka_unit_test(keep_api_rejects_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

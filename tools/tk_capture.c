@@ -9,7 +9,6 @@
 #include <stdlib.h>
 #include <net/if.h>
 #include <poll.h>
-#include <signal.h>
 #include <string.h>
 #include <sys/socket.h>
 #include <sys/uio.h>
@@ -25,49 +24,6 @@
 
 #define SERIAL_SNAPLEN 65535
 #define READ_CHUNK 4096u
-
-void tk_time_now(tk_time_t *t)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    t->sec = (int64_t)ts.tv_sec;
-    t->nsec = (uint32_t)ts.tv_nsec;
-}
-
-void tk_time_format(char *buf, size_t cap, const tk_time_t *t, unsigned digits)
-{
-    if (digits == 6u) {
-        snprintf(buf, cap, "%lld.%06u", (long long)t->sec, (unsigned)(t->nsec / 1000u));
-    } else {
-        snprintf(buf, cap, "%lld.%09u", (long long)t->sec, (unsigned)t->nsec);
-    }
-}
-
-/* ---- stop on a signal (record and replay run until interrupted) ---- */
-
-static volatile sig_atomic_t stop_requested;
-
-static void on_stop_signal(int sig)
-{
-    (void)sig;
-    stop_requested = 1;
-}
-
-/* SIGINT, SIGTERM and SIGHUP end the loop cleanly (the capture is closed
- * whole). No SA_RESTART: a blocking wait returns EINTR at once. */
-static void catch_stop_signals(void)
-{
-    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
-    struct sigaction sa;
-    size_t i;
-    memset(&sa, 0, sizeof(sa));
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    for (i = 0; i < sizeof(sigs) / sizeof(sigs[0]); i++) {
-        (void)sigaction(sigs[i], &sa, NULL);
-    }
-    stop_requested = 0;
-}
 
 /* ---- writing ---- */
 
@@ -91,20 +47,20 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
     w->records = 0;
 }
 
-static void put_record(tk_cap_writer_t *w, const tk_time_t *t, const uint8_t *rec, size_t n)
+static void put_record(tk_cap_writer_t *w, const struct timespec *t, const uint8_t *rec, size_t n)
 {
     struct pcap_pkthdr h;
     memset(&h, 0, sizeof(h));
-    h.ts.tv_sec = (time_t)t->sec;
-    h.ts.tv_usec = (suseconds_t)t->nsec; /* nanoseconds: the dumper's precision */
+    h.ts.tv_sec = t->tv_sec;
+    h.ts.tv_usec = (suseconds_t)t->tv_nsec; /* nanoseconds: the dumper's precision */
     h.caplen = (bpf_u_int32)n;
     h.len = (bpf_u_int32)n;
     pcap_dump((u_char *)w->dumper, &h, rec);
     w->records++;
 }
 
-void tk_cap_put_serial(tk_cap_writer_t *w, const tk_time_t *t, unsigned dir, const uint8_t *data,
-                       size_t n)
+void tk_cap_put_serial(tk_cap_writer_t *w, const struct timespec *t, unsigned dir,
+                       const uint8_t *data, size_t n)
 {
     uint8_t rec[1u + READ_CHUNK];
     while (n > 0) { /* longer writes become several records (never by reads) */
@@ -117,7 +73,7 @@ void tk_cap_put_serial(tk_cap_writer_t *w, const tk_time_t *t, unsigned dir, con
     }
 }
 
-void tk_cap_put_can(tk_cap_writer_t *w, const tk_time_t *t, const uint8_t *rec, size_t n)
+void tk_cap_put_can(tk_cap_writer_t *w, const struct timespec *t, const uint8_t *rec, size_t n)
 {
     uint8_t out[TK_CAP_CAN_MAX];
     uint32_t id;
@@ -170,8 +126,8 @@ static int tap_write(void *ctx, const uint8_t *data, size_t n)
     tk_cap_tap_t *tap = ctx;
     int rc = tap->inner.ops->write(tap->inner.ctx, data, n);
     if (rc > 0) {
-        tk_time_t t;
-        tk_time_now(&t);
+        struct timespec t;
+        clock_gettime(CLOCK_REALTIME, &t);
         tk_cap_put_serial(tap->w, &t, TK_CAP_TO_GIMBAL, data, (size_t)rc);
         tk_cap_flush(tap->w);
     }
@@ -183,8 +139,8 @@ static int tap_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
     tk_cap_tap_t *tap = ctx;
     int rc = tap->inner.ops->read(tap->inner.ctx, buf, cap, timeout_ms);
     if (rc > 0) {
-        tk_time_t t;
-        tk_time_now(&t);
+        struct timespec t;
+        clock_gettime(CLOCK_REALTIME, &t);
         tk_cap_put_serial(tap->w, &t, TK_CAP_FROM_GIMBAL, buf, (size_t)rc);
         tk_cap_flush(tap->w);
     }
@@ -265,59 +221,65 @@ bool tk_cap_is_capture(const uint8_t *head, size_t n)
     return false;
 }
 
-/* A FILE that gives back the bytes already consumed from a pipe, then the
- * rest of the pipe. */
+/* libpcap reads a FILE; the caller has consumed the first bytes of the
+ * descriptor (a pipe cannot seek back): a FILE that gives them back first,
+ * then reads the descriptor. */
 typedef struct {
-    FILE *in;
-    uint8_t head[8];
+    int fd;
+    uint8_t *head;
     size_t n, pos;
-} replay_head_t;
+} head_fd_t;
 
 static ssize_t head_read(void *cookie, char *buf, size_t size)
 {
-    replay_head_t *h = cookie;
+    head_fd_t *h = cookie;
     if (h->pos < h->n) {
         size_t k = h->n - h->pos < size ? h->n - h->pos : size;
         memcpy(buf, h->head + h->pos, k);
         h->pos += k;
         return (ssize_t)k;
     }
-    size = fread(buf, 1, size, h->in);
-    return size == 0 && ferror(h->in) ? -1 : (ssize_t)size;
+    for (;;) {
+        ssize_t got = read(h->fd, buf, size);
+        if (got >= 0 || errno == EIO) { /* EIO: a pty whose writer went away */
+            return got < 0 ? 0 : got;
+        }
+        if (errno != EINTR || tk_signal != 0) {
+            return -1;
+        }
+    }
 }
 
 static int head_close(void *cookie)
 {
-    replay_head_t *h = cookie;
-    int rc = h->in == stdin ? 0 : fclose(h->in);
+    head_fd_t *h = cookie;
+    free(h->head);
     free(h);
-    return rc;
+    return 0; /* the descriptor is the caller's */
 }
 
-void tk_cap_reader_open(tk_cap_reader_t *r, FILE *in, const uint8_t *head, size_t nhead,
+void tk_cap_reader_open(tk_cap_reader_t *r, int fd, const uint8_t *head, size_t nhead,
                         const char *path)
 {
+    static const cookie_io_functions_t io = {head_read, NULL, NULL, head_close};
     char err[PCAP_ERRBUF_SIZE];
+    head_fd_t *h = calloc(1, sizeof(*h));
     pcap_t *p;
+    FILE *in;
     int lt;
     memset(r, 0, sizeof(*r));
     r->path = path;
-    if (fseek(in, 0, SEEK_SET) != 0) {
-        /* a pipe: hand libpcap a FILE that starts with the consumed bytes */
-        static const cookie_io_functions_t io = {head_read, NULL, NULL, head_close};
-        replay_head_t *h = calloc(1, sizeof(*h));
-        FILE *f;
-        if (h == NULL || nhead > sizeof(h->head)) {
-            tk_die("cannot read %s: out of memory", path);
-        }
-        h->in = in;
+    if (h == NULL || (nhead > 0 && (h->head = malloc(nhead)) == NULL)) {
+        tk_die("cannot read %s: out of memory", path);
+    }
+    h->fd = fd;
+    if (nhead > 0) {
         memcpy(h->head, head, nhead);
-        h->n = nhead;
-        f = fopencookie(h, "rb", io);
-        if (f == NULL) {
-            tk_die("cannot read %s: %s", path, strerror(errno));
-        }
-        in = f;
+    }
+    h->n = nhead;
+    in = fopencookie(h, "rb", io);
+    if (in == NULL) {
+        tk_die("cannot read %s: %s", path, strerror(errno));
     }
     err[0] = '\0';
     p = pcap_fopen_offline_with_tstamp_precision(in, PCAP_TSTAMP_PRECISION_NANO, err);
@@ -410,7 +372,7 @@ int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap)
     memset(rec, 0, sizeof(*rec));
     rec->index = ++r->index;
     rec->t.sec = (int64_t)h->ts.tv_sec;
-    rec->t.nsec = (uint32_t)h->ts.tv_usec; /* nanoseconds: opened with that precision */
+    rec->t.usec = (uint32_t)h->ts.tv_usec / 1000u; /* opened in nanoseconds */
     if (h->caplen < h->len) {
         snprintf(why, cap, "cut to %u of its %u bytes by the capture's snapshot length",
                  (unsigned)h->caplen, (unsigned)h->len);
@@ -438,7 +400,7 @@ static void print_recording(const tk_cap_writer_t *w, const char *what, const ch
     } else {
         printf("until interrupted (Ctrl-C)\n");
     }
-    fflush(stdout);
+    tk_stdout_flush();
 }
 
 static int ms_left(double t_end)
@@ -464,14 +426,13 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_i
     if (tap_in != NULL) {
         tk_link_serial(&links[1], tap_in, baud);
     }
-    catch_stop_signals();
     print_recording(w, dev, tap_in, seconds);
     for (i = 0; i < n; i++) {
         ports[i] = tk_link_port(&links[i]);
         pfd[i].fd = links[i].uart.fd;
         pfd[i].events = POLLIN;
     }
-    while (!stop_requested) {
+    while (tk_signal == 0) {
         int timeout = ms_left(t_end), pr;
         if (timeout == 0) {
             break;
@@ -482,12 +443,12 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_i
         }
         for (i = 0; pr > 0 && i < n; i++) {
             int got;
-            tk_time_t t;
+            struct timespec t;
             if (pfd[i].revents == 0) {
                 continue;
             }
             got = ports[i].ops->read(ports[i].ctx, buf, sizeof(buf), 0);
-            tk_time_now(&t);
+            clock_gettime(CLOCK_REALTIME, &t);
             if (got < 0) {
                 tk_die("cannot read %s: %s", i == 0 ? dev : tap_in,
                        got == TASE_EIO ? "the device went away or hung up" : tase_strerror(got));
@@ -505,6 +466,7 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_i
     }
     tk_cap_close(w);
     print_recorded(w, bytes, "bytes");
+    tk_stdout_flush();
 }
 
 /* A raw socket on `iface` that receives every frame, error frames and CAN
@@ -542,9 +504,8 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *iface, double seconds)
     int fd = open_can_recorder(iface);
     double t_end = seconds > 0.0 ? tk_now_s() + seconds : 0.0;
     unsigned long frames = 0;
-    catch_stop_signals();
     print_recording(w, iface, NULL, seconds);
-    while (!stop_requested) {
+    while (tk_signal == 0) {
         struct pollfd pfd = {fd, POLLIN, 0};
         int timeout = ms_left(t_end), pr;
         if (timeout == 0) {
@@ -563,7 +524,7 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *iface, double seconds)
             struct iovec iov = {&frame, sizeof(frame)};
             struct msghdr msg;
             struct cmsghdr *c;
-            tk_time_t t;
+            struct timespec t;
             ssize_t got;
             memset(&msg, 0, sizeof(msg));
             msg.msg_iov = &iov;
@@ -580,13 +541,10 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *iface, double seconds)
             if (got != (ssize_t)CAN_MTU && got != (ssize_t)CANFD_MTU) {
                 continue; /* not a frame record */
             }
-            tk_time_now(&t);
+            clock_gettime(CLOCK_REALTIME, &t); /* unless the kernel says when */
             for (c = CMSG_FIRSTHDR(&msg); c != NULL; c = CMSG_NXTHDR(&msg, c)) {
                 if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
-                    struct timespec ts;
-                    memcpy(&ts, CMSG_DATA(c), sizeof(ts));
-                    t.sec = (int64_t)ts.tv_sec;
-                    t.nsec = (uint32_t)ts.tv_nsec;
+                    memcpy(&t, CMSG_DATA(c), sizeof(t));
                 }
             }
             tk_cap_put_can(w, &t, (const uint8_t *)&frame, (size_t)got);
@@ -597,6 +555,7 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *iface, double seconds)
     close(fd);
     tk_cap_close(w);
     print_recorded(w, frames, "frames");
+    tk_stdout_flush();
 }
 
 /* ---- replay ---- */
@@ -626,7 +585,7 @@ static bool wait_until(double due)
     for (;;) {
         double left = due - tk_now_s();
         struct timespec ts;
-        if (stop_requested) {
+        if (tk_signal != 0) {
             return false;
         }
         if (left <= 0.0) {
@@ -645,7 +604,7 @@ typedef struct {
     const tk_replay_opts_t *o;
     tk_link_t link;
     tase_port_t port;
-    unsigned long sent, skipped, bytes;
+    unsigned long sent, skipped, bad, bytes;
 } replay_t;
 
 static void send_frame(replay_t *rp, const tase_can_frame_t *f)
@@ -707,7 +666,7 @@ static void replay_send(replay_t *rp, const tk_cap_reader_t *r, const tk_cap_rec
     rp->sent++;
 }
 
-void tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
+unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
 {
     replay_t rp;
     tk_cap_rec_t rec;
@@ -726,11 +685,10 @@ void tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
         tk_link_serial(&rp.link, o->serial, o->baud);
     }
     rp.port = tk_link_port(&rp.link);
-    catch_stop_signals();
-    while (!stop_requested && (rc = tk_cap_next(r, &rec, why, sizeof(why))) != TK_CAP_END) {
+    while (tk_signal == 0 && (rc = tk_cap_next(r, &rec, why, sizeof(why))) != TK_CAP_END) {
         if (rc == TK_CAP_BAD) {
-            fprintf(stderr, "%s: %s: record %lu skipped: %s\n", tk_prog, r->path, rec.index, why);
-            rp.skipped++;
+            tk_warn("%s: record %lu skipped: %s", r->path, rec.index, why);
+            rp.bad++;
             continue;
         }
         if (!replay_selects(&rp, r, &rec)) {
@@ -744,7 +702,7 @@ void tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
         }
         if (o->speed > 0.0) {
             double dt =
-                (double)(rec.t.sec - t0.sec) + ((double)rec.t.nsec - (double)t0.nsec) * 1e-9;
+                (double)(rec.t.sec - t0.sec) + ((double)rec.t.usec - (double)t0.usec) * 1e-6;
             if (!wait_until(start + (dt > 0.0 ? dt : 0.0) / o->speed)) {
                 break;
             }
@@ -754,9 +712,12 @@ void tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
     tk_link_close(&rp.link);
     printf("replayed %lu of %lu records (%lu bytes) to %s in %.3f s%s", rp.sent, r->index, rp.bytes,
            o->can != NULL ? o->can : o->serial, started ? tk_now_s() - start : 0.0,
-           stop_requested ? ", interrupted" : "");
+           tk_signal != 0 ? ", interrupted" : "");
     if (rp.skipped > 0) {
-        printf("; %lu skipped (malformed, or CAN FD/remote/error frames)", rp.skipped);
+        printf("; %lu CAN FD/remote/error frame%s not sent", rp.skipped,
+               rp.skipped == 1 ? "" : "s");
     }
     printf("\n");
+    tk_stdout_flush();
+    return rp.bad;
 }

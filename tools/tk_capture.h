@@ -23,10 +23,11 @@
  *     stored big-endian. Every frame on the interface is recorded (error
  *     frames included).
  *
- * Every function prints one line and exits (tk_die) on an error it cannot
- * recover from, like the rest of the toolkit; malformed records in a
- * capture being read are reported to the caller instead, so a decode can
- * go on with the rest.
+ * JSON and replay use the toolkit's microsecond tk_time_t (the files keep
+ * nanoseconds). Every function prints one line and exits (tk_die) on an
+ * error it cannot recover from, like the rest of the toolkit; malformed
+ * records in a capture being read are reported to the caller instead, so a
+ * decode can go on with the rest.
  */
 #ifndef TASE_TOOLS_TK_CAPTURE_H
 #define TASE_TOOLS_TK_CAPTURE_H
@@ -35,9 +36,9 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <time.h>
 
-#include "tase/can.h"
-#include "tase/port.h"
+#include "toolkit.h"
 
 #define TK_CAP_LINKTYPE_SERIAL 147 /* LINKTYPE_USER0: TASE serial, see above */
 #define TK_CAP_LINKTYPE_CAN 227    /* LINKTYPE_CAN_SOCKETCAN */
@@ -53,18 +54,6 @@ typedef enum {
     TK_CAP_DIR_ALL = 3  /* both; for CAN every frame, whatever its ID */
 } tk_cap_dirs_t;
 
-/* A capture timestamp: seconds since 1970-01-01 UTC and nanoseconds. */
-typedef struct {
-    int64_t sec;
-    uint32_t nsec; /* 0..999999999 */
-} tk_time_t;
-
-/* The wall clock now (CLOCK_REALTIME). */
-void tk_time_now(tk_time_t *t);
-/* Format t into buf[0..cap) as a JSON number of seconds with `digits` (6
- * or 9) decimals. */
-void tk_time_format(char *buf, size_t cap, const tk_time_t *t, unsigned digits);
-
 /* ---- writing ---- */
 
 typedef struct {
@@ -79,13 +68,13 @@ typedef struct {
  * it does not exist; an existing file must be a nanosecond pcap of the
  * same link type). Dies with the reason on failure. */
 void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool append);
-/* One serial record: direction byte + n (>= 1) bytes. */
-void tk_cap_put_serial(tk_cap_writer_t *w, const tk_time_t *t, unsigned dir, const uint8_t *data,
-                       size_t n);
+/* One serial record: direction byte + n (>= 1) bytes, at wall-clock time t. */
+void tk_cap_put_serial(tk_cap_writer_t *w, const struct timespec *t, unsigned dir,
+                       const uint8_t *data, size_t n);
 /* One CAN record: `rec` is a SocketCAN struct can_frame (16 bytes) or
  * canfd_frame (72 bytes) exactly as read from a raw socket, identifier in
  * host byte order (it is written big-endian). */
-void tk_cap_put_can(tk_cap_writer_t *w, const tk_time_t *t, const uint8_t *rec, size_t n);
+void tk_cap_put_can(tk_cap_writer_t *w, const struct timespec *t, const uint8_t *rec, size_t n);
 /* Push buffered records to the file; dies on a write error. */
 void tk_cap_flush(tk_cap_writer_t *w);
 /* Flush and close; dies on a write error. */
@@ -118,17 +107,17 @@ typedef struct {
     unsigned long index; /* records read so far */
 } tk_cap_reader_t;
 
-/* Open a capture. `in` is taken over (closed by tk_cap_reader_close());
- * `head`[0..nhead) are bytes already read from it (at most 8: the caller
- * looked at the magic) and are read again first. Dies when the file is
- * not a capture libpcap reads or its link type is neither of the two. */
-void tk_cap_reader_open(tk_cap_reader_t *r, FILE *in, const uint8_t *head, size_t nhead,
+/* Open a capture on descriptor `fd` (a file or a pipe; not closed here),
+ * of which head[0..nhead) were read already (the caller looked at the
+ * magic): they are read again first. `path` names it in messages. Dies
+ * when libpcap cannot read it or its link type is neither of the two. */
+void tk_cap_reader_open(tk_cap_reader_t *r, int fd, const uint8_t *head, size_t nhead,
                         const char *path);
 void tk_cap_reader_close(tk_cap_reader_t *r);
 
 typedef struct {
     unsigned long index; /* 1-based record number in the file */
-    tk_time_t t;
+    tk_time_t t;         /* capture time, to the microsecond */
     /* serial records */
     unsigned dir;        /* TK_CAP_FROM_GIMBAL or TK_CAP_TO_GIMBAL */
     const uint8_t *data; /* valid until the next call */
@@ -152,18 +141,20 @@ int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap);
 
 /* Record the serial device `dev` (bytes from the gimbal) and optionally a
  * second device `tap_in` (bytes to the gimbal, the other line of a tap)
- * into `w` until `seconds` pass (0: until SIGINT/SIGTERM/SIGHUP). Prints
- * a summary on stderr. */
+ * into `w` until `seconds` pass or, with 0, until a signal the toolkit
+ * catches (tk_signal: SIGINT, SIGTERM, SIGHUP, the normal end of a
+ * recording). Closes `w` and prints a summary on stdout. */
 void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_in, long baud,
                           double seconds);
 /* Record every frame of CAN interface `iface` likewise. */
 void tk_cap_record_can(tk_cap_writer_t *w, const char *iface, double seconds);
 
-/* Send the records of `r` selected by `dirs` to `port` (a serial device:
- * the bytes) or, with `can` non-NULL, to a CAN interface (frames as
- * recorded; serial bytes cut into frames of their direction's ID), at the
- * capture's timing divided by `speed` (0: no waiting). Prints a summary on
- * stdout. */
+/* Send the records of `r` selected by `dirs` to a serial device (the
+ * bytes) or, with `can` non-NULL, to a CAN interface (frames as recorded;
+ * serial bytes cut into frames of their direction's ID), at the capture's
+ * timing divided by `speed` (0: no waiting). Prints a summary on stdout;
+ * a caught signal stops it (the caller then exits 128 + N). Returns the
+ * number of malformed records skipped (each reported on stderr). */
 typedef struct {
     const char *serial; /* device, or NULL */
     long baud;
@@ -171,6 +162,6 @@ typedef struct {
     tk_cap_dirs_t dirs;
     double speed;
 } tk_replay_opts_t;
-void tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o);
+unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o);
 
 #endif /* TASE_TOOLS_TK_CAPTURE_H */

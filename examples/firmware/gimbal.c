@@ -129,14 +129,11 @@ static const tase_packet_handler_t handlers[TASE_PKT_COUNT] = {
 };
 
 /* The role calls this when a telemetry packet is due: fill its typed
- * struct and let the codec lay out the bytes. */
-static int fill_telemetry(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
-                          uint32_t now_ms)
+ * struct; the role lays out the bytes. */
+static int fill_telemetry(void *user, unsigned port, uint16_t id, void *msg, uint32_t now_ms)
 {
     gimbal_app_t *app = user;
     tase_packet_msg_t m;
-    uint8_t frame[TASE_FRAME_OVERHEAD + 63u];
-    int n;
 
     (void)port;
     memset(&m, 0, sizeof m);
@@ -163,14 +160,8 @@ static int fill_telemetry(void *user, unsigned port, uint16_t id, uint8_t *data,
     } else {
         return TASE_EUNKNOWN;
     }
-    n = tase_packet_encode(id, &m, frame, sizeof frame);
-    if (n < (int)TASE_FRAME_OVERHEAD || (size_t)n - TASE_FRAME_OVERHEAD > cap) {
-        app->encode_errors++;
-        return n < 0 ? n : TASE_ENOSPC;
-    }
-    n -= (int)TASE_FRAME_OVERHEAD;
-    memcpy(data, &frame[TASE_FRAME_HEADER], (size_t)n);
-    return n;
+    memcpy(msg, &m, sizeof m); /* msg is the role's tase_packet_msg_t */
+    return 0;
 }
 
 int gimbal_app_init(gimbal_app_t *app, const tase_port_t *port, tase_rx_stats_t *stats,
@@ -188,7 +179,7 @@ int gimbal_app_init(gimbal_app_t *app, const tase_port_t *port, tase_rx_stats_t 
         return r;
     }
     memset(&cb, 0, sizeof cb);
-    cb.fill_telemetry = fill_telemetry; /* apply_setup NULL: accept every setting */
+    cb.fill_telemetry_msg = fill_telemetry; /* apply_setup NULL: accept every setting */
     cb.user = app;
     r = tase_gimbal_init(&app->role, port, NULL, 1u, &cb, now_ms);
     if (r < 0) {

@@ -15,6 +15,13 @@
  * Both roles use the same functions: a gimbal encodes Out packets and
  * decodes In ones, a host the reverse; setup packets go both ways.
  *
+ * TWO LEVELS. tase_packet_encode() and tase_packet_decode() work on whole
+ * frames (sync, size, type, checksum). tase_packet_encode_data() and
+ * tase_packet_decode_data() work on the data bytes alone, which is what
+ * the roles' raw tase_host_send()/tase_gimbal_send() take and what a
+ * request's reply buffer holds; the roles' typed calls (tase_host_send_msg(),
+ * tase_host_transact_msg(), tase_gimbal_send_msg(), ...) use them for you.
+ *
  * Every function is reentrant and ISR-safe (no state besides its
  * arguments). A failing call writes nothing.
  */
@@ -315,7 +322,8 @@ int tase_packet_encode(uint16_t id, const void *msg, uint8_t *out, size_t cap);
 /* Like tase_packet_encode() but with an explicit data length `len`, which
  * must be an accepted length of the packet (tase_schema_length_ok()):
  * 0 for a query (msg may be NULL), 1 for CAMERA_CMD "change active camera
- * only" (only msg->camera is sent). For CAMERA_PASS len must be
+ * only" (only msg->camera is sent), 22 for AXIS_SETTING's short layout
+ * (tase/schema.h TWO LAYOUTS). For CAMERA_PASS len must be
  * 4 + msg->len. Returns as tase_packet_encode(), plus TASE_ELENGTH when
  * len is not accepted (any size_t up to SIZE_MAX; compared without
  * overflow). */
@@ -328,9 +336,12 @@ int tase_packet_encode_len(uint16_t id, const void *msg, size_t len, uint8_t *ou
 int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap);
 
 /* Decode frame f into the typed struct of its packet at msg (which must
- * be that struct, or a tase_packet_msg_t). The struct is zeroed first;
- * fields beyond a short accepted length (query: all; CAMERA_CMD 1-byte
- * form: all but camera) stay zero, so check the return value.
+ * be that struct, or a tase_packet_msg_t), in the layout its length
+ * selects (AXIS_SETTING 22 or 23 bytes). A query (length 0) decodes to a
+ * zeroed struct. The fields a short form leaves out (CAMERA_CMD's 1-byte
+ * form: all but camera) take their "do not change" values
+ * (tase_field_keep(): hfov -1, focus 0xFFFF, flags 0x80, ...), never a
+ * zero that would be a command; the return value tells the forms apart.
  * Returns the data length decoded (>= 0), or
  *   TASE_EARG     f NULL, f->data NULL with f->len > 0, or msg NULL for a
  *                 known packet of accepted length > 0 (msg may be NULL for
@@ -339,6 +350,44 @@ int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap);
  *   TASE_ELENGTH  f->len is not an accepted length for the packet.
  * On error msg is unchanged. O(length). */
 int tase_packet_decode(const tase_frame_t *f, void *msg);
+
+/* ---- data bytes only (no frame around them) ---------------------------- */
+
+/* Encode the DATA of packet `id` (what a frame of it carries, without
+ * sync, size, group/type and checksum) from msg into data[0..cap), at the
+ * packet's table length (CAMERA_PASS: 4 + msg->len). msg may be NULL only
+ * for GYRO_ZERO_CMD (length 0).
+ * Returns the data length (0..253), or
+ *   TASE_EARG     data is NULL (even for length 0), msg is NULL for a
+ *                 packet with data, or CAMERA_PASS data NULL with len > 0;
+ *   TASE_EUNKNOWN id is not in the schema;
+ *   TASE_ETOOLONG CAMERA_PASS len > TASE_CAMERA_PASS_MAX;
+ *   TASE_ENOSPC   cap is smaller than the data length.
+ * Checked in this order. CAMERA_PASS's camera bytes may lie anywhere,
+ * even in data. Nothing is written on error. O(length). */
+int tase_packet_encode_data(uint16_t id, const void *msg, uint8_t *data, size_t cap);
+
+/* Like tase_packet_encode_data() with an explicit data length `len`, as
+ * in tase_packet_encode_len(): 0 for a query (msg may be NULL), 1 for the
+ * CAMERA_CMD camera-only form; TASE_ELENGTH when len is not accepted. */
+int tase_packet_encode_data_len(uint16_t id, const void *msg, size_t len, uint8_t *data,
+                                size_t cap);
+
+/* Decode the data bytes data[0..len) of packet `id` into msg, exactly as
+ * tase_packet_decode() decodes a frame of (group, type) = id carrying
+ * them: same zeroing, same results (TASE_EARG for data NULL with len > 0
+ * or msg NULL with len > 0; TASE_EUNKNOWN; TASE_ELENGTH for any len up to
+ * SIZE_MAX that the packet does not accept). A decoded CAMERA_PASS points
+ * into data. On error msg is unchanged. O(length). */
+int tase_packet_decode_data(uint16_t id, const uint8_t *data, size_t len, void *msg);
+
+/* tase_packet_decode_data() for a descriptor already looked up (the
+ * dispatcher's path: tase_schema_find() once per frame). p NULL gives
+ * TASE_EUNKNOWN (so the result of tase_schema_find() can be passed as it
+ * is); a pointer that is not a descriptor of the schema table gives
+ * TASE_EARG. O(length). */
+int tase_packet_decode_desc(const tase_packet_desc_t *p, const uint8_t *data, size_t len,
+                            void *msg);
 
 #ifdef __cplusplus
 }

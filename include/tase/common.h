@@ -19,13 +19,21 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "tase/config.h" /* TASE_CONFIG_HEADER and the defaults */
+#include "tase/version.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define TASE_VERSION_MAJOR 0
-#define TASE_VERSION_MINOR 1
-#define TASE_VERSION_PATCH 0
+/* Private: an explicit conversion for code in the public headers (static
+ * inline functions, macros) that compiles cleanly as C and as C++ (no
+ * old-style cast there: clang++ -Wold-style-cast). */
+#ifdef __cplusplus
+#define TASE_CAST_(type, value) (static_cast<type>(value))
+#else
+#define TASE_CAST_(type, value) ((type)(value))
+#endif
 
 /* Error codes. Stable: values never change meaning once released. */
 #define TASE_OK 0

@@ -34,6 +34,25 @@
  *         [TASE_PKT_PACKET_RATE] = on_packet_rate,
  *     };
  *
+ * C++ has no array designators (g++: "non-trivial designated
+ * initializers not supported"). From C++14 on, a constexpr function
+ * builds the same constant table, still in ROM and set up at compile time:
+ *
+ *     struct handler_table { tase_packet_handler_t h[TASE_PKT_COUNT]; };
+ *     constexpr handler_table make_handlers()
+ *     {
+ *         handler_table t{};  // every entry NULL
+ *         t.h[TASE_PKT_GIMBAL_CMD] = on_gimbal_cmd;
+ *         t.h[TASE_PKT_PACKET_RATE] = on_packet_rate;
+ *         return t;
+ *     }
+ *     static constexpr handler_table handlers = make_handlers();
+ *     ...
+ *     tase_dispatch_init(&d, handlers.h, on_other, on_error, ctx, &rx.stats);
+ *
+ * (Before C++14, fill a static array at start-up instead; it is then in
+ * RAM.)
+ *
  * Lookup is O(1): the schema's direct index gives the TASE_PKT_* index.
  *
  * STACK AND RAM. The decoded struct lives in the dispatcher instance

@@ -87,13 +87,12 @@ extern "C" {
 #define TASE_DATA_MAX 253u     /* Size is one byte and counts Group+Type */
 #define TASE_FRAME_MAX (TASE_DATA_MAX + TASE_FRAME_OVERHEAD) /* 261 */
 
-/* How many overlapping candidate frames are tracked for zero added
- * latency (1..16). 1 gives a classic parser that re-scans after a failure
- * (bounded latency, never loses a frame). Each extra candidate costs 6
- * bytes of RAM. */
-#ifndef TASE_RX_CANDIDATES
-#define TASE_RX_CANDIDATES 4
-#endif
+/* TASE_RX_CANDIDATES: how many overlapping candidate frames are tracked
+ * for zero added latency (1..16, default 4; set it in TASE_CONFIG_HEADER,
+ * see tase/config.h). 1 gives a classic parser that re-scans after a
+ * failure (bounded latency, never loses a frame). Each extra candidate
+ * costs 6 bytes of RAM. It changes sizeof(tase_rx_t): an application
+ * built with another value than the library does not link. */
 
 /* A received frame. `data` points into the receiver's window or into the
  * caller's input buffer and is valid only until the callback returns. */

@@ -30,7 +30,30 @@
  *
  *  - EVERYTHING ELSE (commands, host sensor/attitude/GPS, SPOI, unknown
  *    setup types) goes to the application's on_frame() callback, which may
- *    answer with tase_gimbal_send() (e.g. a zero-length SPOI_CMD query).
+ *    answer with tase_gimbal_send_msg() (e.g. a zero-length SPOI_CMD query).
+ *
+ * TYPED OR BYTES. Each application callback that carries packet data has
+ * a typed form taking the packet's struct (tase/codec.h) and a form taking
+ * its data bytes; set one of each pair (init refuses both):
+ *     fill_telemetry_msg  / fill_telemetry   (telemetry due)
+ *     apply_setup_msg     / apply_setup      (a setting arrived)
+ * and tase_gimbal_send_msg(), tase_gimbal_setup_set_msg(),
+ * tase_gimbal_setup_get_msg() are the typed forms of tase_gimbal_send(),
+ * tase_gimbal_setup_set(), tase_gimbal_setup_get().
+ *
+ * DISPATCH. on_frame gets (user, port, frame); the dispatcher
+ * (tase/dispatch.h) wants (dispatcher, frame). Either let the role receive
+ * and pass the rest on to a dispatcher with a two-line adapter:
+ *     static void to_dispatch(void *d, unsigned port, const tase_frame_t *f)
+ *     {
+ *         (void)port;                    // or keep it in your context
+ *         tase_dispatch_frame(d, f);
+ *     }
+ *     app.on_frame = to_dispatch; app.user = &dispatcher;
+ * or run your own receiver with tase_dispatch_frame() as its handler and
+ * hand the setup packets to the role from their typed handlers with
+ * tase_gimbal_handle_frame() (init with rx NULL; examples/firmware does
+ * this).
  *
  * SCHEDULE. Each (port, stream) has an anchor time t0 and a slot index k:
  * slot k is due at t0 + floor(k * 1000 / rate) ms. When k reaches rate,
@@ -91,6 +114,17 @@ typedef struct {
     /* Every other valid frame received on `port`. */
     void (*on_frame)(void *user, unsigned port, const tase_frame_t *frame);
     void *user;
+    /* Typed form of fill_telemetry: telemetry packet `id` is due on
+     * `port`: fill its struct at msg (a zeroed tase_packet_msg_t: use its
+     * gimbal_angle, gimbal_rate or georeference member, or cast to that
+     * struct) and return >= 0 to send it, < 0 to skip the slot. */
+    int (*fill_telemetry_msg)(void *user, unsigned port, uint16_t id, void *msg, uint32_t now_ms);
+    /* Typed form of apply_setup: setup packet `id` (TASE_ID_PACKET_RATE
+     * ..., not SYSTEM_VERSION) arrived on `port`, decoded into a private
+     * struct msg that the callback may change. Return >= 0 to accept (msg
+     * is encoded, stored and echoed; reserved bytes as zero) or < 0 to
+     * refuse (the current settings are echoed). */
+    int (*apply_setup_msg)(void *user, unsigned port, uint16_t id, void *msg);
 } tase_gimbal_app_t;
 
 /* Statistics; only incremented by the library, wrap modulo 2^32. */
@@ -136,7 +170,8 @@ typedef struct {
  * application runs its own receiver and hands frames over with
  * tase_gimbal_handle_frame() (firmware that dispatches every frame
  * itself saves the RAM). Returns TASE_OK, or TASE_EARG (g NULL, ports
- * NULL with nports > 0, nports > 3, a present port without write). O(1). */
+ * NULL with nports > 0, nports > 3, a present port without write, app
+ * with both forms of fill_telemetry or of apply_setup). O(1). */
 int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, size_t nports,
                      const tase_gimbal_app_t *app, uint32_t now_ms);
 
@@ -176,6 +211,15 @@ int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms);
 int tase_gimbal_send(tase_gimbal_t *g, unsigned port, uint8_t group, uint8_t type,
                      const uint8_t *data, size_t len);
 
+/* Send packet `id` from its typed struct msg (tase/codec.h) on port
+ * index `port`; msg NULL sends the zero-length form (e.g. a SPOI_CMD
+ * query). Returns the frame length, TASE_EARG (g NULL, port >= 3 or
+ * absent, a CAMERA_PASS tail NULL with len > 0), TASE_EUNKNOWN (id not
+ * in the schema), TASE_ELENGTH (msg NULL for a packet without a
+ * zero-length form), TASE_ETOOLONG (CAMERA_PASS tail over 249 bytes),
+ * or a port error. Uses 261 bytes of stack. O(length). */
+int tase_gimbal_send_msg(tase_gimbal_t *g, unsigned port, uint16_t id, const void *msg);
+
 /* Data length of setup packet `type` (0..7), or TASE_EUNKNOWN (type > 7).
  * O(1). */
 int tase_gimbal_setup_len(uint8_t type);
@@ -193,6 +237,17 @@ int tase_gimbal_setup_get(const tase_gimbal_t *g, uint8_t type, uint8_t *out, si
  * error. O(len). */
 int tase_gimbal_setup_set(tase_gimbal_t *g, uint8_t type, const uint8_t *data, size_t len,
                           uint32_t now_ms);
+
+/* tase_gimbal_setup_set() from the typed struct of setup packet `id`
+ * (TASE_ID_PACKET_RATE .. TASE_ID_CAMERA_ALIGN; reserved bytes stored as
+ * zero). Returns TASE_OK, TASE_EARG (g or msg NULL), TASE_EUNKNOWN (id
+ * is not a setup packet); g unchanged on error. O(length). */
+int tase_gimbal_setup_set_msg(tase_gimbal_t *g, uint16_t id, const void *msg, uint32_t now_ms);
+
+/* The stored setting of setup packet `id` decoded into its struct msg.
+ * Returns its data length, TASE_EARG (g or msg NULL), TASE_EUNKNOWN (id
+ * is not a setup packet; msg unchanged). O(length). */
+int tase_gimbal_setup_get_msg(const tase_gimbal_t *g, uint16_t id, void *msg);
 
 #ifdef __cplusplus
 }

@@ -5,12 +5,30 @@
  * sent as zero length in order to query the current settings.").
  *
  * A tase_host_t owns one port (port.h) and one frame receiver. It can
- *  - send any frame at any time (tase_host_send: commands, host data);
+ *  - send any packet at any time (commands, host data): from its typed
+ *    struct with tase_host_send_msg(), or as data bytes with
+ *    tase_host_send();
  *  - run ONE request at a time: send a frame (a zero-length query, or a
  *    setup packet / SPOI command whose echo confirms it) and wait for the
  *    gimbal's frame of the same group and type, re-sending the request
- *    after `timeout_ms` up to `retries` times. The reply's data bytes are
- *    copied into a caller buffer.
+ *    after `timeout_ms` up to `retries` times. A typed request
+ *    (tase_host_request_msg_start(), tase_host_transact_msg()) decodes
+ *    the reply into the caller's typed struct; a raw one copies the
+ *    reply's data bytes into a caller buffer.
+ *
+ * TYPED USE (tase/codec.h structs):
+ *     tase_gimbal_cmd_t cmd = {1500, -2000, 0, TASE_GIMBAL_FLAGS_POSITION, 0};
+ *     tase_packet_rate_t rates;
+ *     tase_host_send_msg(&h, TASE_ID_GIMBAL_CMD, &cmd);
+ *     r = tase_host_transact_msg(&h, TASE_ID_PACKET_RATE, NULL, &rates, 500, 2);
+ *     // r = 16 (the reply's data length): rates holds the gimbal's settings
+ *
+ * DISPATCH. The frames that are not the pending request's reply go to
+ * on_frame, which is a tase_rx_handler_t like tase_dispatch_frame()
+ * (tase/dispatch.h): pass a dispatcher to get telemetry decoded into
+ * typed handlers:
+ *     tase_dispatch_init(&d, handlers, NULL, NULL, app, &h.rx.stats);
+ *     tase_host_init(&h, &port, tase_dispatch_frame, &d);
  *
  * MATCHING. The pending request completes on the first received frame
  * with the request's group and type and at least one data byte (a
@@ -26,7 +44,13 @@
  * TIME. The core never reads a clock by itself: the poll-driven API takes
  * `now_ms` (any monotonic millisecond count that wraps modulo 2^32, e.g.
  * port->ops->now_ms()). Timeouts are measured per attempt from the
- * moment the attempt was sent.
+ * moment the attempt was sent, as the unsigned difference now_ms - sent,
+ * so they work across the 2^32 wrap. A sample older than the send (a
+ * clock read before the request started and passed in afterwards, or a
+ * clock that stepped back) makes that difference 2^31 or more: it counts
+ * as no time elapsed, never as an expired timeout. Samples must therefore
+ * be less than 2^31 ms (24.8 days) apart, which timeout_ms <= 2^31
+ * guarantees for a host that is polled.
  *
  * TWO WAYS TO USE IT
  *  - Firmware main loop (never blocks):
@@ -42,7 +66,7 @@
  *
  * All functions: not reentrant per instance, not ISR-safe (call from one
  * context); different instances are independent. No allocation, no
- * globals. sizeof(tase_host_t) is about 650 bytes (a tase_rx_t plus a copy
+ * globals. sizeof(tase_host_t) is about 660 bytes (a tase_rx_t plus a copy
  * of the pending request for re-sending).
  */
 #ifndef TASE_HOST_H
@@ -75,7 +99,9 @@ typedef struct {
     tase_port_t port;
     tase_rx_handler_t on_frame;
     void *user;
-    uint8_t *reply; /* caller's reply buffer of the pending request */
+    uint8_t *reply;  /* reply buffer of the pending request */
+    void *reply_msg; /* typed request: the caller's struct, or NULL */
+    bool typed;      /* the pending request is typed */
     size_t reply_cap;
     uint32_t timeout_ms; /* per attempt */
     uint32_t sent_at;    /* when the current attempt was sent */
@@ -101,6 +127,16 @@ int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on
  * from tase_port_write_all() (port_io.h). O(len). */
 int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len);
 
+/* Send packet `id` (TASE_ID_*) from its typed struct msg (tase/codec.h)
+ * now; msg NULL sends the zero-length form (GYRO_ZERO_CMD, or a query
+ * whose answer then goes to on_frame). Returns the frame length, or
+ * TASE_EARG (h NULL, or a CAMERA_PASS tail NULL with len > 0),
+ * TASE_EUNKNOWN (id not in the schema), TASE_ELENGTH (msg NULL for a
+ * packet without a zero-length form), TASE_ETOOLONG (CAMERA_PASS tail
+ * over 249 bytes), all checked before anything is sent, or a port error
+ * from tase_port_write_all(). Uses 261 bytes of stack. O(length). */
+int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg);
+
 /* Start a request: send (group, type, data[0..len)) and wait for the
  * gimbal's frame of the same group and type. len 0 is a query. Up to
  * 1 + retries attempts, each waiting timeout_ms from its sending. The
@@ -117,6 +153,28 @@ int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *d
 int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
                             size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
                             uint8_t retries, uint32_t now_ms);
+
+/* Start a TYPED request for packet `id`: msg NULL sends the zero-length
+ * query (a setup packet, SPOI_CMD, SYSTEM_VERSION), otherwise msg's
+ * packet (set and confirm). When the reply arrives its data is decoded
+ * into reply_msg (the packet's struct or a tase_packet_msg_t; NULL: the
+ * length alone is reported) and tase_host_poll() returns its data length.
+ * A reply of a length the packet does not accept completes the request
+ * with TASE_ELENGTH (reply_msg untouched). A decoded CAMERA_PASS points
+ * into the host instance, valid until the next request starts. reply_msg
+ * must stay valid until the request completes or is cancelled.
+ * Returns TASE_OK (first attempt sent), or
+ *   TASE_EARG     h NULL, timeout_ms 0 or > 2^31; or from the codec:
+ *                 a CAMERA_PASS tail NULL with len > 0;
+ *   TASE_EBUSY    a request is pending (checked before the packet is
+ *                 encoded; the pending one is left untouched);
+ *   TASE_EUNKNOWN id is not in the schema;
+ *   TASE_ELENGTH  msg NULL for a packet without a query form;
+ *   TASE_ETOOLONG CAMERA_PASS tail over 249 bytes;
+ *   a port error  the first attempt could not be sent (no request pending).
+ * O(length). */
+int tase_host_request_msg_start(tase_host_t *h, uint16_t id, const void *msg, void *reply_msg,
+                                uint32_t timeout_ms, uint8_t retries, uint32_t now_ms);
 
 /* tase_host_request_start() with no data: a zero-length query. */
 int tase_host_query_start(tase_host_t *h, uint8_t group, uint8_t type, uint8_t *reply,
@@ -174,6 +232,15 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms);
  * TASE_EUNSUPPORTED for a port without read or now_ms (nothing sent). */
 int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len,
                        uint8_t *reply, size_t reply_cap, uint32_t timeout_ms, uint8_t retries);
+
+/* The typed blocking request: tase_host_request_msg_start() (msg NULL:
+ * a query), then service and poll as tase_host_transact() does. Returns
+ * the reply's data length with reply_msg filled, or a negative code as
+ * tase_host_request_msg_start() + tase_host_poll() (TASE_ETIMEOUT,
+ * TASE_ELENGTH for a reply of a wrong length, ...), TASE_EARG /
+ * TASE_EUNSUPPORTED as tase_host_transact(). */
+int tase_host_transact_msg(tase_host_t *h, uint16_t id, const void *msg, void *reply_msg,
+                           uint32_t timeout_ms, uint8_t retries);
 
 #ifdef __cplusplus
 }

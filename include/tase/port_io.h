@@ -21,11 +21,9 @@
 extern "C" {
 #endif
 
-/* Consecutive calls to write() that took nothing (TASE_EAGAIN,
- * TASE_ENOBUFS or 0) after which tase_port_write_all() gives up. */
-#ifndef TASE_PORT_WRITE_TRIES
-#define TASE_PORT_WRITE_TRIES 64u
-#endif
+/* TASE_PORT_WRITE_TRIES (tase/config.h, default 64): consecutive calls
+ * to write() that took nothing (TASE_EAGAIN, TASE_ENOBUFS or 0) after
+ * which tase_port_write_all() gives up. */
 
 /* Write all n bytes of data to the port.
  * Returns n, or
@@ -50,11 +48,22 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n);
 int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *data,
                          size_t len);
 
-/* Count the result r of a frame write (tase_port_send_frame() or
- * tase_port_write_all()): a success in *sent, a failure of the link in
- * *errors. Failures caused by the caller's arguments (TASE_EARG,
- * TASE_ETOOLONG) are not the link's and count in neither. Either pointer
- * may be NULL. Returns r unchanged. O(1), reentrant. */
+/* Encode packet `id` from its typed struct (tase/codec.h) into a stack
+ * buffer of TASE_FRAME_MAX bytes and write it with tase_port_write_all().
+ * msg NULL sends the zero-length form (a query, or GYRO_ZERO_CMD).
+ * Returns the frame length, a codec error (checked first, nothing sent:
+ * TASE_EUNKNOWN id not in the schema; TASE_ELENGTH msg NULL for a packet
+ * without a zero-length form; TASE_EARG / TASE_ETOOLONG for a bad
+ * CAMERA_PASS tail), TASE_EARG for port NULL, or a tase_port_write_all()
+ * error. Uses 261 bytes of stack. */
+int tase_port_send_msg(const tase_port_t *port, uint16_t id, const void *msg);
+
+/* Count the result r of a frame write (tase_port_send_frame(),
+ * tase_port_send_msg() or tase_port_write_all()): a success in *sent, a
+ * failure of the link in *errors. Failures caused by the caller's
+ * arguments (TASE_EARG, TASE_ETOOLONG, TASE_ELENGTH, TASE_EUNKNOWN) are
+ * not the link's and count in neither. Either pointer may be NULL.
+ * Returns r unchanged. O(1), reentrant. */
 int tase_port_count_tx(int r, uint32_t *sent, uint32_t *errors);
 
 #ifdef __cplusplus

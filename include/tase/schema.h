@@ -15,6 +15,15 @@
  *   - the fields, in the order of the spec's table. Rows named "Reserved"
  *     are not fields: they are written as zero and ignored when read.
  *
+ * TWO LAYOUTS. Table 22 (AXIS_SETTING) has no row 13: read as printed the
+ * packet is 23 bytes with byte 13 reserved, read as a numbering slip it
+ * is 22 bytes with every row from 14 on one byte earlier. Both are
+ * accepted (docs/PROTOCOL-NOTES.md S2): a packet flagged TASE_LEN_SHORT
+ * also takes len - 1 data bytes, and then each field flagged
+ * TASE_FIELD_SHIFT sits one byte earlier. The length of the frame selects
+ * the layout; tase_field_offset() applies it, and the codec, the
+ * dispatcher, tase_field_get() and the tools' JSON all go through it.
+ *
  * A field descriptor (tase_field_t) gives its byte offset in the data,
  * its width (1, 2, 4 or 8 bytes, big-endian on the wire), its signedness
  * and the offset of the matching member in the packet's typed struct
@@ -77,17 +86,30 @@ enum {
 #define TASE_LEN_QUERY 0x04u  /* 0 bytes: query (the setup echo answers) */
 #define TASE_LEN_SHORT1 0x08u /* 1 byte: CAMERA_CMD "change camera only" */
 #define TASE_LEN_TAIL 0x10u   /* len + 0..(253-len) trailing bytes */
+#define TASE_LEN_SHORT 0x20u  /* len - 1: the short layout, see below */
 
-/* Field format byte: width in bytes (1, 2, 4, 8) in bits 0-3 (LSB
- * numbering here: this is a C value, not a wire byte), signed in bit 4. */
+/* Field format byte (LSB numbering here: this is a C value, not a wire
+ * byte): width in bytes (1, 2, 4, 8) in bits 0-3, signed in bit 4, and in
+ * bits 5-6 the kind of the field's "do not change" value (the spec's value
+ * that leaves a setting as it is; read it with tase_field_keep()). */
 #define TASE_FIELD_SIGNED 0x10u
+#define TASE_FIELD_KEEP_NONE 0x00u /* the field has no such value */
+#define TASE_FIELD_KEEP_ONES 0x20u /* all bits set: 0xFF, 0xFFFF (-1 if signed) */
+#define TASE_FIELD_KEEP_ZERO 0x40u /* zero */
+#define TASE_FIELD_KEEP_MSB 0x60u  /* a flags byte whose MSB means "no change" */
+#define TASE_FIELD_KEEP_MASK 0x60u
+/* Bit 7: in the packet's short layout (TASE_LEN_SHORT: one data byte
+ * fewer than the table, AXIS_SETTING's 22 bytes) the field sits one byte
+ * earlier than `offset`. Read offsets through tase_field_offset(). */
+#define TASE_FIELD_SHIFT 0x80u
 #define TASE_FIELD_WIDTH(f) ((unsigned)(f)->fmt & 0x0Fu)
 #define TASE_FIELD_IS_SIGNED(f) (((unsigned)(f)->fmt & TASE_FIELD_SIGNED) != 0u)
+#define TASE_FIELD_KEEP(f) ((unsigned)(f)->fmt & TASE_FIELD_KEEP_MASK)
 
 typedef struct {
     uint8_t offset; /* byte offset in the packet data */
     uint8_t member; /* offsetof() the member in the packet's typed struct */
-    uint8_t fmt;    /* width | TASE_FIELD_SIGNED */
+    uint8_t fmt;    /* width | TASE_FIELD_SIGNED | TASE_FIELD_KEEP_* | _SHIFT */
 } tase_field_t;
 
 typedef struct {
@@ -115,8 +137,9 @@ const tase_packet_desc_t *tase_schema_at(size_t i);
 const tase_field_t *tase_schema_field(const tase_packet_desc_t *p, size_t i);
 
 /* True when `len` data bytes are a valid form of packet p: its table
- * length, or 0 with TASE_LEN_QUERY, 1 with TASE_LEN_SHORT1, or
- * len..253 with TASE_LEN_TAIL. False when p is NULL. O(1). */
+ * length, or 0 with TASE_LEN_QUERY, 1 with TASE_LEN_SHORT1, len - 1 with
+ * TASE_LEN_SHORT, or len..253 with TASE_LEN_TAIL. False when p is NULL.
+ * O(1). */
 bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len);
 
 /* True when a frame of packet p with `len` data bytes is a query (zero
@@ -124,7 +147,15 @@ bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len);
  * is a command, not a query. False when p is NULL. O(1). */
 bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len);
 
-/* Read the integer value of field i of packet p from data[0..len): big-
+/* Byte offset of field i of packet p in a frame with `len` data bytes:
+ * the field's `offset`, one less in the short layout (len == p->len - 1,
+ * p has TASE_LEN_SHORT and the field TASE_FIELD_SHIFT). Returns the
+ * offset (>= 0; the field may still lie beyond len, e.g. in a query), or
+ * TASE_EARG (p NULL or i out of range). O(1), reentrant, ISR-safe. */
+int tase_field_offset(const tase_packet_desc_t *p, size_t i, size_t len);
+
+/* Read the integer value of field i of packet p from data[0..len) (at
+ * tase_field_offset(), so the length selects the layout): big-
  * endian, sign-extended when the field is signed. (A width-8 unsigned
  * field above INT64_MAX would wrap; the spec has no 8-byte field.)
  * Returns TASE_OK and sets *value, or
@@ -133,6 +164,19 @@ bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len);
  * O(width), reentrant, ISR-safe. */
 int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
                    int64_t *value);
+
+/* The "do not change" value of field i of packet p (the spec's value that
+ * leaves a setting as it is, e.g. CAMERA_CMD camera 0xFF, hfov -1, focus
+ * 0xFFFF, flags 0x80; AXIS_SETTING 0xFF / 0xFFFF; CAMERA_TYPE 0): returns
+ * TASE_OK and sets *value to the wire integer (sign-extended for signed
+ * fields), TASE_EUNKNOWN if the field has none, TASE_EARG for NULL
+ * arguments or i out of range. O(1), reentrant, ISR-safe. */
+int tase_field_keep(const tase_packet_desc_t *p, size_t i, int64_t *value);
+
+/* True when `value` of field i of packet p means "do not change" (for a
+ * flags byte whose MSB means "no change", any value with that bit set).
+ * False when the field has none or p is NULL or i out of range. */
+bool tase_field_is_keep(const tase_packet_desc_t *p, size_t i, int64_t value);
 
 /* ---- names (src/tase_schema_names.c; not linked unless used) ----------- */
 

@@ -17,6 +17,8 @@
  * value could land there. From-wire conversions are exact within double.
  *
  * Header only (static inline, no libm): unused helpers cost nothing.
+ * Clean as C and as C++ under the strictest cast warnings (gcc
+ * -Wbad-function-cast, clang -Weverything, clang++ -Wold-style-cast).
  * All functions are pure, reentrant and ISR-safe (when the FPU or soft
  * float may be used there).
  */
@@ -43,30 +45,34 @@ static inline double tase_units_round_clamp(double v, double lo, double hi)
     if (v >= hi) {
         return hi;
     }
-    return v; /* the caller's cast truncates toward zero */
+    return v; /* the caller's conversion truncates toward zero */
 }
 
 static inline int16_t tase_units_sat_i16(double v)
 {
-    return (int16_t)tase_units_round_clamp(v, -32768.0, 32767.0);
+    double r = tase_units_round_clamp(v, -32768.0, 32767.0);
+    return TASE_CAST_(int16_t, r);
 }
 static inline uint16_t tase_units_sat_u16(double v)
 {
-    return (uint16_t)tase_units_round_clamp(v, 0.0, 65535.0);
+    double r = tase_units_round_clamp(v, 0.0, 65535.0);
+    return TASE_CAST_(uint16_t, r);
 }
 static inline int32_t tase_units_sat_i32(double v)
 {
-    return (int32_t)tase_units_round_clamp(v, -2147483648.0, 2147483647.0);
+    double r = tase_units_round_clamp(v, -2147483648.0, 2147483647.0);
+    return TASE_CAST_(int32_t, r);
 }
 static inline uint8_t tase_units_sat_u8(double v)
 {
-    return (uint8_t)tase_units_round_clamp(v, 0.0, 255.0);
+    double r = tase_units_round_clamp(v, 0.0, 255.0);
+    return TASE_CAST_(uint8_t, r);
 }
 
 /* 1/100 degree (or deg/s) */
 static inline double tase_units_cdeg_to_deg(int32_t cdeg)
 {
-    return (double)cdeg / 100.0;
+    return cdeg / 100.0;
 }
 static inline int16_t tase_units_deg_to_cdeg(double deg)
 {
@@ -80,7 +86,7 @@ static inline uint16_t tase_units_deg_to_cdeg_u16(double deg)
 /* milli-arcseconds: 1 degree = 3 600 000 mas */
 static inline double tase_units_mas_to_deg(int32_t mas)
 {
-    return (double)mas / 3600000.0;
+    return mas / 3600000.0;
 }
 static inline int32_t tase_units_deg_to_mas(double deg)
 {
@@ -90,7 +96,7 @@ static inline int32_t tase_units_deg_to_mas(double deg)
 /* centimetres (32-bit heights) */
 static inline double tase_units_cm_to_m(int32_t cm)
 {
-    return (double)cm / 100.0;
+    return cm / 100.0;
 }
 static inline int32_t tase_units_m_to_cm(double m)
 {
@@ -100,7 +106,7 @@ static inline int32_t tase_units_m_to_cm(double m)
 /* cm/s (16-bit signed velocities; use sat_u16(mps * 100) for TAS) */
 static inline double tase_units_cmps_to_mps(int32_t cmps)
 {
-    return (double)cmps / 100.0;
+    return cmps / 100.0;
 }
 static inline int16_t tase_units_mps_to_cmps(double mps)
 {
@@ -110,7 +116,7 @@ static inline int16_t tase_units_mps_to_cmps(double mps)
 /* 1/300 m/s^2 */
 static inline double tase_units_accel_to_mps2(int32_t raw)
 {
-    return (double)raw / 300.0;
+    return raw / 300.0;
 }
 static inline int16_t tase_units_mps2_to_accel(double mps2)
 {
@@ -120,7 +126,7 @@ static inline int16_t tase_units_mps2_to_accel(double mps2)
 /* 0.1 PDOP */
 static inline double tase_units_raw_to_pdop(uint8_t raw)
 {
-    return (double)raw / 10.0;
+    return raw / 10.0;
 }
 static inline uint8_t tase_units_pdop_to_raw(double pdop)
 {

@@ -3,9 +3,9 @@
 # candump and cansend, then the bench tools of issue 6 (tase-sim --can and
 # tase --can, built static for the VM) over vcan0. Skipped (exit 77) only
 # when qemu cannot run at all.
-if(TARGET tase_port AND CMAKE_SYSTEM_NAME STREQUAL "Linux")
+if(TARGET tase_socketcan)
   add_executable(tase_can_vm_agent ${CMAKE_CURRENT_SOURCE_DIR}/vm/can_vm_agent.c)
-  target_link_libraries(tase_can_vm_agent PRIVATE tase_port tase)
+  target_link_libraries(tase_can_vm_agent PRIVATE tase_socketcan tase)
   target_link_options(tase_can_vm_agent PRIVATE -static)
   target_compile_options(tase_can_vm_agent PRIVATE ${TASE_WARNINGS})
   # Static copies of the tools from the same sources (the VM has no libc).
