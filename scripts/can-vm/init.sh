@@ -169,7 +169,7 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
               [ "$(json_int "$v" camera_a)/$(json_int "$v" camera_b)/$(json_int "$v" camera_c)" = 68/97/255 ] &&
               echo "$v" | grep -q "\"name\":\"SYSTEM_VERSION\",\"size\":42,"'
 
-    e=$($T send PACKET_RATE angle_1=20 rate_1=5 geo_ref_1=2 $L --json)
+    e=$($T send PACKET_RATE angle_1=20 rate_1=5 geo_ref_1=2 $L --json | grep '"dir":"out"')
     check "send PACKET_RATE: the gimbal echoes 20/5/2" \
         eval '[ "$(json_int "$e" angle_1)/$(json_int "$e" rate_1)/$(json_int "$e" geo_ref_1)" = 20/5/2 ]'
     $T monitor $L --json --seconds 2 > /tmp/mon.json
@@ -183,13 +183,14 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     $T monitor $L --json --seconds 3.5 > /tmp/move.json &
     mon=$!
     usleep 400000
-    s=$($T send GIMBAL_CMD pan=3000 tilt=-1500 flags=0xA0 $L)
-    check "send GIMBAL_CMD ($s)" [ "$s" = "sent GIMBAL_CMD (8 data bytes)" ]
+    s=$($T point 30 -15 $L | head -1)
+    check "tase point 30 -15 sends GIMBAL_CMD position, stabilised ($s)" \
+        [ "$s" = "sent GIMBAL_CMD pan=3000 tilt=-1500 roll=0 flags=160 impulse_time=0" ]
     # A long packet both ways: 44 data bytes = 52 bytes = 7 CAN frames to the
     # gimbal, whose simulated camera echoes the bytes back.
     pass=$(seq -s, 201 240)
     s=$($T send CAMERA_PASS camera=1 baud=8 data=$pass $L)
-    check "send CAMERA_PASS, 40 camera bytes ($s)" [ "$s" = "sent CAMERA_PASS (44 data bytes)" ]
+    check "send CAMERA_PASS, 40 camera bytes ($s)" [ "$s" = "sent CAMERA_PASS camera=1 baud=8 +40 data bytes" ]
     wait $mon
     check "monitor got the CAMERA_PASS echo with the 40 bytes" \
         grep -q "\"name\":\"CAMERA_PASS\",\"size\":44,\"fields\":{\"camera\":1,\"baud\":8},\"data\":\[$pass\]}" /tmp/move.json
@@ -222,8 +223,8 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
         "$(grep -c '"dir":"in"' /tmp/dec.json) in, $(grep -c '"dir":"out"' /tmp/dec.json) out"
     check "tase decode --candump of the capture exits 0 ($(cat /tmp/t.err))" [ $rc -eq 0 ]
     check "decoded: SYSTEM_VERSION query (in, size 0)" \
-        grep -q '"dir":"in","group":72,"type":3,"name":"SYSTEM_VERSION","size":0,"fields":{}}' /tmp/dec.json
-    ve=$(grep '"dir":"out","group":72,"type":3,"name":"SYSTEM_VERSION","size":42,' /tmp/dec.json)
+        grep -q '"dir":"in","interface":"vcan0","group":72,"type":3,"name":"SYSTEM_VERSION","size":0,"fields":{}}' /tmp/dec.json
+    ve=$(grep '"dir":"out","interface":"vcan0","group":72,"type":3,"name":"SYSTEM_VERSION","size":42,' /tmp/dec.json)
     check "decoded: SYSTEM_VERSION answer (out) 2.5.1 as tase query printed it" \
         eval '[ "$(echo "$ve" | wc -l)" = 1 ] && [ "$(json_int "$ve" major)/$(json_int "$ve" minor)/$(json_int "$ve" sub)" = 2/5/1 ] &&
               [ "${ve#*\"fields\"}" = "${v#*\"fields\"}" ]'
@@ -231,12 +232,14 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
         eval '[ "$(grep -c "\"dir\":\"in\".*\"name\":\"PACKET_RATE\",\"size\":16,\"fields\":{\"angle_1\":20,\"rate_1\":5,\"geo_ref_1\":2," /tmp/dec.json)" = 1 ] &&
               [ "$(grep -c "\"dir\":\"out\".*\"name\":\"PACKET_RATE\",\"size\":16,\"fields\":{\"angle_1\":20,\"rate_1\":5,\"geo_ref_1\":2," /tmp/dec.json)" = 1 ] &&
               grep -q "\"dir\":\"in\".*\"name\":\"PACKET_RATE\",\"size\":0," /tmp/dec.json'
+    check "decoded: every packet has the capture's time and the interface" \
+        eval '[ "$(grep -c "^{\"offset\":[0-9]*,\"time\":[0-9]*\.[0-9]\{6\},\"dir\":\"[a-z]*\",\"interface\":\"vcan0\"," /tmp/dec.json)" = "$(wc -l < /tmp/dec.json)" ]'
     check "decoded: GIMBAL_CMD in, pan 3000 tilt -1500 flags 0xA0" \
-        grep -q '"dir":"in","group":0,"type":128,"name":"GIMBAL_CMD","size":8,"fields":{"pan":3000,"tilt":-1500,.*"flags":160' /tmp/dec.json
+        grep -q '"dir":"in","interface":"vcan0","group":0,"type":128,"name":"GIMBAL_CMD","size":8,"fields":{"pan":3000,"tilt":-1500,.*"flags":160' /tmp/dec.json
     check "decoded: CAMERA_PASS in and its echo out, same 40 bytes" \
         eval '[ "$(grep -c "\"name\":\"CAMERA_PASS\",\"size\":44,\"fields\":{\"camera\":1,\"baud\":8},\"data\":\[$pass\]}" /tmp/dec.json)" = 2 ] &&
-              grep -q "\"dir\":\"in\",\"group\":0,\"type\":66," /tmp/dec.json &&
-              grep -q "\"dir\":\"out\",\"group\":0,\"type\":66," /tmp/dec.json'
+              grep -q "\"dir\":\"in\",\"interface\":\"vcan0\",\"group\":0,\"type\":66," /tmp/dec.json &&
+              grep -q "\"dir\":\"out\",\"interface\":\"vcan0\",\"group\":0,\"type\":66," /tmp/dec.json'
     nd=$(grep -c '"dir":"out".*"name":"GIMBAL_ANGLE"' /tmp/dec.json)
     check "decoded: $nd GIMBAL_ANGLE out, at least the $na the 2 s monitor printed" [ "$nd" -ge "$na" ]
     check "decoded: no frame with a wrong length" eval '! grep -q "\"error\"" /tmp/dec.json'
