@@ -23,6 +23,8 @@ typedef struct {
     tase_rx_t rx[TASE_GIMBAL_PORTS];
     /* apply_setup */
     unsigned applies;
+    uint8_t applied[TASE_DATA_MAX]; /* what the last apply_setup saw */
+    size_t applied_len;
     int refuse;
     uint8_t clamp_to; /* nonzero: PACKET_RATE bytes above it are clamped */
     /* fill_telemetry */
@@ -54,6 +56,8 @@ static int app_apply(void *user, unsigned port, uint8_t type, uint8_t *data, siz
     size_t i;
     (void)port;
     x->applies++;
+    memcpy(x->applied, data, len);
+    x->applied_len = len;
     if (x->refuse) {
         return TASE_ERANGE;
     }
@@ -234,6 +238,133 @@ static void a_setup_packet_of_the_wrong_length_is_counted_not_answered(void **st
     free(x);
 }
 
+/* Spec 4.4.1: bytes 4, 9 and 14 of PACKET_RATE are "Reserved byte set to
+ * zero": what the host put there is neither stored, applied nor echoed. */
+static void reserved_bytes_are_zero_in_what_is_applied_stored_and_echoed(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX], stored[23];
+    uint8_t req[16] = {20, 5, 2, 7, 0xAA, 10, 10, 4, 8, 0xBB, 10, 10, 4, 9, 0xCC, 1};
+    uint8_t want[16];
+    uint8_t axis[23];
+    (void)state;
+
+    memcpy(want, req, sizeof want);
+    want[4] = want[9] = want[14] = 0;
+    feed(x, 0, 0x48, 0x00, req, sizeof req, 10);
+    assert_int_equal(x->applied_len, 16);
+    assert_memory_equal(x->applied, want, 16);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 16);
+    assert_memory_equal(d, want, 16);
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0x00, stored, sizeof stored), 16);
+    assert_memory_equal(stored, want, 16);
+
+    /* AXIS_SETTING's byte 13 (no row in table 22) */
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0x02, axis, sizeof axis), 23);
+    axis[12] = 30;
+    axis[13] = 0xFF;
+    feed(x, 0, 0x48, 0x02, axis, 23, 20);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 23);
+    assert_int_equal(d[12], 30);
+    assert_int_equal(d[13], 0);
+    assert_int_equal(x->applied[13], 0);
+    free(x);
+}
+
+/* Spec 4.4.3: 0xFF (0xFFFF for 16-bit values) means "do not change"; the
+ * echo shows the setting in force, not the 0xFF. */
+static void axis_do_not_change_values_keep_the_stored_settings(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX], defaults[23], req[23], want[23];
+    (void)state;
+
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0x02, defaults, sizeof defaults), 23);
+    memset(req, 0xFF, sizeof req);
+    req[22] = 0; /* temporary: a flag, not a setting (no "do not change") */
+    feed(x, 0, 0x48, 0x02, req, sizeof req, 10);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 23);
+    assert_memory_equal(d, defaults, 23);
+    assert_memory_equal(x->applied, defaults, 23); /* the callback sees them too */
+
+    /* change two fields, leave the rest */
+    req[0] = 0x11; /* pan no-go centre 0x1194 = 45.00 deg */
+    req[1] = 0x94;
+    req[16] = 75; /* tilt max accel */
+    memcpy(want, defaults, sizeof want);
+    want[0] = 0x11;
+    want[1] = 0x94;
+    want[16] = 75;
+    feed(x, 1, 0x48, 0x02, req, sizeof req, 20);
+    assert_int_equal(only_frame(&x->port[1], &g, &t, d), 23);
+    assert_memory_equal(d, want, 23);
+    /* 0xFF in one byte of a 16-bit field is a value, not "do not change" */
+    req[2] = 0xFF;
+    req[3] = 0x00; /* pan no-go range 0xFF00 */
+    want[2] = 0xFF;
+    want[3] = 0x00;
+    feed(x, 1, 0x48, 0x02, req, sizeof req, 30);
+    assert_int_equal(only_frame(&x->port[1], &g, &t, d), 23);
+    assert_memory_equal(d, want, 23);
+    assert_int_equal(x->g.stats.setup_applied, 3);
+    free(x);
+}
+
+/* Spec 4.4.6: CAMERA_TYPE 0 is "do not change", 0xFF "no camera". */
+static void camera_type_zero_keeps_and_the_default_is_no_camera(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX];
+    const uint8_t none[3] = {0xFF, 0xFF, 0xFF}, mine[3] = {68, 97, 0xFF};
+    const uint8_t req[3] = {0, 36, 0}, want[3] = {68, 36, 0xFF};
+    (void)state;
+
+    feed(x, 0, 0x48, 0x05, NULL, 0, 10);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 3);
+    assert_memory_equal(d, none, 3);
+    assert_int_equal(tase_gimbal_setup_set(&x->g, 0x05, mine, 3, 10), TASE_OK);
+    feed(x, 0, 0x48, 0x05, req, 3, 20);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 3);
+    assert_memory_equal(d, want, 3);
+    free(x);
+}
+
+/* Table 22 read as a numbering slip (22 bytes, no byte 13): the role
+ * applies it field by field and echoes in the layout it came in. */
+static void a_22_byte_axis_setting_is_applied_and_echoed_in_its_layout(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX], stored[23];
+    /* no-go zones unchanged (0xFFFF), max rates 20/30/0xFF, accelerations
+     * 40/45/0xFF, gains 50/55/0xFF, temporary 1 */
+    uint8_t req22[22] = {0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF,
+                         0xFF, 20,   30,   0xFF, 40,   45,   0xFF, 50,   55,   0xFF, 1};
+    uint8_t want23[23] = {0x00, 0x00, 0x00, 0x00, 0x23, 0x28, 0x17, 0x70, 0,  0, 0, 0,
+                          20,   0,    30,   0,    40,   45,   0,    50,   55, 0, 1};
+    uint8_t want22[22];
+    (void)state;
+
+    feed(x, 2, 0x48, 0x02, req22, sizeof req22, 10);
+    assert_int_equal(x->g.stats.bad_length, 0);
+    assert_int_equal(x->applied_len, 23); /* the callback sees the table layout */
+    assert_memory_equal(x->applied, want23, 23);
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0x02, stored, sizeof stored), 23);
+    assert_memory_equal(stored, want23, 23);
+    memcpy(want22, want23, 13);
+    memcpy(want22 + 13, want23 + 14, 9);
+    assert_int_equal(only_frame(&x->port[2], &g, &t, d), 22);
+    assert_memory_equal(d, want22, 22);
+    /* a query is answered in the table's 23 bytes */
+    feed(x, 2, 0x48, 0x02, NULL, 0, 20);
+    assert_int_equal(only_frame(&x->port[2], &g, &t, d), 23);
+    assert_memory_equal(d, want23, 23);
+    /* 21 bytes is no layout */
+    feed(x, 2, 0x48, 0x02, req22, 21, 30);
+    assert_int_equal(fake_frames_out(&x->port[2]), 0);
+    assert_int_equal(x->g.stats.bad_length, 1);
+    free(x);
+}
+
 static void system_version_is_query_only_and_answers_the_application_bytes(void **state)
 {
     fix_t *x = make(0, 3, false);
@@ -249,6 +380,8 @@ static void system_version_is_query_only_and_answers_the_application_bytes(void 
     assert_int_equal(tase_gimbal_setup_set(&x->g, 0x03, ver, 42, 0), TASE_OK);
     feed(x, 0, 0x48, 0x03, NULL, 0, 10);
     assert_int_equal(only_frame(&x->port[0], &g, &t, d), 42);
+    /* stored and answered with its reserved bytes 25, 31, 37 zero */
+    ver[25] = ver[31] = ver[37] = 0;
     assert_memory_equal(d, ver, 42);
     /* Writing it is not possible: answered, unchanged, no callback. */
     feed(x, 0, 0x48, 0x03, junk, sizeof junk, 20);
@@ -976,6 +1109,10 @@ int main(void)
         cmocka_unit_test(a_refused_setup_echoes_the_settings_still_in_force),
         cmocka_unit_test(a_setup_packet_of_the_wrong_length_is_counted_not_answered),
         cmocka_unit_test(system_version_is_query_only_and_answers_the_application_bytes),
+        cmocka_unit_test(reserved_bytes_are_zero_in_what_is_applied_stored_and_echoed),
+        cmocka_unit_test(axis_do_not_change_values_keep_the_stored_settings),
+        cmocka_unit_test(camera_type_zero_keeps_and_the_default_is_no_camera),
+        cmocka_unit_test(a_22_byte_axis_setting_is_applied_and_echoed_in_its_layout),
         cmocka_unit_test(other_frames_reach_the_application_which_can_answer),
         cmocka_unit_test(an_hour_of_telemetry_has_exactly_rate_times_3600_packets),
         cmocka_unit_test(jittery_polling_still_gives_exact_counts),

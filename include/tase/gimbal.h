@@ -3,19 +3,30 @@
  * without knowing what the gimbal is (firmware, a simulator, a test).
  *
  * A tase_gimbal_t serves up to TASE_GIMBAL_PORTS ports ("external
- * communications port 1..3" of the PACKET_RATE packet, index 0..2 here),
- * each a tase_port_t with its own frame receiver. It
+ * communications port 1..3" of the PACKET_RATE packet, index 0..2 here:
+ * index i is port i + 1), each a tase_port_t with its own frame receiver.
+ * The spec never says which connector is port 1..3; the three that table 1
+ * gives for gimbal communications, in its order, are Com2 (9600 baud),
+ * Com3 (57600) and CAN, so pass them as indices 0, 1, 2 (Com1 is the
+ * magnetometer's; docs/PROTOCOL-NOTES.md A2). It
  *
  *  - SETUP PACKETS (group 0x48, types 0x00..0x07, spec 4.4): stores the
  *    current data bytes of every setup packet (110 bytes), seeded at init
- *    with the spec's defaults where it gives them. A zero-length packet is
- *    a query: the role answers, on the port it came from, with the stored
- *    bytes. A packet with data of the right length is handed to the
- *    application's apply_setup() callback, which validates and applies it
- *    and may change the bytes (e.g. resolve AXIS_SETTING's 0xFF "do not
- *    change" fields, clamp values); the bytes it leaves are stored and
- *    echoed. If apply_setup() refuses, the stored bytes are echoed
- *    unchanged, so the host always learns the settings in force.
+ *    with the spec's defaults where it gives them (CAMERA_TYPE: 0xFF "no
+ *    camera" until the application stores its cameras). A zero-length
+ *    packet is a query: the role answers, on the port it came from, with
+ *    the stored bytes. A packet with data of an accepted length is first
+ *    made what the gimbal would store: reserved bytes zero, and every field
+ *    holding its "do not change" value (AXIS_SETTING 0xFF/0xFFFF,
+ *    CAMERA_TYPE 0; tase_field_is_keep()) replaced by the stored setting,
+ *    in the table's layout (a 22-byte AXIS_SETTING is laid out as 23). It
+ *    is then handed to the application's apply_setup() callback, which
+ *    validates and applies it and may change the bytes (clamp values);
+ *    the bytes it leaves are stored and echoed, in the layout the packet
+ *    came in (22 or 23 bytes for AXIS_SETTING). If apply_setup() refuses,
+ *    the stored bytes are echoed unchanged, so the host always learns the
+ *    settings in force. The stored bytes never hold a non-zero reserved
+ *    byte nor a "do not change" value.
  *    SYSTEM_VERSION is query-only: any SYSTEM_VERSION packet is answered
  *    with the bytes the application set (tase_gimbal_setup_set()).
  *    A setup packet with a wrong data length is counted (stats.bad_length)
@@ -99,11 +110,13 @@ extern "C" {
 
 /* Application callbacks; any may be NULL. `user` is passed back. */
 typedef struct {
-    /* A setup packet of `type` (0..7, not SYSTEM_VERSION) with its full
-     * data length arrived on `port`. data[0..len) is a private copy the
-     * callback may modify. Return >= 0 to accept (the bytes are stored,
-     * a PACKET_RATE change reschedules, and the bytes are echoed) or < 0
-     * to refuse (the current settings are echoed). NULL accepts all. */
+    /* A setup packet of `type` (0..7, not SYSTEM_VERSION) with data
+     * arrived on `port`. data[0..len) is a private copy in the table's
+     * layout (len is the table length), reserved bytes zero and "do not
+     * change" fields already replaced by the stored settings; the callback
+     * may modify it. Return >= 0 to accept (the bytes are stored, a
+     * PACKET_RATE change reschedules, and the bytes are echoed) or < 0 to
+     * refuse (the current settings are echoed). NULL accepts all. */
     int (*apply_setup)(void *user, unsigned port, uint8_t type, uint8_t *data, size_t len);
     /* Telemetry packet `id` (TASE_ID_GIMBAL_ANGLE, _GIMBAL_RATE,
      * _GEOREFERENCE_DATA) is due on `port`: write its data into
@@ -230,7 +243,9 @@ int tase_gimbal_setup_len(uint8_t type);
 int tase_gimbal_setup_get(const tase_gimbal_t *g, uint8_t type, uint8_t *out, size_t cap);
 
 /* Store setup packet `type` directly (no callback, no echo): load saved
- * settings at start-up, or set SYSTEM_VERSION. A PACKET_RATE change
+ * settings at start-up, or set SYSTEM_VERSION. data is in the table's
+ * layout; reserved bytes are stored as zero, and a field holding its "do
+ * not change" value keeps the stored setting. A PACKET_RATE change
  * reschedules as described above, anchored at now_ms. Returns TASE_OK,
  * TASE_EARG (g NULL, data NULL), TASE_EUNKNOWN (type > 7), TASE_ELENGTH
  * (len is not the type's length, 0 and SIZE_MAX included); g unchanged on

@@ -1,6 +1,8 @@
 /* Bare-metal UART port template; see tase/bm_uart.h. */
 #include "tase/bm_uart.h"
 
+#include <limits.h>
+
 #define DRAIN_CHUNK 32u
 
 int tase_bm_uart_init(tase_bm_uart_t *u, uint8_t *rx_buf, size_t cap,
@@ -35,7 +37,7 @@ int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_fra
     }
     budget = tase_ring_capacity(&u->rx);
     while (budget > 0) {
-        size_t want = budget < DRAIN_CHUNK ? budget : DRAIN_CHUNK;
+        size_t want = (size_t)(budget < DRAIN_CHUNK ? budget : DRAIN_CHUNK);
         size_t n = tase_ring_get(&u->rx, chunk, want);
         int r;
         if (n == 0) {
@@ -54,7 +56,7 @@ static int bm_write(void *ctx, const uint8_t *data, size_t n)
 {
     tase_bm_uart_t *u = ctx;
     int r;
-    if (u == NULL || u->hooks == NULL || (data == NULL && n > 0) || n > 0x7FFFFFFFu) {
+    if (u == NULL || u->hooks == NULL || (data == NULL && n > 0) || n > (size_t)INT_MAX) {
         return TASE_EARG;
     }
     r = u->hooks->tx(u->hw, data, n);
@@ -69,8 +71,8 @@ static int bm_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
     if (u == NULL || u->hooks == NULL || buf == NULL || cap == 0) {
         return TASE_EARG;
     }
-    if (cap > 0x7FFFFFFFu) {
-        cap = 0x7FFFFFFFu;
+    if (cap > (size_t)INT_MAX) {
+        cap = (size_t)INT_MAX; /* the count must fit the int result */
     }
     start = u->hooks->millis(u->hw);
     for (;;) {

@@ -172,12 +172,16 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     e=$($T send PACKET_RATE angle_1=20 rate_1=5 geo_ref_1=2 $L --json | grep '"dir":"out"')
     check "send PACKET_RATE: the gimbal echoes 20/5/2" \
         eval '[ "$(json_int "$e" angle_1)/$(json_int "$e" rate_1)/$(json_int "$e" geo_ref_1)" = 20/5/2 ]'
-    $T monitor $L --json --seconds 2 > /tmp/mon.json
+    $T monitor $L --json --time --seconds 2 > /tmp/mon.json 2> /tmp/mon.err
     na=$(grep -c '"name":"GIMBAL_ANGLE"' /tmp/mon.json)
     nr=$(grep -c '"name":"GIMBAL_RATE"' /tmp/mon.json)
     ng=$(grep -c '"name":"GEOREFERENCE_DATA"' /tmp/mon.json)
     check "monitor 2 s follows PACKET_RATE: $na GIMBAL_ANGLE (40+-8), $nr GIMBAL_RATE (10+-3), $ng GEOREFERENCE_DATA (4+-2)" \
         eval 'near $na 40 8 && near $nr 10 3 && near $ng 4 2'
+    check "monitor's summary has the frames and the CAN bus state ($(cat /tmp/mon.err))" \
+        grep -q "^tase: summary: [0-9]* frames .*, CAN bus error-active (0 error frames, 0 bus-off" /tmp/mon.err
+    check "monitor --time on CAN: the kernel's receive time, close to now" \
+        eval 't=$(json_int "$(head -1 /tmp/mon.json)" time); now=$(date +%s); near "$t" "$now" 5'
 
     # The monitor runs while the position command goes out on the bus.
     $T monitor $L --json --seconds 3.5 > /tmp/move.json &
