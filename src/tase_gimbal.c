@@ -51,6 +51,23 @@ static void sched_start(tase_gimbal_sched_t *s, uint8_t rate, uint32_t now_ms)
     }
 }
 
+/* A port's telemetry demand (bytes/s at the scheduled rates) and its
+ * pacing, restarted so that the next due slot of each stream is sent. */
+static void pace_port(tase_gimbal_t *g, unsigned p)
+{
+    /* Frame length of each telemetry stream's packet (data + 8). */
+    static const uint8_t stream_frame_len[TASE_GIMBAL_STREAMS] = {14u, 26u, 71u};
+    unsigned s;
+    uint32_t d = 0;
+    for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
+        d += (uint32_t)g->sched[p][s].rate * stream_frame_len[s];
+    }
+    g->demand[p] = d;
+    for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
+        g->sched[p][s].acc = d;
+    }
+}
+
 static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
 {
     unsigned p;
@@ -62,7 +79,43 @@ static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
                 sched_start(&g->sched[p][s], rate, now_ms);
             }
         }
+        pace_port(g, p);
     }
+}
+
+/* Telemetry's share of a port's capacity, bytes/s (0: no limit). */
+static uint32_t telemetry_budget(const tase_gimbal_t *g, unsigned p)
+{
+    return (uint32_t)(((uint64_t)g->capacity[p] * TASE_GIMBAL_TELEMETRY_SHARE) / 100u);
+}
+
+/* Whether this due slot of stream s fits the port's budget. When the
+ * rates ask for more than the budget, every stream gets the same fraction
+ * of its slots, spread evenly (an error accumulator, as in Bresenham's
+ * line): no stream starves, and the bytes sent per second stay at the
+ * budget. */
+static bool within_budget(tase_gimbal_t *g, unsigned p, tase_gimbal_sched_t *st)
+{
+    uint32_t budget = telemetry_budget(g, p);
+    if (g->capacity[p] == 0u || g->demand[p] <= budget) {
+        return true;
+    }
+    st->acc += budget;
+    if (st->acc < g->demand[p]) {
+        return false;
+    }
+    st->acc -= g->demand[p];
+    return true;
+}
+
+int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per_s)
+{
+    if (g == NULL || port >= TASE_GIMBAL_PORTS) {
+        return TASE_EARG;
+    }
+    g->capacity[port] = bytes_per_s;
+    pace_port(g, port);
+    return TASE_OK;
 }
 
 int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, size_t nports,
@@ -409,7 +462,11 @@ static int telemetry_frame(tase_gimbal_t *g, unsigned port, uint16_t id, uint8_t
                              frame + TASE_FRAME_HEADER, (size_t)n);
 }
 
-static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_t now_ms)
+/* One stream's due slot, if any. *failed: the port failed a write earlier
+ * in this poll (the remaining slots are not attempted: a stuck port costs
+ * one write bound per poll, not one per due frame); set on a failure. */
+static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_t now_ms,
+                       bool *failed)
 {
     static const uint16_t stream_id[TASE_GIMBAL_STREAMS] = {
         TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE, TASE_ID_GEOREFERENCE_DATA};
@@ -422,14 +479,20 @@ static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_
     if (s->rate == 0 || !reached(now_ms, s->t0 + slot_ms(s->k, s->rate))) {
         return 0;
     }
-    n = telemetry_frame(g, port, id, frame, now_ms);
-    if (n < 0) {
-        g->stats.telemetry_skipped++;
-    } else if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >= 0) {
-        g->stats.telemetry_tx++;
-        sent = 1;
+    if (*failed) {
+        g->stats.slots_after_tx_error++;
+    } else if (!within_budget(g, port, s)) {
+        g->stats.slots_over_capacity++;
     } else {
-        /* counted in tx_errors */
+        n = telemetry_frame(g, port, id, frame, now_ms);
+        if (n < 0) {
+            g->stats.telemetry_skipped++;
+        } else if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >= 0) {
+            g->stats.telemetry_tx++;
+            sent = 1;
+        } else {
+            *failed = true; /* counted in tx_errors */
+        }
     }
     if (++s->k >= s->rate) {
         s->k = 0;
@@ -454,11 +517,12 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
         return 0;
     }
     for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
+        bool failed = false;
         if (!port_present(g, p)) {
             continue;
         }
         for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
-            sent += stream_poll(g, p, s, now_ms);
+            sent += stream_poll(g, p, s, now_ms, &failed);
         }
     }
     return sent;

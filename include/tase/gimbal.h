@@ -79,6 +79,35 @@
  * sent as a burst. Poll at least once per shortest period (every few ms)
  * and every slot is sent, within the poll interval of its due time.
  *
+ * PRIORITY AND CAPACITY. Setup echoes, query answers and the
+ * application's own sends are written at once, as the frame that asks for
+ * them is handled (tase_gimbal_service() reads and answers before it
+ * polls telemetry), and are never held back. Telemetry is what yields: a
+ * link carries only so many bytes per second (9600 baud 8N1: 960 B/s),
+ * and PACKET_RATE may ask for far more (255/255/255 is 28,305 B/s). Bytes
+ * written beyond what the link carries pile up in the driver's transmit
+ * queue, where an echo written later waits behind them (4.3 s behind a
+ * 4 KB tty queue at 9600 baud: longer than a host's retries), and every
+ * write blocks until the queue has room. So the application states each
+ * port's capacity (tase_gimbal_set_capacity(), e.g.
+ * TASE_UART_BYTES_PER_S(9600)), and telemetry may use at most
+ * TASE_GIMBAL_TELEMETRY_SHARE percent of it, the rest staying free for
+ * answers. When the rates ask for more, every stream of that port sends
+ * the same fraction of its due slots, spread evenly, and skips the rest
+ * (stats.slots_over_capacity); the stored and echoed PACKET_RATE stay
+ * what the host asked for. The transmit queue then stays short, and an
+ * answer leaves within a few frame times. Capacity 0 (the default) means
+ * unknown: no limit.
+ *
+ * LONGEST BLOCK. Each frame write blocks at most the port's frame bound
+ * (port_io.h: TASE_PORT_WRITE_TIMEOUT_MS + the port's W). A port whose
+ * write fails gets no further telemetry in the same poll (its remaining
+ * due slots count in stats.slots_after_tx_error), so a stuck port costs
+ * tase_gimbal_poll() one frame bound, not one per due stream: a poll
+ * blocks at most one bound per frame it wrote plus one per present port;
+ * tase_gimbal_feed()/_handle_frame() one per answer written. Within the
+ * capacity the driver's queue has room and writes do not block at all.
+ *
  * TIME comes in as `now_ms` (monotonic, wraps modulo 2^32; e.g. a port's
  * now_ms()). Nothing here reads a clock, allocates or uses globals.
  *
@@ -107,6 +136,16 @@ extern "C" {
 #define TASE_STREAM_ANGLE 0u  /* GIMBAL_ANGLE 0x08/0x10 */
 #define TASE_STREAM_RATE 1u   /* GIMBAL_RATE 0x08/0x40 */
 #define TASE_STREAM_GEOREF 2u /* GEOREFERENCE_DATA 0x10/0x41 */
+
+/* Percentage of a port's capacity telemetry may use (see PRIORITY AND
+ * CAPACITY); the rest is kept for echoes and answers. */
+#ifndef TASE_GIMBAL_TELEMETRY_SHARE
+#define TASE_GIMBAL_TELEMETRY_SHARE 75u
+#endif
+
+/* Bytes per second an asynchronous serial line carries at `baud` with
+ * 10 bits per byte (8N1: start, 8 data, stop). */
+#define TASE_UART_BYTES_PER_S(baud) ((uint32_t)(baud) / 10u)
 
 /* Application callbacks; any may be NULL. `user` is passed back. */
 typedef struct {
@@ -142,26 +181,30 @@ typedef struct {
 
 /* Statistics; only incremented by the library, wrap modulo 2^32. */
 typedef struct {
-    uint32_t frames_rx;         /* valid frames received on all ports */
-    uint32_t setup_applied;     /* setup packets accepted and stored */
-    uint32_t setup_refused;     /* setup packets apply_setup() refused */
-    uint32_t setup_queries;     /* zero-length setup queries answered */
-    uint32_t bad_length;        /* setup packets with a wrong data length */
-    uint32_t telemetry_tx;      /* telemetry frames written */
-    uint32_t telemetry_skipped; /* due slots fill_telemetry() declined */
-    uint32_t slots_skipped;     /* slots passed over because poll was late */
-    uint32_t frames_tx;         /* all frames written (echoes, telemetry, sends) */
-    uint32_t tx_errors;         /* frames a port did not take completely */
+    uint32_t frames_rx;            /* valid frames received on all ports */
+    uint32_t setup_applied;        /* setup packets accepted and stored */
+    uint32_t setup_refused;        /* setup packets apply_setup() refused */
+    uint32_t setup_queries;        /* zero-length setup queries answered */
+    uint32_t bad_length;           /* setup packets with a wrong data length */
+    uint32_t telemetry_tx;         /* telemetry frames written */
+    uint32_t telemetry_skipped;    /* due slots fill_telemetry() declined */
+    uint32_t slots_skipped;        /* slots passed over because poll was late */
+    uint32_t frames_tx;            /* all frames written (echoes, telemetry, sends) */
+    uint32_t tx_errors;            /* frames a port did not take completely */
+    uint32_t slots_over_capacity;  /* due slots skipped to stay within capacity */
+    uint32_t slots_after_tx_error; /* due slots not tried: the port failed earlier
+                                      in the same poll */
 } tase_gimbal_stats_t;
 
 /* Private: the schedule of one telemetry stream. */
 typedef struct {
     uint32_t t0;  /* anchor: slot k is due at t0 + k * 1000 / rate */
+    uint32_t acc; /* capacity pacing: accumulated budget */
     uint16_t k;   /* next slot, 0 <= k < rate */
     uint8_t rate; /* packets per second, 0 = off */
 } tase_gimbal_sched_t;
 
-/* Gimbal instance (about 270 bytes; the receivers are the caller's, see
+/* Gimbal instance (about 350 bytes on Cortex-M; the receivers are the caller's, see
  * tase_gimbal_init()). Treat every field except `stats` as private. */
 typedef struct {
     tase_gimbal_stats_t stats;
@@ -170,6 +213,8 @@ typedef struct {
     tase_rx_t *rx;                       /* caller's receivers, or NULL */
     uint8_t nrx;                         /* how many */
     tase_gimbal_sched_t sched[TASE_GIMBAL_PORTS][TASE_GIMBAL_STREAMS];
+    uint32_t capacity[TASE_GIMBAL_PORTS]; /* bytes/s, 0 = no limit */
+    uint32_t demand[TASE_GIMBAL_PORTS];   /* telemetry bytes/s the rates ask */
     uint8_t setup[TASE_GIMBAL_SETUP_BYTES];
 } tase_gimbal_t;
 
@@ -203,9 +248,18 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
                              uint32_t now_ms);
 
+/* Set the capacity of port index `port` in bytes per second (0: unknown,
+ * no limit; the default), e.g. TASE_UART_BYTES_PER_S(9600) for a
+ * 9600-baud line. See PRIORITY AND CAPACITY. Takes effect at the next due
+ * slot. Returns TASE_OK or TASE_EARG (g NULL, port >= 3). O(1). */
+int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per_s);
+
 /* Send every telemetry packet that is due at now_ms (at most one per
- * stream, see SCHEDULE). Returns the number of frames written (>= 0) or
- * TASE_EARG (g NULL). O(ports * streams) plus the callbacks and writes. */
+ * stream, see SCHEDULE; within the port's capacity, see PRIORITY AND
+ * CAPACITY). Returns the number of frames written (>= 0) or TASE_EARG (g
+ * NULL). Blocks at most one frame bound per frame written plus one per
+ * present port (LONGEST BLOCK).
+ * O(ports * streams) plus the callbacks and writes. */
 int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
 
 /* Read whatever each present port has ready (timeout 0, ports with a
