@@ -11,7 +11,9 @@
 # Every object is built with -Os -ffunction-sections -fdata-sections so the
 # linker's --gc-sections drops what a firmware does not call. Because
 # CMAKE_CROSSCOMPILING is set, the top-level CMakeLists.txt builds the core
-# library only (no ports, tools, tests or checks).
+# library and the bare-metal port (tase::baremetal) only: no POSIX ports,
+# tools, tests or checks. C++ firmware gets arm-none-eabi-g++ with the same
+# CPU flags (plus -fno-exceptions -fno-rtti).
 set(CMAKE_SYSTEM_NAME Generic)
 set(CMAKE_SYSTEM_PROCESSOR arm)
 
@@ -41,6 +43,7 @@ list(APPEND CMAKE_TRY_COMPILE_PLATFORM_VARIABLES TASE_CPU TASE_FLOAT_ABI)
 set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 
 set(CMAKE_C_COMPILER arm-none-eabi-gcc)
+set(CMAKE_CXX_COMPILER arm-none-eabi-g++) # for C++ firmware projects
 set(CMAKE_ASM_COMPILER arm-none-eabi-gcc)
 set(CMAKE_AR arm-none-eabi-ar CACHE FILEPATH "")
 set(CMAKE_RANLIB arm-none-eabi-ranlib CACHE FILEPATH "")
@@ -48,11 +51,14 @@ set(CMAKE_SIZE arm-none-eabi-size CACHE FILEPATH "")
 
 set(CMAKE_C_FLAGS_INIT
     "-mcpu=${TASE_CPU} -mthumb -mfloat-abi=${TASE_FLOAT_ABI} ${_tase_fpu} -Os -ffunction-sections -fdata-sections")
+set(CMAKE_CXX_FLAGS_INIT "${CMAKE_C_FLAGS_INIT} -fno-exceptions -fno-rtti")
 set(CMAKE_ASM_FLAGS_INIT "-mcpu=${TASE_CPU} -mthumb -mfloat-abi=${TASE_FLOAT_ABI} ${_tase_fpu}")
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-Wl,--gc-sections")
 # Keep -Os whatever build type is chosen; MinSizeRel adds -DNDEBUG only.
 set(CMAKE_C_FLAGS_MINSIZEREL_INIT "-DNDEBUG")
 set(CMAKE_C_FLAGS_RELEASE_INIT "-DNDEBUG")
+set(CMAKE_CXX_FLAGS_MINSIZEREL_INIT "-DNDEBUG")
+set(CMAKE_CXX_FLAGS_RELEASE_INIT "-DNDEBUG")
 
 set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
 set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)

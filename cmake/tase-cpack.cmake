@@ -9,9 +9,11 @@
 set(CPACK_PACKAGE_NAME tase)
 set(CPACK_PACKAGE_VENDOR "The tase-gimbal-stack authors")
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
-set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "${PROJECT_DESCRIPTION}")
 # Maintainer field; a distributor building its own packages sets its own.
 set(CPACK_PACKAGE_CONTACT "The tase-gimbal-stack authors <maintainers@users.noreply.h-seed-eca75558.example>" CACHE STRING "Debian Maintainer field")
+# Each package's description below starts with its own synopsis line; an
+# empty package-wide summary keeps CPack from putting a shared one above.
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "")
 set(CPACK_RESOURCE_FILE_LICENSE ${PROJECT_SOURCE_DIR}/LICENSE)
 set(CPACK_PACKAGE_DIRECTORY ${PROJECT_BINARY_DIR}/packages)
 set(CPACK_GENERATOR DEB)
@@ -27,22 +29,22 @@ set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME libtase-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
-set(CPACK_COMPONENT_DEV_DESCRIPTION
+set(CPACK_DEBIAN_DEV_DESCRIPTION
 "TASE gimbal protocol stack: static libraries and headers
- C99 library for the Cloud Cap TASE gimbal's serial and CAN protocol:
- framing, every packet's encoder and decoder, dispatch, CAN, KLV, the host
- and gimbal roles. No heap, no globals. Static libraries for the core
- (tase) and the ports (posix_uart, socketcan, baremetal), headers under
- /usr/include/tase, the CMake package (find_package(tase)) and pkg-config
- files (tase, tase-posix-uart, tase-socketcan, tase-baremetal).")
+C99 library for the Cloud Cap TASE gimbal's serial and CAN protocol:
+framing, every packet's encoder and decoder, dispatch, CAN, KLV, the host
+and gimbal roles. No heap, no globals. Static libraries for the core
+(tase) and the ports (posix_uart, socketcan, baremetal), headers under
+/usr/include/tase, the CMake package (find_package(tase)) and pkg-config
+files (tase, tase-posix-uart, tase-socketcan, tase-baremetal).")
 
 set(CPACK_DEBIAN_TOOLS_PACKAGE_NAME tase-tools)
 set(CPACK_DEBIAN_TOOLS_PACKAGE_SECTION electronics)
 set(CPACK_DEBIAN_TOOLS_PACKAGE_SHLIBDEPS ON) # Depends: libc6 (>= ...)
-set(CPACK_COMPONENT_TOOLS_DESCRIPTION
+set(CPACK_DEBIAN_TOOLS_DESCRIPTION
 "TASE gimbal bench tools: tase and tase-sim
- tase talks to a Cloud Cap TASE gimbal over a serial port or SocketCAN:
- monitor telemetry, send commands, run queries, decode captures to JSON.
- tase-sim is a simulated gimbal on a pseudo-terminal or CAN interface.")
+tase talks to a Cloud Cap TASE gimbal over a serial port or SocketCAN:
+monitor telemetry, send commands, run queries, decode captures to JSON.
+tase-sim is a simulated gimbal on a pseudo-terminal or CAN interface.")
 
 include(CPack)

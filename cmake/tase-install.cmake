@@ -88,7 +88,7 @@ endforeach()
 # Debian wants each package's copyright in /usr/share/doc/<package>/.
 install(FILES ${PROJECT_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/libtase-dev
         RENAME copyright COMPONENT dev)
-install(FILES ${PROJECT_SOURCE_DIR}/README.md
+install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/CHANGELOG.md
         DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/libtase-dev COMPONENT dev)
 
 # The Debian packages; only when tase is the top-level project (a parent

@@ -4,7 +4,8 @@
 TASE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # tase_need LIST...: install the Debian packages named in
-# scripts/packages.d/LIST.txt (one per line, # comments) that are missing.
+# scripts/packages.d/LIST.txt (one per line, # comments; NAME:ARCH for
+# another architecture's package) that are missing.
 # Runs apt-get update once, only when something is missing.
 tase_need() {
     local list pkgs=() missing=() p
@@ -19,9 +20,19 @@ tase_need() {
     done
     [ ${#missing[@]} -eq 0 ] && return 0
     echo "== installing: ${missing[*]}"
-    local sudo=""
+    local sudo="" arch
     [ "$(id -u)" -ne 0 ] && sudo=sudo
     export DEBIAN_FRONTEND=noninteractive
+    # A package of another architecture (libcmocka-dev:s390x): Debian
+    # multiarch, which the following update then indexes.
+    for p in "${missing[@]}"; do
+        case $p in
+        *:*)
+            arch=${p#*:}
+            dpkg --print-foreign-architectures | grep -qx "$arch" || $sudo dpkg --add-architecture "$arch"
+            ;;
+        esac
+    done
     $sudo apt-get -o DPkg::Lock::Timeout=600 update -qq
     $sudo apt-get -o DPkg::Lock::Timeout=600 install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
@@ -32,4 +43,18 @@ tase_all_lists() {
     for f in "$TASE_ROOT"/scripts/packages.d/*.txt; do
         basename "$f" .txt
     done
+}
+
+# tase_version: the library's MAJOR.MINOR.PATCH, from include/tase/version.h.
+tase_version() {
+    sed -n 's/^#define TASE_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\)$/\2/p' \
+        "$TASE_ROOT/include/tase/version.h" | paste -sd.
+}
+
+# Progress and failure lines of the longer check scripts:
+# tase_step TEXT prints TEXT with the seconds since the script started.
+tase_step() { echo "== [${SECONDS} s] $*"; }
+tase_fail() {
+    echo "FAIL: $*"
+    exit 1
 }

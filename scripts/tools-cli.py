@@ -270,7 +270,7 @@ if not VALGRIND:
                        stderr=subprocess.PIPE, timeout=120)
     g.wait()
     ok("a frame at byte 4,294,967,300 has that offset",
-       p.stdout.decode().startswith('{"offset":4294967300,'), p.stdout[:200])
+       p.stdout.decode().startswith('{"offset":4294967300,'), repr(p.stdout[:200]))
 
 print("%d failure(s)" % fails)
 sys.exit(1 if fails else 0)

@@ -167,13 +167,13 @@ int tase_can_3ax_move_encode(const tase_can_3ax_move_t *m, tase_can_frame_t *out
     if (m == NULL || out == NULL) {
         return TASE_EARG;
     }
-    if (m->command != TASE_3AX_DEPLOY && m->command != TASE_3AX_RETRACT) {
+    if (m->command != TASE_3AX_MOVE_DEPLOY && m->command != TASE_3AX_MOVE_RETRACT) {
         return TASE_ERANGE;
     }
     /* 0xFE rather than 1: "non-zero" to a drive that tests for zero, and
      * "completely retracted" to one that reads the byte as a target. */
     frame2(out, TASE_CAN_ID_3AX_MOVE,
-           m->command == TASE_3AX_RETRACT ? (uint8_t)TASE_3AX_RETRACT_BYTE : 0u, 0u);
+           m->command == TASE_3AX_MOVE_RETRACT ? (uint8_t)TASE_3AX_RETRACT_BYTE : 0u, 0u);
     return TASE_OK;
 }
 
@@ -185,7 +185,7 @@ int tase_can_3ax_move_decode(const tase_can_frame_t *f, tase_can_3ax_move_t *m)
     }
     rc = check2(f, TASE_CAN_ID_3AX_MOVE);
     if (rc == TASE_OK) {
-        m->command = f->data[0] == 0u ? TASE_3AX_DEPLOY : TASE_3AX_RETRACT;
+        m->command = f->data[0] == 0u ? TASE_3AX_MOVE_DEPLOY : TASE_3AX_MOVE_RETRACT;
     }
     return rc;
 }

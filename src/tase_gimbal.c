@@ -6,12 +6,14 @@
 #include "tase/codec.h"
 #include "tase/ids.h"
 #include "tase/port_io.h"
+#include "tase/schema.h"
 
 #define SETUP_SYSTEM_VERSION 0x03u
 #define SETUP_PACKET_RATE 0x00u
+#define SETUP_CAMERA_TYPE 0x05u
+#define SETUP_MAX 42u          /* longest setup packet: SYSTEM_VERSION */
 #define RATE_BYTES_PER_PORT 5u /* Angle, Rate, Geo-ref, Camera, Reserved */
 #define SETUP_APPLY_MAX 23u    /* longest writable setup packet: AXIS_SETTING */
-#define SETUP_LEN_MAX 42u      /* longest setup packet: SYSTEM_VERSION */
 #define SERVICE_CHUNK 64u
 #define SERVICE_READS 64u
 
@@ -49,6 +51,23 @@ static void sched_start(tase_gimbal_sched_t *s, uint8_t rate, uint32_t now_ms)
     }
 }
 
+/* A port's telemetry demand (bytes/s at the scheduled rates) and its
+ * pacing, restarted so that the next due slot of each stream is sent. */
+static void pace_port(tase_gimbal_t *g, unsigned p)
+{
+    /* Frame length of each telemetry stream's packet (data + 8). */
+    static const uint8_t stream_frame_len[TASE_GIMBAL_STREAMS] = {14u, 26u, 71u};
+    unsigned s;
+    uint32_t d = 0;
+    for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
+        d += (uint32_t)g->sched[p][s].rate * stream_frame_len[s];
+    }
+    g->demand[p] = d;
+    for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
+        g->sched[p][s].acc = d;
+    }
+}
+
 static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
 {
     unsigned p;
@@ -60,7 +79,43 @@ static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
                 sched_start(&g->sched[p][s], rate, now_ms);
             }
         }
+        pace_port(g, p);
     }
+}
+
+/* Telemetry's share of a port's capacity, bytes/s (0: no limit). */
+static uint32_t telemetry_budget(const tase_gimbal_t *g, unsigned p)
+{
+    return (uint32_t)(((uint64_t)g->capacity[p] * TASE_GIMBAL_TELEMETRY_SHARE) / 100u);
+}
+
+/* Whether this due slot of stream s fits the port's budget. When the
+ * rates ask for more than the budget, every stream gets the same fraction
+ * of its slots, spread evenly (an error accumulator, as in Bresenham's
+ * line): no stream starves, and the bytes sent per second stay at the
+ * budget. */
+static bool within_budget(tase_gimbal_t *g, unsigned p, tase_gimbal_sched_t *st)
+{
+    uint32_t budget = telemetry_budget(g, p);
+    if (g->capacity[p] == 0u || g->demand[p] <= budget) {
+        return true;
+    }
+    st->acc += budget;
+    if (st->acc < g->demand[p]) {
+        return false;
+    }
+    st->acc -= g->demand[p];
+    return true;
+}
+
+int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per_s)
+{
+    if (g == NULL || port >= TASE_GIMBAL_PORTS) {
+        return TASE_EARG;
+    }
+    g->capacity[port] = bytes_per_s;
+    pace_port(g, port);
+    return TASE_OK;
 }
 
 int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, size_t nports,
@@ -81,7 +136,7 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
         /* AXIS_SETTING */
         0x00u, 0x00u, 0x00u, 0x00u, 0x23u, 0x28u, 0x17u, 0x70u, 0x00u, 0x00u, 0x00u, 0x00u, 60u, 0u,
         60u, 0u, 50u, 50u, 0u, 40u, 40u, 0u, 0u,
-        /* SYSTEM_VERSION .. CAMERA_ALIGN: none stated (0) */
+        /* SYSTEM_VERSION .. CAMERA_ALIGN: none stated (0), but see below */
     };
     size_t i;
 
@@ -112,6 +167,9 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
         g->app = *app;
     }
     (void)memcpy(g->setup, setup_defaults, sizeof setup_defaults);
+    /* CAMERA_TYPE: "no camera" until the application stores its cameras;
+     * 0 would be "do not change", which is not a setting. */
+    (void)memset(&g->setup[setup_off[SETUP_CAMERA_TYPE]], 0xFF, setup_len[SETUP_CAMERA_TYPE]);
     sched_from_rates(g, now_ms, true);
     return TASE_OK;
 }
@@ -162,9 +220,41 @@ int tase_gimbal_setup_get(const tase_gimbal_t *g, uint8_t type, uint8_t *out, si
     return setup_len[type];
 }
 
+/* Copy the fields of setup packet p from src (src_len bytes, a layout the
+ * schema accepts) to dst (dst_len bytes, AXIS_SETTING 22 or 23), each at
+ * the offset of its layout; reserved bytes become zero. With `cur` (the
+ * stored bytes, table layout), a field holding its "do not change" value
+ * takes the stored one instead. */
+static void setup_copy(const tase_packet_desc_t *p, const uint8_t *src, size_t src_len,
+                       uint8_t *dst, size_t dst_len, const uint8_t *cur)
+{
+    size_t i;
+    (void)memset(dst, 0, dst_len);
+    for (i = 0; i < p->nfields; i++) {
+        unsigned w = TASE_FIELD_WIDTH(tase_schema_field(p, i));
+        const uint8_t *from = &src[tase_field_offset(p, i, src_len)];
+        int64_t v;
+        if (cur != NULL && tase_field_get(p, i, src, src_len, &v) == TASE_OK &&
+            tase_field_is_keep(p, i, v)) {
+            from = &cur[tase_field_offset(p, i, p->len)];
+        }
+        (void)memcpy(&dst[tase_field_offset(p, i, dst_len)], from, w);
+    }
+}
+
+static const tase_packet_desc_t *setup_desc(uint8_t type)
+{
+    return tase_schema_find(TASE_GROUP_SETUP, type);
+}
+
+/* data (table layout) is what the host or the application asked for:
+ * stored with reserved bytes zero and "do not change" fields unchanged. */
 static void setup_store(tase_gimbal_t *g, uint8_t type, const uint8_t *data, uint32_t now_ms)
 {
-    (void)memcpy(&g->setup[setup_off[type]], data, setup_len[type]);
+    uint8_t tmp[SETUP_MAX];
+    const tase_packet_desc_t *p = setup_desc(type);
+    setup_copy(p, data, p->len, tmp, p->len, &g->setup[setup_off[type]]);
+    (void)memcpy(&g->setup[setup_off[type]], tmp, setup_len[type]);
     if (type == SETUP_PACKET_RATE) {
         sched_from_rates(g, now_ms, false);
     }
@@ -197,7 +287,7 @@ static int setup_type(uint16_t id)
 
 int tase_gimbal_setup_set_msg(tase_gimbal_t *g, uint16_t id, const void *msg, uint32_t now_ms)
 {
-    uint8_t data[SETUP_LEN_MAX];
+    uint8_t data[SETUP_MAX];
     int type = setup_type(id);
     int n;
     if (g == NULL || msg == NULL) {
@@ -250,25 +340,34 @@ static int apply_setup(tase_gimbal_t *g, unsigned port, uint8_t type, uint8_t *d
 static void handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f, uint32_t now_ms)
 {
     uint8_t type = f->type;
+    const tase_packet_desc_t *p = setup_desc(type);
+    const uint8_t *cur = &g->setup[setup_off[type]];
     uint8_t tmp[SETUP_APPLY_MAX];
+    size_t echo_len = setup_len[type];
 
     if (f->len == 0 || type == SETUP_SYSTEM_VERSION) {
         g->stats.setup_queries++;
-    } else if (f->len != setup_len[type] || f->len > sizeof tmp) {
+    } else if (!tase_schema_length_ok(p, f->len) || p->len > sizeof tmp) {
         g->stats.bad_length++;
         return;
     } else {
-        (void)memcpy(tmp, f->data, f->len);
-        if (apply_setup(g, port, type, tmp, f->len) >= 0) {
+        /* The application sees the settings asked for in the table's
+         * layout: reserved bytes zero, "do not change" resolved. */
+        setup_copy(p, f->data, f->len, tmp, p->len, cur);
+        if (apply_setup(g, port, type, tmp, p->len) >= 0) {
             setup_store(g, type, tmp, now_ms);
             g->stats.setup_applied++;
         } else {
             g->stats.setup_refused++;
         }
+        echo_len = f->len; /* answered in the layout it came in */
     }
     /* The echo always carries what is in force now. */
-    (void)tase_gimbal_send(g, port, TASE_GROUP_SETUP, type, &g->setup[setup_off[type]],
-                           setup_len[type]);
+    if (echo_len != setup_len[type]) {
+        setup_copy(p, cur, p->len, tmp, echo_len, NULL);
+        cur = tmp;
+    }
+    (void)tase_gimbal_send(g, port, TASE_GROUP_SETUP, type, cur, echo_len);
 }
 
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
@@ -363,7 +462,11 @@ static int telemetry_frame(tase_gimbal_t *g, unsigned port, uint16_t id, uint8_t
                              frame + TASE_FRAME_HEADER, (size_t)n);
 }
 
-static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_t now_ms)
+/* One stream's due slot, if any. *failed: the port failed a write earlier
+ * in this poll (the remaining slots are not attempted: a stuck port costs
+ * one write bound per poll, not one per due frame); set on a failure. */
+static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_t now_ms,
+                       bool *failed)
 {
     static const uint16_t stream_id[TASE_GIMBAL_STREAMS] = {
         TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE, TASE_ID_GEOREFERENCE_DATA};
@@ -376,14 +479,20 @@ static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_
     if (s->rate == 0 || !reached(now_ms, s->t0 + slot_ms(s->k, s->rate))) {
         return 0;
     }
-    n = telemetry_frame(g, port, id, frame, now_ms);
-    if (n < 0) {
-        g->stats.telemetry_skipped++;
-    } else if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >= 0) {
-        g->stats.telemetry_tx++;
-        sent = 1;
+    if (*failed) {
+        g->stats.slots_after_tx_error++;
+    } else if (!within_budget(g, port, s)) {
+        g->stats.slots_over_capacity++;
     } else {
-        /* counted in tx_errors */
+        n = telemetry_frame(g, port, id, frame, now_ms);
+        if (n < 0) {
+            g->stats.telemetry_skipped++;
+        } else if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >= 0) {
+            g->stats.telemetry_tx++;
+            sent = 1;
+        } else {
+            *failed = true; /* counted in tx_errors */
+        }
     }
     if (++s->k >= s->rate) {
         s->k = 0;
@@ -408,11 +517,12 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
         return 0;
     }
     for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
+        bool failed = false;
         if (!port_present(g, p)) {
             continue;
         }
         for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
-            sent += stream_poll(g, p, s, now_ms);
+            sent += stream_poll(g, p, s, now_ms, &failed);
         }
     }
     return sent;

@@ -171,16 +171,6 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
     return 0;
 }
 
-/* Milliseconds from `since` to `now`, across the 2^32 wrap of the clock.
- * A sample taken before `since` (a clock read earlier and handed in late,
- * or a clock that stepped back) gives a "negative" difference, 2^31 or
- * more as unsigned: that is no time at all, not 49 days. */
-static uint32_t elapsed(uint32_t now_ms, uint32_t since)
-{
-    uint32_t d = now_ms - since;
-    return d >= 0x80000000u ? 0u : d;
-}
-
 static void host_rx(void *user, const tase_frame_t *frame)
 {
     (void)tase_host_handle_frame((tase_host_t *)user, frame);
@@ -207,7 +197,7 @@ int tase_host_poll(tase_host_t *h, uint32_t now_ms)
     if (h->state != HOST_WAITING) {
         return TASE_ESTATE;
     }
-    if (elapsed(now_ms, h->sent_at) < h->timeout_ms) {
+    if (tase_port_elapsed_ms(now_ms, h->sent_at) < h->timeout_ms) {
         return TASE_EAGAIN;
     }
     if (h->retries_left == 0) {
@@ -267,7 +257,7 @@ static int transact_wait(tase_host_t *h)
         if (r != TASE_EAGAIN) {
             return r;
         }
-        waited = elapsed(now, h->sent_at);
+        waited = tase_port_elapsed_ms(now, h->sent_at);
         r = tase_host_service(h, waited < h->timeout_ms ? h->timeout_ms - waited : 0u);
         if (r < 0) {
             (void)tase_host_cancel(h);

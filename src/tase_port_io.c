@@ -1,19 +1,34 @@
 /* Helpers over the port boundary: write-all and frame send. */
 #include "tase/port_io.h"
 
+#include <limits.h>
+
 #include "tase/codec.h"
 #include "tase/frame.h"
+
+uint32_t tase_port_elapsed_ms(uint32_t now_ms, uint32_t since_ms)
+{
+    uint32_t d = now_ms - since_ms;
+    return d >= 0x80000000u ? 0u : d;
+}
 
 int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n)
 {
     size_t done = 0;
     unsigned idle = 0;
+    uint32_t start = 0;
+    uint32_t waited = 0;
+    bool clock;
 
     if (port == NULL || port->ops == NULL || port->ops->write == NULL || (data == NULL && n > 0)) {
         return TASE_EARG;
     }
-    if (n > (size_t)0x7FFFFFFF) {
+    if (n > (size_t)INT_MAX) {
         return TASE_EARG; /* the result must fit the int return */
+    }
+    clock = port->ops->now_ms != NULL;
+    if (clock) {
+        start = port->ops->now_ms(port->ctx);
     }
     while (done < n) {
         int r = port->ops->write(port->ctx, data + done, n - done);
@@ -22,17 +37,21 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n)
                 return TASE_EIO; /* a port claiming more than asked is broken */
             }
             done += (size_t)r;
-            idle = 0;
-            continue;
-        }
-        if (r != 0 && r != TASE_EAGAIN && r != TASE_ENOBUFS) {
+        } else if (r != 0 && r != TASE_EAGAIN && r != TASE_ENOBUFS) {
             return r;
+        } else {
+            idle++;
         }
-        if (++idle >= TASE_PORT_WRITE_TRIES) {
+        if (clock && done < n) {
+            /* The longest wait seen so far: a stale sample cannot undo it. */
+            uint32_t e = tase_port_elapsed_ms(port->ops->now_ms(port->ctx), start);
+            waited = e > waited ? e : waited;
+        }
+        if (done < n && (waited >= TASE_PORT_WRITE_TIMEOUT_MS || idle >= TASE_PORT_WRITE_TRIES)) {
             /* Nothing on the wire yet: the caller may simply retry. Once part
              * of a frame went out, retrying would not repair it. */
             if (done == 0) {
-                return r == 0 ? TASE_EAGAIN : r;
+                return r < 0 ? r : TASE_EAGAIN;
             }
             return TASE_EIO;
         }

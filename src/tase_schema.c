@@ -34,23 +34,6 @@ enum {
 #undef P
 #undef F
 
-/* C99 has no _Static_assert: a negative array size fails the build.
- * Every member must be as wide as its field, and the enumeration in
- * schema.h must follow the list. */
-#define P(N, g, t, fl, l, sz)                                                                      \
-    typedef char chk_idx_##N[((int)TASE_PKT_##N == (int)PKTIDX_##N) ? 1 : -1];
-/* T is a type and m a member name: neither can be parenthesised. */
-/* cppcheck-suppress misra-c2012-20.7 */
-#define F(T, m, o, w, s, k)                                                                        \
-    typedef char chk_##T##_##m[(sizeof(((T *)0)->m) == (w) && offsetof(T, m) < 256u) ? 1 : -1];
-#include "tase_schema_def.h"
-#undef P
-#undef F
-#undef E
-typedef char chk_count
-    [((int)PKTIDX_COUNT == (int)TASE_PKT_COUNT && TASE_PKT_COUNT == TASE_PACKET_COUNT) ? 1 : -1];
-typedef char chk_fields[(FIELD_TOTAL < 256) ? 1 : -1];
-
 #define FMT_U 0u
 #define FMT_S TASE_FIELD_SIGNED
 /* The list's names for a field's "do not change" value. */
@@ -58,6 +41,28 @@ typedef char chk_fields[(FIELD_TOTAL < 256) ? 1 : -1];
 #define ZERO TASE_FIELD_KEEP_ZERO
 #define MSB TASE_FIELD_KEEP_MSB
 #define SHIFT TASE_FIELD_SHIFT
+
+/* C99 has no _Static_assert: a negative array size fails the build.
+ * Every member must be as wide as its field, a field with a "do not
+ * change" value at most 4 bytes wide (unsigned if MSB: tase_field_keep()
+ * relies on both), and the enumeration in schema.h must follow the list. */
+#define P(N, g, t, fl, l, sz)                                                                      \
+    typedef char chk_idx_##N[((int)TASE_PKT_##N == (int)PKTIDX_##N) ? 1 : -1];
+/* T is a type and m a member name: neither can be parenthesised. */
+/* cppcheck-suppress misra-c2012-20.7 */
+#define F(T, m, o, w, s, k)                                                                        \
+    typedef char chk_##T##_##m[(sizeof(((T *)0)->m) == (w) && offsetof(T, m) < 256u &&             \
+                                (((k)&TASE_FIELD_KEEP_MASK) == 0u || (w) <= 4) &&                  \
+                                (((k)&TASE_FIELD_KEEP_MASK) != MSB || FMT_##s == 0u))              \
+                                   ? 1                                                             \
+                                   : -1];
+#include "tase_schema_def.h"
+#undef P
+#undef F
+#undef E
+typedef char chk_count
+    [((int)PKTIDX_COUNT == (int)TASE_PKT_COUNT && TASE_PKT_COUNT == TASE_PACKET_COUNT) ? 1 : -1];
+typedef char chk_fields[(FIELD_TOTAL < 256) ? 1 : -1];
 
 /* Generated from the list like its siblings here, so it stays at file
  * scope although only tase_schema_field() reads it. */
@@ -237,35 +242,25 @@ int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, s
     return TASE_OK;
 }
 
-/* Value of a `w`-byte field whose bits from the top down to `low` are set
- * (low 0: all of them), as tase_field_get() reads it: negative when signed
- * and the top bit is set. The spec has no 8-byte field with such a value;
- * one would read as -1 either way (see tase_field_get()). */
-static int64_t top_bits(unsigned w, unsigned low, bool is_signed)
+/* All bits of an unsigned field of w (1..4, checked at build time) bytes. */
+static uint32_t all_ones(unsigned w)
 {
     unsigned bits = 8u * w;
-    uint64_t mask;
-    uint64_t v;
-    if (w >= 8u) {
-        return -1;
-    }
-    mask = ((uint64_t)1u << bits) - 1u;
-    v = mask & ~(((uint64_t)1u << low) - 1u);
-    return is_signed ? -(int64_t)(mask - v) - 1 : (int64_t)v;
+    return w >= 4u ? 0xFFFFFFFFu : ((uint32_t)1u << bits) - 1u;
 }
 
 int tase_field_keep(const tase_packet_desc_t *p, size_t i, int64_t *value)
 {
     const tase_field_t *f = tase_schema_field(p, i);
-    unsigned w;
+    uint32_t ones;
     if (f == NULL || value == NULL) {
         return TASE_EARG;
     }
-    w = TASE_FIELD_WIDTH(f);
+    ones = all_ones(TASE_FIELD_WIDTH(f));
     switch (TASE_FIELD_KEEP(f)) {
-    case TASE_FIELD_KEEP_ONES: *value = top_bits(w, 0u, TASE_FIELD_IS_SIGNED(f)); break;
+    case TASE_FIELD_KEEP_ONES: *value = TASE_FIELD_IS_SIGNED(f) ? -1 : (int64_t)ones; break;
     case TASE_FIELD_KEEP_ZERO: *value = 0; break;
-    case TASE_FIELD_KEEP_MSB: *value = top_bits(w, 8u * w - 1u, TASE_FIELD_IS_SIGNED(f)); break;
+    case TASE_FIELD_KEEP_MSB: *value = (int64_t)(ones ^ (ones >> 1)); break; /* top bit */
     default: return TASE_EUNKNOWN;
     }
     return TASE_OK;
@@ -273,18 +268,14 @@ int tase_field_keep(const tase_packet_desc_t *p, size_t i, int64_t *value)
 
 bool tase_field_is_keep(const tase_packet_desc_t *p, size_t i, int64_t value)
 {
-    const tase_field_t *f = tase_schema_field(p, i);
     int64_t keep;
     if (tase_field_keep(p, i, &keep) != TASE_OK) {
         return false;
     }
-    if (TASE_FIELD_KEEP(f) != TASE_FIELD_KEEP_MSB) {
-        return value == keep;
+    /* MSB (unsigned fields only): any value of the field with its top bit
+     * set, i.e. from the keep value up to all ones. */
+    if (TASE_FIELD_KEEP(tase_schema_field(p, i)) == TASE_FIELD_KEEP_MSB) {
+        return value >= keep && value <= 2 * keep - 1;
     }
-    /* Any value of the field with its most significant bit set: keep is
-     * the least of them (unsigned) or the most negative (signed). */
-    if (TASE_FIELD_IS_SIGNED(f)) {
-        return value >= keep && value < 0;
-    }
-    return value >= keep && value <= top_bits(TASE_FIELD_WIDTH(f), 0u, false);
+    return value == keep;
 }

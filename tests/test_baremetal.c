@@ -207,15 +207,37 @@ static void a_slow_consumer_loses_only_counted_bytes(void **state)
 
 /* ---- the port template ------------------------------------------------ */
 
+/* A fake core: a millisecond clock, a TX buffer, an interrupt mask, and
+ * a receive interrupt that can be made to fire at chosen points. WFI
+ * (idle) returns at once when an interrupt is pending, else sleeps until
+ * the next SysTick, 1 ms later, as a Cortex-M does. */
 typedef struct {
     uint32_t now;
     uint8_t tx[4096];
     size_t ntx;
     int tx_result;
-    tase_bm_uart_t *uart; /* idle() "receives" a byte, as an ISR would */
+    tase_bm_uart_t *uart;
+    int masked, pending;
+    uint8_t pending_byte;
+    unsigned millis_calls, irq_offs;
+    unsigned arrive_on_millis;  /* the RX interrupt fires in this millis() call */
+    unsigned arrive_on_irq_off; /* ... or right after this irq_off() */
     int idle_calls;
-    int deliver_after_idles;
+    int deliver_after_idles; /* ... or during this sleep */
+    int slept_with_data;     /* sleeps begun while a byte waited: lost wake-ups */
+    int wakes_on_pending;
 } fake_hw_t;
+
+/* The RX interrupt: runs now, or stays pending while masked. */
+static void fake_rx_interrupt(fake_hw_t *f, uint8_t b)
+{
+    if (f->masked) {
+        f->pending = 1;
+        f->pending_byte = b;
+    } else {
+        tase_bm_uart_rx_isr(f->uart, b);
+    }
+}
 
 static int fake_tx(void *hw, const uint8_t *data, size_t n)
 {
@@ -231,19 +253,51 @@ static int fake_tx(void *hw, const uint8_t *data, size_t n)
 
 static uint32_t fake_millis(void *hw)
 {
-    return ((fake_hw_t *)hw)->now;
+    fake_hw_t *f = hw;
+    if (++f->millis_calls == f->arrive_on_millis) {
+        fake_rx_interrupt(f, 0xA5);
+    }
+    return f->now;
 }
 
 static void fake_idle(void *hw)
 {
     fake_hw_t *f = hw;
-    f->now += 1; /* time passes while the core sleeps */
-    if (++f->idle_calls == f->deliver_after_idles) {
-        tase_bm_uart_rx_isr(f->uart, 0x5A);
+    f->idle_calls++;
+    if (f->uart != NULL && tase_ring_count(&f->uart->rx) > 0u) {
+        f->slept_with_data++;
+    }
+    if (f->pending) {
+        f->wakes_on_pending++;
+        return; /* WFI: a pending interrupt wakes the core at once */
+    }
+    f->now += 1; /* asleep until the next SysTick */
+    if (f->idle_calls == f->deliver_after_idles) {
+        fake_rx_interrupt(f, 0x5A);
     }
 }
 
-static const tase_bm_uart_hooks_t fake_hooks = {fake_tx, fake_millis, fake_idle};
+static void fake_irq_off(void *hw)
+{
+    fake_hw_t *f = hw;
+    f->masked = 1;
+    if (++f->irq_offs == f->arrive_on_irq_off) {
+        fake_rx_interrupt(f, 0xA6);
+    }
+}
+
+static void fake_irq_on(void *hw)
+{
+    fake_hw_t *f = hw;
+    f->masked = 0;
+    if (f->pending) {
+        f->pending = 0;
+        tase_bm_uart_rx_isr(f->uart, f->pending_byte);
+    }
+}
+
+static const tase_bm_uart_hooks_t fake_hooks = {fake_tx, fake_millis, fake_idle, fake_irq_off,
+                                                fake_irq_on};
 
 static void port_read_waits_on_the_millisecond_hook_and_wakes_on_rx(void **state)
 {
@@ -433,6 +487,84 @@ static void baremetal_api_rejects_bad_arguments(void **state)
     assert_memory_equal(out, before, sizeof out);
 }
 
+/* The issue's race: a byte whose interrupt fires after read() saw an empty
+ * ring but before the core went to sleep. With a check-then-WFI idle hook
+ * the core slept on with the byte in the ring until the next interrupt;
+ * now the check and the sleep happen with the interrupt masked. */
+static void a_byte_arriving_between_the_check_and_the_sleep_is_not_missed(void **state)
+{
+    static fake_hw_t hw;
+    tase_bm_uart_t u;
+    uint8_t storage[32], buf[8];
+    tase_port_t port;
+    (void)state;
+
+    memset(&hw, 0, sizeof hw);
+    hw.uart = &u;
+    hw.now = 1000;
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw), TASE_OK);
+    port = tase_bm_uart_port(&u);
+    /* millis() call 1 takes the start time, call 2 is the timeout check
+     * right after the ring was found empty: the interrupt fires there. */
+    hw.arrive_on_millis = 2;
+    assert_int_equal(port.ops->read(port.ctx, buf, sizeof buf, 1000), 1);
+    assert_int_equal(buf[0], 0xA5);
+    assert_int_equal(hw.slept_with_data, 0);
+    assert_int_equal(hw.now, 1000); /* returned at once, no tick slept */
+
+    /* The interrupt fires once the mask is on: it stays pending, WFI
+     * returns at once, unmasking runs it, read() returns its byte. */
+    hw.arrive_on_millis = 0;
+    hw.irq_offs = 0;
+    hw.arrive_on_irq_off = 1;
+    assert_int_equal(port.ops->read(port.ctx, buf, sizeof buf, 1000), 1);
+    assert_int_equal(buf[0], 0xA6);
+    assert_int_equal(hw.wakes_on_pending, 1);
+    assert_int_equal(hw.slept_with_data, 0);
+    assert_int_equal(hw.now, 1000);
+    assert_int_equal(hw.masked, 0); /* left unmasked */
+}
+
+static void an_idle_hook_without_the_interrupt_mask_is_refused(void **state)
+{
+    static const tase_bm_uart_hooks_t racy = {fake_tx, fake_millis, fake_idle, NULL, NULL};
+    static const tase_bm_uart_hooks_t half = {fake_tx, fake_millis, fake_idle, fake_irq_off, NULL};
+    static const tase_bm_uart_hooks_t spin = {fake_tx, fake_millis, NULL, NULL, NULL};
+    static fake_hw_t hw;
+    tase_bm_uart_t u;
+    uint8_t storage[8];
+    (void)state;
+    memset(&hw, 0, sizeof hw);
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &racy, &hw), TASE_EARG);
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &half, &hw), TASE_EARG);
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &spin, &hw), TASE_OK);
+}
+
+static void poll_reports_a_receiver_error_and_loses_no_byte_to_it(void **state)
+{
+    static fake_hw_t hw;
+    tase_bm_uart_t u;
+    uint8_t storage[64], wire[TASE_FRAME_MAX];
+    tase_rx_t rx;
+    frame_count_t c;
+    int n, i;
+    (void)state;
+    memset(&hw, 0, sizeof hw);
+    hw.uart = &u;
+    assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw), TASE_OK);
+    n = tase_frame_encode(wire, sizeof wire, 0x48, 0x00, NULL, 0);
+    for (i = 0; i < n; i++) {
+        tase_bm_uart_rx_isr(&u, wire[i]);
+    }
+    memset(&rx, 0xFF, sizeof rx); /* never initialised: garbage */
+    memset(&c, 0, sizeof c);
+    assert_int_equal(tase_bm_uart_poll(&u, &rx, count_frame, &c), TASE_EARG);
+    assert_int_equal(tase_ring_count(&u.rx), (uint32_t)n); /* still there */
+    assert_int_equal(tase_rx_init(&rx), TASE_OK);
+    assert_int_equal(tase_bm_uart_poll(&u, &rx, count_frame, &c), 1);
+    assert_int_equal(c.frames, 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -445,6 +577,9 @@ int main(void)
         cmocka_unit_test(port_read_waits_on_the_millisecond_hook_and_wakes_on_rx),
         cmocka_unit_test(port_write_goes_to_the_tx_hook_whole_or_reports_its_error),
         cmocka_unit_test(main_loop_poll_delivers_every_frame_the_isr_received),
+        cmocka_unit_test(a_byte_arriving_between_the_check_and_the_sleep_is_not_missed),
+        cmocka_unit_test(an_idle_hook_without_the_interrupt_mask_is_refused),
+        cmocka_unit_test(poll_reports_a_receiver_error_and_loses_no_byte_to_it),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

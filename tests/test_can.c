@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include "tase/can.h"
+#include "tase/flags.h"
 
 /* GIMBAL_ANGLE pan 10.00, tilt -5.00, roll 0 framed by hand from the spec:
  * checksum 0x00+0xFF+0x5A+0x08+0x08+0x10+0x03+0xE8+0xFE+0x0C = 0x036E. */
@@ -256,27 +257,48 @@ static void move_command_encodes_deploy_as_zero_and_retract_as_nonzero(void **st
     tase_can_3ax_move_t m;
     tase_can_frame_t f;
     (void)state;
-    m.command = TASE_3AX_DEPLOY;
+    m.command = TASE_3AX_MOVE_DEPLOY;
     assert_int_equal(tase_can_3ax_move_encode(&m, &f), TASE_OK);
     assert_int_equal(f.id, 0x12010000u);
     assert_true(f.extended);
     assert_int_equal(f.dlc, 2);
     assert_int_equal(f.data[0], 0x00);
     assert_int_equal(f.data[1], 0x00);
-    m.command = TASE_3AX_RETRACT;
+    m.command = TASE_3AX_MOVE_RETRACT;
     assert_int_equal(tase_can_3ax_move_encode(&m, &f), TASE_OK);
     assert_int_not_equal(f.data[0], 0x00);
     assert_int_equal(f.data[1], 0x00);
-    m.command = TASE_3AX_DEPLOY;
+    m.command = TASE_3AX_MOVE_DEPLOY;
     assert_int_equal(tase_can_3ax_move_decode(&f, &m), TASE_OK);
-    assert_int_equal(m.command, TASE_3AX_RETRACT);
+    assert_int_equal(m.command, TASE_3AX_MOVE_RETRACT);
     f.data[0] = 0x01; /* any non-zero byte means retract */
-    m.command = TASE_3AX_DEPLOY;
+    m.command = TASE_3AX_MOVE_DEPLOY;
     assert_int_equal(tase_can_3ax_move_decode(&f, &m), TASE_OK);
-    assert_int_equal(m.command, TASE_3AX_RETRACT);
+    assert_int_equal(m.command, TASE_3AX_MOVE_RETRACT);
     f.data[0] = 0x00;
     assert_int_equal(tase_can_3ax_move_decode(&f, &m), TASE_OK);
-    assert_int_equal(m.command, TASE_3AX_DEPLOY);
+    assert_int_equal(m.command, TASE_3AX_MOVE_DEPLOY);
+}
+
+/* Spec 4.1.6 vs 5.3.1: RETRACT_DEPLOY_CMD's byte 1 deploys, the move
+ * frame's byte 1 retracts. The command names carry the packet's values, so
+ * a gimbal passing the packet's byte on moves the right way (or, for a
+ * non-zero byte other than 1, gets TASE_ERANGE: nothing moves). */
+static void move_command_values_mean_what_retract_deploy_cmd_means(void **state)
+{
+    tase_can_3ax_move_t m;
+    tase_can_frame_t f;
+    (void)state;
+    assert_int_equal(TASE_3AX_MOVE_DEPLOY, TASE_DEPLOY);
+    assert_int_equal(TASE_3AX_MOVE_RETRACT, TASE_RETRACT);
+    m.command = (tase_3ax_command_t)TASE_DEPLOY;
+    assert_int_equal(tase_can_3ax_move_encode(&m, &f), TASE_OK);
+    assert_int_equal(f.data[0], 0x00); /* 5.3.1: "0 for deploy" */
+    m.command = (tase_3ax_command_t)TASE_RETRACT;
+    assert_int_equal(tase_can_3ax_move_encode(&m, &f), TASE_OK);
+    assert_int_equal(f.data[0], TASE_3AX_RETRACT_BYTE);
+    m.command = (tase_3ax_command_t)2; /* a deploy byte of 2: not a command here */
+    assert_int_equal(tase_can_3ax_move_encode(&m, &f), TASE_ERANGE);
 }
 
 static void move_command_rejects_bad_input(void **state)
@@ -290,14 +312,14 @@ static void move_command_rejects_bad_input(void **state)
     assert_int_equal(f.dlc, 0x5C);
     assert_int_equal(tase_can_3ax_move_encode(NULL, &f), TASE_EARG);
     f = ext_frame(TASE_CAN_ID_3AX_STATUS, angle_pkt, 2);
-    m.command = TASE_3AX_DEPLOY;
+    m.command = TASE_3AX_MOVE_DEPLOY;
     assert_int_equal(tase_can_3ax_move_decode(&f, &m), TASE_EUNKNOWN);
     f = ext_frame(TASE_CAN_ID_3AX_MOVE, angle_pkt + 1, 3);
     assert_int_equal(tase_can_3ax_move_decode(&f, &m), TASE_ELENGTH);
     f.dlc = 2;
     f.extended = false;
     assert_int_equal(tase_can_3ax_move_decode(&f, &m), TASE_EUNKNOWN);
-    assert_int_equal(m.command, TASE_3AX_DEPLOY);
+    assert_int_equal(m.command, TASE_3AX_MOVE_DEPLOY);
 }
 
 static void status_bytes_decode_to_position_and_signed_speed(void **state)
@@ -407,7 +429,7 @@ static void null_and_unknown_roles_are_rejected_without_counting(void **state)
     tase_can_rx_t crx;
     tase_can_split_t s;
     tase_can_frame_t f = ext_frame(TASE_CAN_ID_TO_GIMBAL, angle_pkt, 8), copy;
-    tase_can_3ax_move_t m = {TASE_3AX_RETRACT};
+    tase_can_3ax_move_t m = {TASE_3AX_MOVE_RETRACT};
     tase_can_3ax_status_t st = {7, 5};
     got_t got;
     (void)state;
@@ -446,7 +468,7 @@ static void null_and_unknown_roles_are_rejected_without_counting(void **state)
     assert_int_equal(tase_can_3ax_status_decode(&f, NULL), TASE_EARG);
     assert_int_equal(st.position, 7);
     assert_int_equal(st.speed_dps, 5);
-    assert_int_equal(m.command, TASE_3AX_RETRACT);
+    assert_int_equal(m.command, TASE_3AX_MOVE_RETRACT);
 }
 
 /* Bad arguments of can.h give their documented codes and change nothing,
@@ -524,6 +546,7 @@ int main(void)
         cmocka_unit_test(receiver_takes_only_its_direction),
         cmocka_unit_test(other_ids_between_fragments_do_not_break_a_packet),
         cmocka_unit_test(move_command_encodes_deploy_as_zero_and_retract_as_nonzero),
+        cmocka_unit_test(move_command_values_mean_what_retract_deploy_cmd_means),
         cmocka_unit_test(move_command_rejects_bad_input),
         cmocka_unit_test(status_bytes_decode_to_position_and_signed_speed),
         cmocka_unit_test(status_round_trips_every_speed_and_position),

@@ -10,6 +10,7 @@
 
 #include <cmocka.h>
 
+#include "packet_fill.h"
 #include "tase/codec.h"
 #include "tase/flags.h"
 
@@ -237,41 +238,9 @@ static void axis_setting_22_byte_layout_decodes_and_encodes_to_hand_computed_fra
 
 /* ---- every packet: round trips -------------------------------------- */
 
-/* The value of a struct member of width w, as unsigned bits. */
-static uint64_t member_bits(const uint8_t *p, unsigned w)
+static uint8_t rnd8(void)
 {
-    uint8_t b;
-    uint16_t h;
-    uint32_t x;
-    uint64_t q;
-    switch (w) {
-    case 1: memcpy(&b, p, 1); return b;
-    case 2: memcpy(&h, p, 2); return h;
-    case 4: memcpy(&x, p, 4); return x;
-    default: memcpy(&q, p, 8); return q;
-    }
-}
-
-/* Fill the data bytes of packet p: fields from `fill`, reserved zero. */
-static void fill_fields(const tase_packet_desc_t *p, uint8_t *data, int mode)
-{
-    size_t k, b;
-    memset(data, 0, p->len);
-    for (k = 0; k < p->nfields; k++) {
-        const tase_field_t *f = tase_schema_field(p, k);
-        unsigned w = TASE_FIELD_WIDTH(f);
-        for (b = 0; b < w; b++) {
-            uint8_t v;
-            switch (mode) {
-            case 0: v = 0xFF; break;                 /* -1, 0xFFFF, 0xFFFFFFFF */
-            case 1: v = b == 0 ? 0x80 : 0x00; break; /* INT16_MIN, INT32_MIN */
-            case 2: v = b == 0 ? 0x7F : 0xFF; break; /* INT16_MAX, INT32_MAX */
-            case 3: v = 0x00; break;
-            default: v = (uint8_t)rnd(); break;
-            }
-            data[f->offset + b] = v;
-        }
-    }
+    return (uint8_t)rnd();
 }
 
 static void every_packet_round_trips_random_and_extreme_values(void **state)
@@ -289,7 +258,7 @@ static void every_packet_round_trips_random_and_extreme_values(void **state)
                 tase_frame_t f;
                 size_t len = p->len;
                 int n;
-                fill_fields(p, data, mode);
+                packet_fill_fields(p, data, mode, rnd8);
                 if (p->flags & TASE_LEN_TAIL) {
                     size_t extra = rnd() % (TASE_CAMERA_PASS_MAX + 1);
                     for (k = 0; k < extra; k++) {
@@ -311,7 +280,7 @@ static void every_packet_round_trips_random_and_extreme_values(void **state)
                     uint64_t bits = 0, want;
                     unsigned w = TASE_FIELD_WIDTH(fd);
                     assert_int_equal(tase_field_get(p, k, f.data, f.len, &raw), TASE_OK);
-                    bits = member_bits((const uint8_t *)&m1 + fd->member, w);
+                    bits = packet_member_bits((const uint8_t *)&m1 + fd->member, w);
                     want = w == 8 ? (uint64_t)raw : ((uint64_t)raw & ((1ull << (8 * w)) - 1));
                     assert_true(bits == want);
                 }

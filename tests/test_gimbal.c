@@ -11,9 +11,11 @@
 #include <cmocka.h>
 
 #include "fake_port.h"
+#include "fault_port.h"
 #include "tase/codec.h"
 #include "tase/gimbal.h"
 #include "tase/ids.h"
+#include "tase/port_io.h"
 
 #define NSTREAM 3
 
@@ -23,6 +25,8 @@ typedef struct {
     tase_rx_t rx[TASE_GIMBAL_PORTS];
     /* apply_setup */
     unsigned applies;
+    uint8_t applied[TASE_DATA_MAX]; /* what the last apply_setup saw */
+    size_t applied_len;
     int refuse;
     uint8_t clamp_to; /* nonzero: PACKET_RATE bytes above it are clamped */
     /* fill_telemetry */
@@ -54,6 +58,8 @@ static int app_apply(void *user, unsigned port, uint8_t type, uint8_t *data, siz
     size_t i;
     (void)port;
     x->applies++;
+    memcpy(x->applied, data, len);
+    x->applied_len = len;
     if (x->refuse) {
         return TASE_ERANGE;
     }
@@ -234,6 +240,133 @@ static void a_setup_packet_of_the_wrong_length_is_counted_not_answered(void **st
     free(x);
 }
 
+/* Spec 4.4.1: bytes 4, 9 and 14 of PACKET_RATE are "Reserved byte set to
+ * zero": what the host put there is neither stored, applied nor echoed. */
+static void reserved_bytes_are_zero_in_what_is_applied_stored_and_echoed(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX], stored[23];
+    uint8_t req[16] = {20, 5, 2, 7, 0xAA, 10, 10, 4, 8, 0xBB, 10, 10, 4, 9, 0xCC, 1};
+    uint8_t want[16];
+    uint8_t axis[23];
+    (void)state;
+
+    memcpy(want, req, sizeof want);
+    want[4] = want[9] = want[14] = 0;
+    feed(x, 0, 0x48, 0x00, req, sizeof req, 10);
+    assert_int_equal(x->applied_len, 16);
+    assert_memory_equal(x->applied, want, 16);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 16);
+    assert_memory_equal(d, want, 16);
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0x00, stored, sizeof stored), 16);
+    assert_memory_equal(stored, want, 16);
+
+    /* AXIS_SETTING's byte 13 (no row in table 22) */
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0x02, axis, sizeof axis), 23);
+    axis[12] = 30;
+    axis[13] = 0xFF;
+    feed(x, 0, 0x48, 0x02, axis, 23, 20);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 23);
+    assert_int_equal(d[12], 30);
+    assert_int_equal(d[13], 0);
+    assert_int_equal(x->applied[13], 0);
+    free(x);
+}
+
+/* Spec 4.4.3: 0xFF (0xFFFF for 16-bit values) means "do not change"; the
+ * echo shows the setting in force, not the 0xFF. */
+static void axis_do_not_change_values_keep_the_stored_settings(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX], defaults[23], req[23], want[23];
+    (void)state;
+
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0x02, defaults, sizeof defaults), 23);
+    memset(req, 0xFF, sizeof req);
+    req[22] = 0; /* temporary: a flag, not a setting (no "do not change") */
+    feed(x, 0, 0x48, 0x02, req, sizeof req, 10);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 23);
+    assert_memory_equal(d, defaults, 23);
+    assert_memory_equal(x->applied, defaults, 23); /* the callback sees them too */
+
+    /* change two fields, leave the rest */
+    req[0] = 0x11; /* pan no-go centre 0x1194 = 45.00 deg */
+    req[1] = 0x94;
+    req[16] = 75; /* tilt max accel */
+    memcpy(want, defaults, sizeof want);
+    want[0] = 0x11;
+    want[1] = 0x94;
+    want[16] = 75;
+    feed(x, 1, 0x48, 0x02, req, sizeof req, 20);
+    assert_int_equal(only_frame(&x->port[1], &g, &t, d), 23);
+    assert_memory_equal(d, want, 23);
+    /* 0xFF in one byte of a 16-bit field is a value, not "do not change" */
+    req[2] = 0xFF;
+    req[3] = 0x00; /* pan no-go range 0xFF00 */
+    want[2] = 0xFF;
+    want[3] = 0x00;
+    feed(x, 1, 0x48, 0x02, req, sizeof req, 30);
+    assert_int_equal(only_frame(&x->port[1], &g, &t, d), 23);
+    assert_memory_equal(d, want, 23);
+    assert_int_equal(x->g.stats.setup_applied, 3);
+    free(x);
+}
+
+/* Spec 4.4.6: CAMERA_TYPE 0 is "do not change", 0xFF "no camera". */
+static void camera_type_zero_keeps_and_the_default_is_no_camera(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX];
+    const uint8_t none[3] = {0xFF, 0xFF, 0xFF}, mine[3] = {68, 97, 0xFF};
+    const uint8_t req[3] = {0, 36, 0}, want[3] = {68, 36, 0xFF};
+    (void)state;
+
+    feed(x, 0, 0x48, 0x05, NULL, 0, 10);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 3);
+    assert_memory_equal(d, none, 3);
+    assert_int_equal(tase_gimbal_setup_set(&x->g, 0x05, mine, 3, 10), TASE_OK);
+    feed(x, 0, 0x48, 0x05, req, 3, 20);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 3);
+    assert_memory_equal(d, want, 3);
+    free(x);
+}
+
+/* Table 22 read as a numbering slip (22 bytes, no byte 13): the role
+ * applies it field by field and echoes in the layout it came in. */
+static void a_22_byte_axis_setting_is_applied_and_echoed_in_its_layout(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    uint8_t g, t, d[TASE_DATA_MAX], stored[23];
+    /* no-go zones unchanged (0xFFFF), max rates 20/30/0xFF, accelerations
+     * 40/45/0xFF, gains 50/55/0xFF, temporary 1 */
+    uint8_t req22[22] = {0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF,
+                         0xFF, 20,   30,   0xFF, 40,   45,   0xFF, 50,   55,   0xFF, 1};
+    uint8_t want23[23] = {0x00, 0x00, 0x00, 0x00, 0x23, 0x28, 0x17, 0x70, 0,  0, 0, 0,
+                          20,   0,    30,   0,    40,   45,   0,    50,   55, 0, 1};
+    uint8_t want22[22];
+    (void)state;
+
+    feed(x, 2, 0x48, 0x02, req22, sizeof req22, 10);
+    assert_int_equal(x->g.stats.bad_length, 0);
+    assert_int_equal(x->applied_len, 23); /* the callback sees the table layout */
+    assert_memory_equal(x->applied, want23, 23);
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0x02, stored, sizeof stored), 23);
+    assert_memory_equal(stored, want23, 23);
+    memcpy(want22, want23, 13);
+    memcpy(want22 + 13, want23 + 14, 9);
+    assert_int_equal(only_frame(&x->port[2], &g, &t, d), 22);
+    assert_memory_equal(d, want22, 22);
+    /* a query is answered in the table's 23 bytes */
+    feed(x, 2, 0x48, 0x02, NULL, 0, 20);
+    assert_int_equal(only_frame(&x->port[2], &g, &t, d), 23);
+    assert_memory_equal(d, want23, 23);
+    /* 21 bytes is no layout */
+    feed(x, 2, 0x48, 0x02, req22, 21, 30);
+    assert_int_equal(fake_frames_out(&x->port[2]), 0);
+    assert_int_equal(x->g.stats.bad_length, 1);
+    free(x);
+}
+
 static void system_version_is_query_only_and_answers_the_application_bytes(void **state)
 {
     fix_t *x = make(0, 3, false);
@@ -249,6 +382,8 @@ static void system_version_is_query_only_and_answers_the_application_bytes(void 
     assert_int_equal(tase_gimbal_setup_set(&x->g, 0x03, ver, 42, 0), TASE_OK);
     feed(x, 0, 0x48, 0x03, NULL, 0, 10);
     assert_int_equal(only_frame(&x->port[0], &g, &t, d), 42);
+    /* stored and answered with its reserved bytes 25, 31, 37 zero */
+    ver[25] = ver[31] = ver[37] = 0;
     assert_memory_equal(d, ver, 42);
     /* Writing it is not possible: answered, unchanged, no callback. */
     feed(x, 0, 0x48, 0x03, junk, sizeof junk, 20);
@@ -967,6 +1102,281 @@ static void init_refuses_both_forms_of_a_callback(void **state)
     free(fp);
 }
 
+/* ---- priority, capacity and blocking ----------------------------------- */
+
+/* A serial line on a fake microsecond clock: `bps` bytes per second leave
+ * the wire, a driver queue of `qcap` bytes in front of it, and a write
+ * that waits (the clock runs) up to 1000 ms for room, as the POSIX UART
+ * port's does. end_us is when the last byte written so far leaves. */
+typedef struct {
+    uint64_t now_us, end_us;
+    uint32_t bps, qcap;
+    uint64_t bytes;
+    uint32_t writes;
+} line_t;
+
+static uint32_t line_queued(const line_t *l)
+{
+    return l->end_us > l->now_us ? (uint32_t)((l->end_us - l->now_us) * l->bps / 1000000u) : 0u;
+}
+
+static int line_write(void *ctx, const uint8_t *data, size_t n)
+{
+    line_t *l = ctx;
+    uint64_t waited = 0;
+    size_t done = 0;
+    (void)data;
+    l->writes++;
+    while (done < n) {
+        uint32_t room = l->qcap - line_queued(l);
+        size_t take = n - done < room ? n - done : room;
+        if (l->end_us < l->now_us) {
+            l->end_us = l->now_us;
+        }
+        l->end_us += (uint64_t)take * 1000000u / l->bps;
+        done += take;
+        if (done < n) {
+            if (waited >= 1000000u) {
+                break;
+            }
+            l->now_us += 1000u; /* blocked: wait for room */
+            waited += 1000u;
+        }
+    }
+    l->bytes += done;
+    return done > 0 ? (int)done : TASE_EAGAIN;
+}
+
+static int line_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    (void)ctx, (void)buf, (void)cap, (void)timeout_ms;
+    return 0;
+}
+
+static uint32_t line_now(void *ctx)
+{
+    return (uint32_t)(((line_t *)ctx)->now_us / 1000u);
+}
+
+static const tase_port_ops_t line_ops = {line_write, line_read, line_now};
+
+static int zero_fill(void *user, unsigned port, uint16_t id, void *msg, uint32_t now)
+{
+    unsigned *per_stream = user;
+    (void)port, (void)msg, (void)now;
+    per_stream[stream_of(id)]++;
+    return 0;
+}
+
+typedef struct {
+    uint32_t echo_delay_ms; /* query fed at 4 s -> its echo's last byte on the wire */
+    uint32_t worst_poll_ms; /* the longest a poll blocked */
+    uint64_t bytes;         /* telemetry and echo bytes written in 6 s */
+    unsigned per_stream[3];
+    tase_gimbal_stats_t stats;
+} line_run_t;
+
+/* PACKET_RATE 255/255/255 on a 9600-baud line (960 B/s, 4 KB driver
+ * queue), polled every millisecond for 6 s; at 4 s the host queries
+ * PACKET_RATE. */
+static line_run_t run_on_a_9600_baud_line(uint32_t capacity)
+{
+    static line_t l;
+    static tase_gimbal_t g;
+    static tase_rx_t rx;
+    static const uint8_t fast[16] = {255, 255, 255, 0, 0, 255, 255, 255, 0, 0, 255, 255, 255};
+    line_run_t out;
+    tase_port_t port = {&line_ops, &l};
+    tase_gimbal_app_t app;
+    uint8_t q[8];
+    uint32_t t;
+    int n;
+
+    memset(&l, 0, sizeof l);
+    memset(&out, 0, sizeof out);
+    l.bps = 960u;
+    l.qcap = 4096u;
+    memset(&app, 0, sizeof app);
+    app.fill_telemetry_msg = zero_fill;
+    app.user = out.per_stream;
+    assert_int_equal(tase_gimbal_init(&g, &port, &rx, 1, &app, 0), TASE_OK);
+    assert_int_equal(tase_gimbal_set_capacity(&g, 0, capacity), TASE_OK);
+    assert_int_equal(tase_gimbal_setup_set(&g, 0x00, fast, sizeof fast, 0), TASE_OK);
+    n = tase_frame_encode(q, sizeof q, 0x48, 0x00, NULL, 0);
+    for (t = 1; t <= 6000u; t++) {
+        uint64_t before;
+        if (l.now_us < (uint64_t)t * 1000u) {
+            l.now_us = (uint64_t)t * 1000u; /* idle until the next millisecond */
+        }
+        if (t == 4000u) {
+            uint64_t fed = l.now_us;
+            assert_int_equal(tase_gimbal_feed(&g, 0, q, (size_t)n, line_now(&l)), 1);
+            out.echo_delay_ms = (uint32_t)((l.end_us - fed) / 1000u);
+        }
+        before = l.now_us;
+        (void)tase_gimbal_poll(&g, line_now(&l));
+        if ((l.now_us - before) / 1000u > out.worst_poll_ms) {
+            out.worst_poll_ms = (uint32_t)((l.now_us - before) / 1000u);
+        }
+    }
+    out.bytes = l.bytes;
+    out.stats = g.stats;
+    return out;
+}
+
+static void an_echo_gets_through_an_over_rate_schedule_within_the_host_timeout(void **state)
+{
+    line_run_t slow, paced;
+    (void)state;
+    /* The issue's numbers first, to show the model is the real thing: no
+     * capacity given, the queue fills, an echo waits seconds. */
+    slow = run_on_a_9600_baud_line(0u);
+    print_message("no capacity: echo after %u ms, a poll blocked up to %u ms\n",
+                  (unsigned)slow.echo_delay_ms, (unsigned)slow.worst_poll_ms);
+    assert_true(slow.echo_delay_ms > 3000u);
+    assert_true(slow.worst_poll_ms > 50u);
+    /* With the line's capacity the echo leaves well within the host's
+     * default 500 ms, and no write blocks the loop. */
+    paced = run_on_a_9600_baud_line(TASE_UART_BYTES_PER_S(9600));
+    print_message("960 B/s: echo after %u ms, a poll blocked up to %u ms, %lu bytes in 6 s, "
+                  "%u/%u/%u frames, %u slots over capacity\n",
+                  (unsigned)paced.echo_delay_ms, (unsigned)paced.worst_poll_ms,
+                  (unsigned long)paced.bytes, paced.per_stream[0], paced.per_stream[1],
+                  paced.per_stream[2], (unsigned)paced.stats.slots_over_capacity);
+    assert_true(paced.echo_delay_ms < 500u);
+    assert_int_equal(paced.worst_poll_ms, 0);
+    /* telemetry within its share (75 % of 960 B/s) over the 6 s, the echo on top */
+    assert_true(paced.bytes <= 6u * 720u + 24u + 111u);
+    assert_true(paced.bytes >= 5u * 720u);
+    assert_true(paced.stats.slots_over_capacity > 0u);
+    /* every stream got the same share, 720 / (14 + 26 + 71) = 6.5 per
+     * second: none starved */
+    assert_true(paced.per_stream[0] >= 36u && paced.per_stream[0] <= 40u);
+    assert_int_equal(paced.per_stream[1], paced.per_stream[0]);
+    assert_int_equal(paced.per_stream[2], paced.per_stream[0]);
+    assert_int_equal(paced.stats.tx_errors, 0);
+}
+
+static void capacity_is_per_port_and_checks_its_arguments(void **state)
+{
+    fix_t *x = make(0, 3, true);
+    unsigned i;
+    (void)state;
+    /* defaults 10/10/4 per port = 10*14 + 10*26 + 4*71 = 684 B/s: port 0
+     * is given 400 B/s (telemetry 300), port 1 plenty, port 2 none */
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 0, 400u), TASE_OK);
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 1, 100000u), TASE_OK);
+    run(x, 0, 10000, 1);
+    for (i = 0; i < NSTREAM; i++) {
+        /* unlimited is the same as plenty */
+        assert_int_equal(x->count[1][i], x->count[2][i]);
+        /* port 0: the same fraction 300/684 of each stream's slots */
+        assert_true(x->count[0][i] * 684u + 2u * 684u >= x->count[1][i] * 300u);
+        assert_true(x->count[0][i] * 684u <= x->count[1][i] * 300u + 2u * 684u);
+    }
+    assert_int_equal(x->count[1][0], 100); /* 10 s at the default 10/s */
+    assert_int_equal(tase_gimbal_set_capacity(NULL, 0, 1u), TASE_EARG);
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 3, 1u), TASE_EARG);
+    free(x);
+}
+
+/* Every write stalls its whole bound: a poll with three frames due tries
+ * one and leaves the other two (before, it tried each 64 times). */
+static void a_stuck_port_costs_one_frame_bound_per_poll(void **state)
+{
+    fake_port_t *f = calloc(1, sizeof *f);
+    tase_port_t inner = {&fake_ops, f};
+    fault_port_t fp;
+    tase_port_t p;
+    static tase_gimbal_t g;
+    tase_gimbal_app_t app;
+    unsigned per_stream[3] = {0, 0, 0};
+    (void)state;
+    assert_non_null(f);
+    fault_init(&fp, &inner, 7u);
+    fp.p_stall = 256u;
+    fp.write_bound_ms = 1000u;
+    p = fault_port(&fp);
+    memset(&app, 0, sizeof app);
+    app.fill_telemetry_msg = zero_fill;
+    app.user = per_stream;
+    assert_int_equal(tase_gimbal_init(&g, &p, NULL, 1, &app, 0), TASE_OK);
+    /* at 1000 ms all three default streams are due */
+    assert_int_equal(tase_gimbal_poll(&g, 1000), 0);
+    assert_true(fp.spent_ms <= TASE_PORT_WRITE_TIMEOUT_MS + 1000u);
+    assert_int_equal(g.stats.tx_errors, 1);
+    assert_int_equal(g.stats.slots_after_tx_error, 2);
+    /* the next poll tries again */
+    assert_int_equal(tase_gimbal_poll(&g, 1100), 0);
+    assert_int_equal(g.stats.tx_errors, 2);
+    free(f);
+}
+
+/* The gimbal through the fault-injecting port, 500 seeds: queries and
+ * polls with stale and wrapped times; an answer blocks at most one frame
+ * bound, a poll at most one per frame it wrote plus one failed try; every
+ * query is answered or its failure counted. */
+static void the_gimbal_keeps_its_bounds_under_random_faults(void **state)
+{
+    fake_port_t *f = calloc(1, sizeof *f);
+    tase_port_t inner = {&fake_ops, f};
+    static tase_gimbal_t g;
+    static tase_rx_t rx;
+    uint8_t q[8];
+    uint32_t seed;
+    int n = tase_frame_encode(q, sizeof q, 0x48, 0x01, NULL, 0);
+    (void)state;
+    assert_non_null(f);
+    for (seed = 1; seed <= 500u; seed++) {
+        fault_port_t fp;
+        tase_port_t p;
+        tase_gimbal_app_t app;
+        unsigned per_stream[3] = {0, 0, 0};
+        uint32_t now = seed & 1u ? 0xFFFFF000u : seed * 7919u;
+        unsigned i, queries = 0;
+        memset(f, 0, sizeof *f);
+        f->discard = 1;
+        fault_init(&fp, &inner, seed);
+        fp.p_short = fault_rand(&fp) & 0x7Fu;
+        fp.p_eagain = fault_rand(&fp) & 0x3Fu;
+        fp.p_eintr = fault_rand(&fp) & 0x3Fu;
+        fp.p_stall = fault_rand(&fp) & 0x1Fu;
+        fp.write_bound_ms = 1u + fault_rand(&fp) % 300u;
+        fp.hangup_after = seed % 9u == 0u ? 1u + fault_rand(&fp) % 200u : 0u;
+        p = fault_port(&fp);
+        memset(&app, 0, sizeof app);
+        app.fill_telemetry_msg = zero_fill;
+        app.user = per_stream;
+        assert_int_equal(tase_gimbal_init(&g, &p, &rx, 1, &app, now), TASE_OK);
+        if (seed % 2u == 0u) {
+            assert_int_equal(tase_gimbal_set_capacity(&g, 0, 1u + fault_rand(&fp) % 2000u),
+                             TASE_OK);
+        }
+        for (i = 0; i < 300u; i++) {
+            uint32_t before = fp.spent_ms;
+            uint32_t step = fault_rand(&fp) % 16u;
+            /* a caller's time: mostly forward, sometimes a stale sample */
+            uint32_t t = fault_rand(&fp) % 8u == 0u ? now - fault_rand(&fp) % 500u : now + step;
+            now += step;
+            uint32_t bound = TASE_PORT_WRITE_TIMEOUT_MS + fp.write_bound_ms;
+            int sent;
+            if (fault_rand(&fp) % 16u == 0u) {
+                uint32_t tx_before = g.stats.frames_tx + g.stats.tx_errors;
+                assert_int_equal(tase_gimbal_feed(&g, 0, q, (size_t)n, t), 1);
+                assert_int_equal(g.stats.frames_tx + g.stats.tx_errors, tx_before + 1u);
+                assert_true(fp.spent_ms - before <= bound);
+                before = fp.spent_ms;
+                queries++;
+            }
+            sent = tase_gimbal_poll(&g, t);
+            assert_true(sent >= 0);
+            assert_true(fp.spent_ms - before <= ((uint32_t)sent + 1u) * bound);
+        }
+        assert_int_equal(g.stats.setup_queries, queries);
+    }
+    free(f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -976,6 +1386,10 @@ int main(void)
         cmocka_unit_test(a_refused_setup_echoes_the_settings_still_in_force),
         cmocka_unit_test(a_setup_packet_of_the_wrong_length_is_counted_not_answered),
         cmocka_unit_test(system_version_is_query_only_and_answers_the_application_bytes),
+        cmocka_unit_test(reserved_bytes_are_zero_in_what_is_applied_stored_and_echoed),
+        cmocka_unit_test(axis_do_not_change_values_keep_the_stored_settings),
+        cmocka_unit_test(camera_type_zero_keeps_and_the_default_is_no_camera),
+        cmocka_unit_test(a_22_byte_axis_setting_is_applied_and_echoed_in_its_layout),
         cmocka_unit_test(other_frames_reach_the_application_which_can_answer),
         cmocka_unit_test(an_hour_of_telemetry_has_exactly_rate_times_3600_packets),
         cmocka_unit_test(jittery_polling_still_gives_exact_counts),
@@ -994,6 +1408,10 @@ int main(void)
         cmocka_unit_test(a_typed_setting_is_decoded_applied_stored_and_echoed),
         cmocka_unit_test(typed_setup_set_and_send_msg),
         cmocka_unit_test(init_refuses_both_forms_of_a_callback),
+        cmocka_unit_test(an_echo_gets_through_an_over_rate_schedule_within_the_host_timeout),
+        cmocka_unit_test(capacity_is_per_port_and_checks_its_arguments),
+        cmocka_unit_test(a_stuck_port_costs_one_frame_bound_per_poll),
+        cmocka_unit_test(the_gimbal_keeps_its_bounds_under_random_faults),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

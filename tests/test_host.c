@@ -10,9 +10,11 @@
 #include <cmocka.h>
 
 #include "fake_port.h"
+#include "fault_port.h"
 #include "tase/codec.h"
 #include "tase/host.h"
 #include "tase/ids.h"
+#include "tase/port_io.h"
 
 typedef struct {
     fake_port_t port;
@@ -704,6 +706,83 @@ static void a_sample_older_than_the_request_start_is_not_a_timeout(void **state)
     assert_int_equal(x->host.stats.retries, 3);
 }
 
+/* ---- under faults ----------------------------------------------------- */
+
+/* transact through the fault-injecting port, 1500 seeds: interrupted and
+ * stalled reads, short and refused writes, stale clock samples, clock
+ * jumps (half the seeds), hang-ups, clocks starting just before the 2^32
+ * wrap, a gimbal that answers attempt 1..4 or never. The host never sends
+ * more than 1 + retries attempts; a timeout never comes before the
+ * attempts' time has really passed (unless the clock jumped; a stale
+ * sample that became an attempt's send time shortens it by its age at
+ * most, where the old arithmetic read it as 2^32 ms elapsed); without
+ * stale samples it comes within the attempts' bound; a reply is the
+ * gimbal's bytes. */
+static void transact_keeps_its_contract_under_random_faults(void **state)
+{
+    fix_t *x = *state;
+    const uint32_t timeout = 100u;
+    const uint8_t retries = 3u;
+    uint32_t seed;
+    for (seed = 1; seed <= 1500u; seed++) {
+        fault_port_t fp;
+        tase_port_t inner = {&fake_ops, &x->port};
+        tase_port_t p;
+        tase_host_t h;
+        uint8_t reply[64];
+        uint32_t t0;
+        uint32_t spent;
+        unsigned frames;
+        int r;
+        memset(&x->port, 0, sizeof x->port);
+        x->port.now = seed & 1u ? 0xFFFFF000u : seed * 2654435761u;
+        fault_init(&fp, &inner, seed);
+        fp.p_short = fault_rand(&fp) & 0x7Fu;
+        fp.p_eagain = fault_rand(&fp) & 0x3Fu;
+        fp.p_eintr = fault_rand(&fp) & 0x7Fu;
+        fp.p_stall = fault_rand(&fp) & 0x3Fu;
+        fp.p_stale = seed % 3u == 0u ? 0u : fault_rand(&fp) & 0x3Fu;
+        fp.p_jump = seed % 2u == 0u ? fault_rand(&fp) & 0x1Fu : 0u;
+        fp.write_bound_ms = 1u + fault_rand(&fp) % 200u;
+        fp.stale_max_ms = 1u + fault_rand(&fp) % 50u;
+        fp.hangup_after = seed % 7u == 0u ? 1u + fault_rand(&fp) % 30u : 0u;
+        x->port.reply_after = fault_rand(&fp) % 5u; /* 0: the gimbal never answers */
+        x->port.nreply = (size_t)tase_frame_encode(x->port.reply, sizeof x->port.reply, 0x48, 0x03,
+                                                   rates, sizeof rates);
+        p = fault_port(&fp);
+        assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_OK);
+        t0 = x->port.now;
+        r = tase_host_transact(&h, 0x48, 0x03, NULL, 0, reply, sizeof reply, timeout, retries);
+        spent = x->port.now - t0 + fp.spent_ms;
+        frames = fake_frames_out(&x->port);
+        assert_true(frames <= 1u + retries);
+        assert_false(tase_host_busy(&h));
+        if (r >= 0) {
+            assert_int_equal(r, 16);
+            assert_memory_equal(reply, rates, 16);
+        } else if (r == TASE_ETIMEOUT) {
+            assert_int_equal(h.stats.retries, retries);
+            if (fp.jumps == 0u) {
+                /* a stale sample taken as an attempt's send time may
+                 * shorten that attempt by its age, no more */
+                uint32_t early = fp.stales > 0u ? fp.stale_max_ms : 0u;
+                assert_true(spent >= (1u + retries) * (timeout - early));
+            }
+            if (fp.stales == 0u) {
+                assert_true(spent <= (1u + retries) * (timeout + TASE_PORT_WRITE_TIMEOUT_MS +
+                                                       fp.write_bound_ms + 8u));
+            }
+        } else if (r == TASE_EIO) {
+            /* the hang-up, or a first attempt cut part-way */
+            assert_true(fp.hangups > 0u || h.stats.requests == 0u);
+        } else {
+            /* the first attempt never got onto the wire */
+            assert_true(r == TASE_EAGAIN || r == TASE_ENOBUFS);
+            assert_int_equal(h.stats.requests, 0);
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -753,6 +832,8 @@ int main(void)
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(a_sample_older_than_the_request_start_is_not_a_timeout,
                                         setup, teardown),
+        cmocka_unit_test_setup_teardown(transact_keeps_its_contract_under_random_faults, setup,
+                                        teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

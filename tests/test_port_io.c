@@ -10,6 +10,8 @@
 #include <cmocka.h>
 
 #include "fake_port.h"
+#include "fault_port.h"
+#include "tase/codec.h"
 #include "tase/port_io.h"
 
 static fake_port_t *new_fake(void)
@@ -191,6 +193,8 @@ static void count_tx_counts_link_failures_but_not_caller_mistakes(void **state)
     assert_int_equal(tase_port_count_tx(TASE_EAGAIN, &sent, &errors), TASE_EAGAIN);
     assert_int_equal(tase_port_count_tx(TASE_EARG, &sent, &errors), TASE_EARG);
     assert_int_equal(tase_port_count_tx(TASE_ETOOLONG, &sent, &errors), TASE_ETOOLONG);
+    assert_int_equal(tase_port_count_tx(TASE_ELENGTH, &sent, &errors), TASE_ELENGTH);
+    assert_int_equal(tase_port_count_tx(TASE_EUNKNOWN, &sent, &errors), TASE_EUNKNOWN);
     assert_int_equal(sent, 2);
     assert_int_equal(errors, 2);
     assert_int_equal(tase_port_count_tx(5, NULL, NULL), 5);
@@ -228,6 +232,124 @@ static void port_io_api_rejects_bad_arguments(void **state)
     assert_int_equal(tase_port_write_all(&port, NULL, 0), 0);
 }
 
+/* ---- one deadline per frame, under faults ------------------------------ */
+
+/* The issue's case: a port stuck for good (a tty that never drains, a CAN
+ * queue in bus-off). Each write() waits its whole bound W and takes
+ * nothing. One frame must cost one bound, not 64 of them. */
+static void a_stuck_port_costs_one_write_bound_per_frame_not_64(void **state)
+{
+    fake_port_t *f = new_fake();
+    tase_port_t inner = {&fake_ops, f};
+    fault_port_t fp;
+    tase_port_t p;
+    const uint32_t bounds[3] = {1000u, 100u, 20u};
+    unsigned i;
+    (void)state;
+    for (i = 0; i < 3; i++) {
+        fault_init(&fp, &inner, 1u);
+        fp.p_stall = 256u;
+        fp.write_bound_ms = bounds[i];
+        p = fault_port(&fp);
+        assert_int_equal(tase_port_send_frame(&p, 0x00, 0x80, (const uint8_t *)"12345678", 8),
+                         TASE_EAGAIN);
+        assert_true(fp.spent_ms <= TASE_PORT_WRITE_TIMEOUT_MS + bounds[i]);
+        assert_true(fp.spent_ms >= (bounds[i] < TASE_PORT_WRITE_TIMEOUT_MS
+                                        ? TASE_PORT_WRITE_TIMEOUT_MS
+                                        : bounds[i])); /* and it did try until the deadline */
+        assert_int_equal(f->nout, 0);
+    }
+    free(f);
+}
+
+/* Every kind of write fault, 3000 seeds: write_all returns n, or the port
+ * took nothing (EAGAIN/ENOBUFS, nothing on the wire), or it cut the frame
+ * (EIO, a prefix on the wire), or the hang-up's EIO. What reached the wire
+ * is always a prefix of the data, never a byte twice. And the time spent
+ * is within the documented bound: deadline + W, plus one W for each stale
+ * clock sample that could hide time already spent. */
+static void write_all_keeps_its_contract_under_random_faults(void **state)
+{
+    fake_port_t *f = new_fake();
+    tase_port_t inner = {&fake_ops, f};
+    uint8_t data[TASE_FRAME_MAX];
+    uint32_t seed;
+    size_t k;
+    (void)state;
+    for (k = 0; k < sizeof data; k++) {
+        data[k] = (uint8_t)(k * 13u + 5u);
+    }
+    for (seed = 1; seed <= 3000u; seed++) {
+        fault_port_t fp;
+        tase_port_t p;
+        size_t n;
+        int r;
+        uint32_t stales_before;
+        memset(f, 0, sizeof *f);
+        f->now = seed & 1u ? 0xFFFFF000u : seed * 7919u; /* across the wrap, too */
+        fault_init(&fp, &inner, seed);
+        fp.p_short = fault_rand(&fp) & 0xFFu;
+        fp.p_eagain = fault_rand(&fp) & 0xFFu;
+        fp.p_eintr = fault_rand(&fp) & 0x7Fu;
+        fp.p_stall = fault_rand(&fp) & 0x3Fu;
+        fp.p_jump = fault_rand(&fp) & 0x1Fu;
+        fp.p_stale = fault_rand(&fp) & 0x1Fu;
+        fp.write_bound_ms = 1u + fault_rand(&fp) % 1000u;
+        fp.hangup_after = seed % 5u == 0u ? fault_rand(&fp) % 20u + 1u : 0u;
+        f->write_limit = (size_t)(fault_rand(&fp) % 40u);
+        n = 1u + fault_rand(&fp) % sizeof data;
+        p = fault_port(&fp);
+        stales_before = fp.stales;
+        r = tase_port_write_all(&p, data, n);
+        if (r >= 0) {
+            assert_int_equal(r, (int)n);
+            assert_int_equal(f->nout, n);
+        } else if (r == TASE_EAGAIN || r == TASE_ENOBUFS) {
+            assert_int_equal(f->nout, 0);
+        } else {
+            assert_int_equal(r, TASE_EIO);
+            assert_true(f->nout < n);
+        }
+        assert_memory_equal(f->out, data, f->nout);
+        assert_true(fp.spent_ms <= TASE_PORT_WRITE_TIMEOUT_MS +
+                                       fp.write_bound_ms * (1u + fp.stales - stales_before));
+    }
+    free(f);
+}
+
+static void elapsed_is_wrap_safe_and_a_stale_sample_is_no_time(void **state)
+{
+    (void)state;
+    assert_int_equal(tase_port_elapsed_ms(1100u, 1000u), 100);
+    assert_int_equal(tase_port_elapsed_ms(0x0000000Fu, 0xFFFFFFF0u), 0x1F);
+    assert_int_equal(tase_port_elapsed_ms(0xFFFFF000u + 4096u, 0xFFFFF000u), 4096);
+    assert_int_equal(tase_port_elapsed_ms(999u, 1000u), 0);              /* 1 ms stale */
+    assert_int_equal(tase_port_elapsed_ms(0xFFFFFFFFu, 0u), 0);          /* stale across the wrap */
+    assert_int_equal(tase_port_elapsed_ms(0x7FFFFFFFu, 0u), 0x7FFFFFFF); /* the longest */
+    assert_int_equal(tase_port_elapsed_ms(0x80000000u, 0u), 0);
+}
+
+static void send_msg_writes_the_codec_frame_and_checks_it_first(void **state)
+{
+    fake_port_t *f = new_fake();
+    tase_port_t p = {&fake_ops, f};
+    tase_gimbal_angle_t a = {100, -200, 0};
+    uint8_t want[TASE_FRAME_MAX];
+    int n;
+    (void)state;
+    n = tase_packet_encode(TASE_ID_GIMBAL_ANGLE, &a, want, sizeof want);
+    assert_int_equal(tase_port_send_msg(&p, TASE_ID_GIMBAL_ANGLE, &a), n);
+    assert_memory_equal(f->out, want, (size_t)n);
+    f->nout = 0;
+    assert_int_equal(tase_port_send_msg(&p, TASE_ID_PACKET_RATE, NULL), 8); /* a query */
+    assert_int_equal(tase_port_send_msg(&p, TASE_ID_GIMBAL_ANGLE, NULL), TASE_ELENGTH);
+    assert_int_equal(tase_port_send_msg(&p, TASE_ID(0x28, 0), &a), TASE_EUNKNOWN);
+    assert_int_equal(tase_port_send_msg(NULL, TASE_ID(0x28, 0), &a), TASE_EUNKNOWN);
+    assert_int_equal(tase_port_send_msg(NULL, TASE_ID_GIMBAL_ANGLE, &a), TASE_EARG);
+    assert_int_equal(f->nout, 8);
+    free(f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -242,6 +364,10 @@ int main(void)
         cmocka_unit_test(write_all_rejects_a_port_claiming_more_than_asked),
         cmocka_unit_test(write_all_counts_zero_and_enobufs_as_no_progress),
         cmocka_unit_test(send_frame_checks_the_frame_before_the_port),
+        cmocka_unit_test(a_stuck_port_costs_one_write_bound_per_frame_not_64),
+        cmocka_unit_test(write_all_keeps_its_contract_under_random_faults),
+        cmocka_unit_test(elapsed_is_wrap_safe_and_a_stale_sample_is_no_time),
+        cmocka_unit_test(send_msg_writes_the_codec_frame_and_checks_it_first),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

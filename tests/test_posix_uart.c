@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <grp.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <termios.h>
@@ -399,6 +400,174 @@ static void posix_uart_api_rejects_bad_arguments(void **state)
     assert_memory_equal(&u, &copy, sizeof u);
 }
 
+/* ---- exclusive access and the settings given back -------------------- */
+
+/* Fork a child that runs `fn(arg)` and exits with its result; 77 means it
+ * could not do what the check needs (reported as skipped). */
+static int in_child(int (*fn)(const char *), const char *arg)
+{
+    int status = 0;
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        _exit(fn(arg));
+    }
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    assert_true(WIFEXITED(status));
+    return WEXITSTATUS(status);
+}
+
+static int child_open_is_ebusy(const char *path)
+{
+    tase_posix_uart_t u;
+    return tase_posix_uart_open(&u, path, 9600) == TASE_EBUSY && u.fd == -1 ? 0 : 1;
+}
+
+static void a_second_open_of_the_device_is_ebusy_until_the_first_closes(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a, b;
+    (void)state;
+
+    pty_open(&p);
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 9600), TASE_OK);
+    /* in this process ... */
+    b.fd = 99;
+    assert_int_equal(tase_posix_uart_open(&b, p.name, 57600), TASE_EBUSY);
+    assert_int_equal(b.fd, -1);
+    /* ... and from another program */
+    assert_int_equal(in_child(child_open_is_ebusy, p.name), 0);
+    assert_int_equal(a.baud, 9600);
+    assert_int_equal(tase_posix_uart_close(&a), TASE_OK);
+    assert_int_equal(tase_posix_uart_open(&b, p.name, 57600), TASE_OK);
+    assert_int_equal(tase_posix_uart_close(&b), TASE_OK);
+    /* a shared open takes no lock: two may coexist */
+    assert_int_equal(tase_posix_uart_open_flags(&a, p.name, 9600, TASE_POSIX_UART_SHARED), TASE_OK);
+    assert_int_equal(tase_posix_uart_open_flags(&b, p.name, 9600, TASE_POSIX_UART_SHARED), TASE_OK);
+    tase_posix_uart_close(&a);
+    tase_posix_uart_close(&b);
+    assert_int_equal(tase_posix_uart_open_flags(&a, p.name, 9600, 0x2u), TASE_EARG);
+    pty_close(&p);
+}
+
+/* What the kernel's TIOCEXCL adds: a plain open() by any program that does
+ * not lock (cat, a shell redirection) fails too. Root bypasses it, so as
+ * root the check runs in a child that dropped to uid 65534. */
+static int child_plain_open_is_ebusy(const char *path)
+{
+    int fd;
+    if (geteuid() == 0 && (setgroups(0, NULL) != 0 || setgid(65534) != 0 || setuid(65534) != 0)) {
+        return 77;
+    }
+    fd = open(path, O_RDWR | O_NOCTTY | O_NONBLOCK);
+    if (fd >= 0) {
+        close(fd);
+        return 1;
+    }
+    return errno == EBUSY ? 0 : 2;
+}
+
+static void the_kernel_refuses_other_opens_while_the_port_is_open(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a;
+    int excl = -1;
+    int r;
+    (void)state;
+
+    pty_open(&p);
+    assert_int_equal(fchmod(p.slave, 0666), 0);
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 9600), TASE_OK);
+    assert_int_equal(ioctl(p.slave, TIOCGEXCL, &excl), 0);
+    assert_int_equal(excl, 1);
+    r = in_child(child_plain_open_is_ebusy, p.name);
+    if (r == 77) {
+        print_message("SKIPPED the TIOCEXCL open assertion: running as root and could not drop "
+                      "to uid 65534\n");
+    } else {
+        assert_int_equal(r, 0);
+    }
+    assert_int_equal(tase_posix_uart_close(&a), TASE_OK);
+    assert_int_equal(ioctl(p.slave, TIOCGEXCL, &excl), 0);
+    assert_int_equal(excl, 0); /* given back */
+    /* a shared open does not set it */
+    assert_int_equal(tase_posix_uart_open_flags(&a, p.name, 9600, TASE_POSIX_UART_SHARED), TASE_OK);
+    assert_int_equal(ioctl(p.slave, TIOCGEXCL, &excl), 0);
+    assert_int_equal(excl, 0);
+    tase_posix_uart_close(&a);
+    pty_close(&p);
+}
+
+static void assert_termios_equal(const struct termios *a, const struct termios *b)
+{
+    size_t i;
+    assert_int_equal(a->c_iflag, b->c_iflag);
+    assert_int_equal(a->c_oflag, b->c_oflag);
+    assert_int_equal(a->c_cflag, b->c_cflag);
+    assert_int_equal(a->c_lflag, b->c_lflag);
+    for (i = 0; i < NCCS; i++) {
+        assert_int_equal(a->c_cc[i], b->c_cc[i]);
+    }
+    assert_int_equal(cfgetispeed(a), cfgetispeed(b));
+    assert_int_equal(cfgetospeed(a), cfgetospeed(b));
+}
+
+/* A line set up the way a user's terminal program might leave it. */
+static void make_cooked(int fd, struct termios *t)
+{
+    assert_int_equal(tcgetattr(fd, t), 0);
+    t->c_iflag |= ICRNL | IXON;
+    t->c_lflag |= ECHO | ICANON | ISIG;
+    t->c_cc[VMIN] = 1;
+    t->c_cc[VTIME] = 5;
+    assert_int_equal(cfsetispeed(t, B19200), 0);
+    assert_int_equal(cfsetospeed(t, B19200), 0);
+    assert_int_equal(tcsetattr(fd, TCSANOW, t), 0);
+    assert_int_equal(tcgetattr(fd, t), 0);
+}
+
+static void close_gives_the_device_back_with_the_settings_it_had(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a;
+    tase_port_t pa;
+    struct termios before, during, after;
+    (void)state;
+
+    pty_open(&p);
+    make_cooked(p.slave, &before);
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 57600), TASE_OK);
+    assert_int_equal(tcgetattr(p.slave, &during), 0);
+    assert_int_equal(during.c_cc[VMIN], 0);
+    assert_int_equal(during.c_lflag & ICANON, 0);
+    pa = tase_posix_uart_port(&a);
+    assert_int_equal(pa.ops->write(pa.ctx, (const uint8_t *)"abc", 3), 3);
+    assert_int_equal(tase_posix_uart_close(&a), TASE_OK);
+    assert_int_equal(tcgetattr(p.slave, &after), 0);
+    assert_termios_equal(&after, &before);
+
+    /* an attached descriptor gets its settings back too */
+    make_cooked(p.slave, &before);
+    assert_int_equal(tase_posix_uart_attach(&a, dup(p.slave), 9600), TASE_OK);
+    assert_int_equal(tcgetattr(p.slave, &during), 0);
+    assert_int_equal(cfgetospeed(&during), B9600);
+    assert_int_equal(tase_posix_uart_close(&a), TASE_OK);
+    assert_int_equal(tcgetattr(p.slave, &after), 0);
+    assert_termios_equal(&after, &before);
+
+    /* a failed open (busy) changes nothing either */
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 9600), TASE_OK);
+    assert_int_equal(tcgetattr(p.slave, &during), 0);
+    {
+        tase_posix_uart_t b;
+        assert_int_equal(tase_posix_uart_open(&b, p.name, 115200), TASE_EBUSY);
+        assert_int_equal(tcgetattr(p.slave, &after), 0);
+        assert_termios_equal(&after, &during);
+    }
+    tase_posix_uart_close(&a);
+    pty_close(&p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -416,6 +585,9 @@ int main(void)
         cmocka_unit_test(a_hung_up_line_reads_as_eio),
         cmocka_unit_test(the_clock_is_monotonic_milliseconds),
         cmocka_unit_test(bad_arguments_are_rejected),
+        cmocka_unit_test(a_second_open_of_the_device_is_ebusy_until_the_first_closes),
+        cmocka_unit_test(the_kernel_refuses_other_opens_while_the_port_is_open),
+        cmocka_unit_test(close_gives_the_device_back_with_the_settings_it_had),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -11,11 +11,15 @@
 #include <cmocka.h>
 
 #include <errno.h>
+#include <signal.h>
 #include <sys/socket.h>
+#include <sys/time.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <linux/can.h>
+#include <linux/can/error.h>
 
 #include "tase/socketcan.h"
 
@@ -193,7 +197,7 @@ static void threeax_move_goes_out_and_status_comes_back(void **state)
     static const uint8_t pkt_part[4] = {0x00, 0xFF, 0x5A, 0x02};
     (void)state;
     open_pair(&p, TASE_CAN_ROLE_GIMBAL);
-    m.command = TASE_3AX_RETRACT;
+    m.command = TASE_3AX_MOVE_RETRACT;
     assert_int_equal(tase_can_3ax_move_encode(&m, &f), TASE_OK);
     assert_int_equal(tase_socketcan_send_frame(&p.s, &f), TASE_OK);
     assert_int_equal(recv(p.peer, &cf, sizeof(cf), MSG_DONTWAIT), (ssize_t)sizeof(cf));
@@ -257,6 +261,19 @@ static void full_queue_is_reported_never_dropped(void **state)
     close_pair(&p);
 }
 
+/* A host-role pair whose transmit queue is full (nobody reads the peer);
+ * wire holds a 10-byte packet, whose length is returned. */
+static int open_full_pair(pair_t *p, uint8_t *wire)
+{
+    int n;
+    open_pair(p, TASE_CAN_ROLE_HOST);
+    n = make_packet(wire, 0x42, 10);
+    p->s.tx_timeout_ms = 0;
+    while (tase_socketcan_write(&p->s, wire, 8) == 8) {
+    }
+    return n;
+}
+
 static void write_retries_while_the_peer_drains(void **state)
 {
     /* The queue is full when write() starts but frees up within the
@@ -266,11 +283,7 @@ static void write_retries_while_the_peer_drains(void **state)
     int n, rc;
     pid_t pid;
     (void)state;
-    open_pair(&p, TASE_CAN_ROLE_HOST);
-    n = make_packet(wire, 0x42, 10);
-    p.s.tx_timeout_ms = 0;
-    while (tase_socketcan_write(&p.s, wire, 8) == 8) {
-    }
+    n = open_full_pair(&p, wire);
     pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
@@ -404,6 +417,233 @@ static void socketcan_api_rejects_bad_arguments(void **state)
     assert_int_equal(tase_socketcan_read(&p.s, buf, sizeof buf, 0), TASE_EARG);
 }
 
+/* ---- signals ---------------------------------------------------------- */
+
+static volatile sig_atomic_t alarms;
+
+static void on_alarm(int sig)
+{
+    (void)sig;
+    alarms++;
+}
+
+/* SIGALRM every millisecond, without SA_RESTART: every blocking call
+ * meanwhile sees EINTR. Pass 0 to stop. */
+static void alarm_storm(int on)
+{
+    struct sigaction sa;
+    struct itimerval it;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on ? on_alarm : SIG_DFL;
+    sigemptyset(&sa.sa_mask);
+    memset(&it, 0, sizeof it);
+    if (on) {
+        alarms = 0;
+        it.it_interval.tv_usec = 1000;
+        it.it_value.tv_usec = 1000;
+    } else {
+        sa.sa_handler = SIG_IGN; /* a last alarm in flight must not kill us */
+    }
+    assert_int_equal(sigaction(SIGALRM, &sa, NULL), 0);
+    assert_int_equal(setitimer(ITIMER_REAL, &it, NULL), 0);
+}
+
+static void a_signal_storm_neither_fails_nor_shortens_a_read(void **state)
+{
+    pair_t p;
+    uint8_t b[16];
+    uint32_t t0, dt;
+    pid_t pid;
+    static const uint8_t x[3] = {7, 8, 9};
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    alarm_storm(1);
+    t0 = tase_socketcan_now_ms(NULL);
+    assert_int_equal(tase_socketcan_read(&p.s, b, sizeof b, 150), 0);
+    dt = tase_socketcan_now_ms(NULL) - t0;
+    assert_true(dt >= 150u);
+    assert_true(alarms >= 20); /* the wait really was interrupted, many times */
+    /* and data arriving during the storm is returned */
+    pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        usleep(50000);
+        peer_send(&p, 0x10000000u | CAN_EFF_FLAG, x, 3);
+        _exit(0);
+    }
+    assert_int_equal(tase_socketcan_recv_frame(&p.s, &(tase_can_frame_t){0}, 2000), 1);
+    alarm_storm(0);
+    assert_int_equal(waitpid(pid, NULL, 0), pid);
+    assert_int_equal(p.s.stats.last_errno, 0);
+    close_pair(&p);
+}
+
+static void a_signal_storm_does_not_turn_a_full_queue_into_an_io_error(void **state)
+{
+    pair_t p;
+    uint8_t wire[TASE_FRAME_MAX];
+    uint32_t t0, dt;
+    int n;
+    (void)state;
+    n = open_full_pair(&p, wire);
+    p.s.tx_timeout_ms = 100;
+    alarm_storm(1);
+    t0 = tase_socketcan_now_ms(NULL);
+    assert_int_equal(tase_socketcan_write(&p.s, wire, (size_t)n), TASE_ENOBUFS);
+    dt = tase_socketcan_now_ms(NULL) - t0;
+    alarm_storm(0);
+    assert_true(dt >= 100u);
+    assert_true(dt < 1000u); /* within its bound (plus scheduling) */
+    assert_true(alarms >= 20);
+    assert_int_equal(p.s.stats.last_errno, 0);
+    close_pair(&p);
+}
+
+/* ---- bus health, FD frames, timestamps -------------------------------- */
+
+static void peer_error(pair_t *p, uint32_t classes, uint8_t ctrl, uint8_t tec, uint8_t rec)
+{
+    uint8_t d[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    d[1] = ctrl;
+    d[6] = tec;
+    d[7] = rec;
+    peer_send(p, CAN_ERR_FLAG | classes, d, CAN_ERR_DLC);
+}
+
+static tase_socketcan_bus_t bus_after(pair_t *p)
+{
+    tase_socketcan_bus_t b;
+    tase_can_frame_t f;
+    assert_int_equal(tase_socketcan_recv_frame(&p->s, &f, 0), 0); /* no data among them */
+    assert_int_equal(tase_socketcan_bus(&p->s, &b), TASE_OK);
+    return b;
+}
+
+static void error_frames_report_the_bus_state_and_are_never_data(void **state)
+{
+    pair_t p;
+    tase_socketcan_bus_t b;
+    uint8_t buf[16];
+    static const uint8_t x[4] = {1, 2, 3, 4};
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    b = bus_after(&p);
+    assert_int_equal(b.state, TASE_SOCKETCAN_BUS_ACTIVE);
+    peer_error(&p, CAN_ERR_CRTL | CAN_ERR_CNT, CAN_ERR_CRTL_TX_WARNING, 97, 3);
+    b = bus_after(&p);
+    assert_int_equal(b.state, TASE_SOCKETCAN_BUS_WARNING);
+    assert_int_equal(b.tx_error_count, 97);
+    assert_int_equal(b.rx_error_count, 3);
+    peer_error(&p, CAN_ERR_CRTL | CAN_ERR_ACK, CAN_ERR_CRTL_TX_PASSIVE, 0, 0);
+    b = bus_after(&p);
+    assert_int_equal(b.state, TASE_SOCKETCAN_BUS_PASSIVE);
+    assert_int_equal(b.no_acks, 1);
+    assert_int_equal(b.tx_error_count, 97); /* no counters in that one */
+    /* the data around error frames is read as usual */
+    peer_send(&p, 0x10000000u | CAN_EFF_FLAG, x, 2);
+    peer_error(&p, CAN_ERR_BUSOFF, 0, 0, 0);
+    peer_send(&p, 0x10000000u | CAN_EFF_FLAG, x + 2, 2);
+    assert_int_equal(read_all(&p.s, buf, 4, 16), 4);
+    assert_memory_equal(buf, x, 4);
+    assert_int_equal(tase_socketcan_bus(&p.s, &b), TASE_OK);
+    assert_int_equal(b.state, TASE_SOCKETCAN_BUS_OFF);
+    assert_int_equal(b.bus_offs, 1);
+    peer_error(&p, CAN_ERR_RESTARTED, 0, 0, 0);
+    b = bus_after(&p);
+    assert_int_equal(b.state, TASE_SOCKETCAN_BUS_ACTIVE);
+    assert_int_equal(b.restarts, 1);
+    peer_error(&p, CAN_ERR_TX_TIMEOUT, 0, 0, 0);
+    peer_error(&p, CAN_ERR_PROT | CAN_ERR_BUSERROR, 0, 0, 0);
+    peer_error(&p, CAN_ERR_CRTL, CAN_ERR_CRTL_RX_OVERFLOW, 0, 0);
+    b = bus_after(&p);
+    assert_int_equal(b.tx_timeouts, 1);
+    assert_int_equal(b.bus_errors, 1);
+    assert_int_equal(b.overflows, 1);
+    assert_int_equal(b.error_frames, 7);
+    assert_int_equal(b.warnings, 1);
+    assert_int_equal(b.passives, 1);
+    assert_int_equal(b.state, TASE_SOCKETCAN_BUS_ACTIVE);
+    assert_int_equal(p.s.stats.bad_frames, 0); /* error frames are not bad data */
+    assert_int_equal(p.s.stats.frames_rx, 2);
+    assert_int_equal(tase_socketcan_bus(NULL, &b), TASE_EARG);
+    assert_int_equal(tase_socketcan_bus(&p.s, NULL), TASE_EARG);
+    close_pair(&p);
+}
+
+static void peer_send_fd(pair_t *p, uint32_t raw_id, const uint8_t *d, uint8_t len)
+{
+    struct canfd_frame cf;
+    memset(&cf, 0, sizeof cf);
+    cf.can_id = raw_id;
+    cf.len = len;
+    cf.flags = CANFD_BRS;
+    memcpy(cf.data, d, len);
+    assert_int_equal(write(p->peer, &cf, sizeof cf), (ssize_t)sizeof cf);
+}
+
+/* An adopted socket with CAN_RAW_FD_FRAMES passes 72-byte FD records. One
+ * of 8 bytes or fewer must not be taken for a classic frame. */
+static void fd_frames_are_rejected_and_classic_frames_still_read(void **state)
+{
+    pair_t p;
+    uint8_t buf[32];
+    static const uint8_t fd_data[12] = {0xFF, 0x5A, 2, 0x48, 0, 0, 0, 0x4A, 9, 9, 9, 9};
+    static const uint8_t x[5] = {5, 4, 3, 2, 1};
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    peer_send_fd(&p, 0x10000000u | CAN_EFF_FLAG, fd_data, 8);  /* ours, short */
+    peer_send_fd(&p, 0x10000000u | CAN_EFF_FLAG, fd_data, 12); /* ours, long */
+    peer_send_fd(&p, 0x12345678u | CAN_EFF_FLAG, fd_data, 8);  /* somebody else's */
+    peer_send(&p, 0x10000000u | CAN_EFF_FLAG, x, 5);
+    assert_int_equal(tase_socketcan_read(&p.s, buf, sizeof buf, 200), 5);
+    assert_memory_equal(buf, x, 5);
+    assert_int_equal(tase_socketcan_read(&p.s, buf, sizeof buf, 0), 0);
+    assert_int_equal(p.s.stats.fd_rejected, 2);
+    assert_int_equal(p.s.stats.frames_ignored, 1);
+    assert_int_equal(p.s.stats.bytes_rx, 5);
+    close_pair(&p);
+}
+
+static uint64_t realtime_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+static void receive_timestamps_are_the_kernels_not_the_read_time(void **state)
+{
+    pair_t p;
+    tase_can_frame_t f;
+    uint8_t buf[8];
+    uint64_t before, after, ts;
+    static const uint8_t x[2] = {1, 2};
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_GIMBAL);
+    assert_true(tase_socketcan_rx_time_ns(&p.s) == 0u);
+    before = realtime_ns();
+    peer_send(&p, 0x11000000u | CAN_EFF_FLAG, x, 2);
+    after = realtime_ns();
+    usleep(60000); /* read late */
+    assert_int_equal(tase_socketcan_read(&p.s, buf, sizeof buf, 100), 2);
+    ts = tase_socketcan_rx_time_ns(&p.s);
+    assert_true(ts >= before);
+    assert_true(ts <= after); /* stamped on arrival, 60 ms before the read */
+    /* a side frame (3AX status) keeps its own stamp through the queue */
+    before = realtime_ns();
+    peer_send(&p, 0x12020000u | CAN_EFF_FLAG, x, 2);
+    after = realtime_ns();
+    usleep(20000);
+    peer_send(&p, 0x11000000u | CAN_EFF_FLAG, x, 1);
+    assert_int_equal(tase_socketcan_read(&p.s, buf, sizeof buf, 100), 1);
+    assert_true(tase_socketcan_rx_time_ns(&p.s) > after);
+    assert_int_equal(tase_socketcan_recv_frame(&p.s, &f, 0), 1);
+    ts = tase_socketcan_rx_time_ns(&p.s);
+    assert_true(ts >= before && ts <= after);
+    assert_true(tase_socketcan_rx_time_ns(NULL) == 0u);
+    close_pair(&p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -419,6 +659,11 @@ int main(void)
         cmocka_unit_test(adopt_and_open_check_their_arguments),
         cmocka_unit_test(set_filter_on_a_non_can_socket_fails_cleanly),
         cmocka_unit_test(port_table_moves_bytes_both_ways),
+        cmocka_unit_test(a_signal_storm_neither_fails_nor_shortens_a_read),
+        cmocka_unit_test(a_signal_storm_does_not_turn_a_full_queue_into_an_io_error),
+        cmocka_unit_test(error_frames_report_the_bus_state_and_are_never_data),
+        cmocka_unit_test(fd_frames_are_rejected_and_classic_frames_still_read),
+        cmocka_unit_test(receive_timestamps_are_the_kernels_not_the_read_time),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

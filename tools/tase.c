@@ -88,7 +88,8 @@ static const char usage_monitor[] =
     "beside the raw fields (JSON: a top-level \"units\" object). Stops after N\n"
     "packets, S seconds, or on SIGINT/SIGTERM/SIGHUP (exit 0), and prints a summary\n"
     "line on stderr (frames, checksum errors, bad sizes, wrong lengths, unknown,\n"
-    "bytes discarded).\n";
+    "bytes discarded; on CAN the bus state and error counts the port reports).\n"
+    "On CAN, --time is the kernel's receive time of the frame.\n";
 
 static const char usage_send[] =
     "usage: tase send NAME [field=value ...] LINK [--len N] [--zero] [--no-wait]\n"
@@ -1189,6 +1190,7 @@ static int cmd_monitor(args_t *a)
     static tk_dec_t d;
     tk_stream_t *st;
     static uint8_t buf[4096];
+    char extra[192] = "";
     while (a->i < a->argc) {
         if (common_opt(a) || link_opt(a, &lo)) {
             continue;
@@ -1225,14 +1227,34 @@ static int cmd_monitor(args_t *a)
         }
         if (n > 0) {
             tk_time_t now;
-            tk_time_now(&now);
+            uint64_t ns = link.is_can ? tase_socketcan_rx_time_ns(&link.can) : 0u;
+            if (ns != 0u) { /* the kernel's receive time of the frame */
+                now.sec = (int64_t)(ns / 1000000000u);
+                now.usec = (uint32_t)(ns % 1000000000u / 1000u);
+            } else {
+                tk_time_now(&now);
+            }
             tk_dec_bytes(&d, st, buf, (size_t)n, fmt.time ? &now : NULL);
             tk_stdout_flush();
         }
     }
+    if (link.is_can) {
+        tase_socketcan_bus_t bus;
+        static const char *const states[] = {"error-active", "error-warning", "error-passive",
+                                             "bus-off"};
+        if (tase_socketcan_bus(&link.can, &bus) == TASE_OK) {
+            snprintf(extra, sizeof(extra),
+                     ", CAN bus %s (%lu error frames, %lu bus-off, %lu no-ACK, %lu queue full, "
+                     "TEC %u, REC %u)",
+                     states[bus.state & 3u], (unsigned long)bus.error_frames,
+                     (unsigned long)bus.bus_offs, (unsigned long)bus.no_acks,
+                     (unsigned long)bus.enobufs, (unsigned)bus.tx_error_count,
+                     (unsigned)bus.rx_error_count);
+        }
+    }
     tk_link_close(&link);
     tk_stdout_flush();
-    tk_dec_summary(&d, stderr);
+    tk_dec_summary(&d, stderr, extra);
     return TK_EXIT_OK;
 }
 
@@ -1505,7 +1527,7 @@ static int cmd_decode(args_t *a)
     input_close(&in);
     tk_stdout_flush();
     if (stats) {
-        tk_dec_summary(&d, stderr);
+        tk_dec_summary(&d, stderr, "");
     }
     if (bad > 0) {
         tk_exit(TK_EXIT_INPUT, "%s: %lu bad %s%s (the rest was decoded)", in.name, bad,

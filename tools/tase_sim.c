@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "sim_model.h"
+#include "sim_words.h"
 #include "tase/codec.h"
 #include "tase/flags.h"
 #include "tase/gimbal.h"
@@ -90,22 +91,6 @@ static void send_packet(sim_t *s, unsigned port, uint16_t id, const void *msg)
     if (n >= 0) {
         (void)tase_gimbal_send(&s->g, port, TASE_ID_GROUP(id), TASE_ID_TYPE(id), data, (size_t)n);
     }
-}
-
-static uint8_t mode_byte(const sim_t *s)
-{
-    static const uint8_t modes[] = {TASE_MODE_RATE, TASE_MODE_POSITION, TASE_MODE_SPOI,
-                                    TASE_MODE_RATE};
-    uint8_t b = TASE_MODE_SET_VALUE(0u, modes[s->m.mode]);
-    if (s->m.stabilised) {
-        b |= TASE_MODE_STAB;
-    }
-    if (s->m.tax == SIM_3AX_DEPLOYED) {
-        b |= TASE_MODE_3AX_DEPLOYED;
-    } else if (s->m.tax == SIM_3AX_RETRACTED) {
-        b |= TASE_MODE_3AX_RETRACTED;
-    }
-    return b;
 }
 
 /* ---- setup packets ---- */
@@ -213,6 +198,13 @@ static void set_version(sim_t *s, uint32_t now)
                                        now) != TASE_OK) {
         tk_die("internal error: cannot store SYSTEM_VERSION");
     }
+    /* CAMERA_TYPE reports the same cameras (the role starts at "none") */
+    data[0] = s->cam[0].type;
+    data[1] = s->cam[1].type;
+    data[2] = s->cam[2].type;
+    if (tase_gimbal_setup_set(&s->g, TASE_ID_TYPE(TASE_ID_CAMERA_TYPE), data, 3, now) != TASE_OK) {
+        tk_die("internal error: cannot store CAMERA_TYPE");
+    }
 }
 
 /* ---- telemetry ---- */
@@ -257,7 +249,7 @@ static int fill_telemetry(void *user, unsigned port, uint16_t id, uint8_t *data,
         r.p = s->p;
         r.q = s->q;
         r.r = s->r;
-        r.mode = mode_byte(s);
+        r.mode = sim_mode_byte(&s->m);
         return payload(id, &r, data, cap);
     }
     if (id == TASE_ID_GEOREFERENCE_DATA) {
@@ -283,12 +275,12 @@ static int fill_telemetry(void *user, unsigned port, uint16_t id, uint8_t *data,
         r.hfov = tase_units_deg_to_cdeg_u16(hfov);
         r.vfov = tase_units_deg_to_cdeg_u16(vfov_of(hfov));
         r.focal = tase_units_sat_u16(100.0 * 2.4 / tan(hfov * M_PI / 360.0)); /* 4.8 mm sensor */
-        r.mode = mode_byte(s);
+        r.mode = sim_mode_byte(&s->m);
         if (tase_gimbal_setup_get(&s->g, TASE_ID_TYPE(TASE_ID_PACKET_RATE), rates, sizeof(rates)) >=
             13) {
             r.sample_rate = rates[2u + 5u * port];
         }
-        r.nav_health = 0xFFF0u; /* every health bit set, filter mode "normal" */
+        r.nav_health = sim_nav_health();
         r.mount_roll = tase_units_deg_to_cdeg(m->att.roll);
         r.mount_pitch = tase_units_deg_to_cdeg(m->att.pitch);
         r.mount_yaw = tase_units_deg_to_cdeg(m->att.yaw);
@@ -301,6 +293,24 @@ static int fill_telemetry(void *user, unsigned port, uint16_t id, uint8_t *data,
 }
 
 /* ---- commands and host data ---- */
+
+/* SPOI_CMD from the gimbal: the SPOI in force (zeros before the first)
+ * and the gimbal's own flags (stabilisation and mode). */
+static void send_spoi(sim_t *s, unsigned port)
+{
+    tase_spoi_cmd_t a;
+    memset(&a, 0, sizeof(a));
+    if (s->spoi_valid) {
+        a.lat = tase_units_deg_to_mas(s->m.spoi.lat);
+        a.lon = tase_units_deg_to_mas(s->m.spoi.lon);
+        a.height = tase_units_m_to_cm(s->m.spoi.height);
+        a.vnorth = tase_units_sat_i16(s->m.spoi.vn * 100.0);
+        a.veast = tase_units_sat_i16(s->m.spoi.ve * 100.0);
+        a.vdown = tase_units_sat_i16(s->m.spoi.vd * 100.0);
+    }
+    a.flags = sim_spoi_flags(&s->m);
+    send_packet(s, port, TASE_ID_SPOI_CMD, &a);
+}
 
 static const char *mode_name(const sim_model_t *m)
 {
@@ -392,19 +402,7 @@ static void on_frame(void *user, unsigned port, const tase_frame_t *f)
         break;
     case TASE_ID_SPOI_CMD:
         if (len == 0) {
-            tase_spoi_cmd_t a;
-            memset(&a, 0, sizeof(a));
-            if (s->spoi_valid) {
-                a.lat = tase_units_deg_to_mas(s->m.spoi.lat);
-                a.lon = tase_units_deg_to_mas(s->m.spoi.lon);
-                a.height = tase_units_m_to_cm(s->m.spoi.height);
-                a.vnorth = tase_units_sat_i16(s->m.spoi.vn * 100.0);
-                a.veast = tase_units_sat_i16(s->m.spoi.ve * 100.0);
-                a.vdown = tase_units_sat_i16(s->m.spoi.vd * 100.0);
-            }
-            a.flags = (uint8_t)((s->m.stabilised ? TASE_SPOI_STAB : 0u) |
-                                TASE_BITS8_SET(0u, 1, 7, TASE_MODE_VALUE(mode_byte(s))));
-            send_packet(s, port, id, &a);
+            send_spoi(s, port);
         } else {
             sim_pos_t t;
             t.lat = tase_units_mas_to_deg(msg.spoi_cmd.lat);
@@ -417,7 +415,7 @@ static void on_frame(void *user, unsigned port, const tase_frame_t *f)
             s->spoi_valid = true;
             logf_(s, now, "SPOI_CMD: pointing at %.6f, %.6f, %.1f m", t.lat, t.lon, t.height);
             if (msg.spoi_cmd.flags & TASE_SPOI_ECHO) {
-                send_packet(s, port, id, &msg.spoi_cmd);
+                send_spoi(s, port); /* the gimbal's flags, not the request's */
             }
         }
         break;

@@ -145,7 +145,7 @@ void tk_dec_finish(tk_dec_t *d)
     flush_out(d);
 }
 
-void tk_dec_summary(const tk_dec_t *d, FILE *out)
+void tk_dec_summary(const tk_dec_t *d, FILE *out, const char *extra)
 {
     const tk_counts_t *n = &d->n;
     fprintf(out,
@@ -159,5 +159,5 @@ void tk_dec_summary(const tk_dec_t *d, FILE *out)
         fprintf(out, ", %llu CAN frames (%llu not datalink)", (unsigned long long)n->can_frames,
                 (unsigned long long)n->can_other);
     }
-    fputc('\n', out);
+    fprintf(out, "%s\n", extra);
 }

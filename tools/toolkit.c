@@ -329,10 +329,9 @@ void tk_link_can(tk_link_t *l, const char *iface, bool gimbal)
                "and can-raw modules, or see docs/CAN.md for the VM)",
                iface);
     } else if (rc == TASE_ENODEV) {
-        tk_die("cannot open CAN interface %s: no such interface", iface);
+        tk_die("cannot open CAN interface %s: no such device", iface);
     } else if (rc == TASE_EDOWN) {
-        tk_die("cannot open CAN interface %s: the interface is down (ip link set %s up)", iface,
-               iface);
+        tk_die("cannot open CAN interface %s: interface is down (ip link set %s up)", iface, iface);
     } else if (rc != TASE_OK) {
         tk_die("cannot open CAN interface %s: %s", iface, tase_strerror(rc));
     }

@@ -279,8 +279,8 @@ void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n,
 bool tk_dec_can(tk_dec_t *d, const char *iface, const tase_can_frame_t *f, const tk_time_t *time);
 /* End of input: settle every stream's pending frames. */
 void tk_dec_finish(tk_dec_t *d);
-/* One summary line on `out` ("tase: N frames, ..."). */
-void tk_dec_summary(const tk_dec_t *d, FILE *out);
+/* One summary line on `out` ("tase: summary: N frames, ..." and `extra`). */
+void tk_dec_summary(const tk_dec_t *d, FILE *out, const char *extra);
 
 /* ---- offsets ---- */
 

@@ -4,6 +4,8 @@
 
 #include <string.h>
 
+#include "tase/flags.h"
+
 /* Software 0.1.0 released 2024-05-17; board fields zero; camera A type 3
  * with 40.00..2.00 degrees of field of view; no cameras B and C. */
 static const uint8_t version_info[42] = {
@@ -19,6 +21,30 @@ int16_t gimbal_sim_pan(uint32_t t)
 int16_t gimbal_sim_tilt(uint32_t t)
 {
     return (int16_t) - (int32_t)(t % 9000u);
+}
+
+uint8_t gimbal_mode_byte(uint8_t cmd_flags)
+{
+    unsigned kind = TASE_GIMBAL_KIND(cmd_flags);
+    bool stab;
+    unsigned mode;
+
+    if (kind == 0u) { /* legacy encoding: bit 6 stabilisation, bit 7 position */
+        stab = (cmd_flags & TASE_GIMBAL_LEGACY_STAB) != 0u;
+        mode =
+            (cmd_flags & TASE_GIMBAL_LEGACY_POSITION) != 0u ? TASE_MODE_POSITION : TASE_MODE_RATE;
+    } else {
+        stab = (cmd_flags & TASE_GIMBAL_STAB) != 0u;
+        if (kind == TASE_GIMBAL_KIND_POSITION) {
+            mode = TASE_MODE_POSITION;
+        } else if (kind == TASE_GIMBAL_KIND_SPOI_ERROR ||
+                   kind == TASE_GIMBAL_KIND_SPOI_ERROR_RATE) {
+            mode = TASE_MODE_SPOI;
+        } else {
+            mode = TASE_MODE_RATE; /* rate, impulse (a timed rate) */
+        }
+    }
+    return (uint8_t)(TASE_MODE_SET_VALUE(0u, mode) | (stab ? TASE_MODE_STAB : 0u));
 }
 
 static void trace(gimbal_app_t *app, const tase_frame_t *f, unsigned route, const int64_t *v,
@@ -144,7 +170,7 @@ static int fill_telemetry(void *user, unsigned port, uint16_t id, void *msg, uin
         m.gimbal_rate.time = now_ms;
         m.gimbal_rate.pan_rate = app->cmd_pan;
         m.gimbal_rate.tilt_rate = app->cmd_tilt;
-        m.gimbal_rate.mode = app->cmd_flags; /* stands in for the mode byte */
+        m.gimbal_rate.mode = gimbal_mode_byte(app->cmd_flags);
     } else if (id == TASE_ID_GEOREFERENCE_DATA) {
         uint8_t rates[16];
         m.georeference.time = now_ms;

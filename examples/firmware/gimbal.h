@@ -61,6 +61,12 @@ typedef struct {
 int gimbal_app_init(gimbal_app_t *app, const tase_port_t *port, tase_rx_stats_t *stats,
                     gimbal_trace_t trace, void *trace_user, uint32_t now_ms);
 
+/* The Mode byte of GIMBAL_RATE (spec 4.2.2, tase/flags.h TASE_MODE_*) of a
+ * gimbal obeying a GIMBAL_CMD with these flags: stabilisation from the
+ * command, mode position / SPOI / rate (rate and impulse commands), no 3AX
+ * (this board has none). */
+uint8_t gimbal_mode_byte(uint8_t cmd_flags);
+
 /* Telemetry contents are functions of the poll time t (ms) so that a
  * receiver can check them: pan = 3t mod 18000, tilt = -(t mod 9000). */
 int16_t gimbal_sim_pan(uint32_t t);

@@ -30,6 +30,7 @@
 #include "gimbal.h"
 #include "stream.h"
 #include "tase/bm_uart.h"
+#include "tase/flags.h"
 
 #define CPU_HZ 25000000u /* mps2-an385 */
 #define TICK_HZ 1000u    /* one simulated millisecond per SysTick */
@@ -168,6 +169,19 @@ static void check_telemetry(host_t *h, const tase_frame_t *f)
         got[6] = m.gimbal_rate.r;
         got[7] = m.gimbal_rate.mode;
         n = 8;
+        /* Read through flags.h: every GIMBAL_CMD of the stream is a
+         * stabilised position command (0xA0); before the first, rate
+         * feedback without stabilisation. */
+        if (m.gimbal_rate.pan_rate != 0) {
+            check(TASE_MODE_VALUE(m.gimbal_rate.mode) == TASE_MODE_POSITION &&
+                      (m.gimbal_rate.mode & TASE_MODE_STAB) != 0u,
+                  "mode byte: stabilised position feedback", m.gimbal_rate.mode,
+                  TASE_MODE_STAB | TASE_MODE_POSITION);
+        } else {
+            check(TASE_MODE_VALUE(m.gimbal_rate.mode) == TASE_MODE_RATE &&
+                      (m.gimbal_rate.mode & TASE_MODE_STAB) == 0u,
+                  "mode byte: rate feedback", m.gimbal_rate.mode, TASE_MODE_RATE);
+        }
     } else {
         h->georefs++;
         got[0] = (int32_t)m.georeference.time;

@@ -116,6 +116,18 @@ def sim_tilt(t):
     return -(t % 9000)
 
 
+def mode_byte(flags):
+    """GIMBAL_RATE Mode byte (spec 4.2.2; bit 0 = MSB) for the last
+    GIMBAL_CMD flags (4.1.1): bit 0 stabilisation, bits 3-7 the mode
+    (0 rate, 1 position, 2 SPOI; PROTOCOL-NOTES D2)."""
+    kind = (flags >> 4) & 7
+    if kind == 0:  # legacy: 0x02 stabilisation, 0x01 position
+        stab, mode = flags & 0x02, 1 if flags & 0x01 else 0
+    else:  # 1 rate, 2 position, 3 impulse (a timed rate), 4-5 SPOI error
+        stab, mode = flags & 0x80, {2: 1, 4: 2, 5: 2}.get(kind, 0)
+    return (0x80 if stab else 0) | mode
+
+
 def telemetry(events):
     """Per-millisecond model of the gimbal role's schedule (gimbal.h,
     SCHEDULE): a stream anchored at a with rate r sends slot n >= 1 at
@@ -135,7 +147,7 @@ def telemetry(events):
                 if s == 0:
                     v = [sim_pan(t), sim_tilt(t), 0]
                 elif s == 1:
-                    v = [t, cmd[0], cmd[1], 0, 0, 0, 0, cmd[2]]
+                    v = [t, cmd[0], cmd[1], 0, 0, 0, 0, mode_byte(cmd[2])]
                 else:
                     v = [t, 1000 * t, -2000 * t, 12345, sim_pan(t), sim_tilt(t), rates[2], 4000]
                 out.append((ids[s], t, v))

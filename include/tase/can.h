@@ -23,9 +23,10 @@
  * the multidrop bus are counted and ignored.
  *
  * 3AX. Two fixed 2-byte frames outside the datalink: the move command
- * (gimbal -> 3AX) and the position/speed status (3AX -> gimbal). Note the
- * polarity of the move command is the opposite of the datalink's
- * RETRACT_DEPLOY_CMD (0x00/0x43): on CAN, 0 means deploy.
+ * (gimbal -> 3AX) and the position/speed status (3AX -> gimbal). The move
+ * frame's byte has the opposite polarity of the datalink's
+ * RETRACT_DEPLOY_CMD (0x00/0x43): on CAN, 0 means deploy. The command
+ * names below carry RETRACT_DEPLOY_CMD's values and the codec inverts.
  *
  * Everything here is reentrant and ISR-safe except where an instance is
  * shared: one tase_can_rx_t or tase_can_split_t must be used from one
@@ -160,9 +161,16 @@ int tase_can_rx_feed(tase_can_rx_t *crx, const tase_can_frame_t *f, tase_rx_hand
 
 /* ---- 3AX retract/deploy drive ---------------------------------------- */
 
+/* What the gimbal asks the 3AX to do. The values are those of the
+ * RETRACT_DEPLOY_CMD `deploy` byte (tase/flags.h TASE_DEPLOY = 1,
+ * TASE_RETRACT = 0), so a value carried from that packet keeps its meaning;
+ * the move frame's own byte has the opposite sense (0 deploys) and only
+ * the encoder and decoder see it. Formerly TASE_3AX_DEPLOY = 0 and
+ * TASE_3AX_RETRACT = 1: renamed so that code written for those values
+ * fails to build instead of moving the wrong way. */
 typedef enum {
-    TASE_3AX_DEPLOY = 0, /* byte 0 == 0 */
-    TASE_3AX_RETRACT = 1 /* byte 0 != 0; sent as 0xFE */
+    TASE_3AX_MOVE_RETRACT = 0, /* frame byte 0 != 0; sent as 0xFE */
+    TASE_3AX_MOVE_DEPLOY = 1   /* frame byte 0 == 0 */
 } tase_3ax_command_t;
 
 #define TASE_3AX_RETRACT_BYTE 0xFEu       /* what the encoder sends to retract */

@@ -28,9 +28,12 @@
  *   TASE_RX_CANDIDATES (1..16, default 4)   ABI: changes sizeof(tase_rx_t),
  *       so also of tase_host_t and tase_can_rx_t, and the stride of the
  *       receiver array given to tase_gimbal_init(). See tase/frame.h.
+ *   TASE_PORT_WRITE_TIMEOUT_MS (default 100)  the deadline of one frame
+ *       write by tase_port_write_all() (tase/port_io.h).
  *   TASE_PORT_WRITE_TRIES (default 64)  tase_port_write_all()'s give-up
- *       count (tase/port_io.h). Used only inside the library: the value
- *       the library was built with is the one that applies.
+ *       count for a port whose clock does not move (tase/port_io.h).
+ *       Both are used only inside the library: the values the library
+ *       was built with are the ones that apply.
  *   TASE_RING_BARRIER()  the bare-metal ring's barrier hook (tase/ring.h),
  *       used only inside port/baremetal/tase_ring.c.
  * No other macro changes a type's size or a function's signature.
@@ -66,6 +69,9 @@
 #error "TASE_RX_CANDIDATES must be 1..16"
 #endif
 
+#ifndef TASE_PORT_WRITE_TIMEOUT_MS
+#define TASE_PORT_WRITE_TIMEOUT_MS 100u
+#endif
 #ifndef TASE_PORT_WRITE_TRIES
 #define TASE_PORT_WRITE_TRIES 64u
 #endif
@@ -107,19 +113,21 @@
 #define TASE_CONFIG_TAG_ rx_candidates_16
 #endif
 
-#define TASE_CONFIG_PASTE_(name, tag) name##_##tag
-#define TASE_CONFIG_NAME_(name, tag) TASE_CONFIG_PASTE_(name, tag)
-/* name -> name_<configuration tag>, the link name of an ABI-guarded
- * function. */
-#define TASE_CONFIG_LINK_NAME(name) TASE_CONFIG_NAME_(name, TASE_CONFIG_TAG_)
+#define TASE_CONFIG_PASTE_(stem, tag) stem##tag
+#define TASE_CONFIG_NAME_(stem, tag) TASE_CONFIG_PASTE_(stem, tag)
+/* stem -> stem<configuration tag>: the link name of an ABI-guarded
+ * function is its name, "_", and the tag. (The stem is spelled with the
+ * trailing "_" so that no macro expands to its own name: clang
+ * -Wdisabled-macro-expansion.) */
+#define TASE_CONFIG_LINK_NAME(stem) TASE_CONFIG_NAME_(stem, TASE_CONFIG_TAG_)
 
 /* The ABI-guarded functions: the initialisers of tase_rx_t (frame.h),
  * tase_can_rx_t (can.h), tase_host_t (host.h) and of tase_gimbal_t with
  * its receiver array (gimbal.h). A new type that embeds a tase_rx_t, or
  * takes an array of them, adds its initialiser here. */
-#define tase_rx_init TASE_CONFIG_LINK_NAME(tase_rx_init)
-#define tase_can_rx_init TASE_CONFIG_LINK_NAME(tase_can_rx_init)
-#define tase_host_init TASE_CONFIG_LINK_NAME(tase_host_init)
-#define tase_gimbal_init TASE_CONFIG_LINK_NAME(tase_gimbal_init)
+#define tase_rx_init TASE_CONFIG_LINK_NAME(tase_rx_init_)
+#define tase_can_rx_init TASE_CONFIG_LINK_NAME(tase_can_rx_init_)
+#define tase_host_init TASE_CONFIG_LINK_NAME(tase_host_init_)
+#define tase_gimbal_init TASE_CONFIG_LINK_NAME(tase_gimbal_init_)
 
 #endif /* TASE_CONFIG_H */

@@ -8,9 +8,10 @@
  * taking the spec's first and last bit numbers. Header only; the macros
  * are constant expressions usable in case labels.
  *
- * Enumerations the spec lists without values (gimbal mode, navigation
- * filter mode) are numbered here in the spec's order from 0; this is a
- * decision of this library, see docs/PROTOCOL-NOTES.md.
+ * Enumerations the spec lists without values are numbered by this
+ * library (docs/PROTOCOL-NOTES.md): the navigation filter mode in the
+ * spec's order from 0 (P8), the gimbal mode as Cloud Cap's later public
+ * header numbers the same modes (D2).
  */
 #ifndef TASE_FLAGS_H
 #define TASE_FLAGS_H
@@ -100,7 +101,10 @@
 #define TASE_CAMERA_FLAG_STAB TASE_BIT8(6)
 #define TASE_CAMERA_FLAG_TITLE TASE_BIT8(7)
 
-/* ---- RETRACT_DEPLOY_CMD (4.1.6); note 5.3.1 uses the opposite sense -- */
+/* ---- RETRACT_DEPLOY_CMD (4.1.6) --------------------------------------- */
+/* The `deploy` byte: non-zero deploys, zero retracts. The 3AX CAN move
+ * frame (5.3.1) has the opposite byte sense; tase/can.h hides it behind
+ * TASE_3AX_MOVE_DEPLOY / _RETRACT, which have these same values. */
 #define TASE_RETRACT 0u
 #define TASE_DEPLOY 1u /* any non-zero value deploys */
 
@@ -110,13 +114,18 @@
 #define TASE_MODE_3AX_RETRACTED TASE_BIT8(2)
 #define TASE_MODE_VALUE(mode) TASE_BITS8_GET(mode, 3, 7)
 #define TASE_MODE_SET_VALUE(mode, v) TASE_BITS8_SET(mode, 3, 7, v)
-/* Mode values, in the spec's order (values are our decision). */
-#define TASE_MODE_RATE 0u
-#define TASE_MODE_POSITION 1u
-#define TASE_MODE_SPOI 2u
-#define TASE_MODE_PAN_INIT 3u
-#define TASE_MODE_TILT_INIT 4u
-#define TASE_MODE_POSITION_INIT 5u
+/* Mode values (bits 3-7, 0..31). The spec lists six modes without values;
+ * these are the values Cloud Cap's later public gimbal packet header gives
+ * the same modes (PROTOCOL-NOTES D2). Its numbers 3-9 and 14-15 are modes
+ * this spec does not have (video tracking, scan, rig test, retract
+ * detection), and it splits tilt initialisation into two phases. */
+#define TASE_MODE_RATE 0u           /* "Rate feedback" */
+#define TASE_MODE_POSITION 1u       /* "Position feedback" */
+#define TASE_MODE_SPOI 2u           /* "Sensor point of interest" */
+#define TASE_MODE_PAN_INIT 10u      /* "Pan initialization" */
+#define TASE_MODE_TILT_INIT 11u     /* "Tilt initialization", first phase */
+#define TASE_MODE_TILT_INIT_2 12u   /* "Tilt initialization", second phase */
+#define TASE_MODE_POSITION_INIT 13u /* "Position initialization" */
 
 /* ---- HOST_SENSOR flags (4.2.3) ---------------------------------------- */
 #define TASE_HOST_SENSOR_BIAS_CORRECTED TASE_BIT8(0)
@@ -129,11 +138,18 @@
 #define TASE_HOST_ATT_OVERWRITE TASE_BIT8(7)
 
 /* ---- SPOI_CMD flags (4.3.2) ------------------------------------------- */
-/* Bit 0: to the gimbal, request an echo; from the gimbal, stab is on. */
+/* To the gimbal: bit 0 requests an echo, bits 1-7 zero. From the gimbal:
+ * "bit 0 set if stabilization is on", "1-7) Mode": read exactly like the
+ * Mode byte above (PROTOCOL-NOTES P4), i.e. bits 1-2 the 3AX state and bits
+ * 3-7 the mode. A gimbal that writes a bare mode number into bits 1-7
+ * instead leaves bits 1-2 clear for every mode below 32, so the mode reads
+ * the same under both readings; reading bits 1-7 as the number would turn
+ * a copied Mode byte (0xC2: stabilised, deployed, SPOI) into mode 66. */
 #define TASE_SPOI_ECHO TASE_BIT8(0)
-#define TASE_SPOI_STAB TASE_BIT8(0)
-/* Bits 1-7, from the gimbal: a TASE_MODE_* value. */
-#define TASE_SPOI_MODE(flags) TASE_BITS8_GET(flags, 1, 7)
+#define TASE_SPOI_STAB TASE_MODE_STAB
+#define TASE_SPOI_3AX_DEPLOYED TASE_MODE_3AX_DEPLOYED
+#define TASE_SPOI_3AX_RETRACTED TASE_MODE_3AX_RETRACTED
+#define TASE_SPOI_MODE(flags) TASE_MODE_VALUE(flags)
 
 /* ---- GPS status word of GEOREFERENCE_DATA (4.3.3) --------------------- */
 #define TASE_GPS_FIX(status) TASE_BITS16_GET(status, 0, 2)
@@ -199,7 +215,10 @@
 #define TASE_CAMTYPE_FLIR_320_PHOTON_23 97u
 #define TASE_CAMTYPE_FLIR_320_PHOTON_36 98u
 #define TASE_CAMTYPE_FLIR_320_PHOTON_50 99u
-/* The spec spells these THERMOTTEKNIX; the maker is Thermoteknix. */
+/* The spec spells these THERMOTTEKNIX; the maker is Thermoteknix. The
+ * suffix is the lens's field of view rounded, except 307_13, which table 28
+ * lists with a 12.2 deg lens: value and name kept as listed (PROTOCOL-NOTES
+ * S10). */
 #define TASE_CAMTYPE_THERMOTEKNIX_MIRACLE_110_41 112u
 #define TASE_CAMTYPE_THERMOTEKNIX_MIRACLE_110_24 113u
 #define TASE_CAMTYPE_THERMOTEKNIX_MIRACLE_110_15 114u

@@ -3,19 +3,30 @@
  * without knowing what the gimbal is (firmware, a simulator, a test).
  *
  * A tase_gimbal_t serves up to TASE_GIMBAL_PORTS ports ("external
- * communications port 1..3" of the PACKET_RATE packet, index 0..2 here),
- * each a tase_port_t with its own frame receiver. It
+ * communications port 1..3" of the PACKET_RATE packet, index 0..2 here:
+ * index i is port i + 1), each a tase_port_t with its own frame receiver.
+ * The spec never says which connector is port 1..3; the three that table 1
+ * gives for gimbal communications, in its order, are Com2 (9600 baud),
+ * Com3 (57600) and CAN, so pass them as indices 0, 1, 2 (Com1 is the
+ * magnetometer's; docs/PROTOCOL-NOTES.md A2). It
  *
  *  - SETUP PACKETS (group 0x48, types 0x00..0x07, spec 4.4): stores the
  *    current data bytes of every setup packet (110 bytes), seeded at init
- *    with the spec's defaults where it gives them. A zero-length packet is
- *    a query: the role answers, on the port it came from, with the stored
- *    bytes. A packet with data of the right length is handed to the
- *    application's apply_setup() callback, which validates and applies it
- *    and may change the bytes (e.g. resolve AXIS_SETTING's 0xFF "do not
- *    change" fields, clamp values); the bytes it leaves are stored and
- *    echoed. If apply_setup() refuses, the stored bytes are echoed
- *    unchanged, so the host always learns the settings in force.
+ *    with the spec's defaults where it gives them (CAMERA_TYPE: 0xFF "no
+ *    camera" until the application stores its cameras). A zero-length
+ *    packet is a query: the role answers, on the port it came from, with
+ *    the stored bytes. A packet with data of an accepted length is first
+ *    made what the gimbal would store: reserved bytes zero, and every field
+ *    holding its "do not change" value (AXIS_SETTING 0xFF/0xFFFF,
+ *    CAMERA_TYPE 0; tase_field_is_keep()) replaced by the stored setting,
+ *    in the table's layout (a 22-byte AXIS_SETTING is laid out as 23). It
+ *    is then handed to the application's apply_setup() callback, which
+ *    validates and applies it and may change the bytes (clamp values);
+ *    the bytes it leaves are stored and echoed, in the layout the packet
+ *    came in (22 or 23 bytes for AXIS_SETTING). If apply_setup() refuses,
+ *    the stored bytes are echoed unchanged, so the host always learns the
+ *    settings in force. The stored bytes never hold a non-zero reserved
+ *    byte nor a "do not change" value.
  *    SYSTEM_VERSION is query-only: any SYSTEM_VERSION packet is answered
  *    with the bytes the application set (tase_gimbal_setup_set()).
  *    A setup packet with a wrong data length is counted (stats.bad_length)
@@ -68,6 +79,35 @@
  * sent as a burst. Poll at least once per shortest period (every few ms)
  * and every slot is sent, within the poll interval of its due time.
  *
+ * PRIORITY AND CAPACITY. Setup echoes, query answers and the
+ * application's own sends are written at once, as the frame that asks for
+ * them is handled (tase_gimbal_service() reads and answers before it
+ * polls telemetry), and are never held back. Telemetry is what yields: a
+ * link carries only so many bytes per second (9600 baud 8N1: 960 B/s),
+ * and PACKET_RATE may ask for far more (255/255/255 is 28,305 B/s). Bytes
+ * written beyond what the link carries pile up in the driver's transmit
+ * queue, where an echo written later waits behind them (4.3 s behind a
+ * 4 KB tty queue at 9600 baud: longer than a host's retries), and every
+ * write blocks until the queue has room. So the application states each
+ * port's capacity (tase_gimbal_set_capacity(), e.g.
+ * TASE_UART_BYTES_PER_S(9600)), and telemetry may use at most
+ * TASE_GIMBAL_TELEMETRY_SHARE percent of it, the rest staying free for
+ * answers. When the rates ask for more, every stream of that port sends
+ * the same fraction of its due slots, spread evenly, and skips the rest
+ * (stats.slots_over_capacity); the stored and echoed PACKET_RATE stay
+ * what the host asked for. The transmit queue then stays short, and an
+ * answer leaves within a few frame times. Capacity 0 (the default) means
+ * unknown: no limit.
+ *
+ * LONGEST BLOCK. Each frame write blocks at most the port's frame bound
+ * (port_io.h: TASE_PORT_WRITE_TIMEOUT_MS + the port's W). A port whose
+ * write fails gets no further telemetry in the same poll (its remaining
+ * due slots count in stats.slots_after_tx_error), so a stuck port costs
+ * tase_gimbal_poll() one frame bound, not one per due stream: a poll
+ * blocks at most one bound per frame it wrote plus one per present port;
+ * tase_gimbal_feed()/_handle_frame() one per answer written. Within the
+ * capacity the driver's queue has room and writes do not block at all.
+ *
  * TIME comes in as `now_ms` (monotonic, wraps modulo 2^32; e.g. a port's
  * now_ms()). Nothing here reads a clock, allocates or uses globals.
  *
@@ -97,13 +137,25 @@ extern "C" {
 #define TASE_STREAM_RATE 1u   /* GIMBAL_RATE 0x08/0x40 */
 #define TASE_STREAM_GEOREF 2u /* GEOREFERENCE_DATA 0x10/0x41 */
 
+/* Percentage of a port's capacity telemetry may use (see PRIORITY AND
+ * CAPACITY); the rest is kept for echoes and answers. */
+#ifndef TASE_GIMBAL_TELEMETRY_SHARE
+#define TASE_GIMBAL_TELEMETRY_SHARE 75u
+#endif
+
+/* Bytes per second an asynchronous serial line carries at `baud` with
+ * 10 bits per byte (8N1: start, 8 data, stop). */
+#define TASE_UART_BYTES_PER_S(baud) ((uint32_t)(baud) / 10u)
+
 /* Application callbacks; any may be NULL. `user` is passed back. */
 typedef struct {
-    /* A setup packet of `type` (0..7, not SYSTEM_VERSION) with its full
-     * data length arrived on `port`. data[0..len) is a private copy the
-     * callback may modify. Return >= 0 to accept (the bytes are stored,
-     * a PACKET_RATE change reschedules, and the bytes are echoed) or < 0
-     * to refuse (the current settings are echoed). NULL accepts all. */
+    /* A setup packet of `type` (0..7, not SYSTEM_VERSION) with data
+     * arrived on `port`. data[0..len) is a private copy in the table's
+     * layout (len is the table length), reserved bytes zero and "do not
+     * change" fields already replaced by the stored settings; the callback
+     * may modify it. Return >= 0 to accept (the bytes are stored, a
+     * PACKET_RATE change reschedules, and the bytes are echoed) or < 0 to
+     * refuse (the current settings are echoed). NULL accepts all. */
     int (*apply_setup)(void *user, unsigned port, uint8_t type, uint8_t *data, size_t len);
     /* Telemetry packet `id` (TASE_ID_GIMBAL_ANGLE, _GIMBAL_RATE,
      * _GEOREFERENCE_DATA) is due on `port`: write its data into
@@ -129,26 +181,30 @@ typedef struct {
 
 /* Statistics; only incremented by the library, wrap modulo 2^32. */
 typedef struct {
-    uint32_t frames_rx;         /* valid frames received on all ports */
-    uint32_t setup_applied;     /* setup packets accepted and stored */
-    uint32_t setup_refused;     /* setup packets apply_setup() refused */
-    uint32_t setup_queries;     /* zero-length setup queries answered */
-    uint32_t bad_length;        /* setup packets with a wrong data length */
-    uint32_t telemetry_tx;      /* telemetry frames written */
-    uint32_t telemetry_skipped; /* due slots fill_telemetry() declined */
-    uint32_t slots_skipped;     /* slots passed over because poll was late */
-    uint32_t frames_tx;         /* all frames written (echoes, telemetry, sends) */
-    uint32_t tx_errors;         /* frames a port did not take completely */
+    uint32_t frames_rx;            /* valid frames received on all ports */
+    uint32_t setup_applied;        /* setup packets accepted and stored */
+    uint32_t setup_refused;        /* setup packets apply_setup() refused */
+    uint32_t setup_queries;        /* zero-length setup queries answered */
+    uint32_t bad_length;           /* setup packets with a wrong data length */
+    uint32_t telemetry_tx;         /* telemetry frames written */
+    uint32_t telemetry_skipped;    /* due slots fill_telemetry() declined */
+    uint32_t slots_skipped;        /* slots passed over because poll was late */
+    uint32_t frames_tx;            /* all frames written (echoes, telemetry, sends) */
+    uint32_t tx_errors;            /* frames a port did not take completely */
+    uint32_t slots_over_capacity;  /* due slots skipped to stay within capacity */
+    uint32_t slots_after_tx_error; /* due slots not tried: the port failed earlier
+                                      in the same poll */
 } tase_gimbal_stats_t;
 
 /* Private: the schedule of one telemetry stream. */
 typedef struct {
     uint32_t t0;  /* anchor: slot k is due at t0 + k * 1000 / rate */
+    uint32_t acc; /* capacity pacing: accumulated budget */
     uint16_t k;   /* next slot, 0 <= k < rate */
     uint8_t rate; /* packets per second, 0 = off */
 } tase_gimbal_sched_t;
 
-/* Gimbal instance (about 270 bytes; the receivers are the caller's, see
+/* Gimbal instance (about 350 bytes on Cortex-M; the receivers are the caller's, see
  * tase_gimbal_init()). Treat every field except `stats` as private. */
 typedef struct {
     tase_gimbal_stats_t stats;
@@ -157,6 +213,8 @@ typedef struct {
     tase_rx_t *rx;                       /* caller's receivers, or NULL */
     uint8_t nrx;                         /* how many */
     tase_gimbal_sched_t sched[TASE_GIMBAL_PORTS][TASE_GIMBAL_STREAMS];
+    uint32_t capacity[TASE_GIMBAL_PORTS]; /* bytes/s, 0 = no limit */
+    uint32_t demand[TASE_GIMBAL_PORTS];   /* telemetry bytes/s the rates ask */
     uint8_t setup[TASE_GIMBAL_SETUP_BYTES];
 } tase_gimbal_t;
 
@@ -190,9 +248,18 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
                              uint32_t now_ms);
 
+/* Set the capacity of port index `port` in bytes per second (0: unknown,
+ * no limit; the default), e.g. TASE_UART_BYTES_PER_S(9600) for a
+ * 9600-baud line. See PRIORITY AND CAPACITY. Takes effect at the next due
+ * slot. Returns TASE_OK or TASE_EARG (g NULL, port >= 3). O(1). */
+int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per_s);
+
 /* Send every telemetry packet that is due at now_ms (at most one per
- * stream, see SCHEDULE). Returns the number of frames written (>= 0) or
- * TASE_EARG (g NULL). O(ports * streams) plus the callbacks and writes. */
+ * stream, see SCHEDULE; within the port's capacity, see PRIORITY AND
+ * CAPACITY). Returns the number of frames written (>= 0) or TASE_EARG (g
+ * NULL). Blocks at most one frame bound per frame written plus one per
+ * present port (LONGEST BLOCK).
+ * O(ports * streams) plus the callbacks and writes. */
 int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
 
 /* Read whatever each present port has ready (timeout 0, ports with a
@@ -230,7 +297,9 @@ int tase_gimbal_setup_len(uint8_t type);
 int tase_gimbal_setup_get(const tase_gimbal_t *g, uint8_t type, uint8_t *out, size_t cap);
 
 /* Store setup packet `type` directly (no callback, no echo): load saved
- * settings at start-up, or set SYSTEM_VERSION. A PACKET_RATE change
+ * settings at start-up, or set SYSTEM_VERSION. data is in the table's
+ * layout; reserved bytes are stored as zero, and a field holding its "do
+ * not change" value keeps the stored setting. A PACKET_RATE change
  * reschedules as described above, anchored at now_ms. Returns TASE_OK,
  * TASE_EARG (g NULL, data NULL), TASE_EUNKNOWN (type > 7), TASE_ELENGTH
  * (len is not the type's length, 0 and SIZE_MAX included); g unchanged on

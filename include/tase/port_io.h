@@ -5,12 +5,25 @@
  * A port's write() may accept only part of a buffer (it reports how much).
  * The roles (host.h, gimbal.h) must never leave half a frame on the wire
  * when it can be avoided, so they send through tase_port_write_all(),
- * which keeps writing until everything is taken, the port fails, or the
- * port makes no progress TASE_PORT_WRITE_TRIES times in a row.
+ * which keeps writing until everything is taken, the port fails, or its
+ * one deadline per frame has passed.
  *
- * Neither helper blocks by itself: how long a write may wait is the port's
- * business (the POSIX UART port waits up to its write timeout, the
- * bare-metal template's TX hook is blocking).
+ * LONGEST BLOCK of tase_port_write_all(), tase_port_send_frame() and
+ * tase_port_send_msg(), per call (one frame), in total:
+ *     TASE_PORT_WRITE_TIMEOUT_MS + W
+ * where W is the port's own write bound (tase/port.h: the POSIX UART
+ * port's write_timeout_ms, the SocketCAN port's tx_timeout_ms, the
+ * bare-metal template's tx hook). write() is called again only while less
+ * than TASE_PORT_WRITE_TIMEOUT_MS have passed since the helper started,
+ * on the port's clock, so only a call started before that deadline can
+ * still be running after it. A port that waits by itself (both POSIX
+ * ports) returns short only once its own W has passed, so with W at
+ * least the deadline (the defaults: 1000 and 100 ms) it is never called
+ * twice for a frame and the bound is W alone; a port that does not wait
+ * (a full TX ring) is retried until the deadline. A clock sample
+ * older than the start counts as no time (see tase_port_elapsed_ms()).
+ * A port without now_ms is bounded by calls instead: at most
+ * TASE_PORT_WRITE_TRIES calls that take nothing.
  */
 #ifndef TASE_PORT_IO_H
 #define TASE_PORT_IO_H
@@ -21,21 +34,32 @@
 extern "C" {
 #endif
 
-/* TASE_PORT_WRITE_TRIES (tase/config.h, default 64): consecutive calls
- * to write() that took nothing (TASE_EAGAIN, TASE_ENOBUFS or 0) after
- * which tase_port_write_all() gives up. */
+/* TASE_PORT_WRITE_TIMEOUT_MS (tase/config.h, default 100): the deadline
+ * of one frame write (see LONGEST BLOCK).
+ * TASE_PORT_WRITE_TRIES (tase/config.h, default 64): backstop for a port
+ * whose clock does not move (or that has none): calls to write() that took
+ * nothing (TASE_EAGAIN, TASE_ENOBUFS or 0) after which
+ * tase_port_write_all() gives up even before the deadline. */
 
-/* Write all n bytes of data to the port.
- * Returns n, or
+/* Milliseconds from since_ms to now_ms on a clock that wraps modulo 2^32
+ * (unsigned difference). A now_ms sampled before since_ms (a stale sample
+ * or a clock that stepped back: the difference is 2^31 or more) is 0, no
+ * time at all, never 49 days. Times compared must be less than 2^31 ms
+ * apart. O(1), reentrant, ISR-safe. */
+uint32_t tase_port_elapsed_ms(uint32_t now_ms, uint32_t since_ms);
+
+/* Write all n bytes of data to the port within the frame deadline (see
+ * LONGEST BLOCK). Returns n, or
  *   TASE_EARG    port/ops/write NULL, data NULL with n > 0, or
- *                n > INT32_MAX (the count must fit the int result);
- *   TASE_EAGAIN / TASE_ENOBUFS  the port took nothing at all (retry later;
- *                nothing was sent);
- *   TASE_EIO     the port stopped taking bytes part-way (some bytes were
- *                sent; a receiver will discard the cut frame by its
- *                checksum), also when write() claims more than it was
- *                given (a broken port);
- *   any other negative code the port's write() returned.
+ *                n > INT_MAX (the count must fit the int result;
+ *                32767 where int is 16 bits);
+ *   TASE_EAGAIN / TASE_ENOBUFS  the port took nothing before the deadline
+ *                (retry later; nothing was sent);
+ *   TASE_EIO     the deadline passed part-way (some bytes were sent; a
+ *                receiver will discard the cut frame by its checksum),
+ *                also when write() claims more than it was given (a
+ *                broken port);
+ *   any other negative code the port's write() returned (at once).
  * O(n) plus the port's cost. Reentrant if the port's write is; not
  * ISR-safe unless the port's write is. */
 int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n);

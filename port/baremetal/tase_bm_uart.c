@@ -1,6 +1,10 @@
 /* Bare-metal UART port template; see tase/bm_uart.h. */
 #include "tase/bm_uart.h"
 
+#include <limits.h>
+
+#include "tase/port_io.h"
+
 #define DRAIN_CHUNK 32u
 
 int tase_bm_uart_init(tase_bm_uart_t *u, uint8_t *rx_buf, size_t cap,
@@ -8,6 +12,9 @@ int tase_bm_uart_init(tase_bm_uart_t *u, uint8_t *rx_buf, size_t cap,
 {
     if (u == NULL || hooks == NULL || hooks->tx == NULL || hooks->millis == NULL) {
         return TASE_EARG;
+    }
+    if (hooks->idle != NULL && (hooks->irq_off == NULL || hooks->irq_on == NULL)) {
+        return TASE_EARG; /* an idle hook without the mask is the lost-wakeup race */
     }
     if (tase_ring_init(&u->rx, rx_buf, cap) != TASE_OK) {
         return TASE_EARG;
@@ -33,9 +40,17 @@ int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_fra
     if (u == NULL || rx == NULL) {
         return TASE_EARG;
     }
+    /* A receiver that cannot take bytes (never initialised, corrupted) is
+     * found before any byte leaves the ring: nothing is lost to it. */
+    {
+        int r = tase_rx_feed(rx, NULL, 0u, on_frame, user);
+        if (r < 0) {
+            return r;
+        }
+    }
     budget = tase_ring_capacity(&u->rx);
     while (budget > 0) {
-        size_t want = budget < DRAIN_CHUNK ? budget : DRAIN_CHUNK;
+        size_t want = (size_t)(budget < DRAIN_CHUNK ? budget : DRAIN_CHUNK);
         size_t n = tase_ring_get(&u->rx, chunk, want);
         int r;
         if (n == 0) {
@@ -43,9 +58,10 @@ int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_fra
         }
         budget -= (uint32_t)n;
         r = tase_rx_feed(rx, chunk, n, on_frame, user);
-        if (r > 0) {
-            frames += r;
+        if (r < 0) {
+            return r; /* e.g. a handler that corrupted the receiver */
         }
+        frames += r;
     }
     return frames;
 }
@@ -54,7 +70,7 @@ static int bm_write(void *ctx, const uint8_t *data, size_t n)
 {
     tase_bm_uart_t *u = ctx;
     int r;
-    if (u == NULL || u->hooks == NULL || (data == NULL && n > 0) || n > 0x7FFFFFFFu) {
+    if (u == NULL || u->hooks == NULL || (data == NULL && n > 0) || n > (size_t)INT_MAX) {
         return TASE_EARG;
     }
     r = u->hooks->tx(u->hw, data, n);
@@ -69,8 +85,8 @@ static int bm_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
     if (u == NULL || u->hooks == NULL || buf == NULL || cap == 0) {
         return TASE_EARG;
     }
-    if (cap > 0x7FFFFFFFu) {
-        cap = 0x7FFFFFFFu;
+    if (cap > (size_t)INT_MAX) {
+        cap = (size_t)INT_MAX; /* the count must fit the int result */
     }
     start = u->hooks->millis(u->hw);
     for (;;) {
@@ -78,11 +94,19 @@ static int bm_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
         if (n > 0) {
             return (int)n;
         }
-        if ((uint32_t)(u->hooks->millis(u->hw) - start) >= timeout_ms) {
+        if (tase_port_elapsed_ms(u->hooks->millis(u->hw), start) >= timeout_ms) {
             return 0;
         }
         if (u->hooks->idle != NULL) {
-            u->hooks->idle(u->hw);
+            /* Check and sleep with the interrupt masked: a byte arriving
+             * after the check leaves its interrupt pending, which ends
+             * the sleep at once (WFI wakes on a pending interrupt even
+             * while masked); unmasking then runs it. */
+            u->hooks->irq_off(u->hw);
+            if (tase_ring_count(&u->rx) == 0u) {
+                u->hooks->idle(u->hw);
+            }
+            u->hooks->irq_on(u->hw);
         }
     }
 }

@@ -14,11 +14,16 @@
 
 int tase_ring_init(tase_ring_t *r, uint8_t *buf, size_t cap)
 {
-    if (r == NULL || buf == NULL || cap == 0 || cap > 0x80000000u || (cap & (cap - 1u)) != 0) {
+    /* cap - 1 must fit 31 bits, tested without comparing size_t to a
+     * constant it cannot reach where size_t is 16 bits (AVR). */
+    uint32_t mask = (uint32_t)(cap - 1u);
+
+    if (r == NULL || buf == NULL || cap == 0 || (size_t)mask != cap - 1u || mask > 0x7FFFFFFFu ||
+        (cap & (cap - 1u)) != 0) {
         return TASE_EARG;
     }
     r->buf = buf;
-    r->mask = (uint32_t)(cap - 1u);
+    r->mask = mask;
     r->head = 0;
     r->tail = 0;
     r->overflow = 0;
@@ -68,7 +73,7 @@ size_t tase_ring_get(tase_ring_t *r, uint8_t *out, size_t cap)
     /* Finish reading the slots before handing them back to the ISR. */
     TASE_RING_BARRIER();
     r->tail = tail + avail;
-    return avail;
+    return (size_t)avail; /* <= cap */
 }
 
 uint32_t tase_ring_count(const tase_ring_t *r)

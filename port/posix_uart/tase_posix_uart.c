@@ -6,6 +6,8 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/file.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -94,6 +96,7 @@ uint32_t tase_posix_now_ms(void)
 static int map_open_errno(int e)
 {
     switch (e) {
+    case EBUSY: return TASE_EBUSY; /* TIOCEXCL of another program */
     case ENOENT:
     case ENXIO:
     case ENODEV:
@@ -145,15 +148,90 @@ static int configure(int fd, speed_t code)
     return TASE_OK;
 }
 
-static int setup_fd(tase_posix_uart_t *u, int fd, uint32_t baud, speed_t code)
+/* Exclusive use of the device: an advisory lock every cooperating
+ * program (ours, and minicom, picocom, ModemManager...) sees, and the
+ * kernel's TIOCEXCL, which refuses any further open() except root's. */
+static int take_exclusive(tase_posix_uart_t *u, int fd)
 {
-    int flags = fcntl(fd, F_GETFL);
     int r;
-    if (flags < 0 || fcntl(fd, F_SETFL, flags | O_NONBLOCK) < 0) {
+    do {
+        r = flock(fd, LOCK_EX | LOCK_NB);
+    } while (r != 0 && errno == EINTR);
+    if (r != 0) {
+        return errno == EWOULDBLOCK ? TASE_EBUSY : TASE_EIO;
+    }
+#ifdef TIOCEXCL
+    /* Best effort: the lock above already keeps our own programs apart. */
+    u->excl = ioctl(fd, TIOCEXCL) == 0;
+#endif
+    return TASE_OK;
+}
+
+/* Undo what open did to the device, in reverse: settings, then
+ * exclusivity (the lock goes with the descriptor). */
+static void give_back(tase_posix_uart_t *u, int fd)
+{
+    if (u->restore) {
+        while (tcsetattr(fd, TCSADRAIN, &u->saved) != 0 && errno == EINTR) {
+        }
+        u->restore = false;
+    }
+#ifdef TIOCNXCL
+    if (u->excl) {
+        (void)ioctl(fd, TIOCNXCL);
+    }
+#endif
+    u->excl = false;
+}
+
+/* Wait up to timeout_ms for the bytes written to leave the kernel's output
+ * queue; drop what is still there then (a stuck line would otherwise hold
+ * close() for the kernel's closing wait, 30 s). */
+static void drain_bounded(int fd, uint32_t timeout_ms)
+{
+#ifdef TIOCOUTQ
+    uint32_t start = tase_posix_now_ms();
+    int queued = 0;
+    while (ioctl(fd, TIOCOUTQ, &queued) == 0 && queued > 0) {
+        struct timespec ts = {0, 2000000L};
+        if ((uint32_t)(tase_posix_now_ms() - start) >= timeout_ms) {
+            (void)tcflush(fd, TCOFLUSH);
+            return;
+        }
+        (void)nanosleep(&ts, NULL);
+    }
+#else
+    (void)fd;
+    (void)timeout_ms;
+#endif
+}
+
+static int setup_fd(tase_posix_uart_t *u, int fd, uint32_t baud, speed_t code, unsigned flags)
+{
+    int fl = fcntl(fd, F_GETFL);
+    int r;
+    u->restore = false;
+    u->excl = false;
+    if (!isatty(fd)) {
+        return TASE_ENODEV; /* before anything is changed */
+    }
+    if (fl < 0 || fcntl(fd, F_SETFL, fl | O_NONBLOCK) < 0) {
         return TASE_EIO;
     }
+    if ((flags & TASE_POSIX_UART_SHARED) == 0u) {
+        r = take_exclusive(u, fd);
+        if (r != TASE_OK) {
+            return r;
+        }
+    }
+    if (tcgetattr(fd, &u->saved) != 0) {
+        give_back(u, fd);
+        return map_open_errno(errno);
+    }
+    u->restore = true;
     r = configure(fd, code);
     if (r != TASE_OK) {
+        give_back(u, fd);
         return r;
     }
     u->fd = fd;
@@ -162,27 +240,35 @@ static int setup_fd(tase_posix_uart_t *u, int fd, uint32_t baud, speed_t code)
     return TASE_OK;
 }
 
-int tase_posix_uart_open(tase_posix_uart_t *u, const char *path, uint32_t baud)
+int tase_posix_uart_open_flags(tase_posix_uart_t *u, const char *path, uint32_t baud,
+                               unsigned flags)
 {
     speed_t code;
     int fd, r;
 
-    if (u == NULL || path == NULL) {
+    if (u == NULL || path == NULL || (flags & ~TASE_POSIX_UART_SHARED) != 0u) {
         return TASE_EARG;
     }
     u->fd = -1;
     if (!baud_code(baud, &code)) {
         return TASE_EUNSUPPORTED;
     }
-    fd = open(path, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    do {
+        fd = open(path, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    } while (fd < 0 && errno == EINTR);
     if (fd < 0) {
         return map_open_errno(errno);
     }
-    r = setup_fd(u, fd, baud, code);
+    r = setup_fd(u, fd, baud, code, flags);
     if (r != TASE_OK) {
         (void)close(fd);
     }
     return r;
+}
+
+int tase_posix_uart_open(tase_posix_uart_t *u, const char *path, uint32_t baud)
+{
+    return tase_posix_uart_open_flags(u, path, baud, 0u);
 }
 
 int tase_posix_uart_attach(tase_posix_uart_t *u, int fd, uint32_t baud)
@@ -196,10 +282,7 @@ int tase_posix_uart_attach(tase_posix_uart_t *u, int fd, uint32_t baud)
     if (!baud_code(baud, &code)) {
         return TASE_EUNSUPPORTED;
     }
-    if (!isatty(fd)) {
-        return TASE_ENODEV;
-    }
-    return setup_fd(u, fd, baud, code);
+    return setup_fd(u, fd, baud, code, TASE_POSIX_UART_SHARED);
 }
 
 int tase_posix_uart_close(tase_posix_uart_t *u)
@@ -211,6 +294,10 @@ int tase_posix_uart_close(tase_posix_uart_t *u)
     if (u->fd < 0) {
         return TASE_OK;
     }
+    if (u->restore) {
+        drain_bounded(u->fd, u->write_timeout_ms);
+    }
+    give_back(u, u->fd);
     r = close(u->fd);
     u->fd = -1;
     return r == 0 ? TASE_OK : TASE_EIO;

@@ -10,13 +10,25 @@
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <sys/uio.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <linux/can.h>
+#include <linux/can/error.h>
 #include <linux/can/raw.h>
 
 #define RETRY_SLEEP_MS 1u
+
+#ifndef CAN_ERR_CNT
+#define CAN_ERR_CNT 0x00000200U /* Linux 5.19+: error counters in data[6..7] */
+#endif
+
+/* The error classes the port asks the kernel for: everything about the
+ * bus's health, not lost arbitration (normal on a busy bus). */
+#define ERR_CLASSES                                                                                \
+    (CAN_ERR_TX_TIMEOUT | CAN_ERR_CRTL | CAN_ERR_PROT | CAN_ERR_TRX | CAN_ERR_ACK |                \
+     CAN_ERR_BUSOFF | CAN_ERR_BUSERROR | CAN_ERR_RESTARTED | CAN_ERR_CNT)
 
 /* The IDs each role's filter passes: its datalink ID, and for the gimbal
  * the 3AX status it listens to. */
@@ -49,16 +61,26 @@ static int set_filter(int fd, tase_can_role_t role)
 {
     struct can_filter flt[2];
     uint32_t ids[2];
+    can_err_mask_t err = ERR_CLASSES;
     size_t n = role_filter_ids(role, ids);
     size_t i;
     for (i = 0; i < n; i++) {
         flt[i].can_id = ids[i] | CAN_EFF_FLAG;
         flt[i].can_mask = CAN_EFF_FLAG | CAN_RTR_FLAG | CAN_EFF_MASK;
     }
-    if (setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, flt, (socklen_t)(n * sizeof(flt[0]))) != 0) {
+    if (setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, flt, (socklen_t)(n * sizeof(flt[0]))) != 0 ||
+        setsockopt(fd, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err, sizeof err) != 0) {
         return TASE_EIO;
     }
     return TASE_OK;
+}
+
+/* Kernel receive timestamps on every record, best effort: a socket that
+ * cannot give them reports 0. */
+static void want_timestamps(int fd)
+{
+    int on = 1;
+    (void)setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
 }
 
 uint32_t tase_socketcan_now_ms(void *ctx)
@@ -85,6 +107,9 @@ static void sleep_ms(uint32_t ms)
     }
 }
 
+/* Wait for events up to timeout_ms. 0 also when a signal interrupted the
+ * wait: every caller loops on its own deadline, so the wait resumes with
+ * the time left instead of failing. */
 static int wait_fd(int fd, short events, uint32_t timeout_ms)
 {
     struct pollfd p;
@@ -93,7 +118,10 @@ static int wait_fd(int fd, short events, uint32_t timeout_ms)
     p.events = events;
     p.revents = 0;
     rc = poll(&p, 1, timeout_ms > 0x7FFFFFFFu ? 0x7FFFFFFF : (int)timeout_ms);
-    return rc < 0 && errno != EINTR ? TASE_EIO : rc;
+    if (rc < 0) {
+        return errno == EINTR ? 0 : TASE_EIO;
+    }
+    return rc;
 }
 
 static void init_instance(tase_socketcan_t *s, int fd, tase_can_role_t role, unsigned flags)
@@ -171,6 +199,7 @@ int tase_socketcan_open(tase_socketcan_t *s, const char *ifname, tase_can_role_t
         close(fd);
         return rc;
     }
+    want_timestamps(fd);
     init_instance(s, fd, role, TASE_SOCKETCAN_OWN_FD);
     return TASE_OK;
 }
@@ -189,6 +218,7 @@ int tase_socketcan_adopt(tase_socketcan_t *s, int fd, tase_can_role_t role, unsi
     if ((flags & TASE_SOCKETCAN_SET_FILTER) != 0u && set_filter(fd, role) != TASE_OK) {
         return TASE_EIO;
     }
+    want_timestamps(fd);
     init_instance(s, fd, role, flags);
     return TASE_OK;
 }
@@ -257,9 +287,16 @@ static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, uint32_t d
         if (e == EINTR) {
             continue;
         }
+        if (e == ENETDOWN) {
+            s->stats.last_errno = e;
+            return TASE_EDOWN; /* interface down (or bus-off without auto-restart) */
+        }
         if (e != EAGAIN && e != EWOULDBLOCK && e != ENOBUFS) {
             s->stats.last_errno = e;
             return TASE_EIO;
+        }
+        if (e == ENOBUFS) {
+            s->bus.enobufs++;
         }
         if (remaining(deadline) == 0u) {
             s->stats.tx_full++;
@@ -269,7 +306,7 @@ static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, uint32_t d
         /* ENOBUFS comes from the interface queue, which poll() does not
          * see, so sleep a little too rather than spin on POLLOUT. */
         if (e == ENOBUFS) {
-            sleep_ms(RETRY_SLEEP_MS);
+            sleep_ms(remaining(deadline) < RETRY_SLEEP_MS ? remaining(deadline) : RETRY_SLEEP_MS);
         } else if (wait_fd(s->fd, POLLOUT, remaining(deadline)) < 0) {
             s->stats.last_errno = errno;
             return TASE_EIO;
@@ -308,29 +345,147 @@ int tase_socketcan_write(tase_socketcan_t *s, const uint8_t *data, size_t n)
     }
 }
 
-/* Next data frame from the socket within timeout_ms: 1, 0 or TASE_EIO. */
-static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_ms)
+/* One record of a CAN_RAW socket: a classic frame (CAN_MTU bytes) or, on
+ * a socket with CAN_RAW_FD_FRAMES, an FD frame (CANFD_MTU bytes). */
+typedef union {
+    struct can_frame cc;
+    struct canfd_frame fd;
+} can_record_t;
+
+/* Count an error frame and follow the bus state it reports. */
+static void bus_error_frame(tase_socketcan_t *s, const struct can_frame *cf)
 {
-    struct can_frame cf;
+    tase_socketcan_bus_t *b = &s->bus;
+    canid_t c = cf->can_id & CAN_ERR_MASK;
+    uint8_t ctrl = (c & CAN_ERR_CRTL) != 0u ? cf->data[1] : 0u;
+    b->error_frames++;
+    if ((c & CAN_ERR_TX_TIMEOUT) != 0u) {
+        b->tx_timeouts++;
+    }
+    if ((c & CAN_ERR_ACK) != 0u) {
+        b->no_acks++;
+    }
+    if ((c & (CAN_ERR_PROT | CAN_ERR_TRX | CAN_ERR_BUSERROR)) != 0u) {
+        b->bus_errors++;
+    }
+    if ((ctrl & (CAN_ERR_CRTL_RX_OVERFLOW | CAN_ERR_CRTL_TX_OVERFLOW)) != 0u) {
+        b->overflows++;
+    }
+    if ((c & CAN_ERR_CNT) != 0u) {
+        b->tx_error_count = cf->data[6];
+        b->rx_error_count = cf->data[7];
+    }
+    /* The worst state a frame reports wins; a restart or "active again"
+     * ends a passive or bus-off period. */
+    if ((c & CAN_ERR_BUSOFF) != 0u) {
+        b->bus_offs++;
+        b->state = TASE_SOCKETCAN_BUS_OFF;
+    } else if ((ctrl & (CAN_ERR_CRTL_RX_PASSIVE | CAN_ERR_CRTL_TX_PASSIVE)) != 0u) {
+        b->passives++;
+        b->state = TASE_SOCKETCAN_BUS_PASSIVE;
+    } else if ((ctrl & (CAN_ERR_CRTL_RX_WARNING | CAN_ERR_CRTL_TX_WARNING)) != 0u) {
+        b->warnings++;
+        b->state = TASE_SOCKETCAN_BUS_WARNING;
+    } else if ((ctrl & CAN_ERR_CRTL_ACTIVE) != 0u || (c & CAN_ERR_RESTARTED) != 0u) {
+        b->state = TASE_SOCKETCAN_BUS_ACTIVE;
+    } else {
+        /* a bus error without a state change */
+    }
+    if ((c & CAN_ERR_RESTARTED) != 0u) {
+        b->restarts++;
+    }
+}
+
+/* One record from the socket into *cf (a classic frame fills the first
+ * CAN_MTU bytes), with its kernel receive time in *ns (0: none). Returns
+ * the record's length, 0 for an AF_UNIX peer that closed, -1 with errno. */
+static ssize_t recv_record(int fd, can_record_t *cf, uint64_t *ns)
+{
+    union {
+        struct cmsghdr align;
+        unsigned char buf[CMSG_SPACE(sizeof(struct timespec))];
+    } ctl;
+    struct iovec iov;
+    struct msghdr m;
+    struct cmsghdr *c;
+    ssize_t n;
+    iov.iov_base = cf;
+    iov.iov_len = sizeof *cf;
+    memset(&m, 0, sizeof m);
+    m.msg_iov = &iov;
+    m.msg_iovlen = 1;
+    m.msg_control = ctl.buf;
+    m.msg_controllen = sizeof ctl.buf;
+    n = recvmsg(fd, &m, 0);
+    *ns = 0;
+    if (n <= 0) {
+        return n;
+    }
+    if ((m.msg_flags & MSG_TRUNC) != 0) {
+        return (ssize_t)sizeof *cf + 1; /* longer than any CAN record */
+    }
+    for (c = CMSG_FIRSTHDR(&m); c != NULL; c = CMSG_NXTHDR(&m, c)) {
+        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+            struct timespec ts;
+            memcpy(&ts, CMSG_DATA(c), sizeof ts);
+            *ns = (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+        }
+    }
+    return n;
+}
+
+/* One record of the socket, sorted: 1 (a data frame for the caller, *f
+ * filled), 0 (nothing for the caller: counted and dropped), or TASE_EIO. */
+static int take_record(tase_socketcan_t *s, ssize_t n, const can_record_t *cf, tase_can_frame_t *f)
+{
+    if (n == (ssize_t)CAN_MTU && (cf->cc.can_id & CAN_ERR_FLAG) != 0u) {
+        bus_error_frame(s, &cf->cc);
+        return 0;
+    }
+    if (n == (ssize_t)CAN_MTU) {
+        s->stats.frames_rx++;
+        if (from_linux(&cf->cc, f)) {
+            return 1;
+        }
+        s->stats.bad_frames++;
+        return 0;
+    }
+    if (n == (ssize_t)CANFD_MTU) {
+        /* An FD socket (adopted with CAN_RAW_FD_FRAMES) passes FD frames:
+         * the TASE datalink is classic CAN only. */
+        tase_can_frame_t id;
+        s->stats.frames_rx++;
+        memset(&id, 0, sizeof id);
+        id.extended = (cf->fd.can_id & CAN_EFF_FLAG) != 0u;
+        id.id = cf->fd.can_id & (id.extended ? CAN_EFF_MASK : CAN_SFF_MASK);
+        if (role_wants(s->role, &id)) {
+            s->stats.fd_rejected++;
+        } else {
+            s->stats.frames_ignored++;
+        }
+        return 0;
+    }
+    if (n == 0) {
+        s->stats.last_errno = EPIPE; /* an AF_UNIX peer that closed */
+        return TASE_EIO;
+    }
+    s->stats.bad_frames++; /* a short or over-long message: not ours to decode */
+    return 0;
+}
+
+/* Next data frame from the socket within timeout_ms: 1, 0 or TASE_EIO;
+ * *ns is the frame's kernel receive time. */
+static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint32_t timeout_ms)
+{
+    can_record_t cf;
     uint32_t deadline = tase_socketcan_now_ms(NULL) + timeout_ms;
     for (;;) {
-        ssize_t n = read(s->fd, &cf, sizeof(cf));
-        if (n == (ssize_t)sizeof(cf)) {
-            s->stats.frames_rx++;
-            if (from_linux(&cf, f)) {
-                return 1;
-            }
-            s->stats.bad_frames++;
-            continue;
-        }
+        ssize_t n = recv_record(s->fd, &cf, ns);
         if (n >= 0) {
-            /* A CAN FD record or a short message: not ours to decode. An
-             * AF_UNIX peer that closed gives 0 bytes: report it. */
-            if (n == 0) {
-                s->stats.last_errno = EPIPE;
-                return TASE_EIO;
+            int rc = take_record(s, n, &cf, f);
+            if (rc != 0) {
+                return rc;
             }
-            s->stats.bad_frames++;
             continue;
         }
         if (errno == EINTR) {
@@ -351,11 +506,11 @@ static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_m
 }
 
 /* Next frame the role's filter passes (software copy of the kernel's). */
-static int recv_wanted(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_ms)
+static int recv_wanted(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint32_t timeout_ms)
 {
     uint32_t deadline = tase_socketcan_now_ms(NULL) + timeout_ms;
     for (;;) {
-        int rc = raw_recv(s, f, remaining(deadline));
+        int rc = raw_recv(s, f, ns, remaining(deadline));
         if (rc <= 0 || role_wants(s->role, f)) {
             return rc;
         }
@@ -363,14 +518,17 @@ static int recv_wanted(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeou
     }
 }
 
-static void side_push(tase_socketcan_t *s, const tase_can_frame_t *f)
+static void side_push(tase_socketcan_t *s, const tase_can_frame_t *f, uint64_t ns)
 {
+    unsigned i;
     if (s->side_count == TASE_SOCKETCAN_SIDEQ) {
         s->side_head = (uint8_t)((s->side_head + 1u) % TASE_SOCKETCAN_SIDEQ);
         s->side_count--;
         s->stats.side_dropped++;
     }
-    s->side[(s->side_head + s->side_count) % TASE_SOCKETCAN_SIDEQ] = *f;
+    i = (s->side_head + s->side_count) % TASE_SOCKETCAN_SIDEQ;
+    s->side[i] = *f;
+    s->side_ns[i] = ns;
     s->side_count++;
 }
 
@@ -383,6 +541,9 @@ static size_t take_pending(tase_socketcan_t *s, uint8_t *buf, size_t cap)
     memcpy(buf, &s->pend[s->pend_pos], k);
     s->pend_pos = (uint8_t)(s->pend_pos + k);
     s->stats.bytes_rx += (uint32_t)k;
+    if (k > 0u) {
+        s->rx_ns = s->pend_ns;
+    }
     return k;
 }
 
@@ -390,6 +551,7 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
 {
     tase_can_frame_t f;
     uint32_t deadline;
+    uint64_t ns;
     size_t got;
     if (!usable(s) || buf == NULL || cap > (size_t)0x7FFFFFFF) {
         return TASE_EARG;
@@ -398,7 +560,7 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
     got = take_pending(s, buf, cap);
     /* Once some bytes are in hand, only drain what is already queued. */
     while (got < cap) {
-        int rc = recv_wanted(s, &f, got > 0u ? 0u : remaining(deadline));
+        int rc = recv_wanted(s, &f, &ns, got > 0u ? 0u : remaining(deadline));
         if (rc < 0) {
             return got > 0u ? (int)got : rc;
         }
@@ -410,9 +572,10 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
             memcpy(s->pend, f.data, (size_t)rc);
             s->pend_pos = 0;
             s->pend_len = (uint8_t)rc;
+            s->pend_ns = ns;
             got += take_pending(s, buf + got, cap - got);
         } else if (rc == TASE_EUNKNOWN) {
-            side_push(s, &f);
+            side_push(s, &f, ns);
         } else {
             s->stats.bad_frames++;
         }
@@ -427,11 +590,33 @@ int tase_socketcan_recv_frame(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t
     }
     if (s->side_count > 0u) {
         *f = s->side[s->side_head];
+        s->rx_ns = s->side_ns[s->side_head];
         s->side_head = (uint8_t)((s->side_head + 1u) % TASE_SOCKETCAN_SIDEQ);
         s->side_count--;
         return 1;
     }
-    return recv_wanted(s, f, timeout_ms);
+    {
+        uint64_t ns;
+        int rc = recv_wanted(s, f, &ns, timeout_ms);
+        if (rc == 1) {
+            s->rx_ns = ns;
+        }
+        return rc;
+    }
+}
+
+int tase_socketcan_bus(const tase_socketcan_t *s, tase_socketcan_bus_t *out)
+{
+    if (s == NULL || out == NULL) {
+        return TASE_EARG;
+    }
+    *out = s->bus;
+    return TASE_OK;
+}
+
+uint64_t tase_socketcan_rx_time_ns(const tase_socketcan_t *s)
+{
+    return s == NULL ? 0u : s->rx_ns;
 }
 
 static int port_write(void *ctx, const uint8_t *data, size_t n)

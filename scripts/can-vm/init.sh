@@ -142,11 +142,11 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     $T monitor --can vcan1 --seconds 1 2> /tmp/t.err
     rc=$?
     check "monitor on a down interface: exit 1, one line ($(cat /tmp/t.err))" \
-        eval '[ $rc -eq 1 ] && one_line_error /tmp/t.err "vcan1: .*interface is down"'
+        eval '[ $rc -eq 1 ] && one_line_error /tmp/t.err "vcan1: interface is down"'
     tase-sim --can tasenosuch0 --seconds 1 > /dev/null 2> /tmp/t.err
     rc=$?
     check "tase-sim on a missing interface: exit 1, one line ($(cat /tmp/t.err))" \
-        eval '[ $rc -eq 1 ] && one_line_error /tmp/t.err "tasenosuch0: no such"'
+        eval '[ $rc -eq 1 ] && one_line_error /tmp/t.err "tasenosuch0: no such device"'
     $T query SYSTEM_VERSION $L --timeout 200 --retries 0 2> /tmp/t.err
     rc=$?
     check "query with no gimbal on the bus times out ($(cat /tmp/t.err))" \
@@ -166,29 +166,34 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     sim=$!
     wait_for /tmp/sim.log 'simulated gimbal on CAN interface vcan0' || { cat /tmp/sim.log; fail "tase-sim --can vcan0 did not start"; }
 
-    v=$($T query SYSTEM_VERSION $L --json | tail -1) # the answer
+    v=$($T query SYSTEM_VERSION $L --json)
     echo "   $v"
     check "query SYSTEM_VERSION: version 2.5.1, cameras 68/97/255 (none)" \
         eval '[ "$(json_int "$v" major)/$(json_int "$v" minor)/$(json_int "$v" sub)" = 2/5/1 ] &&
               [ "$(json_int "$v" camera_a)/$(json_int "$v" camera_b)/$(json_int "$v" camera_c)" = 68/97/255 ] &&
               echo "$v" | grep -q "\"name\":\"SYSTEM_VERSION\",\"size\":42,"'
 
-    e=$($T send PACKET_RATE angle_1=20 rate_1=5 geo_ref_1=2 $L --json | tail -1) # the echo
+    e=$($T send PACKET_RATE angle_1=20 rate_1=5 geo_ref_1=2 $L --json | grep '"dir":"out"')
     check "send PACKET_RATE: the gimbal echoes 20/5/2" \
         eval '[ "$(json_int "$e" angle_1)/$(json_int "$e" rate_1)/$(json_int "$e" geo_ref_1)" = 20/5/2 ]'
-    $T monitor $L --json --seconds 2 > /tmp/mon.json
+    $T monitor $L --json --time --seconds 2 > /tmp/mon.json 2> /tmp/mon.err
     na=$(grep -c '"name":"GIMBAL_ANGLE"' /tmp/mon.json)
     nr=$(grep -c '"name":"GIMBAL_RATE"' /tmp/mon.json)
     ng=$(grep -c '"name":"GEOREFERENCE_DATA"' /tmp/mon.json)
     check "monitor 2 s follows PACKET_RATE: $na GIMBAL_ANGLE (40+-8), $nr GIMBAL_RATE (10+-3), $ng GEOREFERENCE_DATA (4+-2)" \
         eval 'near $na 40 8 && near $nr 10 3 && near $ng 4 2'
+    check "monitor's summary has the frames and the CAN bus state ($(cat /tmp/mon.err))" \
+        grep -q "^tase: summary: [0-9]* frames .*, CAN bus error-active (0 error frames, 0 bus-off" /tmp/mon.err
+    check "monitor --time on CAN: the kernel's receive time, close to now" \
+        eval 't=$(json_int "$(head -1 /tmp/mon.json)" time); now=$(date +%s); near "$t" "$now" 5'
 
     # The monitor runs while the position command goes out on the bus.
     $T monitor $L --json --seconds 3.5 > /tmp/move.json &
     mon=$!
     usleep 400000
-    s=$($T send GIMBAL_CMD pan=3000 tilt=-1500 roll=0 flags=0xA0 impulse_time=0 $L)
-    check "send GIMBAL_CMD ($s)" [ "$s" = "sent GIMBAL_CMD pan=3000 tilt=-1500 roll=0 flags=160 impulse_time=0" ]
+    s=$($T point 30 -15 $L | head -1)
+    check "tase point 30 -15 sends GIMBAL_CMD position, stabilised ($s)" \
+        [ "$s" = "sent GIMBAL_CMD pan=3000 tilt=-1500 roll=0 flags=160 impulse_time=0" ]
     # A long packet both ways: 44 data bytes = 52 bytes = 7 CAN frames to the
     # gimbal, whose simulated camera echoes the bytes back.
     pass=$(seq -s, 201 240)
@@ -237,6 +242,8 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
         eval '[ "$(grep -c "\"dir\":\"in\".*\"name\":\"PACKET_RATE\",\"size\":16,\"fields\":{\"angle_1\":20,\"rate_1\":5,\"geo_ref_1\":2," /tmp/dec.json)" = 1 ] &&
               [ "$(grep -c "\"dir\":\"out\".*\"name\":\"PACKET_RATE\",\"size\":16,\"fields\":{\"angle_1\":20,\"rate_1\":5,\"geo_ref_1\":2," /tmp/dec.json)" = 1 ] &&
               grep -q "\"dir\":\"in\".*\"name\":\"PACKET_RATE\",\"size\":0," /tmp/dec.json'
+    check "decoded: every packet has the capture's time and the interface" \
+        eval '[ "$(grep -c "^{\"offset\":[0-9]*,\"time\":[0-9]*\.[0-9]\{6\},\"dir\":\"[a-z]*\",\"interface\":\"vcan0\"," /tmp/dec.json)" = "$(wc -l < /tmp/dec.json)" ]'
     check "decoded: GIMBAL_CMD in, pan 3000 tilt -1500 flags 0xA0" \
         grep -q '"dir":"in","interface":"vcan0","group":0,"type":128,"name":"GIMBAL_CMD","size":8,"fields":{"pan":3000,"tilt":-1500,.*"flags":160' /tmp/dec.json
     check "decoded: CAMERA_PASS in and its echo out, same 40 bytes" \

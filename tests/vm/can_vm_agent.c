@@ -56,7 +56,7 @@ static int send_what(const char *ifname, tase_socketcan_t *s, const char *what)
     size_t i;
     static const uint8_t angle[6] = {0x03, 0xE8, 0xFE, 0x0C, 0x00, 0x00};
     if (strcmp(what, "retract") == 0) {
-        m.command = TASE_3AX_RETRACT;
+        m.command = TASE_3AX_MOVE_RETRACT;
         if (tase_can_3ax_move_encode(&m, &f) != TASE_OK || tase_socketcan_send_frame(s, &f) != 0) {
             return 1;
         }

@@ -10,7 +10,8 @@
  *
  *     static uint8_t rx_storage[512];                // power of two
  *     static tase_bm_uart_t com3;
- *     static const tase_bm_uart_hooks_t com3_hooks = {my_tx, my_millis, my_wfi};
+ *     static const tase_bm_uart_hooks_t com3_hooks = {my_tx, my_millis, my_wfi,
+ *                                                     my_irq_off, my_irq_on};
  *     tase_bm_uart_init(&com3, rx_storage, sizeof rx_storage, &com3_hooks, USART3);
  *     // then enable the RXNE interrupt:
  *     void USART3_IRQHandler(void) {
@@ -34,10 +35,21 @@
  *          or TASE_EARG (ctx NULL or not initialised, data NULL with
  *          n > 0, n > INT32_MAX; the hook is not called).
  *  read    takes what the ring holds; if empty, waits until bytes arrive
- *          or timeout_ms passes on hooks->millis(), calling hooks->idle()
- *          (e.g. __WFI(): the RX interrupt wakes the core) between checks,
- *          or spinning if idle is NULL. Returns the count (0: timeout),
- *          or TASE_EARG (ctx NULL or not initialised, buf NULL, cap 0).
+ *          or timeout_ms passes on hooks->millis() (wrap- and stale-safe),
+ *          spinning if idle is NULL, else sleeping race-free:
+ *              irq_off(hw);                    // __disable_irq()
+ *              if (ring empty) idle(hw);       // __WFI()
+ *              irq_on(hw);                     // __enable_irq()
+ *          A byte that arrives after the emptiness check cannot be missed:
+ *          its interrupt stays pending while masked, and a pending
+ *          interrupt ends WFI even while PRIMASK masks it (Cortex-M), so
+ *          the core does not sleep on until the next, unrelated interrupt.
+ *          (Calling __WFI() after an unmasked check is the classic
+ *          lost-wakeup race: init refuses an idle hook without
+ *          irq_off/irq_on.) Sleeping ends on any interrupt; the timeout
+ *          needs one that ticks, e.g. SysTick. Returns the count (0:
+ *          timeout), or TASE_EARG (ctx NULL or not initialised, buf NULL,
+ *          cap 0).
  *  now_ms  hooks->millis(hw) (a SysTick millisecond counter); 0 for ctx
  *          NULL or not initialised.
  */
@@ -54,12 +66,20 @@ extern "C" {
 
 typedef struct {
     /* Transmit n bytes (blocking, or queued for an interrupt/DMA). Returns
-     * 0 when all were taken, a negative TASE_E* code otherwise. Required. */
+     * 0 when all were taken, a negative TASE_E* code otherwise. Its
+     * longest block is the port's write bound W. Required. */
     int (*tx)(void *hw, const uint8_t *data, size_t n);
     /* Monotonic milliseconds (modulo 2^32). Required. */
     uint32_t (*millis)(void *hw);
-    /* Called while read() waits for bytes; NULL: busy-wait. */
+    /* Sleep until an interrupt is pending, e.g. __WFI(). Called by read()
+     * only between irq_off() and irq_on(), after it found the ring empty
+     * with the interrupt masked; it must NOT unmask. NULL: read()
+     * busy-waits (and irq_off/irq_on are not needed). */
     void (*idle)(void *hw);
+    /* Mask / unmask the RX interrupt (or all: __disable_irq() and
+     * __enable_irq()). Required when idle is set. */
+    void (*irq_off)(void *hw);
+    void (*irq_on)(void *hw);
 } tase_bm_uart_hooks_t;
 
 typedef struct {
@@ -72,7 +92,8 @@ extern const tase_port_ops_t tase_bm_uart_ops;
 
 /* Set up u with receive storage rx_buf[0..cap) (power of two) and hooks.
  * Returns TASE_OK or TASE_EARG (NULL argument, hooks without tx or
- * millis, cap not a power of two). Call before enabling the interrupt. */
+ * millis, idle without irq_off and irq_on, cap not a power of two). Call
+ * before enabling the interrupt. */
 int tase_bm_uart_init(tase_bm_uart_t *u, uint8_t *rx_buf, size_t cap,
                       const tase_bm_uart_hooks_t *hooks, void *hw);
 
@@ -81,9 +102,14 @@ int tase_bm_uart_init(tase_bm_uart_t *u, uint8_t *rx_buf, size_t cap,
 void tase_bm_uart_rx_isr(tase_bm_uart_t *u, uint8_t byte);
 
 /* MAIN LOOP: drain everything the ring holds into a frame receiver, in
- * chunks of 32 bytes. Returns the number of frames delivered (>= 0) or
- * TASE_EARG (u or rx NULL). Bounded: stops after one ring capacity's worth of bytes even
- * if the ISR keeps adding, so the main loop cannot be starved. */
+ * chunks of 32 bytes. Returns the number of frames delivered (>= 0), or
+ * TASE_EARG (u or rx NULL), or the receiver's error: tase_rx_feed()'s
+ * TASE_EARG for a receiver that is not initialised or was corrupted
+ * (checked before any byte leaves the ring, so none is lost; if a frame
+ * handler corrupts it midway, the chunk being fed is lost and the rest
+ * stays in the ring). Bounded: stops after one ring capacity's worth of
+ * bytes even if the ISR keeps adding, so the main loop cannot be
+ * starved. */
 int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_frame, void *user);
 
 /* The tase_port_t of u: {&tase_bm_uart_ops, u}. */

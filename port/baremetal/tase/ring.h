@@ -53,8 +53,9 @@
  * write buffers, caches, ARMv8-A weak ordering). Define the port hook
  *     TASE_RING_BARRIER()
  * before compiling tase_ring.c (e.g. -D'TASE_RING_BARRIER()=__DMB()' with
- * CMSIS, or a C11 atomic_thread_fence(memory_order_seq_cst)), either on
- * the command line or in a header named by -DTASE_RING_CONFIG='"file.h"'
+ * CMSIS, or a C11 atomic_thread_fence(memory_order_seq_cst)), on the
+ * command line, in the library's configuration header (TASE_CONFIG_HEADER,
+ * tase/config.h) or in a header named by -DTASE_RING_CONFIG='"file.h"'
  * that tase_ring.c includes first. The ring
  * calls it between writing data and publishing `head`, between reading
  * `head` and reading data, between reading data and publishing `tail`, and

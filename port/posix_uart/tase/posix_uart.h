@@ -2,6 +2,24 @@
  * tase/posix_uart.h - the POSIX serial port: a termios device (RS-232
  * adapter, USB serial, pseudo-terminal) as a tase_port_t (tase/port.h).
  *
+ * EXCLUSIVE ACCESS. tase_posix_uart_open() takes the device for itself:
+ * an flock(LOCK_EX | LOCK_NB) lock, which every program that locks serial
+ * devices the same way respects (a second tase_posix_uart_open() of the
+ * device, in this or another process, fails with TASE_EBUSY, "device
+ * busy: in use by another program"), plus the kernel's TIOCEXCL, which
+ * makes any further open() of the device fail with EBUSY for everybody
+ * but root. Two readers of one serial line would each get a random half
+ * of the byte stream; this makes that impossible by accident.
+ * TASE_POSIX_UART_SHARED (tase_posix_uart_open_flags()) opens without
+ * either. Both end when the device is closed (or the process exits).
+ *
+ * SETTINGS GIVEN BACK. The device's termios settings as found at open are
+ * saved and restored by tase_posix_uart_close(), so a shell, `cat` or
+ * another program sees the device as it was (otherwise VMIN = 0 would
+ * stay behind and make a blocking read return at once). A program that
+ * may be killed by a signal should close the port from its handler, or
+ * restore the saved settings itself: `saved` holds them while open.
+ *
  * The device is opened in raw 8N1 mode at one of the standard rates
  * (the TASE links are 9600 baud on Com2 and 57600 on Com3): no echo, no
  * canonical line editing, no signal characters, no CR/LF translation in
@@ -30,6 +48,8 @@
 #ifndef TASE_POSIX_UART_H
 #define TASE_POSIX_UART_H
 
+#include <termios.h>
+
 #include "tase/port.h"
 
 #ifdef __cplusplus
@@ -38,34 +58,59 @@ extern "C" {
 
 #define TASE_POSIX_UART_WRITE_TIMEOUT_MS 1000u
 
+/* tase_posix_uart_open_flags() flags */
+#define TASE_POSIX_UART_SHARED 0x1u /* no flock(), no TIOCEXCL */
+
 typedef struct {
     int fd; /* -1 when closed */
     uint32_t baud;
     uint32_t write_timeout_ms; /* may be changed after open */
+    struct termios saved;      /* the device's settings found at open */
+    bool restore;              /* saved is valid: close() restores it */
+    bool excl;                 /* TIOCEXCL set by us: close() clears it */
 } tase_posix_uart_t;
 
 extern const tase_port_ops_t tase_posix_uart_ops;
 
-/* Open `path` (e.g. "/dev/ttyUSB0") at `baud` bits per second, raw 8N1.
- * Any pending input and output is discarded. Returns TASE_OK or
+/* Open `path` (e.g. "/dev/ttyUSB0") at `baud` bits per second, raw 8N1,
+ * for exclusive use (see EXCLUSIVE ACCESS), saving the device's settings
+ * for close(). Any pending input and output is discarded. Returns TASE_OK
+ * or
  *   TASE_EARG         u or path NULL;
  *   TASE_EUNSUPPORTED baud is not a standard termios rate (checked before
  *                     the device is touched) or the device refused it;
  *   TASE_ENODEV       no such device, or it is not a terminal;
  *   TASE_EACCES       permission denied;
+ *   TASE_EBUSY        the device is in use by another program (its lock,
+ *                     or its TIOCEXCL); nothing was changed;
  *   TASE_EIO          any other OS error.
- * On error u is left closed (fd -1). */
+ * On error u is left closed (fd -1) and the device as it was. Blocks only
+ * as long as open() of the device does (O_NONBLOCK: no carrier wait). */
 int tase_posix_uart_open(tase_posix_uart_t *u, const char *path, uint32_t baud);
 
+/* tase_posix_uart_open() with flags: 0 or TASE_POSIX_UART_SHARED (no
+ * exclusive access; the settings are still saved and restored). Other
+ * flag bits: TASE_EARG. */
+int tase_posix_uart_open_flags(tase_posix_uart_t *u, const char *path, uint32_t baud,
+                               unsigned flags);
+
 /* Take over an already open terminal descriptor (e.g. an openpty()
- * master) and configure it exactly like tase_posix_uart_open(). The
- * descriptor is made non-blocking and is closed by tase_posix_uart_close().
- * Returns as tase_posix_uart_open() (TASE_ENODEV when fd is not a tty;
- * the fd is then left open and untouched). */
+ * master) and configure it exactly like tase_posix_uart_open(), saving its
+ * settings for close(); no lock is taken (the caller opened it and
+ * decides who else may). The descriptor is made non-blocking and is
+ * closed by tase_posix_uart_close(). Returns as tase_posix_uart_open()
+ * (TASE_ENODEV when fd is not a tty; the fd is then left open and
+ * untouched). */
 int tase_posix_uart_attach(tase_posix_uart_t *u, int fd, uint32_t baud);
 
-/* Close the device. Returns TASE_OK (also when already closed), TASE_EARG
- * if u is NULL, TASE_EIO if close() failed (the fd is gone anyway). */
+/* Close the device: wait up to write_timeout_ms for the bytes written to
+ * leave the kernel's queue (what is still queued then is discarded, so a
+ * stuck line cannot hold the close), restore the settings saved at open
+ * (after the last bytes went out at our rate), give up the exclusive
+ * access, close the descriptor. Longest block: write_timeout_ms plus the
+ * time the UART needs for its hardware FIFO. Returns TASE_OK (also when
+ * already closed), TASE_EARG if u is NULL, TASE_EIO if close() failed
+ * (the fd is gone anyway). */
 int tase_posix_uart_close(tase_posix_uart_t *u);
 
 /* The tase_port_t of an open instance: {&tase_posix_uart_ops, u}. With u

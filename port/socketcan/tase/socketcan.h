@@ -36,13 +36,42 @@
  * at most tx_timeout_ms in total (default TASE_SOCKETCAN_TX_TIMEOUT_MS).
  * If the time runs out, write() returns how many bytes went out in whole
  * frames (0 < n < len: the caller sends the rest later), or TASE_ENOBUFS
- * when none did; nothing is ever dropped silently.
+ * when none did; nothing is ever dropped silently. A queue stays full
+ * when no node acknowledges the frames or the controller is bus-off:
+ * tase_socketcan_bus() tells which.
+ *
+ * LONGEST BLOCK (the port contract of tase/port.h): write() and
+ * send_frame() tx_timeout_ms in total; read() and recv_frame() timeout_ms
+ * in total. A signal (EINTR) never ends a wait early or makes it fail: the
+ * wait resumes with the time left.
+ *
+ * BUS HEALTH. open() (and adopt() with TASE_SOCKETCAN_SET_FILTER) asks the
+ * kernel for error frames (CAN_RAW_ERR_FILTER: controller state, bus-off,
+ * restarts, TX timeouts, missing ACKs, protocol and transceiver errors).
+ * They arrive in the receive queue with the data, so they are taken into
+ * account as the socket is read (read(), recv_frame()); none reaches the
+ * caller as data. tase_socketcan_bus() returns the state they reported
+ * and the counts, plus the ENOBUFS refusals of the transmit path. What a
+ * given controller reports depends on its driver; vcan reports nothing
+ * by itself (docs/CAN.md).
+ *
+ * CAN FD. The datalink is classic CAN. On an adopted socket with
+ * CAN_RAW_FD_FRAMES, classic frames (CAN_MTU records) are read as usual and
+ * FD frames (CANFD_MTU records) are dropped: counted in stats.fd_rejected
+ * when they carry one of the role's IDs, else in stats.frames_ignored.
+ *
+ * RECEIVE TIMESTAMPS. The port asks for kernel receive timestamps
+ * (SO_TIMESTAMPNS: CLOCK_REALTIME, taken when the frame entered the
+ * kernel, so they are not delayed by a late read).
+ * tase_socketcan_rx_time_ns() gives the one of the frame whose data was
+ * last returned.
  *
  * ERRORS. open(): interface name missing or too long -> TASE_ENODEV or
  * TASE_EARG; interface not up -> TASE_EDOWN; kernel without CAN
  * (EAFNOSUPPORT/EPROTONOSUPPORT) -> TASE_EUNSUPPORTED; EPERM/EACCES ->
- * TASE_EACCES; anything else -> TASE_EIO. A descriptor error while reading
- * or writing -> TASE_EIO (errno kept in stats.last_errno).
+ * TASE_EACCES; anything else -> TASE_EIO. Writing to an interface that
+ * went down (ENETDOWN) -> TASE_EDOWN. A descriptor error while reading or
+ * writing -> TASE_EIO (errno kept in stats.last_errno).
  *
  * Threads: one instance is used by one thread at a time. Not ISR code.
  */
@@ -64,16 +93,40 @@ extern "C" {
 #define TASE_SOCKETCAN_SET_FILTER 0x2u /* install the role's CAN_RAW_FILTER */
 
 typedef struct {
-    uint32_t frames_rx;      /* frames read from the socket */
+    uint32_t frames_rx;      /* data frames read from the socket */
     uint32_t frames_tx;      /* frames written */
     uint32_t bytes_rx;       /* datalink payload bytes returned by read() */
     uint32_t frames_ignored; /* outside the role's ID set (dropped) */
-    uint32_t bad_frames;     /* wrong size, remote/error frames, bad dlc */
+    uint32_t bad_frames;     /* wrong size, remote frames, bad dlc */
     uint32_t side_dropped;   /* side-queue overflow */
     uint32_t tx_retries;     /* EAGAIN/ENOBUFS retried */
     uint32_t tx_full;        /* writes that ran out of time (TASE_ENOBUFS or short) */
-    int last_errno;          /* errno of the last TASE_EIO */
+    int last_errno;          /* errno of the last TASE_EIO / TASE_EDOWN */
+    uint32_t fd_rejected;    /* CAN FD frames with one of the role's IDs (dropped) */
 } tase_socketcan_stats_t;
+
+/* Controller state, as the last error frame reported it. */
+#define TASE_SOCKETCAN_BUS_ACTIVE 0u  /* error-active: normal (and before any report) */
+#define TASE_SOCKETCAN_BUS_WARNING 1u /* an error counter reached 96 */
+#define TASE_SOCKETCAN_BUS_PASSIVE 2u /* error-passive: a counter reached 128 */
+#define TASE_SOCKETCAN_BUS_OFF 3u     /* bus-off: the controller left the bus */
+
+/* Bus health, from the kernel's error frames (counts wrap modulo 2^32). */
+typedef struct {
+    uint8_t state;          /* TASE_SOCKETCAN_BUS_* */
+    uint8_t tx_error_count; /* the controller's TEC and REC, from the last */
+    uint8_t rx_error_count; /*   error frame that carried them (else 0) */
+    uint32_t error_frames;  /* error frames received */
+    uint32_t warnings;      /* reports of the warning level */
+    uint32_t passives;      /* reports of error-passive */
+    uint32_t bus_offs;      /* reports of bus-off */
+    uint32_t restarts;      /* controller restarts (back to error-active) */
+    uint32_t tx_timeouts;   /* frames the driver gave up transmitting */
+    uint32_t no_acks;       /* transmissions nobody acknowledged */
+    uint32_t bus_errors;    /* protocol, transceiver and bus errors */
+    uint32_t overflows;     /* controller RX/TX buffer overflows */
+    uint32_t enobufs;       /* writes the interface queue refused (ENOBUFS) */
+} tase_socketcan_bus_t;
 
 /* Instance; every field but `stats` and `tx_timeout_ms` is private. */
 typedef struct {
@@ -82,12 +135,16 @@ typedef struct {
     tase_can_role_t role;
     uint32_t tx_timeout_ms; /* retry budget of one write()/send_frame() */
     tase_socketcan_stats_t stats;
-    uint8_t pend[8]; /* accepted payload not yet returned by read() */
+    tase_socketcan_bus_t bus; /* read with tase_socketcan_bus() */
+    uint64_t rx_ns;           /* see tase_socketcan_rx_time_ns() */
+    uint64_t pend_ns;         /* receive time of the frame in pend[] */
+    uint8_t pend[8];          /* accepted payload not yet returned by read() */
     uint8_t pend_pos;
     uint8_t pend_len;
     uint8_t side_head;
     uint8_t side_count;
     tase_can_frame_t side[TASE_SOCKETCAN_SIDEQ];
+    uint64_t side_ns[TASE_SOCKETCAN_SIDEQ];
 } tase_socketcan_t;
 
 /* Open a raw CAN socket on interface `ifname` for `role`, non-blocking,
@@ -110,7 +167,9 @@ void tase_socketcan_close(tase_socketcan_t *s);
 tase_port_t tase_socketcan_port(tase_socketcan_t *s);
 extern const tase_port_ops_t tase_socketcan_ops;
 
-/* Byte stream (the tase_port_ops_t contract, see tase/port.h). Both
+/* Byte stream (the tase_port_ops_t contract, see tase/port.h; write() as
+ * described under TRANSMIT QUEUE FULL, and TASE_EDOWN when the interface
+ * went down before any byte went out). Both
  * return TASE_EARG, touching nothing, for s NULL, closed or corrupted
  * (role or private queue indices out of range), n or cap > INT32_MAX,
  * data NULL with n > 0, buf NULL. read() with cap 0 returns 0. */
@@ -119,15 +178,26 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
 
 /* Send one frame (validated with tase_can_frame_check()). Returns TASE_OK,
  * TASE_EARG (s as for write(), f NULL or failing the check; nothing
- * sent), TASE_ENOBUFS (queue still full after tx_timeout_ms) or
- * TASE_EIO. */
+ * sent), TASE_ENOBUFS (queue still full after tx_timeout_ms),
+ * TASE_EDOWN (the interface went down) or TASE_EIO. */
 int tase_socketcan_send_frame(tase_socketcan_t *s, const tase_can_frame_t *f);
 
 /* Receive one frame, waiting at most timeout_ms. Returns 1 (*f filled),
- * 0 (none in time), TASE_EARG (s as for read(), f NULL) or TASE_EIO. Frames the filters let through
- * but that are not data frames (remote, error, wrong size) are counted in
- * stats.bad_frames and skipped. */
+ * 0 (none in time), TASE_EARG (s as for read(), f NULL) or TASE_EIO.
+ * Frames the filters let through but that are not classic data frames
+ * are skipped: error frames update the bus health, remote frames and
+ * wrong sizes count in stats.bad_frames, FD frames as described above. */
 int tase_socketcan_recv_frame(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t timeout_ms);
+
+/* Copy the bus health (see BUS HEALTH) into *out. Returns TASE_OK, or
+ * TASE_EARG (s or out NULL). O(1); never blocks. */
+int tase_socketcan_bus(const tase_socketcan_t *s, tase_socketcan_bus_t *out);
+
+/* Kernel receive time (CLOCK_REALTIME, ns since the epoch) of the frame
+ * whose data read() or recv_frame() returned last: for read(), the frame
+ * that carried its last byte. 0 before any, when the socket gives no
+ * timestamps, or for s NULL. O(1). */
+uint64_t tase_socketcan_rx_time_ns(const tase_socketcan_t *s);
 
 /* Monotonic milliseconds (CLOCK_MONOTONIC), for the port table. */
 uint32_t tase_socketcan_now_ms(void *ctx);
