@@ -41,6 +41,7 @@ cleanup() {
 }
 trap cleanup EXIT
 . "$here/check-lib.sh"
+under_valgrind TASE SIM
 # dissect CAPTURE [tshark args]: tshark with the dissector and a clean
 # configuration (no personal plugins or preferences), PDML on stdout
 dissect() {

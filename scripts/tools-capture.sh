@@ -22,6 +22,7 @@ cleanup() {
 trap cleanup EXIT
 
 . "$(dirname "$0")/check-lib.sh"
+under_valgrind TASE SIM
 # Timing tolerances (seconds of replay jitter, ms for a --speed 0 run);
 # looser when scripts/check-valgrind.sh runs the programs under memcheck.
 tol=0.150 fast_ms=350
