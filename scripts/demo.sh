@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The project's main job: on a machine with no gimbal, build the tools,
 # start a simulated TASE gimbal (tase-sim) on a pseudo-terminal and run a
-# scripted host session against it with the `tase` command line.
+# scripted host session against it with the `tase` command line: queries,
+# setup echoes, the bench verbs (point, rate, camera, retract/deploy),
+# telemetry with time and units, and the KLV output.
 # Exits 0 when every step worked, non-zero (with the reason) otherwise.
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
@@ -45,7 +47,9 @@ for _ in $(seq 100); do
 done
 [ -L "$work/gimbal" ] || fail "tase-sim did not start: $(cat "$work/sim.log")"
 head -2 "$work/sim.log"
-link=(--serial "$work/gimbal")
+# --record: every command also appends its bytes, both ways and timestamped,
+# to one pcap capture (decoded at the end)
+link=(--serial "$work/gimbal" --record "$work/session.pcap")
 
 step "Host: who are you? (zero-length SYSTEM_VERSION query, answered by the gimbal)"
 show "$TASE" query SYSTEM_VERSION "${link[@]}"
@@ -56,20 +60,40 @@ show "$TASE" send PACKET_RATE angle_1=5 rate_1=2 geo_ref_1=1 "${link[@]}"
 echo "(the gimbal echoes a setup packet; unspecified fields kept their current values)"
 
 step "Host: point the camera at pan 45 deg, tilt -20 deg, stabilised (GIMBAL_CMD position)"
-show "$TASE" send GIMBAL_CMD pan=4500 tilt=-2000 flags=0xA0 "${link[@]}"
+show "$TASE" point 45 -20 "${link[@]}"
+echo "(the verb states the mode; 'tase send GIMBAL_CMD' without flags= is refused)"
 
-step "Telemetry for 3 seconds (angles and rates in 1/100 deg, deg/s)"
-show "$TASE" monitor "${link[@]}" --seconds 3 | tee "$work/mon.txt"
-last=$(grep '^GIMBAL_ANGLE' "$work/mon.txt" | tail -1)
-[ "$last" = "GIMBAL_ANGLE pan=4500 tilt=-2000 roll=0" ] ||
-    fail "the gimbal did not reach pan 45, tilt -20 (last: $last)"
-echo "-> the gimbal reached pan 45.00 deg, tilt -20.00 deg"
+step "Telemetry for 3 seconds, with host time and engineering units"
+show "$TASE" monitor "${link[@]}" --seconds 3 --time --units | tee "$work/mon.txt"
+last=$(grep 'GIMBAL_ANGLE' "$work/mon.txt" | tail -1)
+case $last in
+    *"GIMBAL_ANGLE pan=4500 (45.00 deg) tilt=-2000 (-20.00 deg) roll=0"*) ;;
+    *) fail "the gimbal did not reach pan 45, tilt -20 (last: $last)" ;;
+esac
+echo "-> the gimbal reached pan 45.00 deg, tilt -20.00 deg (the summary line is on stderr)"
 
 step "Host: pan right at 10 deg/s (GIMBAL_CMD rate), one second of telemetry as JSON"
-show "$TASE" send GIMBAL_CMD pan=1000 tilt=0 flags=0x90 "${link[@]}"
+show "$TASE" rate 10 0 "${link[@]}"
 show "$TASE" monitor "${link[@]}" --json --seconds 1.1 | tee "$work/mon.json"
 grep -q '"name":"GIMBAL_RATE".*"pan_rate":1000,' "$work/mon.json" ||
     fail "GIMBAL_RATE does not report the commanded 10 deg/s"
+show "$TASE" rate 0 0 "${link[@]}"
+
+step "Host: camera B, then camera A zoomed to 10 deg of horizontal field of view"
+show "$TASE" camera B "${link[@]}"
+show "$TASE" camera A --hfov 10 "${link[@]}"
+echo "(every other camera setting goes as the spec's \"do not change\" value)"
+
+step "Host: a setting the gimbal refuses is not a success (exit 3 names the field)"
+echo "\$ $TASE send AXIS_SETTING pan_max_rate=0 ${link[*]}"
+rc=0
+"$TASE" send AXIS_SETTING pan_max_rate=0 "${link[@]}" || rc=$?
+[ $rc = 3 ] || fail "a refused AXIS_SETTING exited $rc, not 3"
+echo "-> exit 3: the gimbal kept its max rate"
+
+step "Host: retract the gimbal and wait for the echo that says the move is complete"
+show "$TASE" retract "${link[@]}" --wait 5
+show "$TASE" deploy "${link[@]}" --wait 5
 
 step "KLV metadata output (second pty, one packet about every 900 ms)"
 timeout 2 cat "$work/klv" >"$work/klv.bin" 2>/dev/null || true
@@ -78,6 +102,16 @@ echo "\$ $TASE klv $work/klv.bin"
 grep -q '"fields":{"utc"' "$work/klv.json" || fail "no KLV packet decoded"
 head -1 "$work/klv.json"
 echo "($(wc -l <"$work/klv.json") packet(s) in 2 s; raw values in fields, engineering units in units)"
+
+step "The session as recorded by --record (pcap; Wireshark: tools/wireshark/tase.lua)"
+echo "\$ $TASE decode $work/session.pcap | head -3"
+"$TASE" decode "$work/session.pcap" >"$work/session.json"
+head -3 "$work/session.json"
+nin=$(grep -c '"dir":"in"' "$work/session.json" || true)
+nout=$(grep -c '"dir":"out"' "$work/session.json" || true)
+grep -q '"dir":"in".*"name":"GIMBAL_CMD","size":8,"fields":{"pan":4500,"tilt":-2000,' "$work/session.json" ||
+    fail "the recorded session lacks the position command"
+echo "($nin packets to the gimbal and $nout from it, each with its capture time in seconds)"
 
 step "Stopping the simulator; its log of what it was asked to do:"
 kill "$sim_pid"

@@ -4,6 +4,7 @@
  * conventions: docs/TOOLS.md. */
 #define _XOPEN_SOURCE 700
 
+#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -34,7 +35,9 @@ static const char usage[] =
     "--klv-link PATH adds the KLV metadata output (an 87-byte packet about every\n"
     "900 ms) on a second pseudo-terminal, symlinked at PATH. It answers every In\n"
     "packet of the spec and streams GIMBAL_ANGLE, GIMBAL_RATE and GEOREFERENCE_DATA\n"
-    "at the PACKET_RATE rates. Runs until interrupted, or for S seconds.\n";
+    "at the PACKET_RATE rates. Runs until SIGINT, SIGTERM or SIGHUP, or for S\n"
+    "seconds, then removes its links. A link another running tase-sim holds is\n"
+    "refused. Exit status: 0 success, 1 failure, 2 bad command line.\n";
 
 typedef struct {
     uint8_t type;      /* table 28, 0xFF none */
@@ -54,14 +57,6 @@ typedef struct {
     bool quiet;
     bool spoi_valid;
 } sim_t;
-
-static volatile sig_atomic_t stop_flag;
-
-static void on_signal(int sig)
-{
-    (void)sig;
-    stop_flag = 1;
-}
 
 static void logf_(const sim_t *s, uint32_t now, const char *fmt, ...)
 {
@@ -472,7 +467,6 @@ int main(int argc, char **argv)
     tase_gimbal_app_t app;
     uint32_t now, last, next_klv;
     double t_end;
-    struct sigaction sa;
     int i, slave_fd = -1, klv_slave = -1;
     bool have_klv = false;
     uint8_t axis[TASE_DATA_MAX];
@@ -484,6 +478,11 @@ int main(int argc, char **argv)
         bool more = i + 1 < argc;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             fputs(usage, stdout);
+            tk_stdout_flush();
+            return 0;
+        } else if (strcmp(a, "--version") == 0) {
+            printf("tase-sim %s\n", TASE_VERSION_STRING);
+            tk_stdout_flush();
             return 0;
         } else if (strcmp(a, "--quiet") == 0) {
             s.quiet = true;
@@ -506,6 +505,14 @@ int main(int argc, char **argv)
     }
     if (link != NULL && can != NULL) {
         tk_usage_error("give either --link or --can, not both");
+    }
+    if (link != NULL && klv_link != NULL) {
+        char a[PATH_MAX], b[PATH_MAX];
+        if (strcmp(link, klv_link) == 0 ||
+            (tk_canonical_path(link, a, sizeof(a)) == 0 &&
+             tk_canonical_path(klv_link, b, sizeof(b)) == 0 && strcmp(a, b) == 0)) {
+            tk_usage_error("--klv-link must differ from --link (%s)", link);
+        }
     }
 
     sim_model_init(&s.m);
@@ -548,11 +555,7 @@ int main(int argc, char **argv)
     decode_setup(TASE_ID_TYPE(TASE_ID_AXIS_SETTING), axis, 23, &axs);
     apply_axis(&s, &axs);
 
-    memset(&sa, 0, sizeof(sa));
-    sa.sa_handler = on_signal;
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
-    signal(SIGPIPE, SIG_IGN);
+    tk_catch_signals(); /* SIGINT, SIGTERM, SIGHUP stop the loop below */
 
     printf("tase-sim: simulated gimbal on %s%s", can ? "CAN interface " : "", path);
     printf(link ? " (link %s)\n" : "\n", link);
@@ -564,7 +567,7 @@ int main(int argc, char **argv)
     last = now;
     next_klv = now + KLV_PERIOD_MS;
     t_end = tk_now_s() + seconds;
-    while (!stop_flag && (seconds == 0.0 || tk_now_s() < t_end)) {
+    while (tk_signal == 0 && (seconds == 0.0 || tk_now_s() < t_end)) {
         struct timespec ts = {0, (long)STEP_MS * 1000000L};
         uint32_t dt;
         nanosleep(&ts, NULL);
@@ -590,11 +593,12 @@ int main(int argc, char **argv)
             next_klv += KLV_PERIOD_MS;
         }
     }
+    /* only links that still point at our ptys */
     if (link != NULL) {
-        unlink(link);
+        tk_pty_unlink(link, path);
     }
-    if (klv_link != NULL) {
-        unlink(klv_link);
+    if (have_klv) {
+        tk_pty_unlink(klv_link, klv_path);
     }
     logf_(&s, tase_posix_now_ms(), "stopped: %lu frames in, %lu out",
           (unsigned long)s.g.stats.frames_rx, (unsigned long)s.g.stats.frames_tx);

@@ -1,6 +1,6 @@
-/* Shared helpers of the host tools: errors, argument parsing, clocks,
- * descriptor-backed ports and pseudo-terminals. */
-#define _XOPEN_SOURCE 700 /* posix_openpt, grantpt, unlockpt, ptsname */
+/* Shared helpers of the host tools: errors, numbers, standard output,
+ * signals, clocks, descriptor-backed ports and pseudo-terminals. */
+#define _GNU_SOURCE /* posix_openpt, grantpt, unlockpt, ptsname; struct ucred */
 
 #include "toolkit.h"
 
@@ -10,15 +10,47 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <limits.h>
+#include <stddef.h>
 #include <sys/ioctl.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
 const char *tk_prog = "tase";
 
-static void vdie(int status, const char *fmt, va_list ap)
+volatile sig_atomic_t tk_signal;
+
+/* Links open now: every exit path closes them, so a device is always left
+ * as the port's close() leaves it. */
+#define MAX_OPEN_LINKS 4
+static tk_link_t *open_links[MAX_OPEN_LINKS];
+
+static void track_link(tk_link_t *l, bool open)
+{
+    size_t i;
+    for (i = 0; i < MAX_OPEN_LINKS; i++) {
+        if (open ? open_links[i] == NULL : open_links[i] == l) {
+            open_links[i] = open ? l : NULL;
+            return;
+        }
+    }
+}
+
+static void close_all_links(void)
+{
+    size_t i;
+    for (i = 0; i < MAX_OPEN_LINKS; i++) {
+        if (open_links[i] != NULL) {
+            tk_link_close(open_links[i]);
+        }
+    }
+}
+
+static void vmsg(const char *fmt, va_list ap)
 {
     char msg[512];
     vsnprintf(msg, sizeof(msg), fmt, ap);
@@ -28,16 +60,32 @@ static void vdie(int status, const char *fmt, va_list ap)
             *c = ' ';
         }
     }
-    fflush(stdout);
     fprintf(stderr, "%s: %s\n", tk_prog, msg);
+}
+
+static void vexit(int status, const char *fmt, va_list ap)
+{
+    /* what was printed before the error still goes out (errors ignored:
+     * the error line is the one to report) */
+    (void)fflush(stdout);
+    close_all_links();
+    vmsg(fmt, ap);
     exit(status);
+}
+
+void tk_exit(int status, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vexit(status, fmt, ap);
+    va_end(ap);
 }
 
 void tk_die(const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    vdie(TK_EXIT_FAIL, fmt, ap);
+    vexit(TK_EXIT_FAIL, fmt, ap);
     va_end(ap);
 }
 
@@ -45,40 +93,167 @@ void tk_usage_error(const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    vdie(TK_EXIT_USAGE, fmt, ap);
+    vexit(TK_EXIT_USAGE, fmt, ap);
     va_end(ap);
 }
 
-int tk_parse_int(const char *s, long long min, long long max, long long *out)
+void tk_warn(const char *fmt, ...)
 {
-    char *end;
-    long long v;
-    if (s == NULL || *s == '\0') {
-        return -1;
+    va_list ap;
+    va_start(ap, fmt);
+    vmsg(fmt, ap);
+    va_end(ap);
+}
+
+/* ---- numbers ---- */
+
+static int hex_digit(char c)
+{
+    if (c >= '0' && c <= '9') {
+        return c - '0';
     }
-    errno = 0;
-    v = strtoll(s, &end, 0);
-    if (errno != 0 || *end != '\0' || v < min || v > max) {
-        return -1;
+    if (c >= 'a' && c <= 'f') {
+        return c - 'a' + 10;
+    }
+    if (c >= 'A' && c <= 'F') {
+        return c - 'A' + 10;
+    }
+    return -1;
+}
+
+int tk_parse_int(const char *s, long long min, long long max, long long *out, bool *hex)
+{
+    unsigned long long mag = 0, limit;
+    unsigned base = 10;
+    bool neg = false, overflow = false;
+    long long v;
+    if (s == NULL) {
+        return TK_NUM_SYNTAX;
+    }
+    if (*s == '+' || *s == '-') {
+        neg = *s == '-';
+        s++;
+    }
+    if (s[0] == '0' && s[1] == 'x') {
+        base = 16;
+        s += 2;
+    }
+    if (*s == '\0') {
+        return TK_NUM_SYNTAX;
+    }
+    /* magnitudes up to 2^63 (INT64_MIN) are representable */
+    limit = (unsigned long long)INT64_MAX + 1u;
+    for (; *s != '\0'; s++) {
+        int d = base == 16 ? hex_digit(*s) : (*s >= '0' && *s <= '9' ? *s - '0' : -1);
+        if (d < 0) {
+            return TK_NUM_SYNTAX;
+        }
+        if (mag > (limit - (unsigned)d) / base) {
+            overflow = true; /* keep checking the syntax */
+        } else {
+            mag = mag * base + (unsigned)d;
+        }
+    }
+    if (overflow || (!neg && mag > (unsigned long long)INT64_MAX)) {
+        return TK_NUM_RANGE;
+    }
+    v = neg ? (mag == limit ? INT64_MIN : -(long long)mag) : (long long)mag;
+    if (v < min || v > max) {
+        return TK_NUM_RANGE;
     }
     *out = v;
-    return 0;
+    if (hex != NULL) {
+        *hex = base == 16 && !neg;
+    }
+    return TK_NUM_OK;
+}
+
+int tk_parse_real(const char *s, double *out)
+{
+    const char *p = s;
+    size_t digits = 0;
+    if (s == NULL) {
+        return TK_NUM_SYNTAX;
+    }
+    if (*p == '+' || *p == '-') {
+        p++;
+    }
+    for (; *p >= '0' && *p <= '9'; p++) {
+        digits++;
+    }
+    if (*p == '.') {
+        for (p++; *p >= '0' && *p <= '9'; p++) {
+            digits++;
+        }
+    }
+    if (digits == 0 || *p != '\0' || digits > 30) {
+        return TK_NUM_SYNTAX;
+    }
+    *out = strtod(s, NULL);
+    return TK_NUM_OK;
 }
 
 int tk_parse_seconds(const char *s, double *out)
 {
-    char *end;
     double v;
-    if (s == NULL || *s == '\0' || *s == '-') {
-        return -1;
-    }
-    errno = 0;
-    v = strtod(s, &end);
-    if (errno != 0 || *end != '\0' || !(v >= 0.0) || v > 1e7) {
+    if (tk_parse_real(s, &v) != TK_NUM_OK || s[0] == '-' || s[0] == '+' || v > 1e7) {
         return -1;
     }
     *out = v;
     return 0;
+}
+
+/* ---- standard output and signals ---- */
+
+void tk_stdout_buffered(void)
+{
+    (void)setvbuf(stdout, NULL, _IOFBF, 1u << 16);
+}
+
+void tk_stdout_flush(void)
+{
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        int e = errno;
+        clearerr(stdout);
+        tk_die("cannot write to standard output: %s", e ? strerror(e) : "write error");
+    }
+}
+
+static void on_signal(int sig)
+{
+    tk_signal = sig;
+}
+
+void tk_catch_signals(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof(sa));
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = 0; /* no SA_RESTART: a blocking wait returns at once */
+    (void)sigaction(SIGINT, &sa, NULL);
+    (void)sigaction(SIGTERM, &sa, NULL);
+    (void)sigaction(SIGHUP, &sa, NULL);
+    (void)signal(SIGPIPE, SIG_IGN);
+}
+
+void tk_exit_if_signalled(void)
+{
+    int sig = tk_signal;
+    if (sig != 0) {
+        tk_exit(128 + sig, "interrupted by %s",
+                sig == SIGINT ? "SIGINT" : (sig == SIGTERM ? "SIGTERM" : "SIGHUP"));
+    }
+}
+
+/* ---- clocks ---- */
+
+void tk_time_now(tk_time_t *t)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    t->sec = (int64_t)ts.tv_sec;
+    t->usec = (uint32_t)(ts.tv_nsec / 1000);
 }
 
 double tk_now_s(void)
@@ -100,15 +275,26 @@ uint32_t tk_now_ms(void)
 void tk_link_serial(tk_link_t *l, const char *path, long baud)
 {
     int rc;
+    struct stat st;
     memset(l, 0, sizeof(*l));
     if (baud <= 0 || !tase_posix_uart_baud_supported((uint32_t)baud)) {
         tk_usage_error("unsupported baud rate %ld", baud);
     }
     rc = tase_posix_uart_open(&l->uart, path, (uint32_t)baud);
-    if (rc != TASE_OK) {
+    if (rc == TASE_ENODEV && stat(path, &st) == 0) {
+        tk_die("cannot open serial device %s: not a terminal (a serial device or pseudo-terminal "
+               "is needed)",
+               path);
+    } else if (rc == TASE_ENODEV) {
+        tk_die("cannot open serial device %s: %s", path, strerror(errno));
+    } else if (rc == TASE_EBUSY) {
+        tk_die("cannot open serial device %s: device busy: in use by another program", path);
+    } else if (rc != TASE_OK) {
         tk_die("cannot open serial device %s: %s", path,
                rc == TASE_EIO ? strerror(errno) : tase_strerror(rc));
     }
+    l->open = true;
+    track_link(l, true);
 }
 
 void tk_link_pty(tk_link_t *l, int fd)
@@ -120,6 +306,7 @@ void tk_link_pty(tk_link_t *l, int fd)
     if (rc != TASE_OK) {
         tk_die("cannot set up the pseudo-terminal: %s", tase_strerror(rc));
     }
+    l->open = true;
     /* a simulator must not stall when nobody reads the link: drop instead */
     l->uart.write_timeout_ms = 0;
     /* The port reads with poll(), but plain readers of the slave (cat, a
@@ -137,9 +324,19 @@ void tk_link_can(tk_link_t *l, const char *iface, bool gimbal)
     memset(l, 0, sizeof(*l));
     l->is_can = true;
     rc = tase_socketcan_open(&l->can, iface, gimbal ? TASE_CAN_ROLE_GIMBAL : TASE_CAN_ROLE_HOST);
-    if (rc != TASE_OK) {
+    if (rc == TASE_EUNSUPPORTED) {
+        tk_die("cannot open CAN interface %s: this kernel has no SocketCAN support (load the can "
+               "and can-raw modules, or see docs/CAN.md for the VM)",
+               iface);
+    } else if (rc == TASE_ENODEV) {
+        tk_die("cannot open CAN interface %s: no such device", iface);
+    } else if (rc == TASE_EDOWN) {
+        tk_die("cannot open CAN interface %s: interface is down (ip link set %s up)", iface, iface);
+    } else if (rc != TASE_OK) {
         tk_die("cannot open CAN interface %s: %s", iface, tase_strerror(rc));
     }
+    l->open = true;
+    track_link(l, true);
 }
 
 tase_port_t tk_link_port(tk_link_t *l)
@@ -149,6 +346,11 @@ tase_port_t tk_link_port(tk_link_t *l)
 
 void tk_link_close(tk_link_t *l)
 {
+    if (!l->open) {
+        return;
+    }
+    l->open = false;
+    track_link(l, false);
     if (l->is_can) {
         tase_socketcan_close(&l->can);
     } else {
@@ -177,12 +379,90 @@ int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n)
     return 0;
 }
 
+int tk_canonical_path(const char *path, char *out, size_t cap)
+{
+    char dir[PATH_MAX], real[PATH_MAX];
+    const char *slash = strrchr(path, '/');
+    const char *base = slash != NULL ? slash + 1 : path;
+    size_t dl = slash != NULL ? (size_t)(slash - path) : 0u;
+    int n;
+    if (*base == '\0' || dl >= sizeof(dir)) {
+        errno = EINVAL;
+        return -1;
+    }
+    if (slash == NULL) {
+        strcpy(dir, ".");
+    } else if (dl == 0u) {
+        strcpy(dir, "/");
+    } else {
+        memcpy(dir, path, dl);
+        dir[dl] = '\0';
+    }
+    if (realpath(dir, real) == NULL) {
+        return -1;
+    }
+    n = snprintf(out, cap, "%s/%s", strcmp(real, "/") == 0 ? "" : real, base);
+    if (n < 0 || (size_t)n >= cap) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    return 0;
+}
+
+/* Claim `link` for this process: an abstract Unix socket named after the
+ * link's canonical path, released by the kernel when the process ends
+ * (a crash included), so no lock file is ever left behind. */
+static void claim_link(const char *link)
+{
+    char canon[PATH_MAX];
+    struct sockaddr_un sa;
+    uint64_t h = 1469598103934665603u; /* FNV-1a 64 */
+    const char *c;
+    socklen_t len;
+    int fd;
+    if (tk_canonical_path(link, canon, sizeof(canon)) != 0) {
+        tk_die("cannot create symlink %s: %s", link, strerror(errno));
+    }
+    for (c = canon; *c != '\0'; c++) {
+        h = (h ^ (uint8_t)*c) * 1099511628211u;
+    }
+    memset(&sa, 0, sizeof(sa));
+    sa.sun_family = AF_UNIX;
+    len = (socklen_t)(offsetof(struct sockaddr_un, sun_path) + 1u +
+                      (size_t)snprintf(sa.sun_path + 1, sizeof(sa.sun_path) - 1u,
+                                       "tase-sim-link:%016llx", (unsigned long long)h));
+    fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (fd < 0) {
+        tk_die("cannot claim %s: %s", link, strerror(errno));
+    }
+    if (bind(fd, (struct sockaddr *)&sa, len) != 0) {
+        int e = errno;
+        struct ucred cred;
+        socklen_t cl = sizeof(cred);
+        int q = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+        long pid = 0;
+        if (e == EADDRINUSE && q >= 0 && connect(q, (struct sockaddr *)&sa, len) == 0 &&
+            getsockopt(q, SOL_SOCKET, SO_PEERCRED, &cred, &cl) == 0) {
+            pid = (long)cred.pid;
+        }
+        if (e == EADDRINUSE) {
+            tk_die("%s is the link of a running tase-sim (pid %ld); not taking it over", link, pid);
+        }
+        tk_die("cannot claim %s: %s", link, strerror(e));
+    }
+    (void)listen(fd, 4); /* so a refused simulator can name the owner */
+    /* kept open (and bound) until this process ends */
+}
+
 int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
 {
-    int fd = posix_openpt(O_RDWR | O_NOCTTY);
+    int fd, sfd;
     const char *name;
-    int sfd;
     struct stat st;
+    if (link != NULL) {
+        claim_link(link); /* before anything is created */
+    }
+    fd = posix_openpt(O_RDWR | O_NOCTTY);
     if (fd < 0) {
         tk_die("cannot create a pseudo-terminal: %s", strerror(errno));
     }
@@ -202,6 +482,7 @@ int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
     *slave_fd = sfd;
     if (link != NULL) {
         if (lstat(link, &st) == 0) {
+            /* a symlink left by a simulator that died: nobody claims it */
             if (!S_ISLNK(st.st_mode)) {
                 tk_die("%s exists and is not a symlink; not replacing it", link);
             }
@@ -212,6 +493,18 @@ int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
         }
     }
     return fd;
+}
+
+void tk_pty_unlink(const char *link, const char *slave)
+{
+    char target[PATH_MAX];
+    ssize_t n = readlink(link, target, sizeof(target) - 1u);
+    if (n > 0 && (size_t)n < sizeof(target) - 1u) {
+        target[n] = '\0';
+        if (strcmp(target, slave) == 0) {
+            (void)unlink(link);
+        }
+    }
 }
 
 int tk_pty_unread(int slave_fd)
@@ -228,4 +521,10 @@ int tk_pty_drop_unread(int slave_fd)
     }
     (void)tcflush(slave_fd, TCIFLUSH);
     return n;
+}
+
+uint64_t tk_offset64(uint64_t base64, uint32_t base32, uint32_t off32)
+{
+    uint32_t d = off32 - base32; /* modulo 2^32 */
+    return (d & 0x80000000u) != 0u ? base64 - (uint64_t)(0u - d) : base64 + d;
 }

@@ -2,54 +2,118 @@
  * tools/toolkit.h - private helpers shared by the `tase` command line and
  * `tase-sim` (host-only, POSIX 2008). Not part of the library's API.
  *
- *  - errors: every failure ends the program with exactly one line on
- *    stderr ("tase: <reason>") and exit status 1 (2 for usage errors);
- *  - links: a tase_port_t over a file descriptor (serial device, pty) and
- *    over a CAN interface when the SocketCAN port is built;
+ *  - errors and exit status: every failure ends the program with one line
+ *    on stderr ("tase: <reason>") and one of the TK_EXIT_* codes;
+ *  - numbers: one strict grammar for every integer and decimal argument;
+ *  - standard output: buffered, every write error reported;
+ *  - signals: SIGINT/SIGTERM/SIGHUP set a flag the loops poll, so links
+ *    are always closed (and devices restored) by the normal path;
+ *  - links: a tase_port_t over a serial device, a pty master or a CAN
+ *    interface;
  *  - packets: a thin view of the library's schema table by name and by
- *    group/type, so JSON output and `tase send` need no per-packet code;
- *  - JSON: one object per frame, the public contract of docs/TOOLS.md.
+ *    group/type, so output and `tase send` need no per-packet code;
+ *  - output: one line per frame, JSON (the public contract of
+ *    docs/TOOLS.md) or text, with optional time and engineering units;
+ *  - decoding: byte streams (serial, or one CAN direction of one
+ *    interface) fed into receivers with 64-bit offsets and counters.
  */
 #ifndef TASE_TOOLS_TOOLKIT_H
 #define TASE_TOOLS_TOOLKIT_H
 
+#include <signal.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 
+#include "tase/can.h"
+#include "tase/candump.h"
 #include "tase/frame.h"
 #include "tase/port.h"
+#include "tase/posix_uart.h"
 #include "tase/schema.h"
 #include "tase/socketcan.h"
-#include "tase/posix_uart.h"
 
-/* ---- errors and arguments ---- */
+/* Stringify a number (usage texts). The version is TASE_VERSION_STRING. */
+#define TK_STR_(x) #x
+#define TK_STR(x) TK_STR_(x)
 
-#define TK_EXIT_FAIL 1
-#define TK_EXIT_USAGE 2
+/* ---- errors and exit status ---- */
+
+#define TK_EXIT_OK 0
+#define TK_EXIT_FAIL 1     /* device, I/O, timeout, write error */
+#define TK_EXIT_USAGE 2    /* bad command line: nothing was sent */
+#define TK_EXIT_MISMATCH 3 /* the gimbal's echo differs from what was sent */
+#define TK_EXIT_INPUT 4    /* input not (fully) understood: bad lines, nothing found */
+/* Interrupted by signal N: 128 + N (the shell's convention). */
 
 /* Program name used as the prefix of error lines. */
 extern const char *tk_prog;
 
-/* Print "<prog>: <message>\n" to stderr and exit(TK_EXIT_FAIL). */
+/* Print "<prog>: <message>\n" to stderr (after flushing stdout) and exit
+ * with the given status. Newlines in the message are folded into spaces. */
+void tk_exit(int status, const char *fmt, ...);
+/* tk_exit(TK_EXIT_FAIL, ...) and tk_exit(TK_EXIT_USAGE, ...). */
 void tk_die(const char *fmt, ...);
-/* Same with exit status TK_EXIT_USAGE (bad command line). */
 void tk_usage_error(const char *fmt, ...);
+/* The same line without exiting. */
+void tk_warn(const char *fmt, ...);
 
-/* Parse a whole decimal, 0x-hex or negative integer in [min, max].
- * Returns 0 or -1 (not a number, trailing characters, out of range). */
-int tk_parse_int(const char *s, long long min, long long max, long long *out);
-/* Parse a non-negative decimal number with an optional fraction. */
+/* ---- numbers ----
+ * Integers: an optional sign ('+' or '-'), then decimal digits (leading
+ * zeros are still decimal) or "0x" and hexadecimal digits. Nothing else:
+ * no spaces, no "0X", no octal, no suffix. Decimal numbers (degrees,
+ * seconds): an optional sign, digits, optionally '.' and digits. */
+
+#define TK_NUM_OK 0
+#define TK_NUM_SYNTAX (-1) /* not a number of the grammar above */
+#define TK_NUM_RANGE (-2)  /* a number, outside [min, max] */
+
+/* Parse a whole integer in [min, max]. Returns a TK_NUM_* code; *out is
+ * set only on TK_NUM_OK. *hex (may be NULL) tells whether it was written
+ * in hex without a sign. */
+int tk_parse_int(const char *s, long long min, long long max, long long *out, bool *hex);
+/* Parse a whole decimal number. Returns TK_NUM_OK or TK_NUM_SYNTAX. */
+int tk_parse_real(const char *s, double *out);
+/* A non-negative decimal number of seconds (at most 1e7). */
 int tk_parse_seconds(const char *s, double *out);
+
+/* ---- clocks ---- */
 
 /* Monotonic clock in milliseconds and seconds. */
 uint32_t tk_now_ms(void);
 double tk_now_s(void);
 
+/* Wall-clock time (Unix seconds and microseconds), as captures carry. */
+typedef struct {
+    int64_t sec;
+    uint32_t usec; /* 0..999999 */
+} tk_time_t;
+void tk_time_now(tk_time_t *t);
+
+/* ---- standard output ---- */
+
+/* Use a large buffer for standard output (before the first write). */
+void tk_stdout_buffered(void);
+/* Flush standard output; on any write error so far exit TK_EXIT_FAIL with
+ * "cannot write to standard output: <reason>". */
+void tk_stdout_flush(void);
+
+/* ---- signals ---- */
+
+/* SIGINT, SIGTERM or SIGHUP caught since tk_catch_signals(), 0 if none. */
+extern volatile sig_atomic_t tk_signal;
+/* Catch those three (without SA_RESTART, so blocking calls return) and
+ * ignore SIGPIPE (a closed reader is then a write error). */
+void tk_catch_signals(void);
+/* If a signal was caught: run the cleanup the caller did (nothing here)
+ * and exit 128 + signal with "interrupted by SIGxxx". */
+void tk_exit_if_signalled(void);
+
 /* ---- links ---- */
 
 typedef struct {
     bool is_can;
+    bool open;
     tase_posix_uart_t uart;
     tase_socketcan_t can;
 } tk_link_t;
@@ -63,6 +127,7 @@ void tk_link_can(tk_link_t *l, const char *iface, bool gimbal);
 void tk_link_pty(tk_link_t *l, int fd);
 /* The port interface over an open link. */
 tase_port_t tk_link_port(tk_link_t *l);
+/* Close (safe to call twice). */
 void tk_link_close(tk_link_t *l);
 
 /* Write a whole buffer through a port, waiting while it is busy. Returns
@@ -72,9 +137,17 @@ int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n);
 /* Create a pseudo-terminal; returns the master descriptor, writes the
  * slave's path (cap bytes) and a descriptor of the slave that this process
  * keeps open (so the master never sees a hang-up between clients). With
- * `link` non-NULL, also makes `link` a symlink to the slave (replacing an
- * old symlink). Dies on error. */
+ * `link` non-NULL, also makes `link` a symlink to the slave. The link is
+ * claimed for the life of the process first: if a running process holds
+ * the claim it dies naming its pid; a symlink nobody claims (left by a
+ * simulator that was killed) is replaced; a file that is not a symlink
+ * never is. Dies on error. */
 int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd);
+/* Remove `link` only if it is still a symlink to `slave` (ours). */
+void tk_pty_unlink(const char *link, const char *slave);
+/* `path` with its directory resolved (the file itself need not exist).
+ * Returns 0, or -1 with errno set. */
+int tk_canonical_path(const char *path, char *out, size_t cap);
 /* Discard what is waiting unread in a pty slave's input (a serial line
  * does not keep bytes nobody reads). Returns the bytes discarded. */
 int tk_pty_drop_unread(int slave_fd);
@@ -85,30 +158,135 @@ int tk_pty_unread(int slave_fd);
 
 typedef struct {
     const char *name; /* JSON name */
-    unsigned offset;  /* byte offset in the data */
+    unsigned offset;  /* byte offset in the data (of the layout asked for) */
     unsigned width;   /* 1, 2, 4 or 8 bytes */
     bool is_signed;
 } tk_field_t;
 
-/* Field i of packet p (i < p->nfields). */
-void tk_field(const tase_packet_desc_t *p, unsigned i, tk_field_t *out);
+/* Field i of packet p (i < p->nfields) in a packet of `len` data bytes
+ * (the length selects the layout: AXIS_SETTING's 22-byte form moves
+ * fields, see tase_field_offset()). */
+void tk_field(const tase_packet_desc_t *p, unsigned i, size_t len, tk_field_t *out);
 /* Raw value of field i from data[0..len); false if it lies beyond len. */
 bool tk_field_get(const tase_packet_desc_t *p, unsigned i, const uint8_t *data, size_t len,
                   long long *v);
 /* Store a raw value big-endian; returns -1 if it does not fit the field. */
 int tk_field_set(const tk_field_t *f, uint8_t *data, long long v);
+/* The range of the field's values as text ("-32768..32767"). */
+void tk_field_range(const tk_field_t *f, char *buf, size_t cap);
+/* Parse a value for the field: the integer grammar above, within the
+ * field's range; a signed field also takes its bit pattern in hex
+ * (0xFFFF is -1 in a 16-bit field, as the spec writes it). Returns a
+ * TK_NUM_* code. */
+int tk_field_parse(const tk_field_t *f, const char *s, long long *v);
 /* The packet named `name`, case-insensitive; dies with a one-line list
  * hint when unknown. */
 const tase_packet_desc_t *tk_packet_by_name(const char *name);
 /* Whether the packet carries free bytes after its fields (CAMERA_PASS). */
 bool tk_packet_has_tail(const tase_packet_desc_t *p);
 
-/* ---- JSON ---- */
+/* ---- output of frames ---- */
 
-/* One JSON object for a frame, with a newline. `dir` (NULL, "in", "out")
- * adds the CAN direction key. */
-void tk_json_frame(FILE *out, const tase_frame_t *f, const char *dir);
-/* One human-readable line for a frame. */
-void tk_text_frame(FILE *out, const tase_frame_t *f);
+typedef struct {
+    bool json;  /* JSON object (the contract) instead of a text line */
+    bool units; /* engineering units beside the raw fields */
+    bool time;  /* the time, when known */
+} tk_fmt_t;
+
+/* Where a frame came from. */
+typedef struct {
+    uint64_t offset;       /* stream offset of its first sync byte */
+    const tk_time_t *time; /* when its last byte arrived, NULL unknown */
+    const char *dir;       /* NULL, "in" (to the gimbal) or "out" */
+    const char *iface;     /* CAN interface, or NULL */
+} tk_meta_t;
+
+/* Longest line tk_format_frame() writes (with the newline and a NUL). */
+#define TK_LINE_MAX 8192u
+
+/* Format one frame as one line ending in '\n' into buf[0..cap) (cap >=
+ * TK_LINE_MAX always suffices); returns its length. */
+size_t tk_format_frame(char *buf, size_t cap, const tk_fmt_t *fmt, const tk_meta_t *m,
+                       const tase_frame_t *f);
+/* Format and write to `out` (no flush). */
+void tk_print_frame(FILE *out, const tk_fmt_t *fmt, const tk_meta_t *m, const tase_frame_t *f);
+/* Append the JSON number of a time ("1700000000.123456") to buf;
+ * returns the length written (at most 28). */
+size_t tk_format_time(char *buf, const tk_time_t *t);
+
+/* ---- decoding byte streams ----
+ * A decoder holds one receiver per stream: the serial line, or one
+ * direction of one CAN interface. Every valid frame is printed with its
+ * 64-bit stream offset, the stream's direction/interface and the time of
+ * the chunk that completed it. Input parsers (raw bytes, candump lines,
+ * captures) only call tk_dec_bytes() / tk_dec_can(). */
+
+#define TK_STREAMS_MAX 32u
+
+typedef struct {
+    char iface[TASE_CANDUMP_IFNAME_MAX]; /* "" for a serial stream */
+    const char *dir;                     /* NULL, "in" or "out" */
+    uint64_t bytes;                      /* bytes fed so far */
+    tase_rx_stats_t seen;                /* rx.stats already added up */
+    tk_time_t last;                      /* time of the last chunk */
+    bool timed;                          /* last is known */
+    tase_rx_t rx;
+} tk_stream_t;
+
+typedef struct {
+    uint64_t bytes;           /* bytes fed to receivers */
+    uint64_t frames;          /* valid frames (printed) */
+    uint64_t unknown;         /* of them: group/type not in the schema */
+    uint64_t bad_length;      /* of them: wrong data length for the type */
+    uint64_t checksum_errors; /* candidate frames with a bad checksum */
+    uint64_t bad_size;        /* candidates with Size < 2 */
+    uint64_t discarded;       /* bytes not part of any valid frame */
+    uint64_t can_frames;      /* CAN frames seen */
+    uint64_t can_other;       /* of them: not datalink frames (other IDs) */
+} tk_counts_t;
+
+typedef struct {
+    tk_fmt_t fmt;
+    FILE *out;
+    uint64_t limit; /* stop printing after this many frames, 0 none */
+    tk_counts_t n;
+    size_t nstreams;
+    tk_stream_t stream[TK_STREAMS_MAX];
+    /* the chunk being fed */
+    tk_stream_t *cur;
+    uint64_t base64;
+    uint32_t base32;
+    const tk_time_t *time;
+    /* formatted lines not yet written to `out` */
+    size_t olen;
+    char obuf[1u << 16];
+} tk_dec_t;
+
+/* Initialise: no streams, counters zero, output to `out` in `fmt`. */
+void tk_dec_init(tk_dec_t *d, const tk_fmt_t *fmt, FILE *out);
+/* The stream of (iface, dir), created on first use ("" / NULL for a
+ * serial line); NULL when TK_STREAMS_MAX streams exist already. `dir` must
+ * be a string constant. */
+tk_stream_t *tk_dec_stream(tk_dec_t *d, const char *iface, const char *dir);
+/* Feed bytes of one stream that arrived at `time` (NULL unknown). The
+ * frames they complete are written to `out` (stdio) before it returns. */
+void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n,
+                  const tk_time_t *time);
+/* Feed one CAN frame seen on `iface`: datalink frames (ID 0x11000000 to
+ * the gimbal, 0x10000000 from it) go to that interface's stream of their
+ * direction, others are only counted. Returns false when no stream could
+ * be created (too many interfaces). */
+bool tk_dec_can(tk_dec_t *d, const char *iface, const tase_can_frame_t *f, const tk_time_t *time);
+/* End of input: settle every stream's pending frames. */
+void tk_dec_finish(tk_dec_t *d);
+/* One summary line on `out` ("tase: summary: N frames, ..." and `extra`). */
+void tk_dec_summary(const tk_dec_t *d, FILE *out, const char *extra);
+
+/* ---- offsets ---- */
+
+/* The 64-bit stream offset of a 32-bit one (the library's offsets wrap
+ * modulo 2^32), given a reference point: the stream held base64 bytes
+ * when its 32-bit count was base32, and off32 lies within 2^31 of it. */
+uint64_t tk_offset64(uint64_t base64, uint32_t base32, uint32_t off32);
 
 #endif /* TASE_TOOLS_TOOLKIT_H */

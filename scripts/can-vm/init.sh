@@ -158,6 +158,10 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     until grep -q ' 7FF#03' /tmp/tools.log 2>/dev/null; do
         cansend vcan0 7FF#03; usleep 20000; i=$((i + 1)); [ $i -gt 200 ] && fail "candump never started (tools)"
     done
+    # tase record --can beside candump: the same session as a pcap capture
+    $T record --can vcan0 -o /tmp/tools.pcap > /tmp/rec.out 2>&1 &
+    trec=$!
+    wait_for /tmp/rec.out recording || { cat /tmp/rec.out; fail "tase record --can did not start"; }
     tase-sim --can vcan0 --seconds 40 > /tmp/sim.log 2>&1 &
     sim=$!
     wait_for /tmp/sim.log 'simulated gimbal on CAN interface vcan0' || { cat /tmp/sim.log; fail "tase-sim --can vcan0 did not start"; }
@@ -169,27 +173,32 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
               [ "$(json_int "$v" camera_a)/$(json_int "$v" camera_b)/$(json_int "$v" camera_c)" = 68/97/255 ] &&
               echo "$v" | grep -q "\"name\":\"SYSTEM_VERSION\",\"size\":42,"'
 
-    e=$($T send PACKET_RATE angle_1=20 rate_1=5 geo_ref_1=2 $L --json)
+    e=$($T send PACKET_RATE angle_1=20 rate_1=5 geo_ref_1=2 $L --json | grep '"dir":"out"')
     check "send PACKET_RATE: the gimbal echoes 20/5/2" \
         eval '[ "$(json_int "$e" angle_1)/$(json_int "$e" rate_1)/$(json_int "$e" geo_ref_1)" = 20/5/2 ]'
-    $T monitor $L --json --seconds 2 > /tmp/mon.json
+    $T monitor $L --json --time --seconds 2 > /tmp/mon.json 2> /tmp/mon.err
     na=$(grep -c '"name":"GIMBAL_ANGLE"' /tmp/mon.json)
     nr=$(grep -c '"name":"GIMBAL_RATE"' /tmp/mon.json)
     ng=$(grep -c '"name":"GEOREFERENCE_DATA"' /tmp/mon.json)
     check "monitor 2 s follows PACKET_RATE: $na GIMBAL_ANGLE (40+-8), $nr GIMBAL_RATE (10+-3), $ng GEOREFERENCE_DATA (4+-2)" \
         eval 'near $na 40 8 && near $nr 10 3 && near $ng 4 2'
+    check "monitor's summary has the frames and the CAN bus state ($(cat /tmp/mon.err))" \
+        grep -q "^tase: summary: [0-9]* frames .*, CAN bus error-active (0 error frames, 0 bus-off" /tmp/mon.err
+    check "monitor --time on CAN: the kernel's receive time, close to now" \
+        eval 't=$(json_int "$(head -1 /tmp/mon.json)" time); now=$(date +%s); near "$t" "$now" 5'
 
     # The monitor runs while the position command goes out on the bus.
     $T monitor $L --json --seconds 3.5 > /tmp/move.json &
     mon=$!
     usleep 400000
-    s=$($T send GIMBAL_CMD pan=3000 tilt=-1500 flags=0xA0 $L)
-    check "send GIMBAL_CMD ($s)" [ "$s" = "sent GIMBAL_CMD (8 data bytes)" ]
+    s=$($T point 30 -15 $L | head -1)
+    check "tase point 30 -15 sends GIMBAL_CMD position, stabilised ($s)" \
+        [ "$s" = "sent GIMBAL_CMD pan=3000 tilt=-1500 roll=0 flags=160 impulse_time=0" ]
     # A long packet both ways: 44 data bytes = 52 bytes = 7 CAN frames to the
     # gimbal, whose simulated camera echoes the bytes back.
     pass=$(seq -s, 201 240)
     s=$($T send CAMERA_PASS camera=1 baud=8 data=$pass $L)
-    check "send CAMERA_PASS, 40 camera bytes ($s)" [ "$s" = "sent CAMERA_PASS (44 data bytes)" ]
+    check "send CAMERA_PASS, 40 camera bytes ($s)" [ "$s" = "sent CAMERA_PASS camera=1 baud=8 +40 data bytes" ]
     wait $mon
     check "monitor got the CAMERA_PASS echo with the 40 bytes" \
         grep -q "\"name\":\"CAMERA_PASS\",\"size\":44,\"fields\":{\"camera\":1,\"baud\":8},\"data\":\[$pass\]}" /tmp/move.json
@@ -208,6 +217,8 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     cansend vcan0 7FF#04
     wait_for /tmp/tools.log ' 7FF#04' || fail "end marker not seen (tools)"
     kill $tdump
+    kill -INT $trec
+    wait $trec
 
     # candump's record, first raw, then decoded offline by the tool. The
     # SYSTEM_VERSION query framed by hand: 00 FF 5A, size 2, group 0x48,
@@ -222,8 +233,8 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
         "$(grep -c '"dir":"in"' /tmp/dec.json) in, $(grep -c '"dir":"out"' /tmp/dec.json) out"
     check "tase decode --candump of the capture exits 0 ($(cat /tmp/t.err))" [ $rc -eq 0 ]
     check "decoded: SYSTEM_VERSION query (in, size 0)" \
-        grep -q '"dir":"in","group":72,"type":3,"name":"SYSTEM_VERSION","size":0,"fields":{}}' /tmp/dec.json
-    ve=$(grep '"dir":"out","group":72,"type":3,"name":"SYSTEM_VERSION","size":42,' /tmp/dec.json)
+        grep -q '"dir":"in","interface":"vcan0","group":72,"type":3,"name":"SYSTEM_VERSION","size":0,"fields":{}}' /tmp/dec.json
+    ve=$(grep '"dir":"out","interface":"vcan0","group":72,"type":3,"name":"SYSTEM_VERSION","size":42,' /tmp/dec.json)
     check "decoded: SYSTEM_VERSION answer (out) 2.5.1 as tase query printed it" \
         eval '[ "$(echo "$ve" | wc -l)" = 1 ] && [ "$(json_int "$ve" major)/$(json_int "$ve" minor)/$(json_int "$ve" sub)" = 2/5/1 ] &&
               [ "${ve#*\"fields\"}" = "${v#*\"fields\"}" ]'
@@ -231,15 +242,57 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
         eval '[ "$(grep -c "\"dir\":\"in\".*\"name\":\"PACKET_RATE\",\"size\":16,\"fields\":{\"angle_1\":20,\"rate_1\":5,\"geo_ref_1\":2," /tmp/dec.json)" = 1 ] &&
               [ "$(grep -c "\"dir\":\"out\".*\"name\":\"PACKET_RATE\",\"size\":16,\"fields\":{\"angle_1\":20,\"rate_1\":5,\"geo_ref_1\":2," /tmp/dec.json)" = 1 ] &&
               grep -q "\"dir\":\"in\".*\"name\":\"PACKET_RATE\",\"size\":0," /tmp/dec.json'
+    check "decoded: every packet has the capture's time and the interface" \
+        eval '[ "$(grep -c "^{\"offset\":[0-9]*,\"time\":[0-9]*\.[0-9]\{6\},\"dir\":\"[a-z]*\",\"interface\":\"vcan0\"," /tmp/dec.json)" = "$(wc -l < /tmp/dec.json)" ]'
     check "decoded: GIMBAL_CMD in, pan 3000 tilt -1500 flags 0xA0" \
-        grep -q '"dir":"in","group":0,"type":128,"name":"GIMBAL_CMD","size":8,"fields":{"pan":3000,"tilt":-1500,.*"flags":160' /tmp/dec.json
+        grep -q '"dir":"in","interface":"vcan0","group":0,"type":128,"name":"GIMBAL_CMD","size":8,"fields":{"pan":3000,"tilt":-1500,.*"flags":160' /tmp/dec.json
     check "decoded: CAMERA_PASS in and its echo out, same 40 bytes" \
         eval '[ "$(grep -c "\"name\":\"CAMERA_PASS\",\"size\":44,\"fields\":{\"camera\":1,\"baud\":8},\"data\":\[$pass\]}" /tmp/dec.json)" = 2 ] &&
-              grep -q "\"dir\":\"in\",\"group\":0,\"type\":66," /tmp/dec.json &&
-              grep -q "\"dir\":\"out\",\"group\":0,\"type\":66," /tmp/dec.json'
+              grep -q "\"dir\":\"in\",\"interface\":\"vcan0\",\"group\":0,\"type\":66," /tmp/dec.json &&
+              grep -q "\"dir\":\"out\",\"interface\":\"vcan0\",\"group\":0,\"type\":66," /tmp/dec.json'
     nd=$(grep -c '"dir":"out".*"name":"GIMBAL_ANGLE"' /tmp/dec.json)
     check "decoded: $nd GIMBAL_ANGLE out, at least the $na the 2 s monitor printed" [ "$nd" -ge "$na" ]
     check "decoded: no frame with a wrong length" eval '! grep -q "\"error\"" /tmp/dec.json'
+
+    # The capture of tase record --can: the same packets as candump's log,
+    # the same kernel receive times (to the microsecond candump keeps).
+    check "tase record --can: $(tail -1 /tmp/rec.out)" grep -q '^recorded [1-9][0-9]* records' /tmp/rec.out
+    $T decode /tmp/tools.pcap > /tmp/pcap.json
+    sed 's/"interface":"[^"]*",//' /tmp/dec.json > /tmp/dec.cmp
+    check "tase decode of the record --can capture: the candump log's $(wc -l < /tmp/dec.cmp) packets, times to the microsecond" \
+        cmp -s /tmp/pcap.json /tmp/dec.cmp
+    # tase replay --can of that capture, seen by candump: every frame, in
+    # order, at 4 times the recorded pace; then only the host's frames.
+    # replay_seen LOG ARGS...: candump (into LOG) watches tase replay ARGS
+    replay_seen() {
+        log=$1
+        shift
+        candump -L vcan0 > $log &
+        rdump=$!
+        i=0
+        until grep -q ' 7FF#05' $log 2>/dev/null; do
+            cansend vcan0 7FF#05; usleep 20000; i=$((i + 1)); [ $i -gt 200 ] && fail "candump never started (replay)"
+        done
+        $T replay /tmp/tools.pcap --can vcan0 "$@" > /tmp/replay.out 2>&1
+        cansend vcan0 7FF#06
+        wait_for $log ' 7FF#06' || fail "end marker not seen (replay)"
+        kill $rdump
+        wait $rdump
+        grep -v ' 7FF#0' $log | cut -d' ' -f2- > /tmp/replayed.txt
+    }
+    grep -v ' 7FF#0' /tmp/tools.log | cut -d' ' -f2- > /tmp/recorded.txt
+    span=$(grep -v ' 7FF#0' /tmp/tools.log | sed -n '1s/^(\([0-9.]*\)).*/\1/p;$s/^(\([0-9.]*\)).*/\1/p' |
+        tr '\n' ' ' | awk '{ printf "%.3f", $2 - $1 }')
+    replay_seen /tmp/replay-all.log --dir all --speed 4
+    took=$(sed -n 's/.* in \([0-9.]*\) s.*/\1/p' /tmp/replay.out)
+    check "replay --can --dir all --speed 4: candump saw the $(wc -l < /tmp/recorded.txt) recorded frames in order ($(cat /tmp/replay.out))" \
+        cmp -s /tmp/recorded.txt /tmp/replayed.txt
+    check "replay --speed 4 took $took s for a $span s session: a quarter, +-0.3 s" \
+        awk -v s="$span" -v t="$took" 'BEGIN { q = s / 4; exit !(t > q - 0.3 && t < q + 0.3) }'
+    replay_seen /tmp/replay-in.log --dir in --speed 0
+    grep ' 11000000#' /tmp/recorded.txt > /tmp/recorded.in
+    check "replay --can --dir in: only the $(wc -l < /tmp/recorded.in) frames sent to the gimbal ($(cat /tmp/replay.out))" \
+        eval 'cmp -s /tmp/recorded.in /tmp/replayed.txt || { diff /tmp/recorded.in /tmp/replayed.txt | head; false; }'
     [ $nfail -eq 0 ] || fail "$nfail bench tool check(s) over vcan0 failed"
 else
     step "bench tools over vcan0: SKIPPED (tase and tase-sim are not built)"

@@ -8,7 +8,9 @@ Run from anywhere: python3 tests/data/gen_captures.py
 Outputs (next to this script):
   decode_noisy.bin / decode_noisy.jsonl        raw serial bytes with noise
   decode_candump.log / decode_candump.jsonl    the same kind of traffic as a
-                                               candump log, both directions
+                                               candump log, both directions (each
+                                               packet with the time of the line
+                                               carrying its last byte)
   klv_noisy.bin / klv_noisy.jsonl              KLV packets (spec table 31, built
                                                here) with noise, a corrupted and
                                                a cut packet; the expected lines
@@ -199,12 +201,15 @@ def candump(rng):
         data = queues[which].pop(0)
         can_id = "11000000" if which == "in" else "10000000"
         t += 0.000731
-        lines.append("(%.6f) vcan0 %s#%s" % (t, can_id, data.hex().upper()))
+        stamp = "%.6f" % t
+        lines.append("(%s) vcan0 %s#%s" % (stamp, can_id, data.hex().upper()))
         pos[which] += len(data)
         while pending[which]:
             o = pending[which][0]
             if o["offset"] + sizes[which][0] > pos[which]:
                 break
+            o["time"] = stamp  # the line that carried the packet's last byte
+            o["interface"] = "vcan0"
             expect.append(pending[which].pop(0))
             sizes[which].pop(0)
         if rng.random() < 0.3:
@@ -273,12 +278,18 @@ def klv_capture(rng):
 
 
 def dump(path, objs):
+    """One JSON object per line, keys in the contract's order: offset, then
+    time, dir and interface when present. Times are the capture's own text
+    (seconds with six decimals), written as JSON numbers."""
+    meta = ("offset", "time", "dir", "interface")
     with open(path, "w") as f:
         for o in objs:
-            if "dir" in o:  # put the direction right after the offset
-                o = {"offset": o["offset"], "dir": o["dir"],
-                     **{k: v for k, v in o.items() if k not in ("offset", "dir")}}
-            f.write(json.dumps(o, separators=(",", ":")) + "\n")
+            o = {**{k: o[k] for k in meta if k in o},
+                 **{k: v for k, v in o.items() if k not in meta}}
+            line = json.dumps(o, separators=(",", ":"))
+            if "time" in o:
+                line = line.replace('"time":"%s"' % o["time"], '"time":%s' % o["time"])
+            f.write(line + "\n")
 
 
 def main():

@@ -1,0 +1,276 @@
+#!/usr/bin/env python3
+"""The bench tools' behaviour that needs no simulated gimbal: the command
+line (numbers, help, version, exit codes, messages), decoding (candump per
+interface and direction, bad lines, hints, statistics, 64-bit offsets, live
+input) and output hygiene (write errors on stdout). Real processes, real
+pipes and FIFOs; every byte stream is built here from the spec's framing.
+
+Usage: scripts/tools-cli.py TASE TASE_SIM   (registered by tests/checks/tools.cmake)
+"""
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+TASE, SIM = sys.argv[1], sys.argv[2]
+TMP = tempfile.mkdtemp(prefix="tase-cli-")
+fails = 0
+# Under scripts/check-valgrind.sh this interpreter runs natively: it puts
+# the programs under memcheck itself (an error exits 99, failing the check).
+VALGRIND = os.environ.get("TASE_UNDER_VALGRIND") == "1"
+VG = ["valgrind", "-q", "--error-exitcode=99", "--leak-check=full",
+      "--errors-for-leak-kinds=definite,indirect", "--show-leak-kinds=definite,indirect"] \
+    if VALGRIND else []
+SLOW = 10.0 if VALGRIND else 1.0
+
+
+def ok(name, cond, detail=""):
+    global fails
+    print(("ok   " if cond else "FAIL ") + name + (": " + detail if detail and not cond else ""))
+    if not cond:
+        fails += 1
+
+
+def run(args, stdin=b"", timeout=30, stdout=subprocess.PIPE):
+    p = subprocess.run(VG + ([TASE] + args if args and args[0] != SIM else args), input=stdin,
+                       stdout=stdout, stderr=subprocess.PIPE, timeout=timeout)
+    out = p.stdout.decode(errors="replace") if p.stdout is not None else ""
+    return p.returncode, out, p.stderr.decode(errors="replace")
+
+
+def expect(name, args, rc, pattern, stdin=b"", lines=1):
+    """args exits with rc and prints `lines` stderr lines, one matching pattern."""
+    got, out, err = run(args, stdin)
+    errl = err.splitlines()
+    good = got == rc and len(errl) == lines and re.search(pattern, err) is not None
+    ok(name, good, "exit %d, stderr %r" % (got, err[:400]))
+    return out, err
+
+
+def frame(group, ptype, data):
+    body = bytes([0x00, 0xFF, 0x5A, len(data) + 2, group, ptype]) + bytes(data)
+    s = sum(body) & 0xFFFF
+    return body + bytes([s >> 8, s & 0xFF])
+
+
+def angle(pan, tilt):
+    return frame(0x08, 0x10, pan.to_bytes(2, "big", signed=True) +
+                 tilt.to_bytes(2, "big", signed=True) + b"\0\0")
+
+
+def candump_lines(iface, can_id, raw, t0, step=0.001):
+    """raw bytes as candump -l lines of up to 8 bytes (list of (time, line))."""
+    out = []
+    for i in range(0, len(raw), 8):
+        t = t0 + step * (i // 8)
+        out.append((t, "(%.6f) %s %s#%s" % (t, iface, can_id, raw[i:i + 8].hex().upper())))
+    return out
+
+
+def write(name, data):
+    path = os.path.join(TMP, name)
+    with open(path, "wb") as f:
+        f.write(data if isinstance(data, bytes) else data.encode())
+    return path
+
+
+def jsonl(out):
+    return [json.loads(l) for l in out.splitlines() if l.strip()]
+
+
+# ---- help, version, "--" ----
+rc, out, _ = run(["help", "monitor"])
+ok("'tase help monitor' prints the monitor usage", rc == 0 and out.startswith("usage: tase monitor"))
+rc, out, _ = run(["--help"])
+ok("--help lists the exit codes", rc == 0 and "exit status" in out and "3 the gimbal's echo" in out)
+rc, out, _ = run(["send", "--help"])
+ok("send --help gives the timeout and retry defaults",
+   rc == 0 and "default 500 ms" in out and "default 2" in out)
+rc, out, _ = run(["--version"])
+ok("tase --version", rc == 0 and re.match(r"^tase \d+\.\d+\.\d+", out) is not None, out)
+rc, out, _ = run([SIM, "--version"])
+ok("tase-sim --version", rc == 0 and re.match(r"^tase-sim \d+\.\d+\.\d+", out) is not None, out)
+noisy = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "data",
+                     "decode_noisy.bin")
+rc, out, _ = run(["decode", "--", noisy])
+ok("'--' ends the options (decode -- FILE)", rc == 0 and out.count("\n") == 12, out[:200])
+dash = write("-odd-name.bin", angle(1, 2))
+rc, out, _ = run(["decode", "--", dash])
+ok("after '--' a name starting with '-' is a file", rc == 0 and '"pan":1,' in out, out)
+
+# ---- numbers and field assignments: refused before anything is opened ----
+L = ["--serial", "/nonexistent/tty"]
+expect("leading zero is decimal, 09 accepted (reaches the link)",
+       ["send", "HOST_SENSOR", "roll=09", "--zero"] + L, 1, "cannot open serial device")
+expect("pan=' 5' refused", ["send", "HOST_SENSOR", "roll= 5", "--zero"] + L, 2,
+       r"bad value ' 5' for HOST_SENSOR.roll: not a number")
+expect("0X10 refused (hex is 0x)", ["send", "HOST_SENSOR", "roll=0X10", "--zero"] + L, 2,
+       "not a number")
+expect("empty value refused", ["send", "HOST_SENSOR", "roll=", "--zero"] + L, 2, "empty")
+expect("duplicate field refused", ["send", "HOST_SENSOR", "roll=100", "roll=200", "--zero"] + L,
+       2, "HOST_SENSOR.roll given twice")
+expect("empty data list items refused", ["send", "CAMERA_PASS", "camera=0", "baud=0",
+                                         "data=,,,"] + L, 2, "empty item 1 in data list")
+expect("empty data item in the middle", ["send", "CAMERA_PASS", "camera=0", "baud=0",
+                                         "data=1,,3"] + L, 2, "empty item 2")
+expect("range error states the range", ["send", "HOST_SENSOR", "roll=40000", "--zero"] + L, 2,
+       r"out of range -32768\.\.32767")
+expect("data byte range", ["send", "CAMERA_PASS", "camera=0", "baud=0", "data=1,256"] + L, 2,
+       r"out of range 0\.\.255")
+expect("missing fields are named", ["send", "HOST_GPS_DATA", "lat=1", "lon=2"] + L, 2,
+       r"HOST_GPS_DATA needs every field.*missing time, height, vnorth")
+expect("GIMBAL_CMD without flags is refused with the modes",
+       ["send", "GIMBAL_CMD", "pan=4500", "tilt=-2000", "roll=0", "impulse_time=0"] + L, 2,
+       r"GIMBAL_CMD needs flags.*0x10 rate.*0xA0 position stabilised")
+expect("GIMBAL_CMD without flags is refused even with --zero",
+       ["send", "GIMBAL_CMD", "pan=4500", "tilt=-2000", "--zero"] + L, 2, "needs flags")
+expect("GIMBAL_CMD flags outside table 5 refused",
+       ["send", "GIMBAL_CMD", "pan=0", "tilt=0", "flags=0x55", "--zero"] + L, 2,
+       "not a mode of the spec's table 5")
+expect("--no-wait setup packet needs every field",
+       ["send", "PACKET_RATE", "angle_1=20", "--no-wait"] + L, 2, "needs every field with --no-wait")
+expect("point: out-of-range angle states the range", ["point", "200", "0"] + L, 2,
+       r"out of range -180\.\.180 deg")
+expect("point: not a number", ["point", "ten", "0"] + L, 2, "not a number")
+expect("rate: range", ["rate", "400", "0"] + L, 2, r"-327\.68\.\.327\.67 deg/s")
+expect("point: negative numbers are arguments", ["point", "-10", "-5.5"] + L, 1,
+       "cannot open serial device")
+expect("camera: bad name", ["camera", "D"] + L, 2, "bad camera 'D'")
+expect("camera: nothing to do", ["camera"] + L, 2, "expected a camera")
+expect("spoi: latitude range", ["spoi", "91", "0", "0"] + L, 2, r"out of range -90\.\.90 deg")
+
+# ---- messages ----
+expect("--serial /dev/null: not a terminal (it exists)",
+       ["query", "SYSTEM_VERSION", "--serial", "/dev/null"], 1,
+       "cannot open serial device /dev/null: not a terminal")
+expect("--serial missing: no such file", ["query", "SYSTEM_VERSION", "--serial", "/nonexistent/tty"],
+       1, "No such file or directory")
+if not os.path.exists("/proc/net/can"):
+    expect("--can on a kernel without CAN says why", ["monitor", "--can", "can0"], 1,
+           "cannot open CAN interface can0: this kernel has no SocketCAN support")
+else:
+    expect("--can missing interface", ["monitor", "--can", "nosuchcan0"], 1,
+           "cannot open CAN interface nosuchcan0")
+
+# ---- candump: per interface and direction ----
+a0, a1 = angle(100, -200), angle(300, -400)
+l0 = candump_lines("can0", "10000000", a0, 1700000000.0)
+l1 = candump_lines("can1", "10000000", a1, 1700000000.0005)
+inter = [l for pair in zip(l0, l1) for l in pair]
+log = write("two.log", "\n".join(l for _, l in inter) + "\n")
+rc, out, err = run(["decode", "--candump", log])
+objs = jsonl(out)
+ok("candump: one GIMBAL_ANGLE on can0 and one on can1, interleaved: 2 objects",
+   rc == 0 and [(o["interface"], o["fields"]["pan"]) for o in objs] == [("can0", 100), ("can1", 300)],
+   out + err)
+ok("candump: \"interface\" follows \"dir\"",
+   objs != [] and list(objs[0].keys())[:4] == ["offset", "time", "dir", "interface"], out)
+ok("candump: \"time\" is the timestamp of the frame that completed the packet",
+   objs != [] and abs(objs[0]["time"] - l0[-1][0]) < 1e-6, out)
+m0 = candump_lines("can0", "10000000", a0, 1700000001.0)
+m1 = candump_lines("vcan0", "10000000", a0, 1700000001.0001)
+log = write("mirror.log", "\n".join(l for pair in zip(m0, m1) for _, l in pair) + "\n")
+rc, out, err = run(["decode", "--candump", log])
+objs = jsonl(out)
+ok("candump: traffic mirrored on can0 and vcan0 gives one object per interface",
+   rc == 0 and len(objs) == 2 and {o["interface"] for o in objs} == {"can0", "vcan0"} and
+   all(o["fields"] == {"pan": 100, "tilt": -200, "roll": 0} for o in objs), out + err)
+# both directions on one interface, interleaved
+cmd = frame(0x00, 0x80, (1000).to_bytes(2, "big") + (0).to_bytes(2, "big") + b"\0\0\x20\0")
+li = candump_lines("can0", "11000000", cmd, 1700000002.0)
+lo = candump_lines("can0", "10000000", a1, 1700000002.0002)
+log = write("dirs.log", "\n".join(l for pair in zip(li, lo) for _, l in pair) + "\n")
+rc, out, err = run(["decode", "--candump", log])
+ok("candump: directions reassembled apart on one interface",
+   rc == 0 and sorted((o["dir"], o["name"]) for o in jsonl(out)) ==
+   [("in", "GIMBAL_CMD"), ("out", "GIMBAL_ANGLE")], out + err)
+
+# blank lines, comments, bad lines with numbers, NUL
+lines = [l for _, l in l0]
+text = "# recorded on the bench\n\n" + lines[0] + "\n   \n" + "garbage line\n" + lines[1] + \
+       "\n" + "(1700000000.5) can0 10000000#00\0FF\n" + "\n".join(lines[2:]) + "\n"
+log = write("mixed.log", text)
+out, err = expect("candump: bad lines reported with their numbers, the rest decoded (exit 4)",
+                  ["decode", "--candump", log], 4, r"2 bad lines", lines=3)
+ok("candump: the bad line's number", "mixed.log:5: not a candump log line" in err, err)
+ok("candump: a NUL is reported as such, not as 'too long'",
+   "mixed.log:7: not a candump log line (it holds a NUL byte)" in err, err)
+ok("candump: blank and '#' lines skipped, packet still decoded",
+   [o["fields"]["pan"] for o in jsonl(out)] == [100], out)
+screen = "  can0  10000000   [8]  00 FF 5A 08 08 10 00 64\n  can0  10000000   [6]  FF 38 00 00 01 D4\n"
+expect("candump: plain candump output gets a hint about the format",
+       ["decode", "--candump", write("screen.txt", screen)], 4,
+       r"screen output\? record a log with 'candump -L'", lines=3)
+
+# ---- silent success: hints and statistics ----
+log = write("plain.log", "\n".join(l for _, l in l0) + "\n")
+expect("a candump log decoded without --candump: hint and exit 4", ["decode", log], 4,
+       r"no TASE packet found in .*plain.log: it looks like a candump log \(add --candump\)")
+expect("noise only: hint and exit 4", ["decode", write("noise.bin", bytes(range(1, 200)))], 4,
+       "no TASE packet found")
+rc, out, err = run(["decode", write("empty.bin", b"")])
+ok("an empty input is no error", rc == 0 and out == "" and err == "", err)
+rc, out, err = run(["decode", "--stats", noisy])
+ok("decode --stats prints the counters on stderr",
+   rc == 0 and re.search(r"summary: 12 frames \(1 unknown, 1 wrong length\), 1 checksum errors, "
+                         r"1 bad sizes, \d+ of \d+ bytes discarded", err) is not None, err)
+
+# ---- output errors ----
+for args in (["decode", noisy], ["list"], ["--help"], ["klv", os.path.join(os.path.dirname(noisy),
+                                                                      "klv_noisy.bin")]):
+    with open("/dev/full", "wb") as full:
+        rc, _, err = run(args, stdout=full)
+    ok("tase %s > /dev/full fails with a message" % args[0],
+       rc == 1 and "cannot write to standard output" in err, "exit %d %s" % (rc, err))
+
+# ---- live input is read as it arrives ----
+def live(args, data, what):
+    fifo = os.path.join(TMP, "fifo-" + what)
+    os.mkfifo(fifo)
+    p = subprocess.Popen(VG + [TASE] + args + [fifo], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    w = os.open(fifo, os.O_WRONLY)
+    os.write(w, data)
+    got = b""
+    deadline = time.time() + 2.0 * SLOW
+    os.set_blocking(p.stdout.fileno(), False)
+    while time.time() < deadline and b"\n" not in got:
+        try:
+            got += p.stdout.read() or b""
+        except (BlockingIOError, TypeError):
+            pass
+        time.sleep(0.02)
+    os.close(w)
+    p.wait(timeout=10)
+    return got
+
+
+klv = open(os.path.join(os.path.dirname(noisy), "klv_noisy.bin"), "rb").read()
+first = json.loads(open(os.path.join(os.path.dirname(noisy), "klv_noisy.jsonl")).readline())
+got = live(["klv"], klv[first["offset"]:first["offset"] + 87], "klv")
+ok("tase klv on a live input prints a packet while the writer is still open",
+   b'"fields":{"utc":' in got, repr(got[:200]))
+got = live(["decode"], angle(7, 8), "decode")
+ok("tase decode on a live input prints a packet while the writer is still open",
+   b'"pan":7,' in got, repr(got[:200]))
+
+# ---- 64-bit offsets (4 GiB through a pipe: about 1.5 s of CPU; not under memcheck) ----
+gen = ("import os,sys,fcntl\n"
+       "try: fcntl.fcntl(1, 1031, 1 << 20)\n"
+       "except OSError: pass\n"
+       "b = b'U' * (1 << 20)\n"
+       "for _ in range(4096): os.write(1, b)\n"
+       "os.write(1, b'UUUU' + bytes.fromhex(sys.argv[1]))\n")
+if not VALGRIND:
+    g = subprocess.Popen([sys.executable, "-c", gen, angle(11, 12).hex()], stdout=subprocess.PIPE)
+    p = subprocess.run([TASE, "decode"], stdin=g.stdout, stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, timeout=120)
+    g.wait()
+    ok("a frame at byte 4,294,967,300 has that offset",
+       p.stdout.decode().startswith('{"offset":4294967300,'), repr(p.stdout[:200]))
+
+print("%d failure(s)" % fails)
+sys.exit(1 if fails else 0)

@@ -1,0 +1,163 @@
+/* Byte streams to printed frames: one receiver per stream (the serial
+ * line, or one direction of one CAN interface), 64-bit offsets and
+ * counters on top of the library's 32-bit ones. */
+#include "toolkit.h"
+
+#include <string.h>
+
+void tk_dec_init(tk_dec_t *d, const tk_fmt_t *fmt, FILE *out)
+{
+    memset(d, 0, sizeof(*d));
+    d->fmt = *fmt;
+    d->out = out;
+}
+
+static bool same_dir(const char *a, const char *b)
+{
+    return a == b || (a != NULL && b != NULL && strcmp(a, b) == 0);
+}
+
+tk_stream_t *tk_dec_stream(tk_dec_t *d, const char *iface, const char *dir)
+{
+    tk_stream_t *s;
+    size_t i;
+    for (i = 0; i < d->nstreams; i++) {
+        s = &d->stream[i];
+        if (same_dir(s->dir, dir) && strncmp(s->iface, iface, sizeof(s->iface) - 1u) == 0) {
+            return s;
+        }
+    }
+    if (d->nstreams == TK_STREAMS_MAX) {
+        return NULL;
+    }
+    s = &d->stream[d->nstreams++];
+    memset(s, 0, sizeof(*s));
+    strncpy(s->iface, iface, sizeof(s->iface) - 1u);
+    s->dir = dir;
+    (void)tase_rx_init(&s->rx);
+    return s;
+}
+
+/* Lines are formatted straight into the decoder's buffer and written in
+ * blocks: one fwrite per line costs more than formatting it. */
+static void flush_out(tk_dec_t *d)
+{
+    if (d->olen > 0u) {
+        (void)fwrite(d->obuf, 1, d->olen, d->out);
+        d->olen = 0;
+    }
+}
+
+static void on_frame(void *user, const tase_frame_t *f)
+{
+    tk_dec_t *d = user;
+    const tk_stream_t *s = d->cur;
+    const tase_packet_desc_t *p = tase_schema_find(f->group, f->type);
+    tk_meta_t m;
+    if (d->limit != 0u && d->n.frames >= d->limit) {
+        return;
+    }
+    d->n.frames++;
+    if (p == NULL) {
+        d->n.unknown++;
+    } else if (!tase_schema_length_ok(p, f->len)) {
+        d->n.bad_length++;
+    }
+    m.offset = tk_offset64(d->base64, d->base32, f->offset);
+    m.time = d->time;
+    m.dir = s->dir;
+    m.iface = s->iface[0] != '\0' ? s->iface : NULL;
+    if (sizeof(d->obuf) - d->olen < TK_LINE_MAX) {
+        flush_out(d);
+    }
+    d->olen += tk_format_frame(d->obuf + d->olen, TK_LINE_MAX, &d->fmt, &m, f);
+}
+
+/* Add what the receiver counted since last time (its counters are 32-bit). */
+static void account(tk_dec_t *d, tk_stream_t *s)
+{
+    const tase_rx_stats_t *now = &s->rx.stats;
+    d->n.checksum_errors += (uint32_t)(now->checksum_errors - s->seen.checksum_errors);
+    d->n.bad_size += (uint32_t)(now->bad_size - s->seen.bad_size);
+    d->n.discarded += (uint32_t)(now->bytes_discarded - s->seen.bytes_discarded);
+    s->seen = *now;
+}
+
+static void begin(tk_dec_t *d, tk_stream_t *s, const tk_time_t *time)
+{
+    d->cur = s;
+    d->base64 = s->bytes;
+    d->base32 = s->rx.stats.bytes_in;
+    d->time = time;
+}
+
+void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n, const tk_time_t *time)
+{
+    if (time != NULL) {
+        s->last = *time;
+        s->timed = true;
+    }
+    while (n > 0u) {
+        /* chunks well below 2^31 keep tk_offset64()'s reference valid */
+        size_t k = n > (1u << 30) ? (size_t)1u << 30 : n;
+        begin(d, s, time);
+        (void)tase_rx_feed(&s->rx, data, k, on_frame, d);
+        s->bytes += k;
+        d->n.bytes += k;
+        account(d, s);
+        data += k;
+        n -= k;
+    }
+    flush_out(d);
+}
+
+bool tk_dec_can(tk_dec_t *d, const char *iface, const tase_can_frame_t *f, const tk_time_t *time)
+{
+    const char *dir = "out"; /* from the gimbal: what a host accepts */
+    tk_stream_t *s;
+    int n = tase_can_accept(TASE_CAN_ROLE_HOST, f);
+    d->n.can_frames++;
+    if (n <= 0) {
+        dir = "in";
+        n = tase_can_accept(TASE_CAN_ROLE_GIMBAL, f);
+    }
+    if (n <= 0) {
+        d->n.can_other++; /* 3AX, other nodes, empty frames */
+        return true;
+    }
+    s = tk_dec_stream(d, iface, dir);
+    if (s == NULL) {
+        return false;
+    }
+    tk_dec_bytes(d, s, f->data, (size_t)n, time);
+    return true;
+}
+
+void tk_dec_finish(tk_dec_t *d)
+{
+    size_t i;
+    for (i = 0; i < d->nstreams; i++) {
+        tk_stream_t *s = &d->stream[i];
+        begin(d, s, s->timed ? &s->last : NULL);
+        (void)tase_rx_flush(&s->rx, on_frame, d);
+        account(d, s);
+    }
+    flush_out(d);
+}
+
+void tk_dec_summary(const tk_dec_t *d, FILE *out, const char *extra)
+{
+    const tk_counts_t *n = &d->n;
+    fprintf(out,
+            "%s: summary: %llu frames (%llu unknown, %llu wrong length), %llu checksum errors, "
+            "%llu bad sizes, %llu of %llu bytes discarded",
+            tk_prog, (unsigned long long)n->frames, (unsigned long long)n->unknown,
+            (unsigned long long)n->bad_length, (unsigned long long)n->checksum_errors,
+            (unsigned long long)n->bad_size, (unsigned long long)n->discarded,
+            (unsigned long long)n->bytes);
+    if (n->can_frames != 0u) {
+        fprintf(out, ", %llu CAN frames (%llu not datalink)", (unsigned long long)n->can_frames,
+                (unsigned long long)n->can_other);
+    }
+    fprintf(out, "%s\n", extra);
+}
