@@ -148,6 +148,28 @@ echo "$f" | grep -q '^FULL rc=-16 .* (transmit queue full)$' || fail "full queue
 echo "$f" | grep -q ' enobufs=0 ' && fail "full queue: no ENOBUFS counted: $f"
 ip link del dev vcan2
 
+step "two senders on one ID: interleaved, both packets are lost (the limit can.h states)"
+# Two GIMBAL_CMD packets of 16 bytes, 8 + 8 each, as an autopilot and a
+# bench tool would send them at once on 0x11000000. Each alone decodes.
+$A recv vcan0 gimbal 2 3000 > /tmp/one.out &
+o=$!
+wait_for /tmp/one.out READY || fail "receiver not ready (one sender)"
+cansend vcan0 11000000#00FF5A0A00800BB8
+cansend vcan0 11000000#00000000000002A6
+cansend vcan0 11000000#00FF5A0A0080F448
+cansend vcan0 11000000#FC18000020000453
+wait $o || { cat /tmp/one.out; fail "one sender at a time: both packets expected"; }
+$A recv vcan0 gimbal 1 1000 > /tmp/two.out &
+o=$!
+wait_for /tmp/two.out READY || fail "receiver not ready (two senders)"
+cansend vcan0 11000000#00FF5A0A00800BB8
+cansend vcan0 11000000#00FF5A0A0080F448
+cansend vcan0 11000000#00000000000002A6
+cansend vcan0 11000000#FC18000020000453
+wait $o && fail "two interleaved senders: a packet got through"
+echo "   $(tail -1 /tmp/two.out)"
+grep -q '^END items=0 checksum_errors=2 ' /tmp/two.out || { cat /tmp/two.out; fail "two senders: 0 of 2 and 2 checksum errors expected"; }
+
 step "bus errors: the error frames vcan can carry"
 # vcan has no controller: it never makes error frames itself. A program
 # can send them (an 8-digit ID with bit 29 set), and the port must take
