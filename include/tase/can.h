@@ -22,6 +22,18 @@
  * 0x12020000). Acceptance is by role, so frames of every other node on
  * the multidrop bus are counted and ignored.
  *
+ * ONE SENDER PER ID. Every node sending in one direction uses the same ID
+ * and the frames carry no source or sequence, so the receiver cannot tell
+ * two senders' bytes apart: if an autopilot and a bench tool both send on
+ * 0x11000000 at the same time, the CAN frames of their datalink frames
+ * (any longer than 8 bytes spans several) interleave on the bus and both
+ * datalink frames fail their checksums (0 of 2 delivered, 2 checksum
+ * errors); two gimbals on 0x10000000 the same. This is a limit
+ * of the protocol, not of this library: give each ID exactly one sender
+ * at a time (disconnect or silence the autopilot before a bench tool
+ * commands the gimbal, or put the tool on its own bus). Listening is
+ * always safe: any number of nodes may receive either ID.
+ *
  * 3AX. Two fixed 2-byte frames outside the datalink: the move command
  * (gimbal -> 3AX) and the position/speed status (3AX -> gimbal). The move
  * frame's byte has the opposite polarity of the datalink's

@@ -26,7 +26,7 @@ wait_for() {
 }
 step() { echo "== $*"; }
 
-for m in can can-raw can-dev vcan; do
+for m in can can-raw can-dev vcan sch_plug; do
     insmod /lib/modules/$m.ko || fail "insmod $m"
 done
 ip link add dev vcan0 type vcan || fail "ip link add vcan0"
@@ -118,6 +118,81 @@ $A send vcan0 host max > /dev/null || fail "send (host)"
 wait $p || { cat /tmp/p2p.out; fail "p2p max packet not received"; }
 grep -q '^PKT 00 42 253 070A0D' /tmp/p2p.out || fail "p2p packet content"
 grep -q 'END items=1 checksum_errors=0 ignored=0' /tmp/p2p.out || { cat /tmp/p2p.out; fail "p2p counters"; }
+
+# ---- faults (issue 14): signals, a full transmit queue, bus errors
+t_faults=$(cut -d' ' -f1 /proc/uptime)
+step "host queries over vcan0 under a SIGALRM every millisecond"
+$A gimbal vcan0 gimbal 8000 > /tmp/gimbal2.out &
+g2=$!
+wait_for /tmp/gimbal2.out READY || fail "gimbal agent not ready"
+q=$($A query vcan0 host)
+echo "   $q"
+kill $g2 2>/dev/null
+wait $g2
+n=$(echo "$q" | sed -n 's/.*alarms=\([0-9]*\).*/\1/p')
+echo "$q" | grep -q '^QUERY rc=16 .* angle_1=10 retries=0 errno=0$' || fail "queries under SIGALRM: $q"
+[ "${n:-0}" -ge 300 ] || fail "the queries were not interrupted by signals: $q"
+
+step "a full transmit queue: vcan2 behind a plugged qdisc"
+ip link add dev vcan2 type vcan || fail "ip link add vcan2"
+ip link set up vcan2 || fail "ip link set up vcan2"
+/usr/sbin/tc qdisc add dev vcan2 root plug limit 1024 || fail "tc qdisc add plug"
+f=$($A fill vcan2 host)
+echo "   $f"
+ms=$(echo "$f" | sed -n 's/.* ms=\([0-9]*\) .*/\1/p')
+# TASE_ENOBUFS within the frame bound: tx_timeout_ms (100) is the
+# SocketCAN port's W, and write_all does not call it again after that;
+# up to 300 ms more for the emulated machine's scheduling.
+echo "$f" | grep -q '^FULL rc=-16 .* (transmit queue full)$' || fail "full queue: $f"
+[ "${ms:-0}" -ge 100 ] && [ "${ms:-0}" -le 400 ] || fail "full queue: not within the bound: $f"
+echo "$f" | grep -q ' enobufs=0 ' && fail "full queue: no ENOBUFS counted: $f"
+ip link del dev vcan2
+
+step "two senders on one ID: interleaved, both packets are lost (the limit can.h states)"
+# Two GIMBAL_CMD packets of 16 bytes, 8 + 8 each, as an autopilot and a
+# bench tool would send them at once on 0x11000000. Each alone decodes.
+$A recv vcan0 gimbal 2 3000 > /tmp/one.out &
+o=$!
+wait_for /tmp/one.out READY || fail "receiver not ready (one sender)"
+cansend vcan0 11000000#00FF5A0A00800BB8
+cansend vcan0 11000000#00000000000002A6
+cansend vcan0 11000000#00FF5A0A0080F448
+cansend vcan0 11000000#FC18000020000453
+wait $o || { cat /tmp/one.out; fail "one sender at a time: both packets expected"; }
+$A recv vcan0 gimbal 1 1000 > /tmp/two.out &
+o=$!
+wait_for /tmp/two.out READY || fail "receiver not ready (two senders)"
+cansend vcan0 11000000#00FF5A0A00800BB8
+cansend vcan0 11000000#00FF5A0A0080F448
+cansend vcan0 11000000#00000000000002A6
+cansend vcan0 11000000#FC18000020000453
+wait $o && fail "two interleaved senders: a packet got through"
+echo "   $(tail -1 /tmp/two.out)"
+grep -q '^END items=0 checksum_errors=2 ' /tmp/two.out || { cat /tmp/two.out; fail "two senders: 0 of 2 and 2 checksum errors expected"; }
+
+step "bus errors: the error frames vcan can carry"
+# vcan has no controller: it never makes error frames itself. A program
+# can send them (an 8-digit ID with bit 29 set), and the port must take
+# them as bus state, never as data.
+$A health vcan0 host 2 5000 > /tmp/bus1.out &
+b1=$!
+wait_for /tmp/bus1.out READY || fail "health agent not ready"
+cansend vcan0 20000204#0020000000008305
+cansend vcan0 20000040#0000000000000000
+wait $b1
+echo "   $(tail -1 /tmp/bus1.out)"
+grep -q '^BUS state=3 errors=2 bus_offs=1 passives=1 restarts=0 no_acks=0 tec=131 rec=5 bad=0$' /tmp/bus1.out ||
+    fail "bus-off not reported"
+$A health vcan0 host 2 5000 > /tmp/bus2.out &
+b2=$!
+wait_for /tmp/bus2.out READY || fail "health agent not ready (2)"
+cansend vcan0 20000100#0000000000000000
+cansend vcan0 20000020#0000000000000000
+wait $b2
+echo "   $(tail -1 /tmp/bus2.out)"
+grep -q '^BUS state=0 errors=2 bus_offs=0 passives=0 restarts=1 no_acks=1 tec=0 rec=0 bad=0$' /tmp/bus2.out ||
+    fail "restart / missing ACK not reported"
+echo "   (the fault checks took $t_faults .. $(cut -d' ' -f1 /proc/uptime) s of guest uptime)"
 
 # ---- the bench tools over vcan0 (issue 6): tase-sim is the gimbal, tase
 # the host, candump the independent recorder. Each check prints a PASS or
