@@ -232,6 +232,11 @@ def compare_pdml(pdml, jsonl):
                 continue
             got.append((t, o))
     exp = [json.loads(line, parse_float=Decimal) for line in open(jsonl)]
+    # Each direction in its stream order; across directions tase decode
+    # prints in the order its receivers decided the frames (a frame held
+    # behind a longer candidate comes later), the dissector in packet order.
+    got.sort(key=lambda to: to[1].get("dir") or "")
+    exp.sort(key=lambda e: e.get("dir") or "")
     # CAMERA_PASS: "data" (the camera bytes) follows "fields"; an unknown
     # packet's bytes are fields.data, for both.
     bad = 0

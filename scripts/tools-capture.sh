@@ -31,6 +31,16 @@ tol=0.250 fast_ms=350
 json_int() { sed -n "s/.*\"$2\":\(-\{0,1\}[0-9][0-9]*\).*/\1/p" <<<"$1"; }
 # same_lines A B: files equal, or the diff shown
 same_lines() { diff -u "$1" "$2" | head -20; cmp -s "$1" "$2"; }
+# Each direction in stream order, exactly. Across directions the order is
+# the order the receivers decided the frames: a frame held behind a longer
+# candidate of its own direction (at most 253 bytes) may come after a
+# later frame of the other one, still with the time its last byte came.
+same_per_dir() {
+    local d
+    for d in out in; do
+        same_lines <(grep "\"dir\":\"$d\"" "$1") <(grep "\"dir\":\"$d\"" "$2") || return 1
+    done
+}
 
 # ---- decode: serial pcap of both directions, files, pipes, pcapng ----
 $U serial-pcap "$dir/noisy.pcap" 1 0.001-3 "$DATA/decode_noisy.bin:out" "$DATA/decode_noisy.bin:in"
@@ -39,7 +49,7 @@ $U expect-serial "$dir/noisy.pcap" "$DATA/decode_noisy.jsonl:out" "$DATA/decode_
 "$TASE" decode "$dir/noisy.pcap" >"$dir/noisy.json"
 rc=$?
 check "decode of a serial pcap (both directions, 1..64-byte records): every packet with dir and time, exit 0" \
-    eval '[ $rc -eq 0 ] && same_lines "$dir/noisy.expect" "$dir/noisy.json"'
+    eval '[ $rc -eq 0 ] && same_per_dir "$dir/noisy.expect" "$dir/noisy.json"'
 "$TASE" decode - <"$dir/noisy.pcap" | cmp -s - "$dir/noisy.json"
 check "decode of the serial pcap from standard input (a file)" [ $? -eq 0 ]
 cat "$dir/noisy.pcap" | "$TASE" decode | cmp -s - "$dir/noisy.json"

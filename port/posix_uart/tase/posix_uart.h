@@ -78,7 +78,8 @@ extern const tase_port_ops_t tase_posix_uart_ops;
 
 /* Open `path` (e.g. "/dev/ttyUSB0") at `baud` bits per second, raw 8N1,
  * for exclusive use (see EXCLUSIVE ACCESS), saving the device's settings
- * for close(). Any pending input and output is discarded. Returns TASE_OK
+ * for close(). Pending input (received before the open) is discarded;
+ * output a previous owner left queued is not (it is still sent). Returns TASE_OK
  * or
  *   TASE_EARG         u or path NULL;
  *   TASE_EUNSUPPORTED baud is not a standard termios rate (checked before
