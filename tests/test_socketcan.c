@@ -235,7 +235,7 @@ static void full_queue_is_reported_never_dropped(void **state)
     int n, rc, guard;
     (void)state;
     open_pair(&p, TASE_CAN_ROLE_HOST);
-    p.s.tx_timeout_ms = 5;
+    p.s.tx_timeout_ms = 50; /* room for a retry even under valgrind */
     n = make_packet(wire, 0x42, TASE_DATA_MAX);
     /* Nobody reads the peer: the socket buffer fills up. */
     for (guard = 0; guard < 100000; guard++) {
