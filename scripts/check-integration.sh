@@ -16,10 +16,15 @@
 #   6. Cortex-M4 through CMake and the toolchain file: the core and
 #      tase::baremetal installed and used by a C and C++ firmware project
 #      (the C++ handler table must land in .rodata);
-#   7. the configuration header: a library built with
-#      -DTASE_CONFIG_HEADER passes it on to find_package and pkg-config
-#      consumers, and an application built with another TASE_RX_CANDIDATES
-#      than its library fails to link (it used to overrun the stack);
+#   7. the configuration and the ABI level: (a) TASE_RX_CANDIDATES has no
+#      effect: an application built with 1 against a default library
+#      links and runs clean under ASan with the library's sizeof(tase_rx_t)
+#      (it used to overrun the stack, then to fail to link); (b) a library
+#      built with -DTASE_CONFIG_HEADER passes it on to add_subdirectory,
+#      find_package and pkg-config consumers, and each sees the value the
+#      library applies; (c) headers of another ABI level (tase/version.h)
+#      do not link against the library, naming the guarded initialiser,
+#      and every initialiser the libraries export carries the level;
 #   8. TASE_BUILD_TOOLS=OFF with the tests on still builds test_sim_model.
 # The Debian packages are consumed by scripts/check-packages.sh.
 # Usage: scripts/check-integration.sh [outdir]
@@ -84,7 +89,8 @@ grep -q "consumer: tase $version from $prefix/lib/cmake/tase" "$out/pkg.log" || 
     tase_fail "find_package did not find the installed tase $version"
 }
 cmake --build "$out/pkg" -j$jobs >/dev/null
-"$out/pkg/app"
+pkg_line=$("$out/pkg/app")
+echo "   $pkg_line"
 "$out/pkg/app_cxx"
 expect_fail "$out/pkg-next.log" "compatible" "find_package(tase $((major + 1)).0)" -- \
     cmake -S "$cons/consumer" -B "$out/pkg-next" -DHOW=package -DTASE_WANT="$((major + 1)).0" -DPORT=none \
@@ -195,30 +201,88 @@ expect_fail "$out/m4-posix.log" "posix_uart" "find_package(tase COMPONENTS posix
     cmake -S "$cons/consumer" -B "$out/m4-posix" -DCMAKE_TOOLCHAIN_FILE="$TASE_ROOT/cmake/arm-none-eabi.cmake" \
     -DTASE_CPU=cortex-m4 -DHOW=package -DPORT=posix_uart -DCMAKE_PREFIX_PATH="$m4"
 
-tase_step "7. one configuration header; a mismatched configuration does not link"
-# An application built with TASE_RX_CANDIDATES 1 against the default
-# library: its tase_rx_t is smaller than the one tase_rx_init() writes.
-expect_fail "$out/mismatch.log" "tase_rx_init_rx_candidates_1" "TASE_RX_CANDIDATES=1 app, default library" -- \
-    gcc -std=c99 -fsanitize=address -DTASE_RX_CANDIDATES=1 -I"$prefix/include" "$cons/app.c" \
-    -L"$prefix/lib" -ltase -o "$out/mismatch"
+tase_step "7. the configuration header and the ABI level"
+# sizeof(tase_rx_t) as a program prints it ("... sizeof(tase_rx_t) N, ...").
+rx_size() { sed -n 's/.*sizeof(tase_rx_t) \([0-9]*\),.*/\1/p' <<<"$1"; }
+# (a) TASE_RX_CANDIDATES=1 in the application only, the library built with
+# the default: links, runs clean under ASan (tase_rx_init writes the whole
+# instance), and both sides agree on sizeof(tase_rx_t) (step 1's consumer
+# was built with the library's configuration).
+gcc -std=c99 -g -fsanitize=address,undefined -fno-sanitize-recover=all -DTASE_RX_CANDIDATES=1 \
+    -I"$prefix/include" "$cons/app.c" -L"$prefix/lib" -ltase -o "$out/cand1" >"$out/cand1.log" 2>&1 || {
+    cat "$out/cand1.log"
+    tase_fail "TASE_RX_CANDIDATES=1 app against the default library did not build"
+}
+cand1_line=$("$out/cand1" 2>&1) || {
+    echo "$cand1_line"
+    tase_fail "TASE_RX_CANDIDATES=1 app against the default library failed under ASan"
+}
+lib_size=$(rx_size "$pkg_line")
+app_size=$(rx_size "$cand1_line")
+[ -n "$lib_size" ] && [ "$lib_size" = "$app_size" ] ||
+    tase_fail "sizeof(tase_rx_t): library's configuration '$lib_size', TASE_RX_CANDIDATES=1 app '$app_size'"
+echo "   $cand1_line"
+echo "   TASE_RX_CANDIDATES=1 app, default library: ran clean under ASan, sizeof(tase_rx_t) $app_size on both sides"
+expect_fail "$out/cand17.log" "TASE_RX_CANDIDATES must be 1..16" "TASE_RX_CANDIDATES=17" -- \
+    gcc -std=c99 -DTASE_RX_CANDIDATES=17 -I"$prefix/include" -c "$cons/app.c" -o "$out/cand17.o"
+
+# (b) A library configured with a header: every consumer kind gets it, and
+# the app checks both the value it sees and that the library applies it.
 cfg="$out/cfg/tase_config.h"
 mkdir -p "$out/cfg"
-printf '#define TASE_RX_CANDIDATES 2\n' >"$cfg"
+printf '#define TASE_PORT_WRITE_TIMEOUT_MS 250u\n' >"$cfg"
 pcfg="$out/prefix-cfg"
 cmake -S "$TASE_ROOT" -B "$out/cfg-lib" -DCMAKE_INSTALL_PREFIX="$pcfg" -DTASE_CONFIG_HEADER="$cfg" \
     -DTASE_BUILD_TESTS=ON -DTASE_BUILD_TOOLS=OFF -DTASE_CHECKS=OFF >/dev/null
 cmake --build "$out/cfg-lib" -j$jobs --target tase tase_posix_uart tase_socketcan tase_baremetal >/dev/null
 cmake --install "$out/cfg-lib" >/dev/null
 [ -f "$pcfg/include/tase/user_config.h" ] || tase_fail "the configuration header was not installed"
-cmake -S "$cons/consumer" -B "$out/cfg-pkg" -DHOW=package -DPORT=posix_uart -DEXPECT_CANDIDATES=2 \
+cmake -S "$cons/consumer" -B "$out/cfg-pkg" -DHOW=package -DPORT=posix_uart -DEXPECT_WRITE_TIMEOUT_MS=250 \
     -DCMAKE_PREFIX_PATH="$pcfg" -DCMAKE_C_FLAGS="-fsanitize=address" >/dev/null
 cmake --build "$out/cfg-pkg" -j$jobs >/dev/null
-"$out/cfg-pkg/app"
+line=$("$out/cfg-pkg/app")
+echo "   find_package: $line"
 PKG_CONFIG_PATH="$pcfg/lib/pkgconfig" make -s -C "$cons/pkgconfig" BUILD="$out/cfg-pc" \
-    APP_DEFS="-DAPP_POSIX_UART -DAPP_EXPECT_CANDIDATES=2 -fsanitize=address" >/dev/null
-"$out/cfg-pc/app"
-expect_fail "$out/mismatch2.log" "tase_rx_init_rx_candidates_4" "default app, library configured for 2" -- \
-    gcc -std=c99 -I"$pcfg/include" "$cons/app.c" -L"$pcfg/lib" -ltase -o "$out/mismatch2"
+    APP_DEFS="-DAPP_POSIX_UART -DAPP_EXPECT_WRITE_TIMEOUT_MS=250 -fsanitize=address" >/dev/null
+line=$("$out/cfg-pc/app")
+echo "   pkg-config: $line"
+cmake -S "$cons/consumer" -B "$out/cfg-subdir" -DHOW=subdir -DTASE_SRC="$TASE_ROOT" -DPORT=baremetal \
+    -DTASE_CONFIG_HEADER="$cfg" -DEXPECT_WRITE_TIMEOUT_MS=250 >/dev/null
+cmake --build "$out/cfg-subdir" -j$jobs >/dev/null
+line=$("$out/cfg-subdir/app")
+echo "   add_subdirectory: $line"
+# The app's check is not vacuous: built without the installed header (no
+# TASE_USER_CONFIG) it sees 100 ms while the library applies 250.
+expect_fail "$out/cfg-none.log" "^FAIL" "an app without the library's configuration header" -- \
+    bash -c "gcc -std=c99 -I'$pcfg/include' '$cons/app.c' -L'$pcfg/lib' -ltase -o '$out/cfg-none' && '$out/cfg-none'"
+
+# (c) Headers of another ABI level (a copy of the installed ones with
+# TASE_ABI_LEVEL changed, standing in for another release's headers, such
+# as a stale /usr/local/include) against the library: no link.
+level=$(sed -n 's/^#define TASE_ABI_LEVEL \([0-9][0-9]*\)$/\1/p' "$prefix/include/tase/version.h")
+[ -n "$level" ] || tase_fail "tase/version.h: no TASE_ABI_LEVEL"
+next=$((level + 1))
+mkdir -p "$out/abi-next"
+cp -r "$prefix/include" "$out/abi-next/"
+sed -i "s/^#define TASE_ABI_LEVEL $level\$/#define TASE_ABI_LEVEL $next/" "$out/abi-next/include/tase/version.h"
+grep -q "^#define TASE_ABI_LEVEL $next\$" "$out/abi-next/include/tase/version.h" ||
+    tase_fail "could not make headers of ABI level $next"
+expect_fail "$out/abi-next.log" "tase_rx_init_abi$next" "headers of ABI level $next, library of level $level" -- \
+    gcc -std=c99 -I"$out/abi-next/include" "$cons/app.c" -L"$prefix/lib" -ltase -o "$out/abi-next/app"
+# Every guarded initialiser (tase/config.h's list) is defined with the
+# level and never under its plain name (0.1.0's headers reference plain
+# names), and no initialiser the libraries export escapes the list.
+mapfile -t guarded < <(sed -n 's/^#define \(tase_[a-z0-9_]*\) TASE_CONFIG_LINK_NAME(.*/\1/p' \
+    "$prefix/include/tase/config.h")
+[ "${#guarded[@]}" -gt 0 ] || tase_fail "tase/config.h: no guarded function found"
+defined=$(nm -g --defined-only "$prefix"/lib/libtase*.a 2>/dev/null | awk '$2 == "T" {print $3}' | sort -u)
+for g in "${guarded[@]}"; do
+    grep -qx "${g}_abi$level" <<<"$defined" || tase_fail "$g: no ${g}_abi$level in the installed libraries"
+    ! grep -qx "$g" <<<"$defined" || tase_fail "$g: defined under its plain name"
+done
+unguarded=$(grep -E '^tase_[a-z0-9_]*_(init|open|open_flags|attach|adopt)$' <<<"$defined" || true)
+[ -z "$unguarded" ] || tase_fail "initialisers without the ABI level (add them to tase/config.h): $unguarded"
+echo "   ${#guarded[@]} initialisers link as <name>_abi$level; headers of level $next do not link"
 
 tase_step "8. TASE_BUILD_TOOLS=OFF with the tests on: test_sim_model links and passes"
 cmake --build "$out/cfg-lib" -j$jobs --target test_sim_model >/dev/null

@@ -79,11 +79,11 @@ def globals_of(obj):
 
 def link_name(objs, name):
     """The symbol a function links as: the initialisers guarded by
-    tase/config.h carry the configuration (tase_rx_init ->
-    tase_rx_init_rx_candidates_4)."""
+    tase/config.h carry the ABI level, and any configuration that may
+    join it later (tase_rx_init -> tase_rx_init_abi2)."""
     for o in objs.values():
         for s in globals_of(o):
-            if s == name or re.fullmatch(re.escape(name) + r"_rx_candidates_\d+", s):
+            if s == name or re.fullmatch(re.escape(name) + r"_abi\d+(?:_[A-Za-z0-9_]+)?", s):
                 return s
     return name
 

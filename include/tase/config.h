@@ -12,7 +12,7 @@
  *     cmake -DTASE_CONFIG_HEADER=/path/my_tase_config.h   (CMake; see below)
  *
  *     // my_tase_config.h
- *     #define TASE_RX_CANDIDATES 1
+ *     #define TASE_PORT_WRITE_TIMEOUT_MS 250u
  *
  * It is included before the defaults below, so it may set any of them.
  * Passing single macros with -D works too, but one header named once in
@@ -25,9 +25,6 @@
  * TASE_USER_CONFIG defined, which includes it from here.
  *
  * THE OPTIONS
- *   TASE_RX_CANDIDATES (1..16, default 4)   ABI: changes sizeof(tase_rx_t),
- *       so also of tase_host_t and tase_can_rx_t, and the stride of the
- *       receiver array given to tase_gimbal_init(). See tase/frame.h.
  *   TASE_PORT_WRITE_TIMEOUT_MS (default 100)  the deadline of one frame
  *       write by tase_port_write_all() (tase/port_io.h).
  *   TASE_PORT_WRITE_TRIES (default 64)  tase_port_write_all()'s give-up
@@ -36,25 +33,35 @@
  *       was built with are the ones that apply.
  *   TASE_RING_BARRIER()  the bare-metal ring's barrier hook (tase/ring.h),
  *       used only inside port/baremetal/tase_ring.c.
- * No other macro changes a type's size or a function's signature.
+ *   TASE_RX_CANDIDATES (1..16, default 4)  NO EFFECT since 0.2.0: the
+ *       receiver it sized keeps one pending candidate whatever the value
+ *       (tase/frame.h). Accepted and range-checked so that configurations
+ *       that set it keep building; the library and the application may
+ *       differ in it.
+ * No option changes a type's layout or a function's signature.
  *
  * MISMATCH DETECTION
- * A program whose configuration differs from the library's must not link:
- * an instance sized for one TASE_RX_CANDIDATES and initialised by code
- * built for another is a memory overrun. So every function that
- * initialises an instance whose size depends on the configuration has a
- * link name that carries the configuration: the call tase_rx_init(&rx)
- * compiled with the default links to tase_rx_init_rx_candidates_4, and
- * the library built with TASE_RX_CANDIDATES 1 only defines
- * tase_rx_init_rx_candidates_1. A mismatch is then a link error naming
- * the value the application expected, e.g.
- *     undefined reference to `tase_host_init_rx_candidates_1'
- * Fix: build the library and the application with the same
- * TASE_CONFIG_HEADER. In source code the functions keep their plain
- * names (macros below); debuggers and nm show the link names.
+ * Headers of one release used with the library of another (a stale copy
+ * in /usr/local/include, an old libtase-dev) would describe instances of
+ * another size than the library fills: 0.1.0's tase_rx_t is 328 bytes on
+ * x86-64, 0.2.0's 296. So every function that initialises an instance the
+ * application allocates and the library fills links under a name that
+ * carries the headers' ABI level (TASE_ABI_LEVEL, tase/version.h): the
+ * call tase_rx_init(&rx) links to tase_rx_init_abi2, and a library of
+ * another level does not define that name. A mismatch is a link error
+ * naming the level the application's headers expected, e.g.
+ *     undefined reference to `tase_rx_init_abi2'
+ * (0.1.0's headers give `tase_rx_init': that release had no tag). Fix:
+ * build against the headers installed with the library you link. In
+ * source code the functions keep their plain names (macros below);
+ * debuggers and nm show the link names.
+ * A future option that changes a layout joins the tag, so that a library
+ * and an application configured differently fail to link the same way.
  */
 #ifndef TASE_CONFIG_H
 #define TASE_CONFIG_H
+
+#include "tase/version.h" /* TASE_ABI_LEVEL */
 
 #if defined(TASE_CONFIG_HEADER)
 #include TASE_CONFIG_HEADER
@@ -62,6 +69,7 @@
 #include "tase/user_config.h" /* the configuration a CMake build was given */
 #endif
 
+/* No effect (see THE OPTIONS); still range-checked. */
 #ifndef TASE_RX_CANDIDATES
 #define TASE_RX_CANDIDATES 4
 #endif
@@ -76,58 +84,44 @@
 #define TASE_PORT_WRITE_TRIES 64u
 #endif
 
-/* The configuration's link-name tag (one value per ABI-changing setting;
- * a chain of #if rather than token pasting, so that 4, 4u and (4) give
- * the same name). */
-#if TASE_RX_CANDIDATES == 1
-#define TASE_CONFIG_TAG_ rx_candidates_1
-#elif TASE_RX_CANDIDATES == 2
-#define TASE_CONFIG_TAG_ rx_candidates_2
-#elif TASE_RX_CANDIDATES == 3
-#define TASE_CONFIG_TAG_ rx_candidates_3
-#elif TASE_RX_CANDIDATES == 4
-#define TASE_CONFIG_TAG_ rx_candidates_4
-#elif TASE_RX_CANDIDATES == 5
-#define TASE_CONFIG_TAG_ rx_candidates_5
-#elif TASE_RX_CANDIDATES == 6
-#define TASE_CONFIG_TAG_ rx_candidates_6
-#elif TASE_RX_CANDIDATES == 7
-#define TASE_CONFIG_TAG_ rx_candidates_7
-#elif TASE_RX_CANDIDATES == 8
-#define TASE_CONFIG_TAG_ rx_candidates_8
-#elif TASE_RX_CANDIDATES == 9
-#define TASE_CONFIG_TAG_ rx_candidates_9
-#elif TASE_RX_CANDIDATES == 10
-#define TASE_CONFIG_TAG_ rx_candidates_10
-#elif TASE_RX_CANDIDATES == 11
-#define TASE_CONFIG_TAG_ rx_candidates_11
-#elif TASE_RX_CANDIDATES == 12
-#define TASE_CONFIG_TAG_ rx_candidates_12
-#elif TASE_RX_CANDIDATES == 13
-#define TASE_CONFIG_TAG_ rx_candidates_13
-#elif TASE_RX_CANDIDATES == 14
-#define TASE_CONFIG_TAG_ rx_candidates_14
-#elif TASE_RX_CANDIDATES == 15
-#define TASE_CONFIG_TAG_ rx_candidates_15
-#elif TASE_RX_CANDIDATES == 16
-#define TASE_CONFIG_TAG_ rx_candidates_16
-#endif
+/* The link-name tag: "abi" and the ABI level. An option that changes a
+ * layout adds its value as one more operand of the paste, through a chain
+ * of #if (so that 4, 4u and (4) give the same name), e.g.
+ * tase_rx_init_abi3_foo4. */
+#define TASE_CONFIG_PASTE_(stem, level) stem##abi##level
+#define TASE_CONFIG_NAME_(stem, level) TASE_CONFIG_PASTE_(stem, level)
+/* stem -> stem<tag>: the link name of an ABI-guarded function is its
+ * name, "_", and the tag. (The stem is spelled with the trailing "_" so
+ * that no macro expands to its own name: clang
+ * -Wdisabled-macro-expansion. Only the level is macro-expanded, so a
+ * macro of the application's named like a part of the tag cannot
+ * change it.) */
+#define TASE_CONFIG_LINK_NAME(stem) TASE_CONFIG_NAME_(stem, TASE_ABI_LEVEL)
 
-#define TASE_CONFIG_PASTE_(stem, tag) stem##tag
-#define TASE_CONFIG_NAME_(stem, tag) TASE_CONFIG_PASTE_(stem, tag)
-/* stem -> stem<configuration tag>: the link name of an ABI-guarded
- * function is its name, "_", and the tag. (The stem is spelled with the
- * trailing "_" so that no macro expands to its own name: clang
- * -Wdisabled-macro-expansion.) */
-#define TASE_CONFIG_LINK_NAME(stem) TASE_CONFIG_NAME_(stem, TASE_CONFIG_TAG_)
-
-/* The ABI-guarded functions: the initialisers of tase_rx_t (frame.h),
- * tase_can_rx_t (can.h), tase_host_t (host.h) and of tase_gimbal_t with
- * its receiver array (gimbal.h). A new type that embeds a tase_rx_t, or
- * takes an array of them, adds its initialiser here. */
+/* The ABI-guarded functions: every initialiser of an instance whose
+ * layout the application allocates and the library fills. A program that
+ * keeps any state of the library calls one of them, so it cannot link
+ * against a library of another ABI level. A new such type adds its
+ * initialisers here. The stateless functions (encoders, decoders,
+ * schema lookups) are not guarded: a program that only encodes or
+ * decodes is not caught this way, though a change to a message struct's
+ * layout raises the level all the same. */
+/* core (libtase): tase/frame.h, dispatch.h, can.h, klv.h, host.h, gimbal.h */
 #define tase_rx_init TASE_CONFIG_LINK_NAME(tase_rx_init_)
+#define tase_dispatch_init TASE_CONFIG_LINK_NAME(tase_dispatch_init_)
 #define tase_can_rx_init TASE_CONFIG_LINK_NAME(tase_can_rx_init_)
+#define tase_can_split_init TASE_CONFIG_LINK_NAME(tase_can_split_init_)
+#define tase_klv_rx_init TASE_CONFIG_LINK_NAME(tase_klv_rx_init_)
 #define tase_host_init TASE_CONFIG_LINK_NAME(tase_host_init_)
 #define tase_gimbal_init TASE_CONFIG_LINK_NAME(tase_gimbal_init_)
+/* ports: tase/ring.h and bm_uart.h (libtase_baremetal), posix_uart.h
+ * (libtase_posix_uart), socketcan.h (libtase_socketcan) */
+#define tase_ring_init TASE_CONFIG_LINK_NAME(tase_ring_init_)
+#define tase_bm_uart_init TASE_CONFIG_LINK_NAME(tase_bm_uart_init_)
+#define tase_posix_uart_open TASE_CONFIG_LINK_NAME(tase_posix_uart_open_)
+#define tase_posix_uart_open_flags TASE_CONFIG_LINK_NAME(tase_posix_uart_open_flags_)
+#define tase_posix_uart_attach TASE_CONFIG_LINK_NAME(tase_posix_uart_attach_)
+#define tase_socketcan_open TASE_CONFIG_LINK_NAME(tase_socketcan_open_)
+#define tase_socketcan_adopt TASE_CONFIG_LINK_NAME(tase_socketcan_adopt_)
 
 #endif /* TASE_CONFIG_H */

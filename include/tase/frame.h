@@ -110,12 +110,14 @@ extern "C" {
 #define TASE_DATA_MAX 253u     /* Size is one byte and counts Group+Type */
 #define TASE_FRAME_MAX (TASE_DATA_MAX + TASE_FRAME_OVERHEAD) /* 261 */
 
-/* TASE_RX_CANDIDATES (1..16, default 4; tase/config.h) was the number of
- * overlapping candidate frames the receiver tracked. Since the greedy
- * receiver above keeps only the earliest pending candidate, it needs no
- * candidate slots: every value gives the same frames, timing, RAM and
- * code. The setting is still accepted (and range-checked) so that build
- * configurations that set it keep building. */
+/* TASE_RX_CANDIDATES (1..16, default 4; tase/config.h) has no effect
+ * since 0.2.0. It was the number of overlapping candidate frames the
+ * previous receiver tracked; the greedy receiver above keeps only the
+ * earliest pending candidate, so every value gives the same frames,
+ * timing, RAM (sizeof(tase_rx_t)) and code. It is still accepted and
+ * range-checked so that configurations that set it keep building, it is
+ * not part of any link name, and an application may set it differently
+ * from its library. */
 
 /* A received frame. `data` points into the receiver's window or into the
  * caller's input buffer and is valid only until the callback returns. */

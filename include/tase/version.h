@@ -30,4 +30,22 @@
     TASE_VERSION_XSTR_(TASE_VERSION_MAJOR)                                                         \
     "." TASE_VERSION_XSTR_(TASE_VERSION_MINOR) "." TASE_VERSION_XSTR_(TASE_VERSION_PATCH)
 
+/* The ABI level: which layout of the public types and which function
+ * signatures these headers describe. It is raised whenever a release
+ * changes the layout (size or members) of a public type or the signature
+ * of a public function, and only then, so two releases with the same
+ * level can be mixed. The initialisers of the instances an application
+ * allocates and the library fills link under names that carry it
+ * (tase_rx_init -> tase_rx_init_abi2; the list is in tase/config.h), so
+ * headers of one level used with the library of another, such as a stale
+ * copy in /usr/local/include, fail to link instead of overrunning memory:
+ *     undefined reference to `tase_rx_init_abi2'
+ * Levels:
+ *   1  0.1.0, the first release (its initialisers link under their plain
+ *      names, tase_rx_init; sizeof(tase_rx_t) 328 on x86-64).
+ *   2  0.2.0: the greedy receiver (sizeof(tase_rx_t) 296 on x86-64)
+ *      and the other changes CHANGELOG.md lists under 0.2.0.
+ * Keep it a plain decimal number: it is pasted into link names. */
+#define TASE_ABI_LEVEL 2
+
 #endif /* TASE_VERSION_H */

@@ -2,9 +2,12 @@
  * scripts/check-integration.sh: a GIMBAL_CMD goes through the encoder,
  * the receiver and the dispatcher into a typed handler, a CAN receiver
  * (whose instance holds a tase_rx_t) is initialised, and, when the build
- * links a port, that port is exercised a little. Exit 0 and one "ok" line
- * when everything behaved. APP_EXPECT_CANDIDATES, when defined, is the
- * TASE_RX_CANDIDATES the build's configuration header must have set. */
+ * links a port, that port is exercised a little; a stalling port checks
+ * that the library applies the frame write deadline the application's
+ * headers name (TASE_PORT_WRITE_TIMEOUT_MS, tase/config.h). Exit 0 and
+ * one "ok" line when everything behaved. APP_EXPECT_WRITE_TIMEOUT_MS,
+ * when defined, is the TASE_PORT_WRITE_TIMEOUT_MS the build's
+ * configuration header must have set. */
 #include <stdio.h>
 #include <string.h>
 
@@ -13,6 +16,7 @@
 #include "tase/dispatch.h"
 #include "tase/frame.h"
 #include "tase/ids.h"
+#include "tase/port_io.h"
 #if defined(APP_POSIX_UART)
 #include "tase/posix_uart.h"
 #endif
@@ -31,6 +35,43 @@ static void on_gimbal_cmd(void *user, const tase_frame_t *frame, const void *msg
     (void)user;
     (void)frame;
     pan_seen = cmd->pan;
+}
+
+/* A port that takes one byte per write() call while its clock advances
+ * one millisecond per reading: tase_port_write_all() gives up with an
+ * error after exactly TASE_PORT_WRITE_TIMEOUT_MS bytes, as the library
+ * was built. */
+typedef struct {
+    uint32_t clock_ms;
+    size_t taken;
+} slow_port_t;
+
+static int slow_write(void *ctx, const uint8_t *data, size_t n)
+{
+    slow_port_t *p = (slow_port_t *)ctx;
+    (void)data;
+    (void)n;
+    p->taken++;
+    return 1;
+}
+
+static uint32_t slow_now(void *ctx)
+{
+    slow_port_t *p = (slow_port_t *)ctx;
+    return p->clock_ms++;
+}
+
+/* The library's write deadline equals the one these headers name. */
+static int write_deadline_agrees(void)
+{
+    static const tase_port_ops_t ops = {slow_write, NULL, slow_now};
+    static const uint8_t data[2u * TASE_PORT_WRITE_TIMEOUT_MS + 1u];
+    slow_port_t sp = {0u, 0u};
+    tase_port_t port;
+    port.ops = &ops;
+    port.ctx = &sp;
+    return tase_port_write_all(&port, data, sizeof data) < 0 &&
+           sp.taken == (size_t)TASE_PORT_WRITE_TIMEOUT_MS;
 }
 
 #if defined(APP_BAREMETAL)
@@ -74,8 +115,11 @@ int main(void)
     if (tase_can_rx_init(&crx, TASE_CAN_ROLE_GIMBAL) != TASE_OK) {
         fails++;
     }
-#if defined(APP_EXPECT_CANDIDATES)
-    if (TASE_RX_CANDIDATES != APP_EXPECT_CANDIDATES) {
+    if (!write_deadline_agrees()) {
+        fails++;
+    }
+#if defined(APP_EXPECT_WRITE_TIMEOUT_MS)
+    if (TASE_PORT_WRITE_TIMEOUT_MS != APP_EXPECT_WRITE_TIMEOUT_MS) {
         fails++;
     }
 #endif
@@ -118,7 +162,10 @@ int main(void)
         }
     }
 #endif
-    printf("%s: tase %s, sizeof(tase_rx_t) %u, TASE_RX_CANDIDATES %u\n", fails ? "FAIL" : "ok",
-           TASE_VERSION_STRING, (unsigned)sizeof(tase_rx_t), (unsigned)TASE_RX_CANDIDATES);
+    printf("%s: tase %s, ABI level %u, sizeof(tase_rx_t) %u, TASE_PORT_WRITE_TIMEOUT_MS %u, "
+           "TASE_RX_CANDIDATES %u\n",
+           fails ? "FAIL" : "ok", TASE_VERSION_STRING, (unsigned)TASE_ABI_LEVEL,
+           (unsigned)sizeof(tase_rx_t), (unsigned)TASE_PORT_WRITE_TIMEOUT_MS,
+           (unsigned)TASE_RX_CANDIDATES);
     return fails ? 1 : 0;
 }

@@ -2,5 +2,5 @@
  * library's sources and by the application's alike. */
 #ifndef APP_TASE_CONFIG_H
 #define APP_TASE_CONFIG_H
-#define TASE_RX_CANDIDATES 2
+#define TASE_PORT_WRITE_TIMEOUT_MS 250u
 #endif
