@@ -217,6 +217,15 @@ expect_error "monitor > /dev/full" 1 "cannot write to standard output" \
 expect_error "query > /dev/full" 1 "cannot write to standard output" \
     sh -c 'exec "$0" query SYSTEM_VERSION --serial "$1" >/dev/full' "$TASE" "$dir/gimbal"
 
+# ---- telemetry never asks more than the link carries ----
+quiet "$TASE" send PACKET_RATE angle_1=255 rate_1=255 geo_ref_1=255 "${L[@]}"
+mon=$("$TASE" monitor "${L[@]}" --json --seconds 2 2>"$dir/mon.err")
+na=$(grep -c '"name":"GIMBAL_ANGLE"' <<<"$mon")
+bytes=$(sed -n 's/.* of \([0-9]*\) bytes discarded.*/\1/p' "$dir/mon.err")
+check "PACKET_RATE 255/255/255 on a 57600-baud link: $na GIMBAL_ANGLE and $bytes bytes in 2 s (at most 2 x 5760)" \
+    eval '[ "$na" -gt 20 ] && [ "$na" -lt 300 ] && [ "$bytes" -le 11520 ]'
+quiet "$TASE" send PACKET_RATE angle_1=20 rate_1=5 geo_ref_1=2 "${L[@]}"
+
 # ---- the device is left as found and held exclusively; signals ----
 stty -F "$dir/gimbal" 9600 min 1 time 5
 before=$(stty -F "$dir/gimbal" -g)
