@@ -10,6 +10,7 @@ Usage: scripts/tools-cli.py TASE TASE_SIM   (registered by tests/checks/tools.cm
 import json
 import os
 import re
+import select
 import subprocess
 import sys
 import tempfile
@@ -256,6 +257,44 @@ ok("tase klv on a live input prints a packet while the writer is still open",
 got = live(["decode"], angle(7, 8), "decode")
 ok("tase decode on a live input prints a packet while the writer is still open",
    b'"pan":7,' in got, repr(got[:200]))
+
+# ---- decode writes its output in blocks, not one write() per frame ----
+# 2 MB of back-to-back GIMBAL_ANGLE frames (about 143,000) through a pipe
+# that stays open: once every frame is out, the process waits for more input
+# and its write() count (/proc/PID/io syscw) can be read.
+def write_calls(frames):
+    p = subprocess.Popen(VG + [TASE, "decode"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                         stderr=subprocess.DEVNULL)
+    feeder = threading.Thread(target=lambda: (p.stdin.write(frames), p.stdin.flush()))
+    feeder.start()
+    lines, want = 0, frames.count(b"\x00\xff\x5a")
+    deadline = time.time() + 20 * SLOW
+    while lines < want and time.time() < deadline:
+        if not select.select([p.stdout], [], [], 0.5)[0]:
+            continue
+        chunk = p.stdout.read1(1 << 16)
+        if not chunk:
+            break
+        lines += chunk.count(b"\n")
+    feeder.join()
+    try:
+        io = dict(l.split(": ") for l in open("/proc/%d/io" % p.pid).read().splitlines())
+        n = int(io["syscw"])
+    except (OSError, KeyError, ValueError):
+        n = None
+    p.stdin.close()
+    p.stdout.read()
+    p.wait(timeout=30)
+    return lines, want, n
+
+
+dense = b"".join(angle(i % 18000, -(i % 9000)) for i in range(2000)) * 72
+lines, want, n = write_calls(dense)
+if n is None:
+    print("skip decode write() count: no /proc/PID/io on this kernel")
+else:
+    ok("decode of %d dense frames: %d lines with %d write() calls (one per frame before)"
+       % (want, lines, n), lines == want and n < want // 100)
 
 # ---- 64-bit offsets (4 GiB through a pipe: about 1.5 s of CPU; not under memcheck) ----
 gen = ("import os,sys,fcntl\n"
