@@ -228,6 +228,12 @@ for args in (["decode", noisy], ["list"], ["--help"], ["klv", os.path.join(os.pa
     ok("tase %s > /dev/full fails with a message" % args[0],
        rc == 1 and "cannot write to standard output" in err, "exit %d %s" % (rc, err))
 
+p = subprocess.Popen(VG + [TASE, "decode", noisy], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+p.stdout.close()  # the reader is gone before the first line
+rc, err = p.wait(timeout=30), p.stderr.read().decode()
+ok("a reader that goes away ends decode quietly with 141 (SIGPIPE's status)",
+   rc == 141 and err == "", "exit %d %r" % (rc, err))
+
 # ---- live input is read as it arrives ----
 def live(args, data, what):
     fifo = os.path.join(TMP, "fifo-" + what)

@@ -23,7 +23,7 @@ static const char usage_exit[] =
     "exit status: 0 success; 1 failure (device, I/O, timeout, writing the output);\n"
     "  2 bad command line (nothing was sent); 3 the gimbal's echo differs from the\n"
     "  setting sent; 4 input not fully understood (bad candump lines, no packet\n"
-    "  found); 128+N interrupted by signal N.\n";
+    "  found); 128+N interrupted by signal N (141: the output's reader went away).\n";
 
 static const char usage_link[] =
     "link options:\n"

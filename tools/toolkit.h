@@ -95,7 +95,9 @@ void tk_time_now(tk_time_t *t);
 /* Use a large buffer for standard output (before the first write). */
 void tk_stdout_buffered(void);
 /* Flush standard output; on any write error so far exit TK_EXIT_FAIL with
- * "cannot write to standard output: <reason>". */
+ * "cannot write to standard output: <reason>", except a reader that went
+ * away (EPIPE): then exit 128 + SIGPIPE without a message, as programs
+ * killed by SIGPIPE do (links closed first). */
 void tk_stdout_flush(void);
 
 /* ---- signals ---- */
