@@ -54,11 +54,15 @@ set(CMAKE_C_FLAGS_INIT
 set(CMAKE_CXX_FLAGS_INIT "${CMAKE_C_FLAGS_INIT} -fno-exceptions -fno-rtti")
 set(CMAKE_ASM_FLAGS_INIT "-mcpu=${TASE_CPU} -mthumb -mfloat-abi=${TASE_FLOAT_ABI} ${_tase_fpu}")
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-Wl,--gc-sections")
-# Keep -Os whatever build type is chosen; MinSizeRel adds -DNDEBUG only.
-set(CMAKE_C_FLAGS_MINSIZEREL_INIT "-DNDEBUG")
-set(CMAKE_C_FLAGS_RELEASE_INIT "-DNDEBUG")
-set(CMAKE_CXX_FLAGS_MINSIZEREL_INIT "-DNDEBUG")
-set(CMAKE_CXX_FLAGS_RELEASE_INIT "-DNDEBUG")
+# Keep -Os whatever build type is chosen (tase builds Release by default).
+# CMake appends its own -O3 / -O2 to the *_INIT values of the build types,
+# so the per-type flags are set as cache entries here, before it does; a
+# value given with -D on the command line still wins.
+foreach(lang C CXX)
+  set(CMAKE_${lang}_FLAGS_RELEASE "-DNDEBUG" CACHE STRING "")
+  set(CMAKE_${lang}_FLAGS_MINSIZEREL "-DNDEBUG" CACHE STRING "")
+  set(CMAKE_${lang}_FLAGS_RELWITHDEBINFO "-g -DNDEBUG" CACHE STRING "")
+endforeach()
 
 set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
 set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)

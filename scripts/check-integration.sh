@@ -173,6 +173,9 @@ tase_step "6. Cortex-M4 through CMake and cmake/arm-none-eabi.cmake: core + tase
 m4="$out/prefix-m4"
 cmake -S "$TASE_ROOT" -B "$out/m4-lib" -DCMAKE_TOOLCHAIN_FILE="$TASE_ROOT/cmake/arm-none-eabi.cmake" \
     -DTASE_CPU=cortex-m4 -DCMAKE_INSTALL_PREFIX="$m4" >/dev/null
+# tase builds Release by default; the toolchain file must keep its -Os.
+flags=$(grep -h '^C_FLAGS' "$out/m4-lib/CMakeFiles/tase.dir/flags.make")
+[[ $flags == *-Os* && $flags != *-O2* && $flags != *-O3* ]] || tase_fail "m4: not built with -Os alone: $flags"
 cmake --build "$out/m4-lib" -j$jobs >/dev/null
 cmake --install "$out/m4-lib" >/dev/null
 [ -f "$m4/lib/libtase_baremetal.a" ] || tase_fail "m4: tase::baremetal not installed"

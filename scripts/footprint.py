@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Footprint of the core on Cortex-M0+ and Cortex-M4 at -Os: flash and RAM
 per module (object file), the receive path and the whole core as linked,
-sizeof of every public struct type, and worst-case stack depths from
--fstack-usage/-fcallgraph-info. Writes docs/FOOTPRINT.md (or --out FILE).
+sizeof of every public struct type, worst-case stack depths from
+-fstack-usage/-fcallgraph-info, and the example gimbal (examples/firmware)
+and autopilot (examples/autopilot) images with their measured stacks.
+Writes docs/FOOTPRINT.md (or --out FILE).
 Run through scripts/footprint.sh, which installs what it needs.
 
 Works on whatever src/*.c exist: modules are found by object file, the
@@ -198,21 +200,14 @@ def contributors(obj, n=4):
     return sorted(syms, key=lambda x: -x[1])[:n]
 
 
-def firmware_image(out):
-    """Build examples/firmware (Cortex-M3) and measure the ELF: totals from
-    arm-none-eabi-size, the library's share per object from the link map,
-    and (when QEMU is there) the stack high-water mark the image prints."""
-    bdir = os.path.join(out, "firmware")
-    run(["cmake", "-S", os.path.join(ROOT, "examples", "firmware"), "-B", bdir,
-         "-DCMAKE_TOOLCHAIN_FILE=" + os.path.join(ROOT, "cmake", "arm-none-eabi.cmake"),
-         "-DTASE_CPU=cortex-m3"])
-    run(["cmake", "--build", bdir, "-j2"])
-    elf = os.path.join(bdir, "tase_gimbal.elf")
-    text, data, bss = berkeley(elf)
-    # Link map: input sections kept in the image, by archive member.
+def map_shares(path, app_dir, app_label):
+    """Flash and RAM of each part of a linked image from its link map: the
+    input sections kept, by archive member (libtase.a / libtase_baremetal.a
+    objects), the application's own objects (app_dir is its CMake object
+    directory) and the C library."""
     share = {}
     pending = None
-    for line in open(os.path.join(bdir, "tase_gimbal.map")):
+    for line in open(path):
         if line.startswith("Linker script and memory map"):
             share.clear()
             pending = None
@@ -225,37 +220,121 @@ def firmware_image(out):
         if m and (m.group(1) or pending):
             path = m.group(4)
             a = re.search(r"(libtase(?:_baremetal)?\.a)\((\w+)\.c\.obj\)", path)
-            if a:
-                key = "%s %s" % (a.group(1), a.group(2))
-            elif "tase_gimbal.elf.dir" in path:
-                key = "application (startup.c, main.c, gimbal.c)"
+            if a:  # module names drop the files' "tase_" prefix, as in build()
+                key = "%s %s" % (a.group(1), a.group(2).replace("tase_", "", 1))
+            elif app_dir in path:
+                key = app_label
             else:
                 key = "newlib, libgcc (printf, semihosting, memcpy, ...)"
             sec = m.group(1) or pending
             kind = "ram" if sec.startswith((".data", ".bss")) else "flash"
             share.setdefault(key, {"flash": 0, "ram": 0})[kind] += int(m.group(3), 16)
         pending = None
+    return share
+
+
+def build_image(out, example, cpu, elf):
+    """Configure and build examples/<example> for cpu; the ELF's path."""
+    bdir = os.path.join(out, example)
+    run(["cmake", "-S", os.path.join(ROOT, "examples", example), "-B", bdir,
+         "-DCMAKE_TOOLCHAIN_FILE=" + os.path.join(ROOT, "cmake", "arm-none-eabi.cmake"),
+         "-DTASE_CPU=" + cpu])
+    run(["cmake", "--build", bdir, "-j2"])
+    return os.path.join(bdir, elf)
+
+
+def stack_printed(output):
+    """The stack high-water mark an example image prints, or None."""
+    m = re.search(r"\+ (\d+) B stack used", output or "")
+    return int(m.group(1)) if m else None
+
+
+def firmware_image(out):
+    """Build examples/firmware (Cortex-M3) and measure the ELF: totals from
+    arm-none-eabi-size, the library's share per object from the link map,
+    and (when QEMU is there) the stack high-water mark the image prints."""
+    elf = build_image(out, "firmware", "cortex-m3", "tase_gimbal.elf")
+    text, data, bss = berkeley(elf)
+    share = map_shares(elf[:-len(".elf")] + ".map", "tase_gimbal.elf.dir",
+                       "application (startup.c, main.c, gimbal.c)")
     stack = None
     try:
         o = subprocess.run(["qemu-system-arm", "-M", "mps2-an385", "-nographic", "-monitor",
                             "none", "-icount", "shift=5,sleep=off", "-semihosting-config",
                             "enable=on,target=native", "-kernel", elf],
                            capture_output=True, text=True, timeout=120).stdout
-        m = re.search(r"\+ (\d+) B stack used", o)
-        stack = int(m.group(1)) if m else None
+        stack = stack_printed(o)
     except (OSError, subprocess.TimeoutExpired):
         pass
     return {"text": text, "data": data, "bss": bss, "share": share, "stack": stack}
+
+
+def autopilot_image(out, sim):
+    """Build examples/autopilot (Cortex-M4F) and measure it like the gimbal
+    image. Its stack high-water mark needs the mission flown against a live
+    tase-sim (scripts/check-autopilot.sh); sim is that binary, or None to
+    build one in the host tree under `out`."""
+    elf = build_image(out, "autopilot", "cortex-m4", "tase_autopilot.elf")
+    text, data, bss = berkeley(elf)
+    share = map_shares(elf[:-len(".elf")] + ".map", "tase_autopilot.elf.dir",
+                       "application (startup.c, board.c, link.c, flight.c, main.c)")
+    stack = bm_uart = None
+    try:
+        if sim is None:
+            host = os.path.join(out, "host")
+            run(["cmake", "-S", ROOT, "-B", host, "-DTASE_BUILD_TESTS=OFF", "-DTASE_CHECKS=OFF"])
+            run(["cmake", "--build", host, "--target", "tase_sim", "-j2"])
+            sim = os.path.join(host, "tools", "tase-sim")
+        o = subprocess.run([os.path.join(ROOT, "scripts", "check-autopilot.sh"), sim,
+                            os.path.dirname(elf)], capture_output=True, text=True,
+                           timeout=300).stdout
+        stack = stack_printed(o)
+        m = re.search(r"tase_bm_uart_t (\d+)", o)
+        bm_uart = int(m.group(1)) if m else None
+    except (OSError, subprocess.SubprocessError):
+        pass
+    return {"text": text, "data": data, "bss": bss, "share": share, "stack": stack,
+            "bm_uart": bm_uart}
+
+
+def image_tables(p, img, stack_what):
+    """The size table and the per-part table of an example image."""
+    p("| | bytes |")
+    p("|---|---:|")
+    p("| flash (text + rodata + data) | %d |" % (img["text"] + img["data"]))
+    p("| RAM, static (data + bss) | %d |" % (img["data"] + img["bss"]))
+    if img["stack"] is not None:
+        p("| stack high-water mark measured by the image under QEMU (%s) | %d |" % (
+            stack_what, img["stack"]))
+    p("")
+    p("| part | flash | static RAM |")
+    p("|---|---:|---:|")
+    lib = [k for k in img["share"] if k.startswith("libtase.a")]
+    port = [k for k in img["share"] if k.startswith("libtase_baremetal.a")]
+    for k in sorted(lib) + sorted(port):
+        p("| %s | %d | %d |" % (k, img["share"][k]["flash"], img["share"][k]["ram"]))
+    p("| **library total (libtase.a)** | %d | %d |" % (
+        sum(img["share"][k]["flash"] for k in lib), sum(img["share"][k]["ram"] for k in lib)))
+    p("| **bare-metal port total (libtase_baremetal.a)** | %d | %d |" % (
+        sum(img["share"][k]["flash"] for k in port),
+        sum(img["share"][k]["ram"] for k in port)))
+    for k in sorted(img["share"]):
+        if k not in lib and k not in port:
+            p("| %s | %d | %d |" % (k, img["share"][k]["flash"], img["share"][k]["ram"]))
+    p("")
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "FOOTPRINT.md"))
     ap.add_argument("--build", default=os.path.join(ROOT, "build-footprint"))
+    ap.add_argument("--sim", default=None,
+                    help="tase-sim binary for the autopilot image's mission (default: build one)")
     args = ap.parse_args()
     os.makedirs(args.build, exist_ok=True)
 
     img = firmware_image(args.build)
+    apimg = autopilot_image(args.build, args.sim)
     res = {}
     for cpu in CPUS:
         bdir, objs = build(cpu, args.build)
@@ -432,35 +511,39 @@ def main():
           "bare-metal ring/UART port; everything else is semihosting and newlib's printf, "
           "which a real firmware would not carry.")
         p("")
-        p("| | bytes |")
-        p("|---|---:|")
-        p("| flash (text + rodata + data) | %d |" % (img["text"] + img["data"]))
-        p("| RAM, static (data + bss) | %d |" % (img["data"] + img["bss"]))
-        if img["stack"] is not None:
-            p("| stack high-water mark measured by the image under QEMU (main loop + SysTick "
-              "interrupt, before printf) | %d |" % img["stack"])
-        p("")
-        p("| part | flash | static RAM |")
-        p("|---|---:|---:|")
-        lib = [k for k in img["share"] if k.startswith("libtase.a")]
-        port = [k for k in img["share"] if k.startswith("libtase_baremetal.a")]
-        for k in sorted(lib) + sorted(port):
-            p("| %s | %d | %d |" % (k, img["share"][k]["flash"], img["share"][k]["ram"]))
-        p("| **library total (libtase.a)** | %d | %d |" % (
-            sum(img["share"][k]["flash"] for k in lib), sum(img["share"][k]["ram"] for k in lib)))
-        p("| **bare-metal port total (libtase_baremetal.a)** | %d | %d |" % (
-            sum(img["share"][k]["flash"] for k in port),
-            sum(img["share"][k]["ram"] for k in port)))
-        for k in sorted(img["share"]):
-            if k not in lib and k not in port:
-                p("| %s | %d | %d |" % (k, img["share"][k]["flash"], img["share"][k]["ram"]))
-        p("")
+        image_tables(p, img, "main loop + SysTick interrupt, before printf")
         p("The library has no static data: its RAM is the instances the application owns "
           "(two tase_rx_t of %d B, the host-side one only for the self-check; a "
           "tase_gimbal_t of %d B, initialised without receivers because this image feeds "
           "its own receiver through the dispatcher and hands setup frames to the role; a "
           "tase_dispatch_t of %d B)." % (rxsz, types.get("tase_gimbal_t", 0),
                                          types.get("tase_dispatch_t", 0)))
+        p("")
+    if apimg is not None:
+        p("## The example autopilot image (Cortex-M4F, QEMU mps2-an386)")
+        p("")
+        p("`examples/autopilot` linked with `--gc-sections` (`arm-none-eabi-size` of "
+          "`tase_autopilot.elf`; the share of each object from the link map), the host side: "
+          "it uses the host role (requests with retries, its receiver), the dispatcher with "
+          "typed decode, the typed encoder and the bare-metal ring/UART port. Everything else "
+          "is the application (board, flight model, mission), the flight model's "
+          "single-precision maths (newlib's libm), double-precision unit conversions in "
+          "software, semihosting and newlib's printf with floating point; a real autopilot "
+          "carries most of that anyway and would not carry printf.")
+        p("")
+        image_tables(p, apimg, "main loop + UART0 and SysTick interrupts over the whole "
+                     "mission against tase-sim, before printf")
+        p("The library has no static data: its RAM is the instances the application owns "
+          "(a tase_host_t of %d B holding its tase_rx_t of %d B and a copy of the pending "
+          "request for re-sending, a tase_dispatch_t of %d B, and the bare-metal port's "
+          "tase_bm_uart_t%s with its 512-byte ring, sized for about 45 ms of 115200 baud)." % (
+              types.get("tase_host_t", 0), rxsz, types.get("tase_dispatch_t", 0),
+              " of %d B" % apimg["bm_uart"] if apimg["bm_uart"] is not None else ""))
+        p("")
+        p("The stack high-water mark depends on where the interrupts happen to land in the "
+          "deepest call chain (an exception frame with floating-point context is 104 B), so it "
+          "varies by up to about 150 B from run to run; `scripts/check-autopilot.sh` prints it "
+          "with every run.")
         p("")
     p("## sizeof of the public types")
     p("")

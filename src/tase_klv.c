@@ -395,8 +395,10 @@ double tase_klv_utc_s(uint64_t v)
  * (every range here contains 0). */
 static int64_t nearest_sat(double x, int64_t lo, int64_t hi)
 {
+    /* NaN, for which every comparison is false (cppcheck assumes none). */
+    /* cppcheck-suppress incorrectLogicOperator */
     if (!(x < 0.0) && !(x >= 0.0)) {
-        return 0; /* NaN: every comparison is false */
+        return 0;
     }
     if (x <= (double)lo) {
         return lo;

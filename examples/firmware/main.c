@@ -79,7 +79,7 @@ static uint32_t millis_hook(void *hw)
     return ticks;
 }
 
-static const tase_bm_uart_hooks_t uart_hooks = {tx_hook, millis_hook, NULL};
+static const tase_bm_uart_hooks_t uart_hooks = {tx_hook, millis_hook, NULL, NULL, NULL};
 
 /* ---- checks ---- */
 

@@ -28,10 +28,13 @@ extern "C" {
 
 /* Private: an explicit conversion for code in the public headers (static
  * inline functions, macros) that compiles cleanly as C and as C++ (no
- * old-style cast there: clang++ -Wold-style-cast). */
+ * old-style cast there: clang++ -Wold-style-cast). A type name cannot be
+ * put in parentheses, hence the MISRA 20.7 suppressions. */
 #ifdef __cplusplus
+/* cppcheck-suppress misra-c2012-20.7 */
 #define TASE_CAST_(type, value) (static_cast<type>(value))
 #else
+/* cppcheck-suppress misra-c2012-20.7 */
 #define TASE_CAST_(type, value) ((type)(value))
 #endif
 

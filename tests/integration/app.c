@@ -101,7 +101,7 @@ int main(void)
 #endif
 #if defined(APP_BAREMETAL)
     {
-        static const tase_bm_uart_hooks_t hooks = {no_tx, no_millis, NULL};
+        static const tase_bm_uart_hooks_t hooks = {no_tx, no_millis, NULL, NULL, NULL};
         static uint8_t ring[512];
         tase_bm_uart_t u;
         int i;
