@@ -40,7 +40,11 @@ def run(args, stdin=b"", timeout=30, stdout=subprocess.PIPE):
     p = subprocess.run(VG + ([TASE] + args if args and args[0] != SIM else args), input=stdin,
                        stdout=stdout, stderr=subprocess.PIPE, timeout=timeout)
     out = p.stdout.decode(errors="replace") if p.stdout is not None else ""
-    return p.returncode, out, p.stderr.decode(errors="replace")
+    # memcheck's own notes (==PID== lines) are not the program's; a memory
+    # error shows as exit 99
+    err = "".join(l for l in p.stderr.decode(errors="replace").splitlines(True)
+                  if not re.match(r"==\d+== ", l))
+    return p.returncode, out, err
 
 
 def expect(name, args, rc, pattern, stdin=b"", lines=1):
@@ -228,9 +232,12 @@ for args in (["decode", noisy], ["list"], ["--help"], ["klv", os.path.join(os.pa
     ok("tase %s > /dev/full fails with a message" % args[0],
        rc == 1 and "cannot write to standard output" in err, "exit %d %s" % (rc, err))
 
-p = subprocess.Popen(VG + [TASE, "decode", noisy], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+# (more output than a pipe holds, so the write must meet the closed end)
+big = write("dense.bin", b"".join(angle(i, -i) for i in range(20000)))
+p = subprocess.Popen(VG + [TASE, "decode", big], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 p.stdout.close()  # the reader is gone before the first line
-rc, err = p.wait(timeout=30), p.stderr.read().decode()
+rc = p.wait(timeout=60 * SLOW)
+err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
 ok("a reader that goes away ends decode quietly with 141 (SIGPIPE's status)",
    rc == 141 and err == "", "exit %d %r" % (rc, err))
 
@@ -300,7 +307,7 @@ if n is None:
     print("skip decode write() count: no /proc/PID/io on this kernel")
 else:
     ok("decode of %d dense frames: %d lines with %d write() calls (one per frame before)"
-       % (want, lines, n), lines == want and n < want // 100)
+       % (want, lines, n), lines == want and n < want // 20)
 
 # ---- 64-bit offsets (4 GiB through a pipe: about 1.5 s of CPU; not under memcheck) ----
 gen = ("import os,sys,fcntl\n"
