@@ -1,52 +1,80 @@
 /*
- * Fuzz harness: the datalink receiver fed arbitrary bytes.
+ * Fuzz harness: the datalink receiver fed arbitrary bytes, against a
+ * reference greedy scan.
  *
  * Input: 2 bytes seeding the split points, then the byte stream. The
- * stream is fed to one receiver in random chunks (1..300 bytes) and to a
- * second one in a single call; after every call the harness checks:
- *   - stats.bytes_in equals the bytes fed so far;
- *   - the return value equals the callbacks made by that call, and
- *     stats.frames_ok equals all callbacks so far;
+ * stream is fed to three receivers: in random chunks (1..300 bytes), one
+ * byte at a time with tase_rx_push(), and in a single call, each beside
+ * the reference greedy scan of tests/rx_reference.h (slow and obvious,
+ * sharing no code with src/tase_frame.c) fed one byte at a time. Checks:
+ *   - after every call, all counters equal the reference's at that point
+ *     (bytes_in, frames_ok, checksum_errors, bad_size, bytes_discarded),
+ *     and the return value equals the callbacks made by that call;
+ *   - every receiver delivers exactly the reference's frames, in order:
+ *     same offset, header and data, and stats.bytes_in in the callback
+ *     equal to the byte count at which the reference decided the frame
+ *     (its own last byte, or the last byte of the earlier candidate whose
+ *     failure released it), whatever the split;
  *   - every delivered frame re-encodes to exactly the input bytes at its
- *     offset, and lies inside what was fed (no false frame, no corruption,
- *     no frame from beyond the input);
- *   - bytes_discarded + bytes covered by delivered frames <= bytes_in, with
- *     equality after tase_rx_flush();
- * and at the end: flush leaves the receiver empty and reusable, and the
- * chunked and one-shot receivers saw the same frames and counters (the
- * header promises split independence).
+ *     offset, and delivered frames never overlap (nothing inside a
+ *     delivered frame is delivered);
+ *   - from inside the callback, tase_rx_feed(), tase_rx_push() and
+ *     tase_rx_flush() on the same receiver return TASE_EBUSY and change
+ *     nothing;
+ *   - after tase_rx_flush(): bytes_discarded + bytes of delivered frames ==
+ *     bytes_in, and the receiver is empty and reusable.
  */
 #include <string.h>
 
+#include "../tests/rx_reference.h"
 #include "fuzz.h"
 #include "tase/frame.h"
 
 #define MAX_INPUT 65536u
-#define MAX_FRAMES (MAX_INPUT / 3u + 1u) /* distinct sync starts */
+#define MAX_FRAMES (MAX_INPUT / 8u + 1u) /* delivered frames never overlap */
 
 typedef struct {
-    uint32_t offset;
+    uint32_t offset, seen_at;
     uint8_t group, type, len;
 } rec_t;
+
+/* ---- the reference greedy scan (tests/rx_reference.h) ---------------- */
+
+typedef struct {
+    rec_t *f;
+    size_t n;
+} ref_out_t;
+
+static void ref_record(void *user, const uint8_t *frame, size_t offset, size_t flen, size_t seen_at)
+{
+    ref_out_t *o = user;
+    FZ_CHECK(o->n < MAX_FRAMES);
+    o->f[o->n].offset = (uint32_t)offset;
+    o->f[o->n].seen_at = (uint32_t)seen_at;
+    o->f[o->n].group = frame[4];
+    o->f[o->n].type = frame[5];
+    o->f[o->n].len = (uint8_t)(flen - 8u);
+    o->n++;
+}
+
+/* ---- the receivers ------------------------------------------------------ */
 
 typedef struct {
     const uint8_t *stream;
     size_t stream_len;
-    const tase_rx_t *rx;
-    size_t n;         /* callbacks so far */
-    rec_t *f;         /* f[0..n) */
-    uint8_t *cover;   /* cover[i] = 1 when byte i is inside a delivered frame */
-    uint32_t covered; /* bytes marked in cover */
+    tase_rx_t *rx;
+    size_t n; /* callbacks so far */
+    rec_t *f; /* f[0..n) */
 } sink_t;
 
-static rec_t frames_a[MAX_FRAMES], frames_b[MAX_FRAMES];
-static uint8_t cover_a[MAX_INPUT], cover_b[MAX_INPUT];
+static rec_t want[MAX_FRAMES], got[MAX_FRAMES];
 
 static void on_frame(void *user, const tase_frame_t *fr)
 {
     sink_t *s = user;
     uint8_t enc[TASE_FRAME_MAX];
     size_t total = (size_t)fr->len + TASE_FRAME_OVERHEAD;
+    tase_rx_t before;
     int n;
     FZ_CHECK(fr->data != NULL);
     FZ_CHECK(fr->len <= TASE_DATA_MAX);
@@ -56,34 +84,81 @@ static void on_frame(void *user, const tase_frame_t *fr)
     n = tase_frame_encode(enc, sizeof(enc), fr->group, fr->type, fr->data, fr->len);
     FZ_CHECK(n == (int)total);
     FZ_CHECK(memcmp(enc, s->stream + fr->offset, total) == 0);
+    /* stream order, never inside (or overlapping) the previous one */
+    FZ_CHECK(s->n == 0u || fr->offset >= s->f[s->n - 1u].offset + s->f[s->n - 1u].len + 8u);
     FZ_CHECK(s->n < MAX_FRAMES);
     s->f[s->n].offset = fr->offset;
+    s->f[s->n].seen_at = s->rx->stats.bytes_in;
     s->f[s->n].group = fr->group;
     s->f[s->n].type = fr->type;
     s->f[s->n].len = fr->len;
     s->n++;
-    for (n = 0; n < (int)total; n++) {
-        s->covered += 1u - s->cover[fr->offset + (uint32_t)n];
-        s->cover[fr->offset + (uint32_t)n] = 1;
-    }
+    /* re-entrant calls are refused and change nothing */
+    memcpy(&before, s->rx, sizeof(before));
+    FZ_CHECK(tase_rx_feed(s->rx, enc, total, on_frame, s) == TASE_EBUSY);
+    FZ_CHECK(tase_rx_push(s->rx, enc[0], on_frame, s) == TASE_EBUSY);
+    FZ_CHECK(tase_rx_flush(s->rx, on_frame, s) == TASE_EBUSY);
+    FZ_CHECK(memcmp(&before, s->rx, sizeof(before)) == 0);
 }
 
-static void check_call(const tase_rx_t *rx, const sink_t *s, int ret, size_t before, size_t fed)
+enum { FEED_CHUNKS, FEED_PUSH, FEED_WHOLE };
+
+/* Feed data[0..size) to rx in `mode` beside a reference, comparing after
+ * every call; then flush and compare the frames with want[0..nwant). */
+static void run(tase_rx_t *rx, const uint8_t *data, size_t size, int mode, uint32_t *seed,
+                size_t nwant)
 {
-    FZ_CHECK(ret >= 0);
-    FZ_CHECK((size_t)ret == s->n - before);
-    FZ_CHECK(rx->stats.frames_ok == (uint32_t)s->n);
-    FZ_CHECK(rx->stats.bytes_in == (uint32_t)fed);
-    FZ_CHECK(rx->stats.bytes_discarded + s->covered <= rx->stats.bytes_in);
+    sink_t sink = {data, size, rx, 0, got};
+    ref_out_t out = {want, 0}; /* rewrites the frames of the first run */
+    ref_t ref;
+    size_t pos = 0, before, k;
+    uint32_t covered = 0;
+    int ret;
+    ref_init(&ref, data, ref_record, &out);
+    FZ_CHECK(tase_rx_init(rx) == TASE_OK);
+    while (pos < size) {
+        size_t chunk = mode == FEED_WHOLE  ? size - pos
+                       : mode == FEED_PUSH ? 1u
+                                           : 1u + fz_rand(seed) % 300u;
+        if (chunk > size - pos) {
+            chunk = size - pos;
+        }
+        before = sink.n;
+        if (mode == FEED_PUSH) {
+            ret = tase_rx_push(rx, data[pos], on_frame, &sink);
+        } else {
+            ret = tase_rx_feed(rx, data + pos, chunk, on_frame, &sink);
+        }
+        pos += chunk;
+        ref_feed_to(&ref, pos);
+        FZ_CHECK(ret >= 0 && (size_t)ret == sink.n - before);
+        FZ_CHECK(memcmp(&rx->stats, &ref.st, sizeof(ref.st)) == 0);
+        FZ_CHECK(sink.n == out.n);
+    }
+    before = sink.n;
+    ret = tase_rx_flush(rx, on_frame, &sink);
+    ref_advance(&ref, true);
+    FZ_CHECK(ret >= 0 && (size_t)ret == sink.n - before);
+    FZ_CHECK(memcmp(&rx->stats, &ref.st, sizeof(ref.st)) == 0);
+    FZ_CHECK(sink.n == out.n && out.n == nwant);
+    FZ_CHECK(memcmp(got, want, nwant * sizeof(rec_t)) == 0);
+    for (k = 0; k < sink.n; k++) {
+        covered += got[k].len + 8u;
+    }
+    /* every byte is now either in a delivered frame or discarded */
+    FZ_CHECK(rx->stats.bytes_in == (uint32_t)size);
+    FZ_CHECK(rx->stats.bytes_discarded + covered == (uint32_t)size);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static tase_rx_t a, b;
-    sink_t sa, sb;
+    static tase_rx_t rx;
+    static rec_t first[MAX_FRAMES];
+    ref_out_t out = {first, 0};
+    ref_t ref;
     uint32_t seed;
-    size_t pos = 0, before;
-    int ret;
+    size_t nwant;
+    int mode;
     uint8_t probe[TASE_FRAME_MAX];
     int plen;
 
@@ -94,51 +169,26 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     data += 2;
     size -= 2u;
 
-    FZ_CHECK(tase_rx_init(&a) == TASE_OK);
-    FZ_CHECK(tase_rx_init(&b) == TASE_OK);
-    memset(cover_a, 0, size);
-    memset(cover_b, 0, size);
-    sa = (sink_t){data, size, &a, 0, frames_a, cover_a, 0};
-    sb = (sink_t){data, size, &b, 0, frames_b, cover_b, 0};
+    /* the reference alone first: how many frames there are */
+    ref_init(&ref, data, ref_record, &out);
+    ref_feed_to(&ref, size);
+    ref_advance(&ref, true);
+    nwant = out.n;
 
-    while (pos < size) {
-        size_t chunk = 1u + fz_rand(&seed) % 300u;
-        if (chunk > size - pos) {
-            chunk = size - pos;
-        }
-        before = sa.n;
-        ret = tase_rx_feed(&a, data + pos, chunk, on_frame, &sa);
-        pos += chunk;
-        check_call(&a, &sa, ret, before, pos);
+    for (mode = FEED_CHUNKS; mode <= FEED_WHOLE; mode++) {
+        run(&rx, data, size, mode, &seed, nwant);
+        FZ_CHECK(memcmp(want, first, nwant * sizeof(rec_t)) == 0);
     }
-    ret = tase_rx_feed(&b, data, size, on_frame, &sb);
-    check_call(&b, &sb, ret, 0, size);
-
-    /* split independence, before and after flush */
-    FZ_CHECK(memcmp(&a.stats, &b.stats, sizeof(a.stats)) == 0);
-    before = sa.n;
-    ret = tase_rx_flush(&a, on_frame, &sa);
-    check_call(&a, &sa, ret, before, size);
-    before = sb.n;
-    ret = tase_rx_flush(&b, on_frame, &sb);
-    check_call(&b, &sb, ret, before, size);
-    FZ_CHECK(memcmp(&a.stats, &b.stats, sizeof(a.stats)) == 0);
-    FZ_CHECK(sa.n == sb.n);
-    FZ_CHECK(memcmp(frames_a, frames_b, sa.n * sizeof(rec_t)) == 0);
-
-    /* every byte is now either in a delivered frame or discarded */
-    FZ_CHECK(a.stats.bytes_discarded + sa.covered == (uint32_t)size);
 
     /* flush left the receiver empty: a fresh frame is found at once, at
      * the offset that follows the input, and nothing else is */
-    FZ_CHECK(a.len == 0u && a.ncand == 0u);
+    FZ_CHECK(rx.len == 0u && rx.end == 0u && rx.busy == 0u);
     plen = tase_frame_encode(probe, sizeof(probe), 0x08, 0x10, data, size < 6u ? size : 6u);
     FZ_CHECK(plen > 0);
     {
-        uint32_t ok = a.stats.frames_ok, disc = a.stats.bytes_discarded;
-        tase_rx_t c = a;
-        FZ_CHECK(tase_rx_feed(&c, probe, (size_t)plen, NULL, NULL) == 1);
-        FZ_CHECK(c.stats.frames_ok == ok + 1u && c.stats.bytes_discarded == disc);
+        uint32_t ok = rx.stats.frames_ok, disc = rx.stats.bytes_discarded;
+        FZ_CHECK(tase_rx_feed(&rx, probe, (size_t)plen, NULL, NULL) == 1);
+        FZ_CHECK(rx.stats.frames_ok == ok + 1u && rx.stats.bytes_discarded == disc);
     }
     return 0;
 }

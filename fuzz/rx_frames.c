@@ -18,11 +18,12 @@
  * The checked property is zero collateral loss: every frame whose own
  * bytes were left untouched is delivered exactly once, in order, at its
  * offset, and within the documented latency bound (TASE_FRAME_MAX - 8
- * bytes late at most; at its last byte unless candidates overflowed).
+ * bytes late at most; late only when it lay inside a pending candidate).
  * The only excuse for missing one is a delivered frame that is not one of
  * ours overlapping it (a valid frame hidden in noise or in a corrupted
  * frame, or a checksum collision): the receiver cannot tell that frame
- * from a real one, and a valid frame's bytes are never re-used.
+ * from a real one, and a valid frame's bytes are never re-used. Delivered
+ * frames come in stream order and never overlap.
  */
 #include <string.h>
 
@@ -60,6 +61,8 @@ static void on_frame(void *user, const tase_frame_t *fr)
 {
     sink_t *s = user;
     FZ_CHECK(s->n < MAX_RX);
+    /* stream order; nothing inside (or overlapping) a delivered frame */
+    FZ_CHECK(s->n == 0u || fr->offset >= got[s->n - 1u].end);
     got[s->n].start = fr->offset;
     got[s->n].end = fr->offset + fr->len + TASE_FRAME_OVERHEAD;
     got[s->n].seen_at = s->rx->stats.bytes_in;

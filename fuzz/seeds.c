@@ -73,7 +73,7 @@ static int seeds_rx_bytes(const char *dir)
         put_frame(0x10, 0x10, 30, (uint8_t)k);
     }
     bad |= save(dir, "rx_bytes", 2);
-    /* more overlapping false syncs than candidate slots */
+    /* ten overlapping false syncs hiding two frames */
     put_byte(0x00), put_byte(0x07);
     for (k = 0; k < 10; k++) {
         put(sync, 3), put_byte(0xF0);

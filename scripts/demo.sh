@@ -47,7 +47,9 @@ for _ in $(seq 100); do
 done
 [ -L "$work/gimbal" ] || fail "tase-sim did not start: $(cat "$work/sim.log")"
 head -2 "$work/sim.log"
-link=(--serial "$work/gimbal")
+# --record: every command also appends its bytes, both ways and timestamped,
+# to one pcap capture (decoded at the end)
+link=(--serial "$work/gimbal" --record "$work/session.pcap")
 
 step "Host: who are you? (zero-length SYSTEM_VERSION query, answered by the gimbal)"
 show "$TASE" query SYSTEM_VERSION "${link[@]}"
@@ -100,6 +102,16 @@ echo "\$ $TASE klv $work/klv.bin"
 grep -q '"fields":{"utc"' "$work/klv.json" || fail "no KLV packet decoded"
 head -1 "$work/klv.json"
 echo "($(wc -l <"$work/klv.json") packet(s) in 2 s; raw values in fields, engineering units in units)"
+
+step "The session as recorded by --record (pcap; Wireshark: tools/wireshark/tase.lua)"
+echo "\$ $TASE decode $work/session.pcap | head -3"
+"$TASE" decode "$work/session.pcap" >"$work/session.json"
+head -3 "$work/session.json"
+nin=$(grep -c '"dir":"in"' "$work/session.json" || true)
+nout=$(grep -c '"dir":"out"' "$work/session.json" || true)
+grep -q '"dir":"in".*"name":"GIMBAL_CMD","size":8,"fields":{"pan":4500,"tilt":-2000,' "$work/session.json" ||
+    fail "the recorded session lacks the position command"
+echo "($nin packets to the gimbal and $nout from it, each with its capture time in seconds)"
 
 step "Stopping the simulator; its log of what it was asked to do:"
 kill "$sim_pid"

@@ -21,6 +21,10 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CPUS = ["cortex-m0plus", "cortex-m4"]
 TARGET_RX_FLASH = 1024
+TARGET_FRAMING_FLASH = 1500
+# Framing alone (issue 12): what a firmware that does its own packet
+# decoding links of the receiver.
+FRAMING_ROOTS = ["tase_rx_init", "tase_rx_push", "tase_rx_feed", "tase_rx_flush"]
 TARGET_CORE_FLASH = 4096
 TARGET_RX_RAM = 272
 TARGET_RX_STACK = 128
@@ -339,8 +343,8 @@ def main():
     for cpu in CPUS:
         bdir, objs = build(cpu, args.build)
         mods = {m: berkeley(o) for m, o in objs.items()}
-        rx_init = link_name(objs, "tase_rx_init")
-        rx_roots = ["tase_rx_feed", rx_init, "tase_rx_flush"]
+        frame_roots = [link_name(objs, r) for r in FRAMING_ROOTS]
+        rx_roots = list(frame_roots)
         has_dispatch = "dispatch" in objs
         if has_dispatch:
             rx_roots += globals_of(objs["dispatch"])
@@ -352,8 +356,7 @@ def main():
         res[cpu] = {
             "mods": mods,
             "rx": linked_size(cpu, objs.values(), rx_roots, args.build),
-            "rx_frame": linked_size(cpu, objs.values(),
-                                    [rx_init, "tase_rx_feed", "tase_rx_flush"], args.build),
+            "rx_frame": linked_size(cpu, objs.values(), frame_roots, args.build),
             "core": linked_size(cpu, core, roots_core, args.build),
             "core_float": linked_size(cpu, core, roots_all, args.build),
             "rest": linked_size(cpu, list(objs.values()), roots_rest, args.build)
@@ -408,6 +411,9 @@ def main():
     m4 = res["cortex-m4"]
     p("| receive path flash: %s | %s | 1024 | %s |" % (
         rxname, " | ".join(str(res[c]["rx"][0]) for c in CPUS), met(m4["rx"][0], TARGET_RX_FLASH)))
+    p("| framing only: %s | %s | %d | %s |" % (
+        ", ".join(FRAMING_ROOTS), " | ".join(str(res[c]["rx_frame"][0]) for c in CPUS),
+        TARGET_FRAMING_FLASH, met(m4["rx_frame"][0], TARGET_FRAMING_FLASH)))
     p("| whole core flash (%s), optional name strings and floating-point unit helpers "
       "excluded | %s | 4096 | %s |" % (
         ", ".join(m for m in CORE_MODULES if m in m4["objs"]),
@@ -458,23 +464,20 @@ def main():
     p("### Gaps and their reasons (Cortex-M4)")
     p("")
     rx_gap = m4["rx"][0] - TARGET_RX_FLASH
-    p("- **Receive path flash, %d B against 1024 (%s).** Framing alone links to %d B: the "
-      "zero-latency receiver tracks up to TASE_RX_CANDIDATES overlapping candidate frames "
-      "(a corrupted Size cannot swallow the frames behind it, no re-scan latency), delivers "
-      "frames in place from the caller's buffer, skips idle bytes with memchr and copies in "
-      "runs, and re-scans its window when more candidates overlap than it tracks; that "
-      "machinery and its fast paths are the ~2 KB (largest symbols: %s). A classic "
-      "single-state parser would be smaller but loses the frames behind a corrupted Size "
-      "or re-scans after each failure; we chose zero latency and ~9 instructions per byte "
-      "(docs/PERFORMANCE.md) over the 1 KB. Dispatch adds %d B: the generic decoder of the "
+    p("- **Receive path flash, %d B against 1024 (%s).** Framing alone (%s) links to %d B "
+      "(%s against its own target of %d B): the greedy receiver keeps one pending candidate "
+      "in a window, scans the caller's buffer in place (memchr over idle bytes, frames checked "
+      "where they lie) and has a byte path for tase_rx_push() (largest symbols: %s). "
+      "Dispatch adds %d B: the generic decoder of the "
       "codec (largest symbols of tase_codec.c: %s) and the schema's ROM tables and lookup "
       "(tase_schema.c: %s), which describe every packet of the spec once." % (
-          m4["rx"][0], "met" if rx_gap <= 0 else "+%d" % rx_gap, m4["rx_frame"][0],
+          m4["rx"][0], "met" if rx_gap <= 0 else "+%d" % rx_gap, ", ".join(FRAMING_ROOTS),
+          m4["rx_frame"][0], met(m4["rx_frame"][0], TARGET_FRAMING_FLASH), TARGET_FRAMING_FLASH,
           biggest("frame", 3), m4["rx"][0] - m4["rx_frame"][0], biggest("codec"),
           biggest("schema")))
     core_gap = m4["core"][0] - TARGET_CORE_FLASH
     p("- **Whole core flash, %d B against 4096 (%s).** By module (object file, everything "
-      "compiled in): %s. Framing is the ~2 KB above; KLV (the MISB ST 0601 "
+      "compiled in): %s. Framing is the receiver above plus the encoder; KLV (the MISB ST 0601 "
       "metadata encoder, decoder and stream receiver) is the other large one; the schema is the ROM description of all 21 packets and their fields that the "
       "codec, dispatcher and tools share." % (
           m4["core"][0], "met" if core_gap <= 0 else "+%d" % core_gap,
@@ -484,16 +487,22 @@ def main():
       "counters in the instance (docs/DESIGN.md, \"RAM: why not 272 bytes\"): a maximal "
       "frame is %d bytes, and even a receiver that keeps only Group, PktType and the data "
       "holds 255, leaving nothing for 32-bit counters. Ours: the %d-byte window (one whole "
-      "frame, delivered as one contiguous view with zero added latency), %d bytes of "
-      "counters (%d of them), and %d bytes of candidate bookkeeping, indices and padding. "
-      "Without the counters it would be about %d bytes; with TASE_RX_CANDIDATES=1 as well, "
-      "about %d. include/tase/frame.h sets the budget at 328 (TASE_RX_SIZE_BUDGET)." % (
+      "frame, delivered as one contiguous view), %d bytes of counters (%d of them), and %d "
+      "bytes of state (held length, the held candidate's end, the busy flag) and padding. "
+      "include/tase/frame.h sets the budget at %d (TASE_RX_SIZE_BUDGET)." % (
           rxsz, "met" if rxsz <= TARGET_RX_RAM else "+%d" % (rxsz - TARGET_RX_RAM), frame_max,
-          frame_max, stats, stats // 4, rxsz - frame_max - stats, rxsz - stats,
-          rxsz - stats - 18))
+          frame_max, stats, stats // 4, rxsz - frame_max - stats, rxsz))
     st4 = rx_stack("cortex-m4")[0]
-    p("- **Receive path stack, %d B against 128 (%s)**, plus the application's handler." % (
-        st4, met(st4, TARGET_RX_STACK)))
+    own4 = stacks["cortex-m4"][0]
+    frame_of = lambda fn: next((v for k, v in own4.items() if k.endswith(":" + fn) or k == fn), 0)
+    p("- **Receive path stack, %d B against 128 (%s)**, plus the application's handler. The "
+      "receiver's share is its entry point (%d B for tase_rx_feed, which at run time is gone: "
+      "it tail-calls the general path) and run() (%d B: the general path and the greedy scan "
+      "in one frame, with the tase_frame_t handed to the callback), which calls the frame "
+      "callback. The receiver before issue 12 called the callback from a 72-byte "
+      "tase_rx_feed(); the greedy receiver's general path keeps more state live (the "
+      "caller's buffer, the window and the scan position at once)." % (
+          st4, met(st4, TARGET_RX_STACK), frame_of("tase_rx_feed"), frame_of("run")))
     p("")
     p("### Biggest contributors per module (Cortex-M4, `arm-none-eabi-nm --size-sort`)")
     p("")

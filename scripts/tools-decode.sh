@@ -26,4 +26,11 @@ for e, g in zip(exp, got):
     assert "units" in g and not set(g["units"]) & set(g["fields"])
 PY
 "$TASE" klv - <"$DATA/klv_noisy.bin" | cmp -s - "$out"
-echo "decode: serial, candump and KLV captures match their expected JSON"
+# Issue 12: a 28-byte CAMERA_PASS whose camera bytes are a whole GIMBAL_CMD
+# frame (pan 90.00, tilt -10.00) decodes to the CAMERA_PASS only.
+printf '\x00\xff\x5a\x16\x00\x42\x01\x08\x00\x00\x00\xff\x5a\x0a\x00\x80\x23\x28\xfc\x18\x00\x00\x00\x00\x03\x42\x05\x41' |
+    "$TASE" decode - >"$out"
+if [ "$(wc -l <"$out")" -ne 1 ] || ! grep -q '^{"offset":0,.*"name":"CAMERA_PASS"' "$out"; then
+    echo "tase decode of a CAMERA_PASS carrying a GIMBAL_CMD frame:"; cat "$out"; exit 1
+fi
+echo "decode: serial, candump and KLV captures match their expected JSON; a frame inside a CAMERA_PASS is data"

@@ -126,6 +126,9 @@ int tase_can_rx_feed(tase_can_rx_t *crx, const tase_can_frame_t *f, tase_rx_hand
     if (crx == NULL || f == NULL) {
         return TASE_EARG;
     }
+    if (crx->rx.busy != 0u) {
+        return TASE_EBUSY; /* from inside its own frame callback: count nothing */
+    }
     n = tase_can_accept(crx->role, f);
     if (n == TASE_EARG) {
         return n; /* corrupted role field: do not count */

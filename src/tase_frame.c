@@ -1,25 +1,38 @@
 /*
- * Frame encoder and receive state machine. The design is described in
- * include/tase/frame.h; comments here explain the non-obvious choices.
+ * Frame encoder and receiver. The contract (which frames, order, latency,
+ * re-entrancy) is in include/tase/frame.h; comments here explain how.
  *
- * Window invariants (all indices are into rx->buf):
- *   - buf[0..len) holds every byte that may still belong to a frame: it
- *     starts at the oldest live candidate's first sync byte, or holds only
- *     a partial sync (00 or 00 FF) when no candidate is alive.
- *   - cand[] is sorted by start; bytes before `scan` have been examined
- *     for sync. scan < len only while more syncs overlap than there are
- *     candidate slots; those bytes are re-examined when a slot frees.
- *   - Delivered frames still in the window are disjoint or nested and all
- *     end below `floor`; `credit` is their total length counting nested
- *     ones once. Each candidate remembers the credit that lay before it,
- *     so trimming the window can tell delivered bytes from discarded ones.
+ * The receiver runs the greedy scan of frame.h online. Its whole state is
+ * the window buf[0..len), which holds one of:
+ *   - nothing (len 0);
+ *   - a partial sync: 00, 00 FF or 00 FF 5A (len 1..3, end 0);
+ *   - the earliest pending candidate, from its first sync byte on: Size
+ *     >= 2 known, last byte still to come (4 <= len <= end, end = Size + 5).
+ * Bytes after a pending candidate are not examined: a frame in them could
+ * only be delivered if the candidate fails, and then the rest of the window
+ * is scanned as if it were new input (scan()). So the scan position never
+ * moves back, each candidate is judged once, and nothing needs tracking
+ * besides the one candidate.
+ *
+ * tase_rx_push() stores a byte inside a frame with one test (len < end).
+ * Every other path runs with `busy` set and `end` zero, so that test fails
+ * while a callback runs and a re-entrant call lands on the busy check.
  */
 #include "tase/frame.h"
 
+#include <limits.h>
 #include <string.h>
 
 #define RX_CAP ((uint16_t)TASE_FRAME_MAX)
-#define NO_EVENT ((uint16_t)0xFFFFu)
+
+/* Keeps the byte events of tase_rx_push() out of line, so that its fast
+ * path (a byte inside a frame) needs no stack frame. GCC and clang only;
+ * another compiler may inline it, which costs speed, not correctness. */
+#if defined(__GNUC__)
+#define RX_NOINLINE __attribute__((noinline))
+#else
+#define RX_NOINLINE
+#endif
 
 /* C99 has no _Static_assert: a negative array size fails the build. */
 typedef char tase_rx_size_check[sizeof(tase_rx_t) <= TASE_RX_SIZE_BUDGET ? 1 : -1];
@@ -115,8 +128,9 @@ int tase_rx_init(tase_rx_t *rx)
     if (rx == NULL) {
         return TASE_EARG;
     }
+    /* Clears `busy` too: a call whose callback re-initialises the receiver
+     * sees that and returns without touching it again. */
     (void)memset(rx, 0, sizeof(*rx));
-    rx->next = NO_EVENT;
     return TASE_OK;
 }
 
@@ -129,494 +143,325 @@ int tase_rx_stats_reset(tase_rx_t *rx)
     return TASE_OK;
 }
 
-static uint16_t cand_event(const tase_rx_cand_t *c)
+static const uint8_t sync[3] = {TASE_SYNC1, TASE_SYNC2, TASE_SYNC3};
+
+/* What one call delivers to, and how many frames it has delivered. */
+typedef struct {
+    tase_rx_handler_t on_frame;
+    void *user;
+    uint32_t count;
+} rx_call_t;
+
+/* Count and hand on the valid frame f[0..Size+6) at stream offset
+ * `offset` (f is in the window or in the caller's buffer). Returns false
+ * when the callback re-initialised the receiver: the caller must then
+ * leave it alone. */
+static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, tase_rx_handler_t on_frame,
+                    void *user)
 {
-    return (c->end != 0u) ? c->end : (uint16_t)(c->start + 3u);
-}
-
-static void update_next(tase_rx_t *rx)
-{
-    uint16_t nx = NO_EVENT;
-    uint8_t i;
-    for (i = 0; i < rx->ncand; i++) {
-        uint16_t e = cand_event(&rx->cand[i]);
-        if (e < nx) {
-            nx = e;
-        }
-    }
-    rx->next = nx;
-}
-
-/* Remove cand[first..last) and close the gap. */
-static void drop_cands(tase_rx_t *rx, uint8_t first, uint8_t last)
-{
-    uint8_t i;
-    uint8_t n = (uint8_t)(last - first);
-    for (i = first; (uint8_t)(i + n) < rx->ncand; i++) {
-        rx->cand[i] = rx->cand[i + n];
-    }
-    rx->ncand = (uint8_t)(rx->ncand - n);
-}
-
-/* Does a sync sequence end at index q (the 0x5A byte)? A frame may not
- * start below `floor`: those bytes belong to a delivered frame. */
-static bool sync_ends_at(const tase_rx_t *rx, uint16_t q)
-{
-    /* q < len <= TASE_FRAME_MAX always; cppcheck cannot see that. */
-    /* cppcheck-suppress arrayIndexOutOfBoundsCond */
-    return q >= 2u && (uint16_t)(q - 2u) >= rx->floor && rx->buf[q] == TASE_SYNC3 &&
-           rx->buf[q - 1u] == TASE_SYNC2 && rx->buf[q - 2u] == TASE_SYNC1;
-}
-
-static void add_cand(tase_rx_t *rx, uint16_t start)
-{
-    tase_rx_cand_t *c = &rx->cand[rx->ncand];
-    c->start = start;
-    c->end = 0u;
-    c->credit = rx->credit;
-    rx->ncand++;
-}
-
-/* cand[i] has reached its event (Size byte or last byte, both already in
- * the window): judge it. Returns true when it is a valid frame, described
- * in *out; the caller hands it on. The callback is not called from here so
- * that it runs on the stack of tase_rx_feed() alone, not below this. The
- * caller refreshes rx->next afterwards. */
-static bool settle(tase_rx_t *rx, uint8_t i, tase_frame_t *out)
-{
-    tase_rx_cand_t *c = &rx->cand[i];
-    uint16_t start = c->start;
-    uint16_t end;
-    uint16_t want;
-    uint8_t last;
-
-    if (c->end == 0u) {
-        uint8_t size = rx->buf[start + 3u];
-        if (size < 2u) {
-            rx->stats.bad_size++;
-            drop_cands(rx, i, (uint8_t)(i + 1u));
-        } else {
-            c->end = (uint16_t)(start + size + 5u);
-        }
-        return false;
-    }
-
-    end = c->end;
-    want = (uint16_t)(((uint16_t)rx->buf[end - 1u] << 8) | rx->buf[end]);
-    if (tase_checksum(0u, &rx->buf[start], (size_t)end - 1u - start) != want) {
-        rx->stats.checksum_errors++;
-        drop_cands(rx, i, (uint8_t)(i + 1u));
-        return false;
-    }
-
-    /* Valid. Nested frames delivered earlier are already part of the
-     * credit accumulated since this candidate began; replace them by it. */
-    rx->credit = (uint16_t)(c->credit + (end - start + 1u));
-    rx->floor = (uint16_t)(end + 1u);
-    last = (uint8_t)(i + 1u);
-    while (last < rx->ncand && rx->cand[last].start <= end) {
-        last++; /* began inside this frame: it was data */
-    }
-    drop_cands(rx, i, last);
+    tase_frame_t fr;
     rx->stats.frames_ok++;
+    if (on_frame != NULL) {
+        fr.offset = offset;
+        fr.group = f[4];
+        fr.type = f[5];
+        fr.len = (uint8_t)(f[3] - 2u);
+        fr.data = &f[TASE_FRAME_HEADER];
+        on_frame(user, &fr);
+    }
+    return rx->busy != 0u;
+}
 
-    out->offset = rx->stats.bytes_in - (uint32_t)(rx->len - start);
-    out->group = rx->buf[start + 4u];
-    out->type = rx->buf[start + 5u];
-    out->len = (uint8_t)(rx->buf[start + 3u] - 2u);
-    out->data = &rx->buf[start + TASE_FRAME_HEADER];
+/* The greedy scan of src[0..m), with nothing pending before it. The first
+ * `counted_before` bytes are already in stats.bytes_in (bytes of the
+ * window); the others are counted as the scan passes them, so that a
+ * callback sees bytes_in up to the byte that decided its frame (its last
+ * byte, or the last byte of a longer candidate before it that failed). A
+ * complete candidate is judged where it lies. The first incomplete one (a sync still arriving, or a
+ * candidate whose last byte has not come) is moved with everything after
+ * it to the window, unless `final` (end of input), where it fails like a
+ * bad one: discard its first byte and scan on. Returns false when a
+ * callback re-initialised the receiver. */
+static bool scan(tase_rx_t *rx, const uint8_t *src, size_t m, size_t counted_before, bool final,
+                 rx_call_t *c)
+{
+    size_t p = 0;
+    size_t held = 0;
+    size_t counted = counted_before;
+    while (p < m) {
+        const uint8_t *s = &src[p];
+        size_t avail = m - p;
+        size_t k = 1;
+        if (s[0] != TASE_SYNC1) {
+            /* noise up to the next 00 */
+            const uint8_t *z = memchr(s, TASE_SYNC1, avail);
+            size_t skip = (z != NULL) ? (size_t)(z - s) : avail;
+            rx->stats.bytes_discarded += (uint32_t)skip;
+            p += skip;
+            continue;
+        }
+        while (k < 3u && k < avail && s[k] == sync[k]) {
+            k++;
+        }
+        if (k == 3u && avail > 3u) {
+            size_t flen = (size_t)s[3] + 6u;
+            if (s[3] < 2u) {
+                rx->stats.bad_size++;
+            } else if (flen <= avail) {
+                uint16_t want = (uint16_t)(((uint16_t)s[flen - 2u] << 8) | s[flen - 1u]);
+                if (tase_checksum(0u, s, flen - 2u) == want) {
+                    if (p + flen > counted) {
+                        rx->stats.bytes_in += (uint32_t)(p + flen - counted);
+                        counted = p + flen;
+                    }
+                    c->count++;
+                    if (!deliver(rx, s, rx->stats.bytes_in - (uint32_t)(counted - p), c->on_frame,
+                                 c->user)) {
+                        return false;
+                    }
+                    p += flen;
+                    continue;
+                }
+                /* Failed, after looking up to its last byte: a frame
+                 * found inside it is delivered as of that byte, the same
+                 * moment as when the stream comes one byte at a time. */
+                rx->stats.checksum_errors++;
+                if (p + flen > counted) {
+                    rx->stats.bytes_in += (uint32_t)(p + flen - counted);
+                    counted = p + flen;
+                }
+            } else if (!final) {
+                held = avail; /* a candidate whose last byte is still to come */
+                break;
+            } else {
+                /* end of input: it can no longer complete */
+            }
+        } else if (k == avail && !final) {
+            held = avail; /* a sync still arriving */
+            break;
+        } else {
+            /* not a sync */
+        }
+        rx->stats.bytes_discarded++;
+        p++;
+    }
+    if (m > counted) {
+        rx->stats.bytes_in += (uint32_t)(m - counted);
+    }
+    if (held > 0u && &src[p] != rx->buf) {
+        (void)memmove(rx->buf, &src[p], held);
+    }
+    rx->len = (uint16_t)held;
     return true;
 }
 
-/* Examine bytes skipped while every candidate slot was busy, adding the
- * candidates found there. Returns the index of one that is already
- * complete (the caller judges it with settle() and hands the frame on
- * before calling again), or -1 when the scan is done or the slots are full
- * again. It does not judge checksums itself, which keeps settle() and the
- * frame callback off this call chain and the receive-path stack shallow. */
-static int rescan(tase_rx_t *rx)
+/* The general path: feed data[0..n) (n may be 0), or settle everything at
+ * end of input (data NULL: tase_rx_flush()). While the window holds
+ * something, just enough bytes to decide it are copied in and the window is
+ * scanned; once it is empty, the rest of the input is scanned in place.
+ * (Five arguments, like the entry points: they can tail-call it.) */
+static int run(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame, void *user)
 {
-    while (rx->scan < rx->len && rx->ncand < TASE_RX_CANDIDATES) {
-        uint16_t q = rx->scan;
-        rx->scan = (uint16_t)(q + 1u);
-        if (!sync_ends_at(rx, q)) {
-            continue;
-        }
-        if ((uint16_t)(q + 1u) < rx->len && rx->buf[q + 1u] < 2u) {
-            rx->stats.bad_size++;
-            continue;
-        }
-        add_cand(rx, (uint16_t)(q - 2u));
-        if ((uint16_t)(q + 1u) < rx->len) { /* else its Size byte is still to come */
-            tase_rx_cand_t *c = &rx->cand[rx->ncand - 1u];
-            c->end = (uint16_t)(c->start + rx->buf[q + 1u] + 5u);
-            if (c->end < rx->len) {
-                return (int)(rx->ncand - 1u);
-            }
-        }
-    }
-    return -1;
-}
-
-/* Judge every candidate whose event is at index q, oldest first. At most
- * one of them is valid: a valid one drops every later candidate that ends
- * at q, since those began inside it. */
-static bool events_at(tase_rx_t *rx, uint16_t q, tase_frame_t *out)
-{
-    uint8_t i = 0;
-    bool got = false;
-    while (i < rx->ncand) {
-        uint8_t before = rx->ncand;
-        if (cand_event(&rx->cand[i]) != q) {
-            i++;
-            continue;
-        }
-        if (settle(rx, i, out)) {
-            got = true;
-        }
-        if (rx->ncand == before) {
-            i++; /* Size accepted: the candidate stays */
-        }
-    }
-    return got;
-}
-
-/* Release buf[0..cut): every byte there not inside a delivered frame is
- * counted as discarded. `credit_before` is the delivered length in it. */
-static void release(tase_rx_t *rx, uint16_t cut, uint16_t credit_before)
-{
-    uint8_t i;
-    rx->stats.bytes_discarded += (uint32_t)(cut - credit_before);
-    rx->credit = (uint16_t)(rx->credit - credit_before);
-    if (cut == 0u) {
-        return;
-    }
-    (void)memmove(rx->buf, &rx->buf[cut], (size_t)(rx->len - cut));
-    rx->len = (uint16_t)(rx->len - cut);
-    rx->scan = (uint16_t)(rx->scan - cut);
-    rx->floor = (rx->floor > cut) ? (uint16_t)(rx->floor - cut) : 0u;
-    if (rx->next != NO_EVENT) {
-        rx->next = (uint16_t)(rx->next - cut);
-    }
-    for (i = 0; i < rx->ncand; i++) {
-        tase_rx_cand_t *c = &rx->cand[i];
-        c->start = (uint16_t)(c->start - cut);
-        if (c->end != 0u) {
-            c->end = (uint16_t)(c->end - cut);
-        }
-        c->credit = (uint16_t)(c->credit - credit_before);
-    }
-}
-
-/* No candidate alive and nothing left to scan: keep only a trailing
- * partial sync (00 or 00 FF) that may still start a frame. */
-static void go_idle(tase_rx_t *rx)
-{
-    uint16_t len = rx->len;
-    uint16_t keep = 0u;
-    if (len > rx->floor) {
-        if (rx->buf[len - 1u] == TASE_SYNC1) {
-            keep = 1u;
-        } else if (len >= 2u && (uint16_t)(len - 2u) >= rx->floor &&
-                   rx->buf[len - 1u] == TASE_SYNC2 && rx->buf[len - 2u] == TASE_SYNC1) {
-            keep = 2u;
-        } else {
-            /* no partial sync at the end: keep nothing */
-        }
-    }
-    rx->stats.bytes_discarded += (uint32_t)(len - keep - rx->credit);
-    rx->credit = 0u;
-    rx->buf[0] = TASE_SYNC1;
-    rx->buf[1] = TASE_SYNC2;
-    rx->len = keep;
-    rx->scan = keep;
-    rx->floor = 0u;
-    rx->next = NO_EVENT;
-}
-
-/* The window is full. The oldest candidate began at index >= 1 (a frame
- * spans at most RX_CAP bytes and it has not ended), so this frees room. */
-static void make_room(tase_rx_t *rx)
-{
-    release(rx, rx->cand[0].start, rx->cand[0].credit);
-}
-
-/* No candidate alive: the window holds only a partial sync (len 0..2,
- * floor 0, no credit), so matching the next sync byte is all there is. */
-static void hunt_byte(tase_rx_t *rx, uint8_t b)
-{
-    static const uint8_t sync[3] = {TASE_SYNC1, TASE_SYNC2, TASE_SYNC3};
-    uint16_t len = rx->len;
-    rx->stats.bytes_in++;
-    if (b == sync[len]) {
-        rx->buf[len] = b;
-        len++;
-        if (len == 3u) {
-            add_cand(rx, 0u);
-            rx->next = 3u;
-        }
-    } else if (b == TASE_SYNC1) {
-        rx->stats.bytes_discarded += len; /* 00 or 00 FF, then 00 again */
-        len = 1u;
-    } else {
-        rx->stats.bytes_discarded += (uint32_t)len + 1u;
-        len = 0u;
-    }
-    rx->len = len;
-    rx->scan = len;
-}
-
-/* Take one byte. Returns true when it completed a valid frame (in *out);
- * the caller then hands it on and calls finish_event(). */
-static bool push_byte(tase_rx_t *rx, uint8_t b, tase_frame_t *out, bool *event)
-{
-    uint16_t q;
-    *event = false;
-    if (rx->ncand == 0u) {
-        hunt_byte(rx, b);
-        return false;
-    }
-    if (rx->len == RX_CAP) {
-        make_room(rx);
-    }
-    q = rx->len;
-    rx->buf[q] = b;
-    rx->len = (uint16_t)(q + 1u);
-    rx->stats.bytes_in++;
-    if (rx->scan == q) {
-        if (b == TASE_SYNC3 && sync_ends_at(rx, q)) {
-            if (rx->ncand < TASE_RX_CANDIDATES) {
-                add_cand(rx, (uint16_t)(q - 2u));
-                if ((uint16_t)(q + 1u) < rx->next) {
-                    rx->next = (uint16_t)(q + 1u);
-                }
-                rx->scan = (uint16_t)(q + 1u);
-            } /* else: all slots busy; rescan() finds it later */
-        } else {
-            rx->scan = (uint16_t)(q + 1u);
-        }
-    }
-    if (q != rx->next) {
-        return false;
-    }
-    *event = true;
-    return events_at(rx, q, out);
-}
-
-/* After an event: deliver the frame it completed, then the frames a rescan
- * of skipped bytes finds, each as soon as it is found; then tidy up. */
-static void finish_event(tase_rx_t *rx, bool got, tase_frame_t *out, tase_rx_handler_t on_frame,
-                         void *user)
-{
-    bool valid = got;
-    for (;;) {
-        int k;
-        if (valid && on_frame != NULL) {
-            on_frame(user, out);
-        }
-        k = rescan(rx);
-        if (k < 0) {
-            break;
-        }
-        valid = settle(rx, (uint8_t)k, out);
-    }
-    update_next(rx);
-    if (rx->ncand == 0u && rx->scan == rx->len) {
-        go_idle(rx);
-    }
-}
-
-/* Invariants every entry point relies on, checked so that a corrupted or
- * never-initialised instance gives TASE_EARG instead of indexing outside
- * buf: held bytes fit, the scan is within them, the candidate count fits,
- * and with no candidate at most a partial sync (2 bytes) is held. */
-static bool rx_sane(const tase_rx_t *rx)
-{
-    return rx->len <= RX_CAP && rx->scan <= rx->len && rx->ncand <= TASE_RX_CANDIDATES &&
-           (rx->ncand != 0u || rx->len < 3u);
-}
-
-int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
-                 void *user)
-{
+    rx_call_t c;
     size_t i = 0;
-    uint32_t before;
-    tase_frame_t frame;
-    if (rx == NULL || (data == NULL && n > 0u) || !rx_sane(rx)) {
-        return TASE_EARG;
-    }
-    before = rx->stats.frames_ok;
-    while (i < n) {
-        if (rx->len == 0u && n - i >= 16u) {
-            /* Idle: everything up to the next 00 is noise. (For a few
-             * bytes a library call costs more than hunt_byte.) */
-            const uint8_t *z = memchr(&data[i], TASE_SYNC1, n - i);
-            size_t skip = (z != NULL) ? (size_t)(z - &data[i]) : (n - i);
-            rx->stats.bytes_in += (uint32_t)skip;
-            rx->stats.bytes_discarded += (uint32_t)skip;
-            i += skip;
-            if (z == NULL) {
+    bool live = true;
+    bool final = data == NULL;
+    c.on_frame = on_frame;
+    c.user = user;
+    c.count = 0u;
+    rx->busy = 1u;
+    rx->end = 0u;
+    while (live) {
+        size_t len = rx->len;
+        size_t need;
+        size_t k;
+        bool short_of;
+        const uint8_t *src = rx->buf;
+        size_t m;
+        size_t counted;
+        if (len == 0u) {
+            if (i == n) {
                 break;
             }
-            /* Fast path: a whole frame is at hand and no byte after its
-             * sync is 5A, so no other candidate can start inside it. Judge
-             * it in place; on a checksum failure fall through to the
-             * general path, which re-examines every byte. */
-            if (n - i >= TASE_FRAME_OVERHEAD && data[i + 1u] == TASE_SYNC2 &&
-                data[i + 2u] == TASE_SYNC3 && data[i + 3u] >= 2u) {
-                size_t flen = (size_t)data[i + 3u] + 6u;
-                if (flen <= n - i && memchr(&data[i + 3u], TASE_SYNC3, flen - 3u) == NULL &&
-                    tase_checksum(0u, &data[i], flen - 2u) ==
-                        (uint16_t)(((uint16_t)data[i + flen - 2u] << 8) | data[i + flen - 1u])) {
-                    frame.offset = rx->stats.bytes_in;
-                    frame.group = data[i + 4u];
-                    frame.type = data[i + 5u];
-                    frame.len = (uint8_t)(data[i + 3u] - 2u);
-                    frame.data = &data[i + TASE_FRAME_HEADER];
-                    rx->stats.bytes_in += (uint32_t)flen;
-                    rx->stats.frames_ok++;
-                    i += flen;
-                    if (on_frame != NULL) {
-                        on_frame(user, &frame);
-                    }
-                    continue;
-                }
+            /* the rest of the input, in place */
+            src = &data[i];
+            m = n - i;
+            counted = 0u;
+            i = n;
+        } else if (len < 4u) {
+            /* A partial sync: the input continues it into a header, or
+             * breaks it. Broken, its bytes are noise (00 FF 5A with a Size
+             * < 2 is a bad Size), and the byte that broke it is scanned in
+             * place like the rest of the input. */
+            while (len < 3u && i < n && data[i] == sync[len]) {
+                rx->buf[len] = data[i];
+                len++;
+                i++;
+                rx->stats.bytes_in++;
             }
-            /* A whole header at hand: open the candidate in one step. */
-            if (n - i >= 4u && data[i + 1u] == TASE_SYNC2 && data[i + 2u] == TASE_SYNC3 &&
-                data[i + 3u] >= 2u) {
-                (void)memcpy(rx->buf, &data[i], 4u);
-                rx->len = 4u;
-                rx->scan = 4u;
-                rx->ncand = 1u;
-                rx->cand[0].start = 0u;
-                rx->cand[0].end = (uint16_t)(data[i + 3u] + 5u);
-                rx->cand[0].credit = 0u;
-                rx->next = rx->cand[0].end;
-                rx->stats.bytes_in += 4u;
-                i += 4u;
-                continue;
+            if (i == n && !final) {
+                rx->len = (uint16_t)len;
+                break;
             }
-        } else if (rx->ncand > 0u && rx->len < RX_CAP) {
-            /* Inside a candidate: copy the run of bytes before the next
-             * event in one go, stopping at a 5A that may end a sync. */
-            size_t run = (size_t)((rx->next < RX_CAP ? rx->next : RX_CAP) - rx->len);
-            /* next > len here (events below len were settled when their
-             * byte arrived); cppcheck's value flow assumes run == 0. */
-            /* cppcheck-suppress knownConditionTrueFalse */
-            if (run > n - i) {
-                run = n - i;
+            if (len == 3u && i < n && data[i] >= 2u) {
+                rx->buf[3] = data[i];
+                len = 4u;
+                i++;
+                rx->stats.bytes_in++;
+            } else {
+                if (len == 3u && i < n) {
+                    rx->stats.bad_size++;
+                }
+                rx->stats.bytes_discarded += (uint32_t)len;
+                len = 0u;
             }
-            /* cppcheck-suppress knownConditionTrueFalse */
-            if (run > 0u && run < 8u) {
-                /* Short runs (byte-at-a-time feeding): no library calls. */
-                size_t k = 0u;
-                bool scanning = rx->scan == rx->len;
-                /* cppcheck-suppress knownConditionTrueFalse */
-                while (k < run && !(scanning && data[i + k] == TASE_SYNC3)) {
-                    rx->buf[rx->len + k] = data[i + k];
-                    k++;
-                }
-                rx->len = (uint16_t)(rx->len + k);
-                if (scanning) {
-                    rx->scan = rx->len;
-                }
+            rx->len = (uint16_t)len;
+            continue;
+        } else {
+            /* the rest of the held candidate (rx_sane: Size >= 2) */
+            need = (size_t)rx->buf[3] + 6u - len;
+            short_of = n - i < need;
+            k = short_of ? n - i : need;
+            if (k > 0u) {
+                (void)memcpy(&rx->buf[len], &data[i], k);
+                rx->len = (uint16_t)(len + k);
                 rx->stats.bytes_in += (uint32_t)k;
                 i += k;
-                if (i == n) {
-                    break;
-                }
-                /* cppcheck-suppress knownConditionTrueFalse */
-            } else if (run > 0u) {
-                if (rx->scan == rx->len) {
-                    const uint8_t *s = memchr(&data[i], TASE_SYNC3, run);
-                    if (s != NULL) {
-                        run = (size_t)(s - &data[i]);
-                    }
-                    rx->scan = (uint16_t)(rx->scan + run);
-                }
-                (void)memcpy(&rx->buf[rx->len], &data[i], run);
-                rx->len = (uint16_t)(rx->len + run);
-                rx->stats.bytes_in += (uint32_t)run;
-                i += run;
-                if (i == n) {
-                    break;
-                }
-            } else {
-                /* run == 0: nothing to copy before the next event */
             }
-        } else {
-            /* only a partial sync held, or the window is full: the byte
-             * goes through push_byte() alone */
-        }
-        {
-            bool event;
-            bool got = push_byte(rx, data[i], &frame, &event);
-            i++;
-            if (event) {
-                finish_event(rx, got, &frame, on_frame, user);
+            if (short_of && !final) {
+                break; /* its last byte is still to come */
             }
+            m = rx->len;
+            counted = m;
         }
+        /* one call site: scan() is inlined here, one stack frame for both */
+        live = scan(rx, src, m, counted, final, &c);
     }
-    return (int)(rx->stats.frames_ok - before);
+    if (live) {
+        rx->end = (rx->len >= 4u) ? (uint16_t)(rx->buf[3] + 5u) : 0u;
+        rx->busy = 0u;
+    }
+    return (c.count > (uint32_t)INT_MAX) ? INT_MAX : (int)c.count;
+}
+
+/* What every entry point checks of an instance, so that a corrupted or
+ * never-initialised one gives TASE_EARG instead of indexing outside buf:
+ * nothing held beyond a partial sync without a candidate, and a held
+ * candidate's end agrees with its Size byte and lies ahead. */
+static bool rx_sane(const tase_rx_t *rx)
+{
+    uint16_t len = rx->len;
+    if (len < 4u) {
+        return rx->end == 0u;
+    }
+    return rx->buf[3] >= 2u && rx->end == (uint16_t)(rx->buf[3] + 5u) && len <= rx->end;
+}
+
+/* What every entry point checks: rx NULL, a call in progress, visibly
+ * corrupted. */
+static int rx_check(const tase_rx_t *rx)
+{
+    if (rx == NULL) {
+        return TASE_EARG;
+    }
+    if (rx->busy != 0u) {
+        /* 1 while a callback runs; anything else is a corrupted instance */
+        return rx->busy == 1u ? TASE_EBUSY : TASE_EARG;
+    }
+    return rx_sane(rx) ? TASE_OK : TASE_EARG;
+}
+
+/* tase_rx_push() for the last byte of a held candidate (and for a receiver
+ * that is busy or visibly corrupted). A valid frame is delivered from the
+ * window; a failed one leaves the byte in the window for the general path
+ * to scan on. */
+RX_NOINLINE static int push_event(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+{
+    uint16_t len = rx->len;
+    uint16_t want;
+    if (rx->busy != 0u) {
+        return rx->busy == 1u ? TASE_EBUSY : TASE_EARG;
+    }
+    /* tase_rx_push() took every other byte of a sane receiver: held
+     * candidate (len >= 4) and len == end is what is left */
+    if (len < 4u || !rx_sane(rx)) {
+        return TASE_EARG;
+    }
+    rx->stats.bytes_in++;
+    want = (uint16_t)(((uint16_t)rx->buf[len - 1u] << 8) | b);
+    if (tase_checksum(0u, rx->buf, (size_t)len - 1u) == want) {
+        rx->len = 0u;
+        rx->end = 0u;
+        rx->busy = 1u;
+        (void)deliver(rx, rx->buf, rx->stats.bytes_in - (uint32_t)len - 1u, on_frame, user);
+        rx->busy = 0u; /* also right when the callback re-initialised rx */
+        return 1;
+    }
+    rx->stats.checksum_errors++;
+    rx->buf[len] = b;
+    rx->len = (uint16_t)(len + 1u);
+    rx->buf[0] = TASE_SYNC2;                     /* judged: its first byte is noise to the scan */
+    return run(rx, rx->buf, 0u, on_frame, user); /* no new byte, not the end */
 }
 
 int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user)
 {
     uint16_t len;
+    uint16_t end;
     if (rx == NULL) {
         return TASE_EARG;
     }
     len = rx->len;
-    /* Most bytes of a frame only need storing: inside a tracked candidate,
-     * fully scanned, not a 5A that may end a sync, not an event, room. */
-    if (rx->ncand != 0u && rx->scan == len && byte != TASE_SYNC3 && len != rx->next &&
-        len < RX_CAP) {
+    end = rx->end;
+    /* Inside a held candidate, not its last byte: store it. (end < RX_CAP
+     * holds for any initialised receiver; testing it keeps a corrupted one
+     * inside buf.) */
+    if (len < end && end < RX_CAP) {
         rx->buf[len] = byte;
-        len++;
-        rx->len = len;
-        rx->scan = len;
+        rx->len = (uint16_t)(len + 1u);
         rx->stats.bytes_in++;
         return 0;
     }
-    if (!rx_sane(rx)) {
-        return TASE_EARG;
-    }
-    if (rx->ncand == 0u) {
-        hunt_byte(rx, byte);
+    /* Hunting a sync, or its Size byte (nothing or a partial sync held, so
+     * end is 0). */
+    if (len < 4u && end == 0u && rx->busy == 0u) {
+        rx->stats.bytes_in++;
+        if ((len < 3u) ? (byte == sync[len]) : (byte >= 2u)) {
+            rx->buf[len] = byte;
+            rx->len = (uint16_t)(len + 1u);
+            if (len == 3u) {
+                rx->end = (uint16_t)(byte + 5u);
+            }
+        } else {
+            /* Broken (a Size < 2 is a bad Size): the bytes held are noise;
+             * a 00 may begin a sync, keep it (buf[0] is 00 already). */
+            uint16_t keep = 0u;
+            if (byte == TASE_SYNC1) {
+                keep = 1u;
+            }
+            if (len == 3u) {
+                rx->stats.bad_size++;
+            }
+            rx->stats.bytes_discarded += (uint32_t)(len + 1u - keep);
+            rx->len = keep;
+        }
         return 0;
     }
-    return tase_rx_feed(rx, &byte, 1u, on_frame, user);
+    return push_event(rx, byte, on_frame, user);
+}
+
+int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
+                 void *user)
+{
+    int r = (data == NULL && n > 0u) ? TASE_EARG : rx_check(rx);
+    if (r != TASE_OK) {
+        return r;
+    }
+    return run(rx, (data != NULL) ? data : rx->buf, n, on_frame, user); /* NULL: flush */
 }
 
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
 {
-    uint32_t before;
-    tase_frame_t frame;
-    if (rx == NULL || !rx_sane(rx)) {
-        return TASE_EARG;
-    }
-    before = rx->stats.frames_ok;
-    /* Tracked candidates cannot complete any more; dropping them frees the
-     * slots so that syncs skipped while they were busy get examined. Each
-     * round either finishes the scan or fills the slots with candidates
-     * that began later, so this terminates within len rounds. */
-    for (;;) {
-        rx->ncand = 0u;
-        if (rx->scan >= rx->len) {
-            break;
-        }
-        for (;;) {
-            int k = rescan(rx);
-            if (k < 0) {
-                break;
-            }
-            if (settle(rx, (uint8_t)k, &frame) && on_frame != NULL) {
-                on_frame(user, &frame);
-            }
-        }
-    }
-    rx->floor = rx->len; /* nothing pending may start a frame */
-    go_idle(rx);
-    return (int)(rx->stats.frames_ok - before);
+    int r = rx_check(rx);
+    return (r != TASE_OK) ? r : run(rx, NULL, 0u, on_frame, user);
 }

@@ -7,6 +7,7 @@
 
 #include "tase/frame.h" /* tase_checksum(): the same 16-bit byte sum */
 
+#include <limits.h>
 #include <string.h>
 
 /* C99 has no _Static_assert: a negative array size fails the build. */
@@ -221,6 +222,8 @@ int tase_klv_rx_init(tase_klv_rx_t *rx)
     if (rx == NULL) {
         return TASE_EARG;
     }
+    /* Clears `busy` too: a call whose callback re-initialises the scanner
+     * sees that and returns without touching it again. */
     (void)memset(rx, 0, sizeof(*rx));
     return TASE_OK;
 }
@@ -255,12 +258,19 @@ static void rx_count(tase_klv_rx_stats_t *s, int err)
     }
 }
 
+/* What one call reports to, and how many packets it has delivered. */
+typedef struct {
+    tase_klv_handler_t on_packet;
+    tase_klv_error_handler_t on_error;
+    void *user;
+    int delivered;
+} klv_call_t;
+
 /* Settle the window as far as its bytes allow. With `final`, a candidate
- * still waiting for bytes fails as truncated instead. */
-static int rx_scan(tase_klv_rx_t *rx, int final, tase_klv_handler_t on_packet,
-                   tase_klv_error_handler_t on_error, void *user)
+ * still waiting for bytes fails as truncated instead. Returns false when a
+ * handler re-initialised the scanner (it must then be left alone). */
+static bool rx_scan(tase_klv_rx_t *rx, int final, klv_call_t *c)
 {
-    int delivered = 0;
     for (;;) {
         const uint8_t *p = memchr(rx->buf, (int)KEY_FIRST, rx->len);
         size_t m;
@@ -268,7 +278,7 @@ static int rx_scan(tase_klv_rx_t *rx, int final, tase_klv_handler_t on_packet,
         int r;
         rx_drop(rx, p == NULL ? rx->len : (size_t)(p - rx->buf), 0);
         if (rx->len == 0u) {
-            return delivered;
+            return true;
         }
         /* Noise that merely starts with 0x06 is not worth an error. */
         m = rx->len < TASE_KLV_KEY_LEN ? rx->len : TASE_KLV_KEY_LEN;
@@ -279,20 +289,28 @@ static int rx_scan(tase_klv_rx_t *rx, int final, tase_klv_handler_t on_packet,
         r = tase_klv_decode(rx->buf, rx->len, &k);
         if (r > 0) {
             rx->stats.packets_ok++;
-            delivered++;
-            if (on_packet != NULL) {
-                on_packet(user, rx->offset, &k);
+            if (c->delivered < INT_MAX) {
+                c->delivered++;
+            }
+            if (c->on_packet != NULL) {
+                c->on_packet(c->user, rx->offset, &k);
+                if (rx->busy == 0u) {
+                    return false;
+                }
             }
             rx_drop(rx, (size_t)r, 1);
             continue;
         }
         if (r == TASE_ETRUNC && !final) {
-            return delivered;
+            return true;
         }
         if (m == TASE_KLV_KEY_LEN) {
             rx_count(&rx->stats, r);
-            if (on_error != NULL) {
-                on_error(user, rx->offset, r);
+            if (c->on_error != NULL) {
+                c->on_error(c->user, rx->offset, r);
+                if (rx->busy == 0u) {
+                    return false;
+                }
             }
         }
         /* Re-scan from the byte after the failed candidate's first byte. */
@@ -300,17 +318,50 @@ static int rx_scan(tase_klv_rx_t *rx, int final, tase_klv_handler_t on_packet,
     }
 }
 
+/* What feed and flush check (rx NULL, a call in progress, a held length
+ * beyond the window: corrupted or never initialised, it would make the
+ * copy size wrap), then the call's context; the scanner is busy from here
+ * to rx_end(). */
+static int rx_begin(tase_klv_rx_t *rx, tase_klv_handler_t on_packet,
+                    tase_klv_error_handler_t on_error, void *user, klv_call_t *c)
+{
+    if (rx == NULL) {
+        return TASE_EARG;
+    }
+    if (rx->busy != 0u) {
+        return TASE_EBUSY;
+    }
+    if (rx->len > TASE_KLV_PACKET_MAX) {
+        return TASE_EARG;
+    }
+    c->on_packet = on_packet;
+    c->on_error = on_error;
+    c->user = user;
+    c->delivered = 0;
+    rx->busy = 1u;
+    return TASE_OK;
+}
+
+/* `live`: no handler re-initialised the scanner, so it is still ours. */
+static int rx_end(tase_klv_rx_t *rx, bool live, const klv_call_t *c)
+{
+    if (live) {
+        rx->busy = 0u;
+    }
+    return c->delivered;
+}
+
 int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n, tase_klv_handler_t on_packet,
                      tase_klv_error_handler_t on_error, void *user)
 {
-    int delivered = 0;
+    klv_call_t c;
     size_t done = 0;
-    /* A held length beyond the window (corrupted or never initialised)
-     * would make `take` wrap. */
-    if (rx == NULL || (data == NULL && n > 0u) || rx->len > TASE_KLV_PACKET_MAX) {
-        return TASE_EARG;
+    bool live = true;
+    int r = (data == NULL && n > 0u) ? TASE_EARG : rx_begin(rx, on_packet, on_error, user, &c);
+    if (r != TASE_OK) {
+        return r;
     }
-    while (done < n) {
+    while (live && done < n) {
         /* rx_scan leaves the window short of a full packet (a full window
          * always decides its candidate), so there is always room. */
         size_t take = TASE_KLV_PACKET_MAX - rx->len;
@@ -321,18 +372,17 @@ int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n, tase_klv_
         rx->len = (uint8_t)(rx->len + take);
         rx->stats.bytes_in += (uint32_t)take;
         done += take;
-        delivered += rx_scan(rx, 0, on_packet, on_error, user);
+        live = rx_scan(rx, 0, &c);
     }
-    return delivered;
+    return rx_end(rx, live, &c);
 }
 
 int tase_klv_rx_flush(tase_klv_rx_t *rx, tase_klv_handler_t on_packet,
                       tase_klv_error_handler_t on_error, void *user)
 {
-    if (rx == NULL || rx->len > TASE_KLV_PACKET_MAX) {
-        return TASE_EARG;
-    }
-    return rx_scan(rx, 1, on_packet, on_error, user);
+    klv_call_t c;
+    int r = rx_begin(rx, on_packet, on_error, user, &c);
+    return (r != TASE_OK) ? r : rx_end(rx, rx_scan(rx, 1, &c), &c);
 }
 
 /* ---- units ------------------------------------------------------------ */

@@ -48,12 +48,13 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n)
             waited = e > waited ? e : waited;
         }
         if (done < n && (waited >= TASE_PORT_WRITE_TIMEOUT_MS || idle >= TASE_PORT_WRITE_TRIES)) {
-            /* Nothing on the wire yet: the caller may simply retry. Once part
-             * of a frame went out, retrying would not repair it. */
+            /* The port kept refusing until the deadline: its queue is full.
+             * Nothing went out, or part of the frame did (the receiver drops
+             * a cut frame by its checksum and finds the next one). */
             if (done == 0) {
                 return r < 0 ? r : TASE_EAGAIN;
             }
-            return TASE_EIO;
+            return TASE_ENOBUFS;
         }
     }
     return (int)n;

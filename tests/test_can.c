@@ -252,6 +252,79 @@ static void other_ids_between_fragments_do_not_break_a_packet(void **state)
     assert_int_equal(tase_can_rx_init(&crx, (tase_can_role_t)9), TASE_EARG);
 }
 
+/* What a frame callback does to its own CAN receiver. */
+typedef struct {
+    tase_can_rx_t *crx;
+    int init; /* 0: feed frames into it; 1: re-initialise it */
+    int calls;
+    int refused;
+} can_reenter_t;
+
+static void can_reenter(void *user, const tase_frame_t *f)
+{
+    can_reenter_t *e = user;
+    tase_can_rx_t before;
+    tase_can_frame_t ours = ext_frame(TASE_CAN_ID_FROM_GIMBAL, angle_pkt, 8);
+    tase_can_frame_t theirs = ext_frame(0x12345678u, angle_pkt, 8);
+    (void)f;
+    e->calls++;
+    if (e->init) {
+        assert_int_equal(tase_can_rx_init(e->crx, TASE_CAN_ROLE_HOST), TASE_OK);
+        return;
+    }
+    memcpy(&before, e->crx, sizeof(before));
+    /* ours or not, nothing is counted or fed while its callback runs */
+    assert_int_equal(tase_can_rx_feed(e->crx, &ours, can_reenter, e), TASE_EBUSY);
+    assert_int_equal(tase_can_rx_feed(e->crx, &theirs, can_reenter, e), TASE_EBUSY);
+    assert_memory_equal(&before, e->crx, sizeof(before));
+    e->refused++;
+}
+
+/* Issue 12: tase_can_rx_feed() from inside its own frame callback is
+ * refused with TASE_EBUSY and counts nothing; tase_can_rx_init() there
+ * resets the instance and the feed that made the callback returns the one
+ * frame it delivered (before, the datalink receiver memcpy'd past its
+ * window, or returned a wrapped negative count). */
+static void can_receiver_calls_from_inside_its_callback(void **state)
+{
+    uint8_t two[28];
+    tase_can_frame_t f[4];
+    tase_can_rx_t crx, fresh;
+    can_reenter_t e;
+    int i, delivered = 0;
+    (void)state;
+    memcpy(two, angle_pkt, 14);
+    memcpy(two + 14, angle_pkt, 14);
+    assert_int_equal(tase_can_split(TASE_CAN_ROLE_GIMBAL, two, 28, f, 4), 4);
+    memset(&e, 0, sizeof(e));
+    e.crx = &crx;
+    assert_int_equal(tase_can_rx_init(&crx, TASE_CAN_ROLE_HOST), TASE_OK);
+    for (i = 0; i < 4; i++) {
+        int r = tase_can_rx_feed(&crx, &f[i], can_reenter, &e);
+        assert_true(r >= 0);
+        delivered += r;
+    }
+    assert_int_equal(delivered, 2);
+    assert_int_equal(e.refused, 2);
+    assert_int_equal(crx.stats.frames_in, 4);
+    assert_int_equal(crx.stats.frames_accepted, 4);
+    assert_int_equal(crx.stats.frames_ignored, 0);
+    assert_int_equal(crx.rx.stats.bytes_in, 28);
+    assert_int_equal(crx.rx.stats.frames_ok, 2);
+
+    /* Re-initialised from the callback: the second CAN frame completes the
+     * first packet (and starts the second, whose bytes are not consumed). */
+    memset(&e, 0, sizeof(e));
+    e.crx = &crx;
+    e.init = 1;
+    assert_int_equal(tase_can_rx_init(&crx, TASE_CAN_ROLE_HOST), TASE_OK);
+    assert_int_equal(tase_can_rx_init(&fresh, TASE_CAN_ROLE_HOST), TASE_OK);
+    assert_int_equal(tase_can_rx_feed(&crx, &f[0], can_reenter, &e), 0);
+    assert_int_equal(tase_can_rx_feed(&crx, &f[1], can_reenter, &e), 1);
+    assert_int_equal(e.calls, 1);
+    assert_memory_equal(&crx, &fresh, sizeof(crx));
+}
+
 static void move_command_encodes_deploy_as_zero_and_retract_as_nonzero(void **state)
 {
     tase_can_3ax_move_t m;
@@ -545,6 +618,7 @@ int main(void)
         cmocka_unit_test(max_frame_survives_gimbal_to_host),
         cmocka_unit_test(receiver_takes_only_its_direction),
         cmocka_unit_test(other_ids_between_fragments_do_not_break_a_packet),
+        cmocka_unit_test(can_receiver_calls_from_inside_its_callback),
         cmocka_unit_test(move_command_encodes_deploy_as_zero_and_retract_as_nonzero),
         cmocka_unit_test(move_command_values_mean_what_retract_deploy_cmd_means),
         cmocka_unit_test(move_command_rejects_bad_input),

@@ -1,6 +1,9 @@
-/* Tests of the datalink layer: frame encoder and receive state machine. */
+/* Tests of the datalink layer: frame encoder and receiver. Built once per
+ * TASE_RX_CANDIDATES value in tests/CMakeLists.txt (the default build and
+ * frame_candidates_<N>), so the contract is checked at every setting. */
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -8,6 +11,7 @@
 
 #include <cmocka.h>
 
+#include "rx_reference.h"
 #include "tase/frame.h"
 
 /* ---- helpers ---------------------------------------------------------- */
@@ -94,6 +98,84 @@ static void assert_frame_is(const seen_t *s, const uint8_t *frame)
     assert_int_equal(s->type, frame[5]);
     assert_int_equal(s->len, frame[3] - 2);
     assert_memory_equal(s->data, frame + 6, s->len);
+}
+
+/* ---- the reference greedy scan (tests/rx_reference.h) --------------- */
+
+static void ref_record(void *user, const uint8_t *frame, size_t offset, size_t flen, size_t seen_at)
+{
+    recorder_t *out = user;
+    seen_t *f;
+    assert_true(out->n < MAX_SEEN);
+    f = &out->f[out->n++];
+    f->offset = (uint32_t)offset;
+    f->group = frame[4];
+    f->type = frame[5];
+    f->len = (uint8_t)(flen - 8);
+    memcpy(f->data, frame + 6, f->len);
+    f->seen_at = (uint32_t)seen_at;
+}
+
+static void assert_same_frames(const recorder_t *got, const recorder_t *want)
+{
+    size_t k;
+    assert_int_equal(got->n, want->n);
+    for (k = 0; k < want->n; k++) {
+        assert_int_equal(got->f[k].offset, want->f[k].offset);
+        assert_int_equal(got->f[k].group, want->f[k].group);
+        assert_int_equal(got->f[k].type, want->f[k].type);
+        assert_int_equal(got->f[k].len, want->f[k].len);
+        assert_memory_equal(got->f[k].data, want->f[k].data, want->f[k].len);
+        assert_int_equal(got->f[k].seen_at, want->f[k].seen_at);
+    }
+}
+
+enum { FEED_BYTES, FEED_CHUNKS, FEED_WHOLE };
+
+/* Feed s[0..n) to `rx` (fresh) in the given way and to the reference: after
+ * every call the counters and the frames delivered so far agree, each
+ * call returns the frames it delivered, and after tase_rx_flush() the
+ * frames (offset, header, data, seen_at) are the same and every byte fed
+ * is either in a delivered frame or discarded. */
+static void differential(tase_rx_t *rx, recorder_t *got, recorder_t *want, const uint8_t *s,
+                         size_t n, int mode)
+{
+    ref_t ref;
+    size_t pos = 0, k, before;
+    uint32_t framed = 0;
+    int r;
+    assert_int_equal(tase_rx_init(rx), TASE_OK);
+    got->rx = rx;
+    got->n = 0;
+    want->n = 0;
+    ref_init(&ref, s, ref_record, want);
+    while (pos < n) {
+        size_t chunk = (mode == FEED_BYTES) ? 1u : (mode == FEED_WHOLE) ? n : 1u + rnd() % 600u;
+        if (chunk > n - pos) {
+            chunk = n - pos;
+        }
+        before = got->n;
+        if (chunk == 1u && (pos / 7u) % 2u == 0u) {
+            r = tase_rx_push(rx, s[pos], record, got);
+        } else {
+            r = tase_rx_feed(rx, s + pos, chunk, record, got);
+        }
+        assert_int_equal(r, (int)(got->n - before));
+        pos += chunk;
+        ref_feed_to(&ref, pos);
+        assert_memory_equal(&rx->stats, &ref.st, sizeof(ref.st));
+        assert_int_equal(got->n, want->n);
+    }
+    before = got->n;
+    r = tase_rx_flush(rx, record, got);
+    assert_int_equal(r, (int)(got->n - before));
+    ref_advance(&ref, true);
+    assert_memory_equal(&rx->stats, &ref.st, sizeof(ref.st));
+    assert_same_frames(got, want);
+    for (k = 0; k < got->n; k++) {
+        framed += got->f[k].len + 8u;
+    }
+    assert_int_equal(rx->stats.bytes_in, rx->stats.bytes_discarded + framed);
 }
 
 /* ---- encoder ---------------------------------------------------------- */
@@ -383,10 +465,11 @@ static void corrupted_size_does_not_swallow_following_packets(void **state)
     tase_rx_t rx;
     recorder_t *r = new_recorder(&rx);
     uint8_t buf[1024];
-    size_t starts[8], ends[8], n = 0, k;
+    size_t starts[10], ends[10], n = 0, k;
     (void)state;
     rng_state = 31337;
-    /* First frame's Size corrupted to 255: it claims the next 255 bytes. */
+    /* First frame's Size corrupted to 255: it claims 261 bytes, index 0..260,
+     * which covers the next eight frames. */
     n += make_frame(buf, 0x08, 0x10, 6);
     buf[3] = 0xFF;
     for (k = 0; k < 8; k++) {
@@ -394,16 +477,30 @@ static void corrupted_size_does_not_swallow_following_packets(void **state)
         n += make_frame(buf + n, 0x08, (uint8_t)k, 10 + k);
         ends[k] = n;
     }
+    assert_true(n < 261);
     feed_bytes_one_by_one(&rx, buf, n, r);
-    assert_int_equal(r->n, 8);
-    for (k = 0; k < 8; k++) {
+    /* held: they lie inside a pending candidate that may still be valid */
+    assert_int_equal(r->n, 0);
+    memset(buf + n, 0x11, 261 - n); /* up to the corrupted candidate's end */
+    n = 261;
+    for (k = 8; k < 10; k++) { /* and two frames after it */
+        starts[k] = n;
+        n += make_frame(buf + n, 0x08, (uint8_t)k, 4);
+        ends[k] = n;
+    }
+    feed_bytes_one_by_one(&rx, buf + ends[7], n - ends[7], r);
+    assert_int_equal(r->n, 10);
+    for (k = 0; k < 10; k++) {
         assert_int_equal(r->f[k].offset, starts[k]);
         assert_int_equal(r->f[k].type, k);
-        /* zero added latency: delivered when its own last byte arrived,
-         * while the corrupted candidate was still undecided */
-        assert_int_equal(r->f[k].seen_at, ends[k]);
+        /* the first eight: released by the call that fed the corrupted
+         * candidate's last byte, late by at most 253 bytes; the others:
+         * zero added latency */
+        assert_int_equal(r->f[k].seen_at, k < 8 ? 261 : ends[k]);
+        assert_true(r->f[k].seen_at - ends[k] <= TASE_FRAME_MAX - 8);
     }
-    assert_int_equal(rx.stats.frames_ok, 8);
+    assert_int_equal(rx.stats.frames_ok, 10);
+    assert_int_equal(rx.stats.checksum_errors, 1);
     free(r);
 }
 
@@ -432,8 +529,11 @@ static void checksum_error_then_clean_packet_inside_claimed_length(void **state)
     assert_int_equal(rx.stats.checksum_errors, 1);
     assert_int_equal(r->n, 2);
     assert_int_equal(r->f[0].offset, 6);
-    assert_int_equal(r->f[0].seen_at, 6 + a);
+    /* held until A's last byte (index 45) proved A wrong */
+    assert_int_equal(r->f[0].seen_at, 46);
+    assert_true(6 + a < 46);
     assert_int_equal(r->f[1].offset, b);
+    assert_int_equal(r->f[1].seen_at, n); /* outside A: zero latency */
     /* only A's first six bytes were noise */
     assert_int_equal(rx.stats.bytes_discarded, 6);
     free(r);
@@ -491,13 +591,74 @@ static size_t build_noisy_stream(uint8_t *buf, size_t cap, size_t frames, size_t
     return n;
 }
 
+/* Is delivered frame f one of the clean frames starts/ends[0..count)? */
+static bool is_clean_frame(const seen_t *f, const size_t *starts, const size_t *ends, size_t count)
+{
+    size_t lo = 0, hi = count;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (starts[mid] < f->offset) {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo < count && starts[lo] == f->offset && ends[lo] - starts[lo] == f->len + 8u;
+}
+
+/* Every clean frame starts[k]..ends[k] is delivered once, in order, within
+ * the latency bound, unless a delivered frame that is not one of them (a
+ * false frame whose checksum holds by chance) covers some of its bytes:
+ * a valid frame's bytes are data. Returns how many were excused so. Also
+ * checks the noise accounting. */
+static size_t assert_clean_frames_delivered(const recorder_t *r, const tase_rx_t *rx,
+                                            const uint8_t *buf, size_t n, const size_t *starts,
+                                            const size_t *ends, size_t count,
+                                            const uint8_t *touched)
+{
+    size_t k, j, g = 0, excused = 0;
+    uint32_t framed = 0;
+    for (k = 0; k < count; k++) {
+        if (touched != NULL && touched[k]) {
+            continue;
+        }
+        while (g < r->n && r->f[g].offset < starts[k]) {
+            g++;
+        }
+        if (g < r->n && r->f[g].offset == starts[k]) {
+            assert_frame_is(&r->f[g], buf + starts[k]);
+            assert_true(r->f[g].seen_at >= ends[k]);
+            assert_true(r->f[g].seen_at - ends[k] <= TASE_FRAME_MAX - 8);
+            continue;
+        }
+        for (j = 0; j < r->n; j++) {
+            const seen_t *f = &r->f[j];
+            if (!is_clean_frame(f, starts, ends, count) && f->offset < ends[k] &&
+                starts[k] < f->offset + f->len + 8u) {
+                break;
+            }
+        }
+        assert_true(j < r->n); /* lost with no excuse */
+        excused++;
+    }
+    for (j = 0; j < r->n; j++) {
+        framed += r->f[j].len + 8u;
+        if (j > 0) { /* stream order, never overlapping */
+            assert_true(r->f[j].offset >= r->f[j - 1].offset + r->f[j - 1].len + 8u);
+        }
+    }
+    assert_int_equal(rx->stats.bytes_in, n);
+    assert_int_equal(rx->stats.bytes_discarded + framed, n);
+    return excused;
+}
+
 static void noisy_stream_delivers_every_clean_packet_once_in_order(void **state)
 {
     tase_rx_t rx;
     recorder_t *r = new_recorder(&rx);
     static uint8_t buf[1 << 20];
     static size_t starts[2000], ends[2000];
-    size_t n, k, late = 0, seed;
+    size_t n, seed, excused = 0;
     (void)state;
     for (seed = 1; seed <= 5; seed++) {
         rng_state = (uint32_t)(seed * 2654435761u);
@@ -506,42 +667,23 @@ static void noisy_stream_delivers_every_clean_packet_once_in_order(void **state)
         r->n = 0;
         feed_bytes_one_by_one(&rx, buf, n, r);
         assert_true(tase_rx_flush(&rx, record, r) >= 0);
-        assert_int_equal(r->n, 2000);
-        for (k = 0; k < 2000; k++) {
-            assert_int_equal(r->f[k].offset, starts[k]);
-            assert_frame_is(&r->f[k], buf + starts[k]);
-            /* zero added latency, or the documented bound when more
-             * false candidates overlap than there are slots */
-            assert_true(r->f[k].seen_at - ends[k] <= TASE_FRAME_MAX - 8);
-            if (r->f[k].seen_at != ends[k]) {
-                late++;
-            }
-        }
-        assert_int_equal(rx.stats.frames_ok, 2000);
-        /* noise accounting: every byte is either in a frame or discarded */
-        {
-            uint32_t framed = 0;
-            for (k = 0; k < 2000; k++) {
-                framed += (uint32_t)(ends[k] - starts[k]);
-            }
-            assert_int_equal(rx.stats.bytes_in, n);
-            assert_int_equal(rx.stats.bytes_discarded + framed, n);
-        }
+        excused += assert_clean_frames_delivered(r, &rx, buf, n, starts, ends, 2000, NULL);
     }
-    /* this noise is dense (a false sync before a quarter of the frames),
-     * so a few frames take the re-scan path; most must not */
-    assert_true(late < 10000 / 100);
+    /* A false frame passes the checksum about once per 65536 candidates;
+     * these streams judge some 5,000 false candidates. */
+    assert_true(excused <= 2);
     free(r);
 }
 
-static void bit_errors_cost_untouched_frames_no_latency(void **state)
+static void bit_errors_cost_untouched_frames_nothing(void **state)
 {
     tase_rx_t rx;
     recorder_t *r = new_recorder(&rx);
+    recorder_t *want = new_recorder(&rx);
     static uint8_t buf[1 << 19];
     static size_t starts[6000], ends[6000];
     static uint8_t touched[6000];
-    size_t n = 0, k, i, got = 0, hit = 0;
+    size_t n = 0, k, i, hit = 0, late = 0;
     (void)state;
     rng_state = 99991;
     for (k = 0; k < 6000; k++) {
@@ -559,22 +701,20 @@ static void bit_errors_cost_untouched_frames_no_latency(void **state)
             }
         }
     }
-    feed_bytes_one_by_one(&rx, buf, n, r);
-    assert_true(tase_rx_flush(&rx, record, r) >= 0);
     for (k = 0; k < 6000; k++) {
-        if (touched[k]) {
-            hit++;
-            continue;
-        }
-        while (got < r->n && r->f[got].offset < starts[k]) {
-            got++;
-        }
-        assert_true(got < r->n);
-        assert_int_equal(r->f[got].offset, starts[k]);
-        assert_int_equal(r->f[got].seen_at, ends[k]);
+        hit += touched[k];
     }
     assert_true(hit > 500); /* the channel really did corrupt frames */
+    differential(&rx, r, want, buf, n, FEED_BYTES);
+    assert_int_equal(assert_clean_frames_delivered(r, &rx, buf, n, starts, ends, 6000, touched), 0);
+    /* Zero added latency except behind a Size byte flipped upwards (a
+     * pending candidate over the next frames): a small share. */
+    for (k = 0; k < r->n; k++) {
+        late += r->f[k].seen_at != r->f[k].offset + r->f[k].len + 8u;
+    }
+    assert_true(late > 0 && late < r->n / 20);
     free(r);
+    free(want);
 }
 
 static void any_split_gives_identical_frames_and_counters(void **state)
@@ -705,26 +845,174 @@ static void flush_of_clean_stream_changes_nothing(void **state)
     free(r);
 }
 
-static void frame_embedded_in_a_valid_frame_yields_both_inner_first(void **state)
+/* Issue 12's repro: a 28-byte CAMERA_PASS whose camera bytes are a whole
+ * GIMBAL_CMD frame (pan 90.00, tilt -10.00). The GIMBAL_CMD is camera data:
+ * only the CAMERA_PASS is delivered, however the bytes arrive. */
+static void camera_pass_carrying_a_frame_gives_only_the_camera_pass(void **state)
+{
+    static const uint8_t pass[28] = {0x00, 0xFF, 0x5A, 0x16, 0x00, 0x42, 0x01, 0x08, 0x00, 0x00,
+                                     0x00, 0xFF, 0x5A, 0x0A, 0x00, 0x80, 0x23, 0x28, 0xFC, 0x18,
+                                     0x00, 0x00, 0x00, 0x00, 0x03, 0x42, 0x05, 0x41};
+    tase_rx_t rx;
+    recorder_t *r = new_recorder(&rx);
+    size_t cut;
+    (void)state;
+    /* the inner bytes really are a valid frame */
+    assert_int_equal(tase_checksum(0, pass + 10, 14), 0x0342);
+    for (cut = 0; cut <= sizeof(pass); cut++) {
+        assert_int_equal(tase_rx_init(&rx), TASE_OK);
+        r->n = 0;
+        if (cut == sizeof(pass)) {
+            feed_bytes_one_by_one(&rx, pass, sizeof(pass), r);
+        } else {
+            assert_true(tase_rx_feed(&rx, pass, cut, record, r) >= 0);
+            assert_true(tase_rx_feed(&rx, pass + cut, sizeof(pass) - cut, record, r) >= 0);
+        }
+        assert_int_equal(tase_rx_flush(&rx, record, r), 0);
+        assert_int_equal(r->n, 1);
+        assert_int_equal(r->f[0].offset, 0);
+        assert_int_equal(r->f[0].group, 0x00);
+        assert_int_equal(r->f[0].type, 0x42);
+        assert_int_equal(r->f[0].len, 20);
+        assert_memory_equal(r->f[0].data, pass + 6, 20);
+        assert_int_equal(r->f[0].seen_at, sizeof(pass));
+        assert_int_equal(rx.stats.frames_ok, 1);
+        assert_int_equal(rx.stats.checksum_errors, 0);
+        assert_int_equal(rx.stats.bytes_discarded, 0);
+    }
+    free(r);
+}
+
+/* A CAMERA_PASS carrying two whole frames, one of them behind a false sync
+ * inside the camera bytes, then the same frames on their own: the first
+ * time they are data, the second time they are frames. */
+static void frames_inside_a_valid_frame_are_data_and_outside_it_are_frames(void **state)
 {
     tase_rx_t rx;
     recorder_t *r = new_recorder(&rx);
-    uint8_t inner[32], outer[64];
-    size_t ni, no;
+    uint8_t a[32], b[32], data[96], buf[256];
+    size_t na, nb, nd = 0, n;
+    int w;
     (void)state;
     rng_state = 6;
-    ni = make_frame(inner, 0x08, 0x10, 6);
-    /* CAMERA_PASS carrying a whole TASE frame as camera bytes */
-    memcpy(outer + 6 + 4, inner, ni);
-    memset(outer + 6, 0, 4);
-    no = (size_t)tase_frame_encode(outer, sizeof(outer), 0x00, 0x42, outer + 6, 4 + ni);
-    assert_int_equal(tase_rx_feed(&rx, outer, no, record, r), 2);
-    assert_int_equal(r->f[0].type, 0x10);
-    assert_int_equal(r->f[0].offset, 10);
-    assert_int_equal(r->f[1].type, 0x42);
-    assert_int_equal(r->f[1].offset, 0);
+    na = make_frame(a, 0x00, 0x80, 8);
+    nb = make_frame(b, 0x08, 0x10, 6);
+    data[nd++] = 1; /* camera, baud, reserved */
+    data[nd++] = 8;
+    data[nd++] = 0;
+    data[nd++] = 0;
+    memcpy(data + nd, a, na);
+    nd += na;
+    data[nd++] = 0x00; /* a false sync claiming 40 bytes */
+    data[nd++] = 0xFF;
+    data[nd++] = 0x5A;
+    data[nd++] = 40;
+    memcpy(data + nd, b, nb);
+    nd += nb;
+    w = tase_frame_encode(buf, sizeof(buf), 0x00, 0x42, data, nd);
+    assert_true(w > 0);
+    n = (size_t)w;
+    memcpy(buf + n, a, na);
+    memcpy(buf + n + na, b, nb);
+    feed_bytes_one_by_one(&rx, buf, n + na + nb, r);
+    assert_int_equal(r->n, 3);
+    assert_int_equal(r->f[0].offset, 0);
+    assert_int_equal(r->f[0].type, 0x42);
+    assert_int_equal(r->f[0].seen_at, n);
+    assert_int_equal(r->f[1].offset, n);
+    assert_frame_is(&r->f[1], a);
+    assert_int_equal(r->f[2].offset, n + na);
+    assert_frame_is(&r->f[2], b);
+    assert_int_equal(rx.stats.checksum_errors, 0);
     assert_int_equal(rx.stats.bytes_discarded, 0);
     free(r);
+}
+
+/* A stream of the troubles the receiver must sort out: valid frames,
+ * CAMERA_PASS frames carrying one or two whole frames (and sometimes a
+ * false sync among them), frames whose Size byte was corrupted upwards,
+ * false syncs with random sizes, noise (some of it sync-rich) and frames
+ * with a bit flipped. */
+static size_t build_mixed_stream(uint8_t *buf, size_t cap)
+{
+    size_t n = 0, m, j;
+    uint8_t data[TASE_DATA_MAX];
+    while (n + 2 * TASE_FRAME_MAX < cap) {
+        uint32_t kind = rnd() % 12;
+        size_t start = n;
+        if (kind == 0) { /* noise, sometimes made of sync bytes */
+            static const uint8_t rich[4] = {0x00, 0xFF, 0x5A, 0x00};
+            bool sync_rich = rnd() % 2 == 0;
+            m = rnd() % 48;
+            for (j = 0; j < m; j++) {
+                buf[n++] = sync_rich ? rich[rnd() % 4] : (uint8_t)rnd();
+            }
+        } else if (kind == 1) { /* false sync, random Size */
+            buf[n++] = 0x00;
+            buf[n++] = 0xFF;
+            buf[n++] = 0x5A;
+            buf[n++] = (uint8_t)rnd();
+        } else if (kind == 2) { /* CAMERA_PASS carrying one or two frames */
+            size_t d = 4, frames = 1 + rnd() % 2;
+            data[0] = 1;
+            data[1] = 8;
+            data[2] = 0;
+            data[3] = 0;
+            for (j = 0; j < frames; j++) {
+                if (rnd() % 3 == 0) {
+                    data[d++] = 0x00;
+                    data[d++] = 0xFF;
+                    data[d++] = 0x5A;
+                    data[d++] = (uint8_t)(2 + rnd() % 120);
+                }
+                d += make_frame(data + d, (uint8_t)(rnd() % 4 * 8), (uint8_t)rnd(), rnd() % 40);
+            }
+            m = (size_t)tase_frame_encode(buf + n, TASE_FRAME_MAX, 0x00, 0x42, data, d);
+            n += m;
+        } else if (kind == 3) { /* Size corrupted upwards */
+            m = make_frame(buf + n, 0x08, 0x41, rnd() % 64);
+            buf[n + 3] = (uint8_t)(buf[n + 3] + 1u + rnd() % (255u - buf[n + 3]));
+            n += m;
+        } else if (kind == 4) { /* one bit flipped anywhere */
+            m = make_frame(buf + n, 0x08, 0x41, rnd() % 64);
+            buf[n + rnd() % m] ^= (uint8_t)(1u << (rnd() % 8));
+            n += m;
+        } else { /* valid, now and then long */
+            n += make_frame(buf + n, (uint8_t)(rnd() % 4 * 8), (uint8_t)rnd(),
+                            rnd() % 8 == 0 ? rnd() % (TASE_DATA_MAX + 1) : rnd() % 64);
+        }
+        assert_true(n >= start);
+    }
+    return n;
+}
+
+/* The receiver against the reference greedy scan, byte at a time (push and
+ * one-byte feeds), in random chunks and in one call. */
+static void receiver_matches_the_reference_greedy_scan(void **state)
+{
+    static uint8_t buf[1 << 17];
+    tase_rx_t rx;
+    recorder_t *got = new_recorder(&rx);
+    recorder_t *want = new_recorder(&rx);
+    size_t n, seed, total = 0, late = 0, k;
+    int mode;
+    (void)state;
+    for (seed = 1; seed <= 6; seed++) {
+        rng_state = (uint32_t)(seed * 0x9E3779B9u);
+        n = build_mixed_stream(buf, sizeof(buf));
+        for (mode = FEED_BYTES; mode <= FEED_WHOLE; mode++) {
+            differential(&rx, got, want, buf, n, mode);
+        }
+        total += got->n;
+        for (k = 0; k < got->n; k++) {
+            late += got->f[k].seen_at != got->f[k].offset + got->f[k].len + 8u;
+        }
+    }
+    /* the streams exercise what they are meant to */
+    assert_true(total > 2000);
+    assert_true(late > 50);
+    free(got);
+    free(want);
 }
 
 static void sync_inside_a_delivered_frame_starts_nothing(void **state)
@@ -809,9 +1097,192 @@ static void push_one_byte_at_a_time_equals_feeding_one_buffer(void **state)
     free(rb);
 }
 
+/* ---- re-entrancy ------------------------------------------------------ */
+
+enum { RE_NONE, RE_FEED, RE_PUSH, RE_FLUSH, RE_RESET, RE_INIT };
+enum { OP_FEED, OP_PUSH_EACH, OP_FLUSH, OP_END };
+
+typedef struct {
+    int op;
+    size_t len;
+} plan_step_t;
+
+typedef struct {
+    tase_rx_t *rx;
+    int action;
+    size_t calls;       /* callbacks so far */
+    size_t refused;     /* nested calls that returned TASE_EBUSY, rx unchanged */
+    size_t allowed;     /* nested reset/init that returned TASE_OK */
+    uint32_t last_seen; /* bytes_in in the last callback, before acting */
+} reenter_t;
+
+/* The frame callback: calls `action` on its own receiver. */
+static void reenter(void *user, const tase_frame_t *fr)
+{
+    static const uint8_t frame[8] = {0x00, 0xFF, 0x5A, 0x02, 0x00, 0x40, 0x01, 0x9B};
+    reenter_t *e = user;
+    tase_rx_t before;
+    uint8_t view[TASE_DATA_MAX];
+    int r = TASE_OK;
+    memcpy(&before, e->rx, sizeof(before));
+    memcpy(view, fr->data, fr->len);
+    e->calls++;
+    e->last_seen = e->rx->stats.bytes_in;
+    switch (e->action) {
+    case RE_FEED: r = tase_rx_feed(e->rx, frame, sizeof(frame), reenter, e); break;
+    case RE_PUSH: r = tase_rx_push(e->rx, 0x00, reenter, e); break;
+    case RE_FLUSH: r = tase_rx_flush(e->rx, reenter, e); break;
+    case RE_RESET: r = tase_rx_stats_reset(e->rx); break;
+    case RE_INIT: r = (e->calls == 1u) ? tase_rx_init(e->rx) : TASE_OK; break;
+    default: break;
+    }
+    if (e->action == RE_FEED || e->action == RE_PUSH || e->action == RE_FLUSH) {
+        assert_int_equal(r, TASE_EBUSY);
+        assert_memory_equal(&before, e->rx, sizeof(before));
+        assert_memory_equal(view, fr->data, fr->len);
+        e->refused++;
+    } else if (e->action != RE_NONE) {
+        assert_int_equal(r, TASE_OK);
+        e->allowed++;
+    }
+}
+
+/* Run `plan` over s with `action` in every callback. Returns the calls'
+ * results in ret[] (one per call) and how many calls were made; stops
+ * after the call whose callback re-initialised the receiver. */
+static size_t run_plan(tase_rx_t *rx, reenter_t *e, const uint8_t *s, const plan_step_t *plan,
+                       int *ret, size_t *cbs)
+{
+    size_t pos = 0, calls = 0, k;
+    assert_int_equal(tase_rx_init(rx), TASE_OK);
+    for (; plan->op != OP_END; plan++) {
+        size_t len = plan->len, each = (plan->op == OP_PUSH_EACH) ? len : 1u;
+        for (k = 0; k < each; k++) {
+            size_t cb = e->calls;
+            if (plan->op == OP_FEED) {
+                ret[calls] = tase_rx_feed(rx, s + pos, len, reenter, e);
+                pos += len;
+            } else if (plan->op == OP_PUSH_EACH) {
+                ret[calls] = tase_rx_push(rx, s[pos++], reenter, e);
+            } else {
+                ret[calls] = tase_rx_flush(rx, reenter, e);
+            }
+            assert_true(ret[calls] >= 0);
+            assert_int_equal(ret[calls], (int)(e->calls - cb));
+            cbs[calls] = e->calls - cb;
+            calls++;
+            if (e->action == RE_INIT && e->calls > 0u) {
+                return calls;
+            }
+        }
+    }
+    return calls;
+}
+
+/* Issue 12: every API call on the same receiver from inside its callback,
+ * on every path that makes a callback (a frame checked in the caller's
+ * buffer, in the window, at tase_rx_push()'s last byte, released by a
+ * failed candidate in tase_rx_push() and in tase_rx_feed(), released by
+ * tase_rx_flush()). feed/push/flush are refused with TASE_EBUSY and change
+ * nothing; stats_reset and init are allowed; every call returns the frames
+ * it delivered, never a negative count. Run under ASan/UBSan by
+ * scripts/check-sanitize.sh. */
+static void every_call_from_inside_the_callback_is_refused_or_safe(void **state)
+{
+    static uint8_t s[1024];
+    uint8_t f1[32], f2[32];
+    size_t n1, n2, n = 0, total, p, calls, plain_calls, k;
+    uint32_t plain_last;
+    int ret[1024], plain_ret[1024], action;
+    size_t cbs[1024], plain_cbs[1024];
+    tase_rx_t rx, plain, fresh;
+    reenter_t e;
+    (void)state;
+    rng_state = 4321;
+    n1 = make_frame(f1, 0x00, 0x80, 8);
+    n2 = make_frame(f2, 0x08, 0x10, 6);
+    /* [f1 f2] [00 FF 5A FF f1 f2 filler up to 261] [00 FF 5A F0 f1 f2] */
+    memcpy(s, f1, n1);
+    memcpy(s + n1, f2, n2);
+    n = n1 + n2;
+    {
+        size_t c = n;
+        s[n++] = 0x00;
+        s[n++] = 0xFF;
+        s[n++] = 0x5A;
+        s[n++] = 0xFF;
+        memcpy(s + n, f1, n1);
+        memcpy(s + n + n1, f2, n2);
+        n += n1 + n2;
+        memset(s + n, 0x11, c + 261 - n);
+        n = c + 261;
+    }
+    total = n;
+    s[n++] = 0x00;
+    s[n++] = 0xFF;
+    s[n++] = 0x5A;
+    s[n++] = 0xF0;
+    memcpy(s + n, f1, n1);
+    memcpy(s + n + n1, f2, n2);
+    n += n1 + n2;
+    {
+        const plan_step_t plans[6][4] = {
+            {{OP_FEED, n1 + n2}, {OP_FLUSH, 0}, {OP_END, 0}},                     /* in place */
+            {{OP_FEED, 5}, {OP_FEED, n1 + n2 - 5}, {OP_FLUSH, 0}, {OP_END, 0}},   /* window */
+            {{OP_PUSH_EACH, n1 + n2}, {OP_FLUSH, 0}, {OP_END, 0}},                /* last byte */
+            {{OP_PUSH_EACH, total}, {OP_FLUSH, 0}, {OP_END, 0}},                  /* push fails */
+            {{OP_FEED, total}, {OP_FLUSH, 0}, {OP_END, 0}},                       /* feed fails */
+            {{OP_FEED, total}, {OP_FEED, n - total}, {OP_FLUSH, 0}, {OP_END, 0}}, /* flush */
+        };
+        assert_int_equal(tase_rx_init(&fresh), TASE_OK);
+        for (p = 0; p < 6; p++) {
+            memset(&e, 0, sizeof(e));
+            e.rx = &plain;
+            e.action = RE_NONE;
+            plain_calls = run_plan(&plain, &e, s, plans[p], plain_ret, plain_cbs);
+            assert_true(e.calls >= 2u); /* the path delivers at least two frames */
+            plain_last = e.last_seen;
+            for (action = RE_FEED; action <= RE_INIT; action++) {
+                memset(&e, 0, sizeof(e));
+                e.rx = &rx;
+                e.action = action;
+                calls = run_plan(&rx, &e, s, plans[p], ret, cbs);
+                if (action == RE_INIT) {
+                    /* the call returns as soon as the callback does, with
+                     * the one frame it delivered; rx is as initialised */
+                    assert_int_equal(ret[calls - 1], 1);
+                    assert_memory_equal(&rx, &fresh, sizeof(rx));
+                    e.action = RE_NONE;
+                    assert_int_equal(tase_rx_feed(&rx, f1, n1, reenter, &e), 1);
+                    assert_int_equal(rx.stats.bytes_in, n1);
+                    continue;
+                }
+                assert_int_equal(calls, plain_calls);
+                for (k = 0; k < calls; k++) {
+                    assert_int_equal(ret[k], plain_ret[k]);
+                    assert_int_equal(cbs[k], plain_cbs[k]);
+                }
+                if (action == RE_RESET) {
+                    /* each callback cleared the counters after its frame was
+                     * counted; only what came after the last one is left */
+                    assert_int_equal(e.allowed, e.calls);
+                    assert_int_equal(rx.stats.frames_ok, 0);
+                    assert_int_equal(rx.stats.bytes_in, plain.stats.bytes_in - plain_last);
+                } else {
+                    assert_int_equal(e.refused, e.calls);
+                    assert_memory_equal(&rx.stats, &plain.stats, sizeof(rx.stats));
+                }
+            }
+        }
+    }
+}
+
 /* Every bad argument of frame.h gives its documented code, and a receiver
  * that is visibly corrupted (indices out of range) is refused by every
- * entry point without being changed or read outside its window. */
+ * entry point without being changed or read outside its window. (The
+ * one-test fast path of tase_rx_push() stores a byte whenever len < end <
+ * TASE_FRAME_MAX, always inside buf; the next byte that is not simply
+ * stored meets the full check.) */
 static void frame_api_rejects_bad_arguments(void **state)
 {
     static const uint8_t bytes[4] = {0x00, 0xFF, 0x5A, 0x04};
@@ -843,14 +1314,27 @@ static void frame_api_rejects_bad_arguments(void **state)
     assert_int_equal(tase_rx_feed(&rx, NULL, 0, NULL, NULL), 0);
     assert_memory_equal(&rx, &copy, sizeof rx);
 
-    for (k = 0; k < 5; k++) {
+    for (k = 0; k < 6; k++) {
         memcpy(&bad, &rx, sizeof rx);
         switch (k) {
         case 0: bad.len = (uint16_t)(TASE_FRAME_MAX + 1u); break;
         case 1: bad.len = 0xFFFFu; break;
-        case 2: bad.scan = (uint16_t)(bad.len + 1u); break;
-        case 3: bad.ncand = (uint8_t)(TASE_RX_CANDIDATES + 1); break;
-        default: bad.ncand = 0; break; /* 3 sync bytes held, no candidate */
+        case 2: /* an end (beyond the window) but only a partial sync held */ bad.end = 300u; break;
+        case 3: /* a held candidate whose end disagrees with its Size */
+            bad.len = 4u;
+            bad.buf[3] = 4u;
+            bad.end = 300u;
+            break;
+        case 4: /* a held candidate with Size < 2, at its last byte */
+            bad.len = 6u;
+            bad.buf[3] = 1u;
+            bad.end = 6u;
+            break;
+        default: /* more held than the candidate's end */
+            bad.len = 12u;
+            bad.buf[3] = 2u;
+            bad.end = 7u;
+            break;
         }
         memcpy(&copy, &bad, sizeof bad);
         assert_int_equal(tase_rx_feed(&bad, bytes, sizeof bytes, NULL, NULL), TASE_EARG);
@@ -882,15 +1366,18 @@ int main(void)
         cmocka_unit_test(checksum_error_then_clean_packet_inside_claimed_length),
         cmocka_unit_test(failed_frame_is_rescanned_from_the_byte_after_its_first_sync),
         cmocka_unit_test(noisy_stream_delivers_every_clean_packet_once_in_order),
-        cmocka_unit_test(bit_errors_cost_untouched_frames_no_latency),
+        cmocka_unit_test(bit_errors_cost_untouched_frames_nothing),
         cmocka_unit_test(any_split_gives_identical_frames_and_counters),
         cmocka_unit_test(push_one_byte_at_a_time_equals_feeding_one_buffer),
         cmocka_unit_test(more_overlapping_candidates_than_slots_still_loses_nothing),
         cmocka_unit_test(flush_finds_clean_packets_held_at_end_of_input),
         cmocka_unit_test(flush_of_clean_stream_changes_nothing),
-        cmocka_unit_test(frame_embedded_in_a_valid_frame_yields_both_inner_first),
+        cmocka_unit_test(camera_pass_carrying_a_frame_gives_only_the_camera_pass),
+        cmocka_unit_test(frames_inside_a_valid_frame_are_data_and_outside_it_are_frames),
+        cmocka_unit_test(receiver_matches_the_reference_greedy_scan),
         cmocka_unit_test(sync_inside_a_delivered_frame_starts_nothing),
         cmocka_unit_test(counters_only_reset_on_request),
+        cmocka_unit_test(every_call_from_inside_the_callback_is_refused_or_safe),
         cmocka_unit_test(strerror_names_every_code),
     };
     return cmocka_run_group_tests_name("frame", tests, NULL, NULL);

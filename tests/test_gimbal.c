@@ -992,6 +992,7 @@ static void typed_telemetry_is_encoded_from_the_filled_structs(void **state)
     assert_memory_equal(x->fp.out + x->fp.nout - (size_t)n, want, (size_t)n);
     assert_int_equal(fake_frames_out(&x->fp), 3);
     assert_int_equal(x->g.stats.telemetry_tx, 5);
+    free(x);
 }
 
 static void a_typed_setting_is_decoded_applied_stored_and_echoed(void **state)

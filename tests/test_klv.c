@@ -1,6 +1,7 @@
 /* Tests of the KLV metadata packet: codec, stream scanner, units. */
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -651,6 +652,156 @@ static void scanner_rejects_bad_arguments_and_resets_counters(void **state)
     assert_int_equal(rx.stats.bytes_in, 0);
 }
 
+/* ---- scanner re-entrancy (issue 12) ----------------------------------- */
+
+enum { KRE_NONE, KRE_FEED, KRE_FLUSH, KRE_RESET, KRE_INIT };
+
+typedef struct {
+    tase_klv_rx_t *rx;
+    int action;
+    bool init_from_error; /* KRE_INIT: in the first error handler call, not the first call */
+    bool inited;
+    size_t calls;   /* handler calls so far */
+    size_t refused; /* nested feed/flush refused with TASE_EBUSY, rx unchanged */
+} klv_reenter_t;
+
+static void klv_reenter_packet(void *user, uint32_t offset, const tase_klv_t *klv);
+static void klv_reenter_error(void *user, uint32_t offset, int err);
+
+static void klv_reenter_act(klv_reenter_t *e, bool from_error)
+{
+    tase_klv_rx_t before;
+    int r = TASE_OK;
+    memcpy(&before, e->rx, sizeof(before));
+    e->calls++;
+    switch (e->action) {
+    case KRE_FEED:
+        r = tase_klv_rx_feed(e->rx, hand_packet, sizeof(hand_packet), klv_reenter_packet,
+                             klv_reenter_error, e);
+        break;
+    case KRE_FLUSH: r = tase_klv_rx_flush(e->rx, klv_reenter_packet, klv_reenter_error, e); break;
+    case KRE_RESET: r = tase_klv_rx_stats_reset(e->rx); break;
+    case KRE_INIT:
+        if (!e->inited && from_error == e->init_from_error) {
+            e->inited = true;
+            r = tase_klv_rx_init(e->rx);
+        }
+        break;
+    default: break;
+    }
+    if (e->action == KRE_FEED || e->action == KRE_FLUSH) {
+        assert_int_equal(r, TASE_EBUSY);
+        assert_memory_equal(&before, e->rx, sizeof(before));
+        e->refused++;
+    } else {
+        assert_int_equal(r, TASE_OK);
+    }
+}
+
+static void klv_reenter_packet(void *user, uint32_t offset, const tase_klv_t *klv)
+{
+    (void)offset;
+    (void)klv;
+    klv_reenter_act(user, false);
+}
+
+static void klv_reenter_error(void *user, uint32_t offset, int err)
+{
+    (void)offset;
+    (void)err;
+    klv_reenter_act(user, true);
+}
+
+/* Feed s[0..n) (in one call or byte by byte) and flush; rets[] gets each
+ * call's result. Stops after the call whose handler re-initialised rx. */
+static size_t klv_reenter_run(klv_reenter_t *e, const uint8_t *s, size_t n, bool bytewise,
+                              int *rets)
+{
+    size_t pos = 0, calls = 0;
+    assert_int_equal(tase_klv_rx_init(e->rx), TASE_OK);
+    while (pos < n) {
+        size_t k = bytewise ? 1u : n;
+        rets[calls] = tase_klv_rx_feed(e->rx, s + pos, k, klv_reenter_packet, klv_reenter_error, e);
+        assert_true(rets[calls] >= 0);
+        pos += k;
+        calls++;
+        if (e->inited) {
+            return calls;
+        }
+    }
+    rets[calls] = tase_klv_rx_flush(e->rx, klv_reenter_packet, klv_reenter_error, e);
+    assert_true(rets[calls] >= 0);
+    return calls + 1u;
+}
+
+/* Every scanner call from inside both handlers: feed/flush refused with
+ * TASE_EBUSY, nothing changed; stats_reset and init allowed, and a call
+ * whose handler re-initialised the scanner returns at once with the
+ * packets it delivered (before issue 12, init from a handler made the next
+ * drop a negative-size memmove). */
+static void scanner_calls_from_inside_a_handler_are_refused_or_safe(void **state)
+{
+    static uint8_t s[4 * 87];
+    static int rets[4 * 87 + 1], plain_rets[4 * 87 + 1];
+    tase_klv_rx_t rx, fresh;
+    tase_klv_rx_stats_t plain_stats;
+    klv_reenter_t e;
+    size_t calls, plain_calls, k, n = 0;
+    int action, bytewise;
+    (void)state;
+    /* packet, key-matched packet with a wrong checksum, packet, cut packet */
+    memcpy(s + n, hand_packet, 87);
+    n += 87;
+    memcpy(s + n, hand_packet, 87);
+    s[n + 86] ^= 1u;
+    n += 87;
+    memcpy(s + n, hand_packet, 87);
+    n += 87;
+    memcpy(s + n, hand_packet, 40);
+    n += 40;
+    assert_int_equal(tase_klv_rx_init(&fresh), TASE_OK);
+    for (bytewise = 0; bytewise <= 1; bytewise++) {
+        memset(&e, 0, sizeof(e));
+        e.rx = &rx;
+        plain_calls = klv_reenter_run(&e, s, n, bytewise != 0, plain_rets);
+        assert_int_equal(e.calls, 4); /* 2 packets, a checksum error, a cut */
+        plain_stats = rx.stats;
+        for (action = KRE_FEED; action <= KRE_INIT + 1; action++) {
+            memset(&e, 0, sizeof(e));
+            e.rx = &rx;
+            e.action = action > KRE_INIT ? KRE_INIT : action;
+            e.init_from_error = action > KRE_INIT;
+            calls = klv_reenter_run(&e, s, n, bytewise != 0, rets);
+            if (e.action == KRE_INIT) {
+                /* from the packet handler (the first packet) or the error
+                 * handler (after the first packet): the call returns the
+                 * packets it delivered, the first one unless the stream
+                 * comes byte by byte and the error came in a later call */
+                assert_true(e.inited);
+                assert_int_equal(rets[calls - 1u], (bytewise && e.init_from_error) ? 0 : 1);
+                assert_memory_equal(&rx, &fresh, sizeof(rx));
+                e.action = KRE_NONE;
+                assert_int_equal(tase_klv_rx_feed(&rx, hand_packet, 87, klv_reenter_packet,
+                                                  klv_reenter_error, &e),
+                                 1);
+                assert_int_equal(rx.stats.bytes_in, 87);
+                continue;
+            }
+            assert_int_equal(calls, plain_calls);
+            for (k = 0; k < calls; k++) {
+                assert_int_equal(rets[k], plain_rets[k]);
+            }
+            if (action == KRE_RESET) {
+                assert_int_equal(rx.stats.packets_ok, 0);
+                assert_int_equal(rx.stats.truncated, 0); /* reset by that very handler */
+            } else {
+                assert_int_equal(e.refused, 4);
+                assert_memory_equal(&rx.stats, &plain_stats, sizeof(plain_stats));
+            }
+        }
+    }
+}
+
 /* ---- units ------------------------------------------------------------ */
 
 #define EPS 1e-9
@@ -867,6 +1018,7 @@ int main(void)
         cmocka_unit_test(packet_is_delivered_by_the_call_that_feeds_its_last_byte),
         cmocka_unit_test(packet_behind_a_cut_packet_comes_out_with_its_last_byte),
         cmocka_unit_test(scanner_rejects_bad_arguments_and_resets_counters),
+        cmocka_unit_test(scanner_calls_from_inside_a_handler_are_refused_or_safe),
         cmocka_unit_test(raw_to_units_match_hand_computed_values),
         cmocka_unit_test(units_to_raw_round_to_nearest),
         cmocka_unit_test(units_to_raw_saturate_where_the_range_ends),

@@ -478,6 +478,14 @@ static void the_kernel_refuses_other_opens_while_the_port_is_open(void **state)
     pty_open(&p);
     assert_int_equal(fchmod(p.slave, 0666), 0);
     assert_int_equal(tase_posix_uart_open(&a, p.name, 9600), TASE_OK);
+    if (ioctl(p.slave, TIOCGEXCL, &excl) != 0 && getenv("TASE_TEST_EMULATOR") != NULL) {
+        /* qemu-user (the s390x check) does not translate TIOCGEXCL */
+        print_message("SKIPPED: %s cannot read the exclusive-mode flag\n",
+                      getenv("TASE_TEST_EMULATOR"));
+        assert_int_equal(tase_posix_uart_close(&a), TASE_OK);
+        pty_close(&p);
+        skip();
+    }
     assert_int_equal(ioctl(p.slave, TIOCGEXCL, &excl), 0);
     assert_int_equal(excl, 1);
     r = in_child(child_plain_open_is_ebusy, p.name);

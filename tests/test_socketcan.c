@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -627,6 +628,13 @@ static void receive_timestamps_are_the_kernels_not_the_read_time(void **state)
     usleep(60000); /* read late */
     assert_int_equal(tase_socketcan_read(&p.s, buf, sizeof buf, 100), 2);
     ts = tase_socketcan_rx_time_ns(&p.s);
+    if (ts == 0u && getenv("TASE_TEST_EMULATOR") != NULL) {
+        /* qemu-user (the s390x check) does not pass SO_TIMESTAMPNS on */
+        print_message("SKIPPED: %s gives no kernel receive timestamps\n",
+                      getenv("TASE_TEST_EMULATOR"));
+        close_pair(&p);
+        skip();
+    }
     assert_true(ts >= before);
     assert_true(ts <= after); /* stamped on arrival, 60 ms before the read */
     /* a side frame (3AX status) keeps its own stamp through the queue */

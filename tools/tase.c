@@ -11,6 +11,7 @@
 #include "tase/host.h"
 #include "tase/klv.h"
 #include "tase/units.h"
+#include "tk_capture.h"
 #include "toolkit.h"
 
 #define DEFAULT_BAUD 57600L
@@ -29,7 +30,10 @@ static const char usage_link[] =
     "link options:\n"
     "  --serial DEV   serial device or pty (e.g. /dev/ttyUSB0, the path tase-sim prints)\n"
     "  --baud N       serial rate, default 57600\n"
-    "  --can IFACE    CAN interface instead of a serial device (e.g. can0)\n";
+    "  --can IFACE    CAN interface instead of a serial device (e.g. can0)\n"
+    "  --record FILE  also record the session's bytes, both directions, to the pcap\n"
+    "                 capture FILE (appended to; serial links only: on CAN run\n"
+    "                 'tase record --can IFACE' beside it)\n";
 
 static const char usage_req[] =
     "request options (when an answer is awaited):\n"
@@ -117,7 +121,9 @@ static const char usage_query[] =
 
 static const char usage_decode[] =
     "usage: tase decode [FILE|-] [--candump] [--stats]\n"
-    "Decodes a raw serial byte capture (default: standard input; a live pty or\n"
+    "Decodes a capture of 'tase record' (pcap or pcapng; each object carries\n"
+    "\"time\" and \"dir\"; a bad record is reported with its number, exit 4) or a\n"
+    "raw serial byte capture (default: standard input; a live pty or\n"
     "pipe is read as bytes arrive) to one JSON object per valid packet, in stream\n"
     "order (contract: docs/TOOLS.md). With --candump the input is a candump log\n"
     "(candump -l or -L): frames of ID 10000000 (from the gimbal, \"dir\":\"out\") and\n"
@@ -134,6 +140,31 @@ static const char usage_klv[] =
     "pty is read as bytes arrive) to one JSON object per valid packet:\n"
     "{\"offset\":N,\"fields\":{raw values in tag order},\"units\":{engineering values}}.\n"
     "Noise and damaged packets are skipped.\n";
+
+static const char usage_record[] =
+    "usage: tase record (--serial DEV [--tap-in DEV2] [--baud N] | --can IFACE) -o FILE\n"
+    "                   [--seconds S]\n"
+    "Records what arrives to the pcap capture FILE (replaced), with a timestamp per\n"
+    "received chunk, until interrupted (Ctrl-C, SIGTERM, SIGHUP: exit 0) or S seconds\n"
+    "have passed.\n"
+    "  --serial DEV   one record per read, byte-exact, as sent by the gimbal\n"
+    "                 (link type USER0 with a direction byte; docs/TOOLS.md)\n"
+    "  --tap-in DEV2  a second device on the other line of a tap: its bytes are\n"
+    "                 recorded as sent to the gimbal\n"
+    "  --can IFACE    every frame on the bus, as SocketCAN records\n"
+    "'tase decode FILE' decodes it; Wireshark reads it (tools/wireshark/tase.lua).\n";
+
+static const char usage_replay[] =
+    "usage: tase replay FILE (--serial DEV [--baud N] | --can IFACE) [--speed X]\n"
+    "                   [--dir out|in|all]\n"
+    "Sends the records of the pcap capture FILE with their recorded timing (divided\n"
+    "by X, default 1; 0 sends without waiting).\n"
+    "  --dir out   what the gimbal sent (the default: plays the gimbal's side)\n"
+    "  --dir in    what was sent to the gimbal (commands: moves a real gimbal)\n"
+    "  --dir all   both; on CAN every recorded frame, whatever its ID\n"
+    "Serial bytes go to a CAN interface as frames of their direction's ID, and the\n"
+    "datalink bytes of CAN frames to a serial device; CAN FD, remote and error\n"
+    "frames are not sent. A bad record is reported and skipped (exit 4).\n";
 
 static const char usage_list[] = "usage: tase list\nLists every packet: group, type, "
                                  "direction, data length and field names.\n";
@@ -156,6 +187,7 @@ typedef struct {
     const char *serial;
     const char *can;
     long baud;
+    const char *record; /* --record FILE, or NULL */
 } link_opts_t;
 
 static void print_usage(const args_t *a)
@@ -232,7 +264,8 @@ static bool link_opt(args_t *a, link_opts_t *l)
 {
     const char *v;
     long long n;
-    if (opt(a, "--serial", true, &l->serial) || opt(a, "--can", true, &l->can)) {
+    if (opt(a, "--serial", true, &l->serial) || opt(a, "--can", true, &l->can) ||
+        opt(a, "--record", true, &l->record)) {
         return true;
     }
     if (opt(a, "--baud", true, &v)) {
@@ -271,6 +304,11 @@ static void check_link_opts(const link_opts_t *lo)
     if (lo->serial == NULL && lo->can == NULL) {
         tk_usage_error("no link given: use --serial DEV or --can IFACE");
     }
+    if (lo->record != NULL && lo->can != NULL) {
+        tk_usage_error("--record records serial links; on CAN run 'tase record --can %s -o FILE' "
+                       "beside this command",
+                       lo->can);
+    }
 }
 
 static void open_link(const link_opts_t *lo, tk_link_t *l, tase_port_t *port)
@@ -282,6 +320,9 @@ static void open_link(const link_opts_t *lo, tk_link_t *l, tase_port_t *port)
         tk_link_can(l, lo->can, false);
     }
     *port = tk_link_port(l);
+    if (lo->record != NULL) {
+        *port = tk_cap_record_session(lo->record, *port);
+    }
 }
 
 /* ---- requests ---- */
@@ -678,7 +719,7 @@ static void send_fields(session_t *s, const fields_t *fs, size_t len, const send
 
 static int cmd_send(args_t *a)
 {
-    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD};
+    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
     send_opts_t o = {false, false, -1, {DEFAULT_TIMEOUT_MS, DEFAULT_RETRIES, false}};
     const char *name = NULL, *v;
     const char *assign[64];
@@ -774,7 +815,7 @@ static int cmd_send(args_t *a)
 
 static int cmd_query(args_t *a)
 {
-    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD};
+    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
     req_opts_t r = {DEFAULT_TIMEOUT_MS, DEFAULT_RETRIES, false};
     const char *name = NULL;
     const tase_packet_desc_t *p;
@@ -1139,7 +1180,7 @@ static int cmd_spoi(args_t *a)
 
 static int cmd_monitor(args_t *a)
 {
-    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD};
+    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
     tk_fmt_t fmt = {false, false, false};
     double seconds = 0.0, t_end;
     long long limit = 0;
@@ -1307,15 +1348,57 @@ static const char *input_guess(const input_t *in, bool candump)
     return " (not a capture of a TASE serial line?)";
 }
 
-static void decode_raw(input_t *in, tk_dec_t *d)
+/* Read the first bytes of an input (at least 4 unless it ends) into buf;
+ * returns how many. */
+static size_t input_head(input_t *in, uint8_t *buf, size_t cap)
 {
-    static uint8_t buf[READ_CHUNK];
+    size_t n = 0, k;
+    while (n < 4 && (k = input_read(in, buf + n, cap - n)) > 0) {
+        n += k;
+    }
+    return n;
+}
+
+/* Raw bytes; buf[0..n) holds the first ones, read already. */
+static void decode_raw(input_t *in, tk_dec_t *d, uint8_t *buf, size_t cap, size_t n)
+{
     tk_stream_t *s = tk_dec_stream(d, "", NULL);
-    size_t n;
-    while ((n = input_read(in, buf, sizeof(buf))) > 0) {
+    while (n > 0) {
         tk_dec_bytes(d, s, buf, n, NULL);
         tk_stdout_flush(); /* a live input's frames go out as they come */
+        n = input_read(in, buf, cap);
     }
+}
+
+/* A pcap/pcapng capture of 'tase record' (tk_capture.h), whose first bytes
+ * are head[0..n): serial records go to the stream of their direction, CAN
+ * frames as in a candump log. Returns the number of bad records. */
+static unsigned long decode_capture(input_t *in, tk_dec_t *d, const uint8_t *head, size_t n)
+{
+    tk_cap_reader_t r;
+    tk_cap_rec_t rec;
+    unsigned long bad = 0;
+    char why[160];
+    int rc;
+    tk_cap_reader_open(&r, in->fd, head, n, in->name);
+    while ((rc = tk_cap_next(&r, &rec, why, sizeof(why))) != TK_CAP_END) {
+        if (rc == TK_CAP_BAD) {
+            if (++bad <= BAD_LINES_SHOWN) {
+                tk_warn("%s: record %lu skipped: %s", in->name, rec.index, why);
+            }
+        } else if (r.linktype == TK_CAP_LINKTYPE_SERIAL) {
+            tk_stream_t *s = tk_dec_stream(d, "", rec.dir == TK_CAP_FROM_GIMBAL ? "out" : "in");
+            tk_dec_bytes(d, s, rec.data, rec.len, &rec.t);
+        } else if (rec.can_data) {
+            (void)tk_dec_can(d, "", &rec.frame, &rec.t); /* one interface: no name */
+        }
+        tk_exit_if_signalled();
+    }
+    tk_cap_reader_close(&r);
+    if (bad > BAD_LINES_SHOWN) {
+        tk_warn("%s: %lu more bad records not shown", in->name, bad - BAD_LINES_SHOWN);
+    }
+    return bad;
 }
 
 typedef struct {
@@ -1408,7 +1491,7 @@ static unsigned long decode_candump(input_t *in, tk_dec_t *d)
 static int cmd_decode(args_t *a)
 {
     const char *path = NULL, *v;
-    bool candump = false, stats = false;
+    bool candump = false, stats = false, capture = false;
     unsigned long bad = 0;
     input_t in;
     static tk_dec_t d;
@@ -1433,7 +1516,14 @@ static int cmd_decode(args_t *a)
     if (candump) {
         bad = decode_candump(&in, &d);
     } else {
-        decode_raw(&in, &d);
+        static uint8_t buf[READ_CHUNK];
+        size_t n = input_head(&in, buf, sizeof(buf));
+        if (tk_cap_is_capture(buf, n)) {
+            capture = true;
+            bad = decode_capture(&in, &d, buf, n);
+        } else {
+            decode_raw(&in, &d, buf, sizeof(buf), n);
+        }
     }
     tk_dec_finish(&d);
     input_close(&in);
@@ -1442,8 +1532,8 @@ static int cmd_decode(args_t *a)
         tk_dec_summary(&d, stderr, "");
     }
     if (bad > 0) {
-        tk_exit(TK_EXIT_INPUT, "%s: %lu bad line%s (the rest was decoded)", in.name, bad,
-                bad == 1 ? "" : "s");
+        tk_exit(TK_EXIT_INPUT, "%s: %lu bad %s%s (the rest was decoded)", in.name, bad,
+                capture ? "record" : "line", bad == 1 ? "" : "s");
     }
     if (d.n.frames == 0 && in.nhead > 0) {
         tk_exit(TK_EXIT_INPUT, "no TASE packet found in %s%s", in.name, input_guess(&in, candump));
@@ -1515,6 +1605,124 @@ static int cmd_klv(args_t *a)
     return TK_EXIT_OK;
 }
 
+/* ---- record / replay (tk_capture.c) ---- */
+
+static int cmd_record(args_t *a)
+{
+    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
+    const char *out = NULL, *tap_in = NULL, *v;
+    double seconds = 0.0;
+    tk_cap_writer_t w;
+    while (a->i < a->argc) {
+        if (common_opt(a) || link_opt(a, &lo)) {
+            continue;
+        }
+        if (opt(a, "-o", true, &out) || opt(a, "--output", true, &out) ||
+            opt(a, "--tap-in", true, &tap_in)) {
+            continue;
+        }
+        if (opt(a, "--seconds", true, &v)) {
+            if (tk_parse_seconds(v, &seconds) != 0 || seconds <= 0.0) {
+                tk_usage_error("bad --seconds value '%s'", v);
+            }
+        } else {
+            bad_arg(a);
+        }
+    }
+    if (lo.record != NULL) {
+        tk_usage_error("record writes its capture with -o FILE (--record is for the other "
+                       "commands)");
+    }
+    if (out == NULL) {
+        tk_usage_error("record needs an output file: -o FILE");
+    }
+    if ((lo.serial != NULL) == (lo.can != NULL)) {
+        tk_usage_error("give either --serial DEV or --can IFACE");
+    }
+    if (tap_in != NULL && lo.serial == NULL) {
+        tk_usage_error("--tap-in is the second line of a serial tap: it needs --serial");
+    }
+    /* a signal is the normal end of a recording: the loops stop on it and
+     * close the capture, and the command succeeds */
+    if (lo.serial != NULL) {
+        tk_cap_create(&w, out, TK_CAP_LINKTYPE_SERIAL, false);
+        tk_cap_record_serial(&w, lo.serial, tap_in, lo.baud, seconds);
+    } else {
+        tk_cap_create(&w, out, TK_CAP_LINKTYPE_CAN, false);
+        tk_cap_record_can(&w, lo.can, seconds);
+    }
+    return TK_EXIT_OK;
+}
+
+static int cmd_replay(args_t *a)
+{
+    link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
+    tk_replay_opts_t ro;
+    const char *path = NULL, *v;
+    static uint8_t head[READ_CHUNK];
+    unsigned long bad;
+    tk_cap_reader_t r;
+    input_t in;
+    size_t n;
+    memset(&ro, 0, sizeof(ro));
+    ro.speed = 1.0;
+    ro.dirs = TK_CAP_DIR_OUT;
+    while (a->i < a->argc) {
+        if (common_opt(a) || link_opt(a, &lo)) {
+            continue;
+        }
+        if (opt(a, "--speed", true, &v)) {
+            if (tk_parse_seconds(v, &ro.speed) != 0) {
+                tk_usage_error("bad --speed value '%s' (a factor: 1 recorded timing, 2 twice as "
+                               "fast, 0 no waiting)",
+                               v);
+            }
+        } else if (opt(a, "--dir", true, &v)) {
+            if (strcmp(v, "out") == 0) {
+                ro.dirs = TK_CAP_DIR_OUT;
+            } else if (strcmp(v, "in") == 0) {
+                ro.dirs = TK_CAP_DIR_IN;
+            } else if (strcmp(v, "all") == 0) {
+                ro.dirs = TK_CAP_DIR_ALL;
+            } else {
+                tk_usage_error("bad --dir value '%s' (out, in or all)", v);
+            }
+        } else if (path == NULL && is_arg(a, false)) {
+            path = a->argv[a->i++];
+        } else {
+            bad_arg(a);
+        }
+    }
+    if (path == NULL) {
+        tk_usage_error("replay needs a capture file (written by 'tase record')");
+    }
+    if (lo.record != NULL) {
+        tk_usage_error("--record is not available with replay");
+    }
+    if ((lo.serial != NULL) == (lo.can != NULL)) {
+        tk_usage_error("give either --serial DEV or --can IFACE");
+    }
+    input_open(&in, path);
+    n = input_head(&in, head, sizeof(head));
+    if (!tk_cap_is_capture(head, n)) {
+        tk_die("%s is not a pcap or pcapng capture (candump logs: can-utils' canplayer "
+               "replays them)",
+               in.name);
+    }
+    tk_cap_reader_open(&r, in.fd, head, n, in.name);
+    ro.serial = lo.serial;
+    ro.baud = lo.baud;
+    ro.can = lo.can;
+    bad = tk_cap_replay(&r, &ro);
+    tk_cap_reader_close(&r);
+    input_close(&in);
+    tk_exit_if_signalled();
+    if (bad > 0) {
+        tk_exit(TK_EXIT_INPUT, "%s: %lu bad record%s skipped", in.name, bad, bad == 1 ? "" : "s");
+    }
+    return TK_EXIT_OK;
+}
+
 /* ---- list ---- */
 
 static int cmd_list(args_t *a)
@@ -1570,8 +1778,11 @@ static const command_t commands[] = {
     {"query", cmd_query, usage_query, USAGE_LINK | USAGE_REQ,
      "ask for a setup packet, SPOI_CMD or SYSTEM_VERSION"},
     {"monitor", cmd_monitor, usage_monitor, USAGE_LINK, "print the packets a live link receives"},
-    {"decode", cmd_decode, usage_decode, 0, "decode a capture (raw bytes, candump log) to JSON"},
+    {"decode", cmd_decode, usage_decode, 0,
+     "decode a capture (pcap, raw bytes, candump log) to JSON"},
     {"klv", cmd_klv, usage_klv, 0, "decode a KLV metadata byte stream to JSON"},
+    {"record", cmd_record, usage_record, 0, "record a serial line or CAN bus to a pcap capture"},
+    {"replay", cmd_replay, usage_replay, 0, "send a capture back with its recorded timing"},
     {"list", cmd_list, usage_list, 0, "list the packets and their field names"},
 };
 

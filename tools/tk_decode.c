@@ -48,6 +48,23 @@ static void flush_out(tk_dec_t *d)
     }
 }
 
+/* The time of the chunk that brought the byte before stream offset `end`
+ * (a frame's last byte), or `fallback` when it is no longer (or never
+ * was) in the history. */
+static const tk_time_t *frame_time(const tk_stream_t *s, uint64_t end, const tk_time_t *fallback)
+{
+    const tk_time_t *t = fallback;
+    size_t i;
+    for (i = 0; i < s->hcount; i++) { /* newest first */
+        size_t k = (s->hnext + TK_HIST - 1u - i) % TK_HIST;
+        if (s->hist[k].end < end) {
+            break;
+        }
+        t = &s->hist[k].time;
+    }
+    return t;
+}
+
 static void on_frame(void *user, const tase_frame_t *f)
 {
     tk_dec_t *d = user;
@@ -64,7 +81,7 @@ static void on_frame(void *user, const tase_frame_t *f)
         d->n.bad_length++;
     }
     m.offset = tk_offset64(d->base64, d->base32, f->offset);
-    m.time = d->time;
+    m.time = frame_time(s, m.offset + f->len + TASE_FRAME_OVERHEAD, d->time);
     m.dir = s->dir;
     m.iface = s->iface[0] != '\0' ? s->iface : NULL;
     if (sizeof(d->obuf) - d->olen < TK_LINE_MAX) {
@@ -101,6 +118,12 @@ void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n, co
         /* chunks well below 2^31 keep tk_offset64()'s reference valid */
         size_t k = n > (1u << 30) ? (size_t)1u << 30 : n;
         begin(d, s, time);
+        if (time != NULL) {
+            s->hist[s->hnext].end = s->bytes + k;
+            s->hist[s->hnext].time = *time;
+            s->hnext = (s->hnext + 1u) % TK_HIST;
+            s->hcount += s->hcount < TK_HIST ? 1u : 0u;
+        }
         (void)tase_rx_feed(&s->rx, data, k, on_frame, d);
         s->bytes += k;
         d->n.bytes += k;

@@ -227,6 +227,7 @@ size_t tk_format_time(char *buf, const tk_time_t *t);
  * captures) only call tk_dec_bytes() / tk_dec_can(). */
 
 #define TK_STREAMS_MAX 32u
+#define TK_HIST 264u /* > TASE_FRAME_MAX chunks */
 
 typedef struct {
     char iface[TASE_CANDUMP_IFNAME_MAX]; /* "" for a serial stream */
@@ -235,6 +236,16 @@ typedef struct {
     tase_rx_stats_t seen;                /* rx.stats already added up */
     tk_time_t last;                      /* time of the last chunk */
     bool timed;                          /* last is known */
+    /* When the recent chunks ended (stream offset after each, and its
+     * time): the receiver may decide a frame up to 253 bytes after its last
+     * byte (a frame inside a longer candidate waits for that one to fail),
+     * and a frame's time is when its last byte arrived, not when it was
+     * decided. TK_HIST chunks cover a whole frame even at one byte each. */
+    struct {
+        uint64_t end;
+        tk_time_t time;
+    } hist[TK_HIST];
+    size_t hnext, hcount;
     tase_rx_t rx;
 } tk_stream_t;
 

@@ -22,6 +22,18 @@
  * 0x12020000). Acceptance is by role, so frames of every other node on
  * the multidrop bus are counted and ignored.
  *
+ * ONE SENDER PER ID. Every node sending in one direction uses the same ID
+ * and the frames carry no source or sequence, so the receiver cannot tell
+ * two senders' bytes apart: if an autopilot and a bench tool both send on
+ * 0x11000000 at the same time, the CAN frames of their datalink frames
+ * (any longer than 8 bytes spans several) interleave on the bus and both
+ * datalink frames fail their checksums (0 of 2 delivered, 2 checksum
+ * errors); two gimbals on 0x10000000 the same. This is a limit
+ * of the protocol, not of this library: give each ID exactly one sender
+ * at a time (disconnect or silence the autopilot before a bench tool
+ * commands the gimbal, or put the tool on its own bus). Listening is
+ * always safe: any number of nodes may receive either ID.
+ *
  * 3AX. Two fixed 2-byte frames outside the datalink: the move command
  * (gimbal -> 3AX) and the position/speed status (3AX -> gimbal). The move
  * frame's byte has the opposite polarity of the datalink's
@@ -144,7 +156,8 @@ typedef struct {
 
 /* Initialise for `role` (the role of the node that receives): empty
  * datalink receiver, all counters zero. Returns TASE_OK or TASE_EARG
- * (crx NULL or unknown role; crx untouched). O(1). */
+ * (crx NULL or unknown role; crx untouched). O(1). Allowed from inside
+ * the instance's own frame callback (see tase_can_rx_feed()). */
 int tase_can_rx_init(tase_can_rx_t *crx, tase_can_role_t role);
 
 /* Feed one received CAN frame. If tase_can_accept() takes it, its payload
@@ -154,8 +167,13 @@ int tase_can_rx_init(tase_can_rx_t *crx, tase_can_role_t role);
  * ours: normal on a shared bus) or TASE_ELENGTH (our ID, bad dlc). These
  * two are the only "errors" that still change the instance (a counter).
  * TASE_EARG: crx or f NULL, or crx->role not a role (corrupted instance;
- * nothing counted). Not reentrant per instance;
- * O(dlc) plus the datalink receiver's cost. */
+ * nothing counted). TASE_EBUSY: called from inside on_frame of this
+ * instance (nothing counted, nothing changed). From inside on_frame,
+ * tase_can_rx_init() is allowed: it resets the instance and the call that
+ * made the callback returns as soon as it does (see frame.h, RE-ENTRANCY);
+ * reading or clearing the counters is allowed too. The returned count is
+ * never negative except for these codes. O(dlc) plus the datalink
+ * receiver's cost. */
 int tase_can_rx_feed(tase_can_rx_t *crx, const tase_can_frame_t *f, tase_rx_handler_t on_frame,
                      void *user);
 

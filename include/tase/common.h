@@ -54,8 +54,8 @@ extern "C" {
 #define TASE_ENODEV (-12)       /* device or interface does not exist */
 #define TASE_EDOWN (-13)        /* interface exists but is down */
 #define TASE_EACCES (-14)       /* permission denied */
-#define TASE_EBUSY (-15)        /* a request is already in progress */
-#define TASE_ENOBUFS (-16)      /* transmit queue full; nothing was sent */
+#define TASE_EBUSY (-15)        /* busy: call or request in progress, device held */
+#define TASE_ENOBUFS (-16)      /* transmit queue full (see the call for what was sent) */
 #define TASE_ETRUNC (-17)       /* input ends before the item is complete */
 #define TASE_EUNSUPPORTED (-18) /* valid request this build/port cannot do */
 #define TASE_ESTATE (-19)       /* call not valid in the current state */

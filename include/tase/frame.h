@@ -11,63 +11,86 @@
  * byte before it, sync bytes included, sent most significant byte first.
  * A frame is therefore 8..261 bytes long.
  *
- * RECEIVER DESIGN
+ * RECEIVER
  *
  * The receiver is a caller-owned tase_rx_t. It never allocates, never
  * blocks, uses no globals and no recursion. Bytes go in with
- * tase_rx_feed(); every valid frame is handed to a callback given with
- * that call, as a view into the receiver's window.
+ * tase_rx_feed() (a buffer) or tase_rx_push() (one byte); every valid
+ * frame is handed to a callback given with that call, as a view into the
+ * receiver's window or into the caller's buffer.
  *
- * Every occurrence of 00 FF 5A in the stream starts a *candidate* frame.
- * Candidates are tracked concurrently (up to TASE_RX_CANDIDATES of them),
- * each judged on its own bytes:
- *   - its Size byte < 2 rejects it at once (stats.bad_size);
- *   - when its last byte arrives its checksum is compared
- *     (stats.checksum_errors on mismatch);
- *   - a candidate whose checksum holds is delivered immediately, and any
- *     candidate that began inside its bytes is dropped (those bytes were
- *     data of a valid frame), as is any sync that starts inside it later.
- * Because a candidate never blocks the ones that start inside it, a
- * corrupted Size byte that claims 255 bytes cannot swallow the packets
- * behind it, and re-scanning after a checksum failure is implicit: the
- * bytes after a failed frame's first sync byte were examined as they
- * arrived.
+ * WHICH FRAMES. Exactly those of the greedy scan: from the start of the
+ * stream, at each position where a complete frame with a valid checksum
+ * begins (00 FF 5A, Size >= 2, Size + 6 bytes, checksum right), that frame
+ * is taken and the scan continues after its last byte; anywhere else the
+ * scan moves on one byte. So:
+ *   - a valid frame's bytes are its data: nothing that lies inside a
+ *     delivered frame is ever delivered. A CAMERA_PASS whose camera bytes
+ *     happen to hold a complete valid frame (a GIMBAL_CMD, say) gives the
+ *     CAMERA_PASS only; the frame-like bytes reach the application as
+ *     camera data and nothing else;
+ *   - no frame is lost behind a corrupted Size byte, a false sync or
+ *     noise: when a candidate fails (Size < 2, stats.bad_size; checksum
+ *     wrong, stats.checksum_errors) the scan resumes at the byte after its
+ *     first sync byte, and a frame inside the failed candidate is found
+ *     there;
+ *   - frames are delivered in stream order, each exactly once.
  *
- * LATENCY. While no more than TASE_RX_CANDIDATES candidates overlap, a
- * clean frame is delivered from within the call that feeds its own last
- * byte: zero added latency, also when it began inside a longer candidate
- * that has not failed yet. Real links rarely overlap more than two
- * candidates (a corrupted frame plus the clean one inside it). When more
- * overlap (adversarial streams full of false sync sequences), syncs past
- * the limit are re-scanned from the window as soon as a tracked candidate
- * ends, and a frame found that way is delivered late by at most
- * TASE_FRAME_MAX - 8 = 253 bytes (it is found no later than the end of the
- * oldest overlapping candidate, which began before it). No frame is lost
- * either way; tase_rx_flush() settles whatever is pending at end of input.
+ * LATENCY. A frame that does not lie inside a still-pending earlier
+ * candidate is delivered from the call that feeds its last byte (zero
+ * added latency). One that does (a pending candidate is one whose last
+ * byte has not arrived yet, e.g. after a Size byte corrupted upwards) is
+ * held while it does: if such a candidate turns out valid, the frame was
+ * its data and is dropped; once every candidate that covered it has
+ * failed, it is delivered from the call that fed the last of their last
+ * bytes, late by at most TASE_FRAME_MAX - 8 = 253 bytes (each began before
+ * it and spans at most TASE_FRAME_MAX bytes). In the callback,
+ * stats.bytes_in counts the bytes up to that deciding byte, whatever the
+ * split of the stream into calls. tase_rx_flush() settles whatever is
+ * pending at end of input: pending candidates can no longer complete, so
+ * they fail and what they were hiding is scanned.
  *
- * One consequence of judging candidates independently: a valid frame whose
- * data carries a complete valid frame (possible with CAMERA_PASS payloads)
- * produces both, the inner one first. In the over-limit path only the
- * outer one is delivered.
+ * COST. The receiver keeps only the earliest pending candidate (the bytes
+ * after it are not examined until it is decided), so the scan position
+ * never moves back: each byte is examined once, each candidate's checksum
+ * is computed once. tase_rx_push() stores a byte inside a frame with one
+ * test; the sync bytes and the Size byte are handled next to it, and the
+ * last byte sums the frame once. A buffer fed with tase_rx_feed() is
+ * scanned in place: idle bytes are skipped with memchr, and a frame wholly
+ * inside the buffer is checked and delivered straight from it. On a clean
+ * telemetry stream (x86-64 gcc -O2, callgrind) that is about 6
+ * instructions per byte fed in 4 KB buffers and about 23 fed one byte at a
+ * time with tase_rx_push(), where the classic single-state parser of
+ * bench/ costs 24; on Cortex-M4 (-O2, QEMU) about 6 and 33 Thumb-2
+ * instructions per byte (classic: 32). A stream made only of false syncs
+ * claiming 253 data bytes is the worst case, about 160 (190 byte at a
+ * time): every candidate there fails and is summed. docs/PERFORMANCE.md
+ * has the measured numbers.
  *
- * COST. From idle, a frame that is wholly inside the bytes of one feed
- * call and has no 5A byte after its sync (so no other candidate can start
- * in it) is checked and delivered straight from the caller's buffer. Other
- * bytes are copied in runs (memchr/memcpy) between sync bytes and frame
- * ends. On x86-64 (gcc -O2, callgrind) a clean telemetry stream costs
- * about 9 instructions per byte fed in 4 KB buffers and about 51 fed one
- * byte at a time through tase_rx_push(); a stream made only of false syncs
- * claiming 253 data bytes is the worst case, about 240 (300 byte at a
- * time). docs/PERFORMANCE.md has the measured numbers.
- *
- * RAM. sizeof(tase_rx_t) is TASE_FRAME_MAX window bytes + counters +
- * candidate bookkeeping; checked against TASE_RX_SIZE_BUDGET at compile
- * time. See docs/DESIGN.md for why the 272-byte target of the original
- * brief cannot hold with 32-bit counters in the instance.
+ * RAM. sizeof(tase_rx_t) is TASE_FRAME_MAX window bytes + counters + 5
+ * bytes of state (296 in all); checked against TASE_RX_SIZE_BUDGET at
+ * compile time. Stack: see docs/FOOTPRINT.md. See
+ * docs/DESIGN.md for why the 272-byte target of the original brief cannot
+ * hold with 32-bit counters in the instance.
  *
  * STATISTICS are 32-bit counters in the instance. The receiver only ever
- * increments them; tase_rx_stats_reset() is the only thing that clears
- * them. Counters wrap modulo 2^32.
+ * increments them; tase_rx_stats_reset() (and tase_rx_init()) are the only
+ * things that clear them. Counters wrap modulo 2^32.
+ *
+ * RE-ENTRANCY. The callback runs inside tase_rx_feed(), tase_rx_push() or
+ * tase_rx_flush(). On the same receiver, from inside the callback:
+ *   - tase_rx_feed(), tase_rx_push() and tase_rx_flush() return TASE_EBUSY
+ *     and change nothing;
+ *   - tase_rx_stats_reset() is allowed: the counters restart from zero at
+ *     that point (offsets of later frames count from there, modulo 2^32);
+ *   - tase_rx_init() is allowed: the receiver is reset, and the call that
+ *     made the callback returns as soon as the callback does, with the
+ *     number of frames it delivered; the rest of its input is not consumed
+ *     (nor counted in bytes_in).
+ * Return values count the frames delivered by that call (never negative
+ * except for an error code), whatever the callback does to the counters.
+ * Different receivers are independent; one receiver must not be used from
+ * two contexts concurrently (e.g. a main loop and an interrupt).
  */
 #ifndef TASE_FRAME_H
 #define TASE_FRAME_H
@@ -87,12 +110,12 @@ extern "C" {
 #define TASE_DATA_MAX 253u     /* Size is one byte and counts Group+Type */
 #define TASE_FRAME_MAX (TASE_DATA_MAX + TASE_FRAME_OVERHEAD) /* 261 */
 
-/* TASE_RX_CANDIDATES: how many overlapping candidate frames are tracked
- * for zero added latency (1..16, default 4; set it in TASE_CONFIG_HEADER,
- * see tase/config.h). 1 gives a classic parser that re-scans after a
- * failure (bounded latency, never loses a frame). Each extra candidate
- * costs 6 bytes of RAM. It changes sizeof(tase_rx_t): an application
- * built with another value than the library does not link. */
+/* TASE_RX_CANDIDATES (1..16, default 4; tase/config.h) was the number of
+ * overlapping candidate frames the receiver tracked. Since the greedy
+ * receiver above keeps only the earliest pending candidate, it needs no
+ * candidate slots: every value gives the same frames, timing, RAM and
+ * code. The setting is still accepted (and range-checked) so that build
+ * configurations that set it keep building. */
 
 /* A received frame. `data` points into the receiver's window or into the
  * caller's input buffer and is valid only until the callback returns. */
@@ -110,8 +133,9 @@ typedef struct {
 typedef struct {
     uint32_t bytes_in;        /* every byte fed */
     uint32_t frames_ok;       /* valid frames delivered */
-    uint32_t checksum_errors; /* candidates whose checksum failed */
-    uint32_t bad_size;        /* candidates rejected for Size < 2 */
+    uint32_t checksum_errors; /* candidates the scan reached (not inside a
+                                 delivered frame) whose checksum failed */
+    uint32_t bad_size;        /* the same, rejected for Size < 2 */
     uint32_t bytes_discarded; /* bytes released without being part of a
                                  delivered frame (noise, failed frames,
                                  incomplete frames at flush) */
@@ -121,33 +145,25 @@ typedef struct {
                                  of a group/type the schema does not know */
 } tase_rx_stats_t;
 
-/* Private bookkeeping of one candidate; do not touch. */
-typedef struct {
-    uint16_t start;  /* window index of its first sync byte */
-    uint16_t end;    /* window index of its last byte; 0 until Size seen */
-    uint16_t credit; /* delivered bytes before `start` (noise accounting) */
-} tase_rx_cand_t;
-
 /* Receiver instance. Treat every field except `stats` as private. */
 typedef struct {
     tase_rx_stats_t stats;
-    uint16_t len;    /* bytes held in buf */
-    uint16_t scan;   /* buf[scan..len) not yet examined for sync */
-    uint16_t floor;  /* no new frame may start below this index */
-    uint16_t next;   /* index of the next candidate event, 0xFFFF none */
-    uint16_t credit; /* bytes of delivered frames still in buf */
-    uint8_t ncand;
-    tase_rx_cand_t cand[TASE_RX_CANDIDATES];
+    /* buf[0..len) holds nothing, a partial sync, or the earliest pending
+     * candidate from its first byte; `end` is the index of that
+     * candidate's last byte (0 when none is held, and during a call);
+     * `busy` is set while a call (and so its callback) runs. */
+    uint16_t len;
+    uint16_t end;
+    uint8_t busy;
     uint8_t buf[TASE_FRAME_MAX];
 } tase_rx_t;
 
 /* Upper bound on sizeof(tase_rx_t) (the same on 32- and 64-bit targets:
  * the instance holds no pointers), enforced at compile time in tase_frame.c. */
-#define TASE_RX_SIZE_BUDGET (328u + 6u * ((unsigned)TASE_RX_CANDIDATES - 4u))
+#define TASE_RX_SIZE_BUDGET 296u
 
-/* Called once per valid frame, in stream order of the frames' last bytes
- * (see LATENCY above for the over-limit exception). Must not call
- * tase_rx_feed()/tase_rx_flush() on the same receiver. */
+/* Called once per valid frame, in stream order. See RE-ENTRANCY above for
+ * what it may call on the same receiver. */
 typedef void (*tase_rx_handler_t)(void *user, const tase_frame_t *frame);
 
 /* 16-bit additive checksum: `seed` plus the sum of n bytes, modulo 2^16.
@@ -166,40 +182,51 @@ int tase_frame_encode(uint8_t *out, size_t cap, uint8_t group, uint8_t type, con
                       size_t len);
 
 /* Initialise (or reset) a receiver: empty window, all counters zero.
- * Returns TASE_OK, or TASE_EARG if rx is NULL. */
+ * Returns TASE_OK, or TASE_EARG if rx is NULL. O(sizeof(tase_rx_t)).
+ * Allowed from inside the receiver's own callback (see RE-ENTRANCY). */
 int tase_rx_init(tase_rx_t *rx);
 
-/* Feed n bytes. Each valid frame completed by them is passed to
+/* Feed n bytes. Each valid frame they complete is passed to
  * on_frame(user, frame) before this returns; on_frame may be NULL (frames
- * are then only counted). Returns the number of frames delivered (>= 0),
- * or TASE_EARG if rx is NULL or data is NULL with n > 0 (any n up to
- * SIZE_MAX), or rx is visibly not an initialised receiver (held length,
- * scan position or candidate count out of range); nothing is consumed.
+ * are then only counted). Returns the number of frames delivered by this
+ * call (>= 0; INT_MAX if more), or
+ *   TASE_EARG  rx is NULL, or data is NULL with n > 0 (any n up to
+ *              SIZE_MAX), or rx is visibly not an initialised receiver
+ *              (held length, held candidate's end and Size disagree);
+ *   TASE_EBUSY called from inside a callback of this receiver;
+ * and then nothing is consumed and rx is unchanged.
  * Feeding a stream one byte at a time or in any split gives the same
- * frames and counters. Not reentrant per receiver; different receivers
- * are independent. Call from one context (e.g. the main loop draining an
- * ISR ring buffer), not concurrently. Worst case O(n * TASE_FRAME_MAX). */
+ * frames, offsets and counters. Cost O(n) on a stream without
+ * overlapping candidates; worst case O(n * TASE_FRAME_MAX) (each
+ * candidate's checksum is summed once, and candidates worth summing are at
+ * least 4 bytes apart). Longest single step: the call that feeds the last
+ * byte of a failing candidate scans the rest of the window, which may hold
+ * up to about 64 overlapping complete candidates to sum (bounded by
+ * TASE_FRAME_MAX^2 / 8 byte additions), plus the callbacks. */
 int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
                  void *user);
 
 /* Feed one byte: the same as tase_rx_feed(rx, &byte, 1, on_frame, user),
- * with a shorter path for the common bytes (inside a frame, or noise while
- * hunting for a sync), for callers that get one byte at a time. Returns
- * the number of frames delivered (0 or more) or TASE_EARG if rx is NULL
- * or visibly corrupted (as tase_rx_feed(); receiver unchanged).
- * Same context rules as tase_rx_feed(). */
+ * for callers that get one byte at a time (a UART interrupt's ring). A
+ * byte inside a frame is only stored, and a frame's Size and last byte are
+ * handled here too, so a clean stream never takes the general path.
+ * Returns the number of frames delivered (0 or 1 on a clean stream; more
+ * when a failing candidate releases frames it was hiding), or TASE_EARG
+ * (rx NULL or visibly corrupted) / TASE_EBUSY (inside a callback of this
+ * receiver), receiver unchanged. Longest block: as tase_rx_feed(). */
 int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user);
 
-/* End of input (end of a capture file, link closed): settle every pending
- * candidate. Frames that can still be completed from the bytes held are
- * delivered; incomplete ones are released and counted in bytes_discarded.
- * Afterwards the receiver is empty (counters kept) and ready for a new
- * stream. Returns frames delivered (>= 0) or TASE_EARG if rx is NULL or
- * visibly corrupted (as tase_rx_feed(); receiver unchanged). */
+/* End of input (end of a capture file, link closed): settle what is
+ * pending. A pending candidate can no longer complete, so it fails (its
+ * bytes are discarded, no counter other than bytes_discarded) and the
+ * bytes after its first sync byte are scanned: frames found there are
+ * delivered. Afterwards the receiver is empty (counters kept) and ready for
+ * a new stream. Returns frames delivered (>= 0), or TASE_EARG /
+ * TASE_EBUSY as tase_rx_feed() (receiver unchanged). */
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user);
 
 /* Zero every counter, nothing else. Returns TASE_OK or TASE_EARG (rx
- * NULL). */
+ * NULL). Allowed from inside the receiver's own callback. */
 int tase_rx_stats_reset(tase_rx_t *rx);
 
 #ifdef __cplusplus

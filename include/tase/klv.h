@@ -56,11 +56,11 @@
  * behind a cut or corrupted one.
  * A delivered packet's bytes are never re-scanned.
  *
- * RAM: sizeof(tase_klv_rx_t) <= TASE_KLV_RX_SIZE_BUDGET (128 bytes: the
- * 91-byte window, 8 counters, the offset; no pointers, so the same on 32-
- * and 64-bit). Stack: about 200 bytes for feed -> scan -> decode on
- * Cortex-M4 -Os (gcc -fstack-usage: 40 + 80 + 72), of which one tase_klv_t
- * (40 bytes).
+ * RAM: sizeof(tase_klv_rx_t) <= TASE_KLV_RX_SIZE_BUDGET (132 bytes: the
+ * 91-byte window, 8 counters, the offset, the length and a busy flag,
+ * padded; no pointers, so the same on 32- and 64-bit). Stack: about 200
+ * bytes for feed -> scan -> decode on Cortex-M4 -Os (gcc -fstack-usage:
+ * 40 + 72 + 72), of which one tase_klv_t (40 bytes).
  *
  * UNITS. The raw fields are what travels on the wire; tase_klv_*_deg() and
  * friends convert them with the corrected scale factors (the spec prints
@@ -167,35 +167,45 @@ typedef struct {
     tase_klv_rx_stats_t stats;
     uint32_t offset; /* stream offset of buf[0] */
     uint8_t len;     /* bytes held in buf */
+    uint8_t busy;    /* a call is in progress (a handler is running) */
     uint8_t buf[TASE_KLV_PACKET_MAX];
 } tase_klv_rx_t;
 
 /* Enforced at compile time in tase_klv.c. */
-#define TASE_KLV_RX_SIZE_BUDGET 128u
+#define TASE_KLV_RX_SIZE_BUDGET 132u
 
 /* Called once per valid packet, in stream order. `offset` is the stream
  * offset of the packet's first key byte, counted from tase_klv_rx_init()
  * (modulo 2^32; tase_klv_rx_stats_reset() does not change it). `klv` is
- * valid only during the call. Must not feed/flush the same scanner. */
+ * valid only during the call. On the same scanner, a handler (this one or
+ * the error handler) may call tase_klv_rx_stats_reset() and
+ * tase_klv_rx_init() (the call that ran the handler then returns as soon
+ * as the handler does, with the packets it delivered; the rest of its
+ * input is not consumed); tase_klv_rx_feed() and tase_klv_rx_flush()
+ * return TASE_EBUSY there and change nothing. */
 typedef void (*tase_klv_handler_t)(void *user, uint32_t offset, const tase_klv_t *klv);
 
 /* Called once per candidate whose 16 key bytes matched but which failed,
  * with its offset and the TASE_E* code from tase_klv_decode() (TASE_ETRUNC
- * only from tase_klv_rx_flush()). For logging; the counters see it too. */
+ * only from tase_klv_rx_flush()). For logging; the counters see it too.
+ * Same re-entrancy rules as tase_klv_handler_t. */
 typedef void (*tase_klv_error_handler_t)(void *user, uint32_t offset, int err);
 
 /* Initialise (or reset) a scanner: empty window, offset 0, counters zero.
- * Returns TASE_OK, or TASE_EARG if rx is NULL. */
+ * Returns TASE_OK, or TASE_EARG if rx is NULL. Allowed from inside the
+ * scanner's own handlers (see tase_klv_handler_t). */
 int tase_klv_rx_init(tase_klv_rx_t *rx);
 
 /* Feed n bytes. Each packet they complete goes to on_packet(user, ...),
  * each failed candidate to on_error(user, ...), before this returns;
- * either handler may be NULL. Returns the number of packets delivered, or
- * TASE_EARG if rx is NULL, data is NULL with n > 0 (any n up to
- * SIZE_MAX), or rx's held length exceeds its window (corrupted or never
- * initialised); nothing is consumed.
+ * either handler may be NULL. Returns the number of packets delivered by
+ * this call (>= 0; INT_MAX if more), or TASE_EARG if rx is NULL, data is
+ * NULL with n > 0 (any n up to SIZE_MAX), or rx's held length exceeds its
+ * window (corrupted or never initialised), or TASE_EBUSY if called from
+ * inside a handler of this scanner; then nothing is consumed.
  * Any split of the stream into calls gives the same packets, offsets and
- * counters. Not reentrant per scanner; scanners are independent.
+ * counters. Scanners are independent; one scanner must not be used from
+ * two contexts concurrently.
  * Worst case O(n * TASE_KLV_PACKET_MAX) (a stream of near-miss
  * candidates); a clean stream costs O(n) when fed in large chunks and
  * O(n * 87) when fed one byte at a time. */
@@ -206,13 +216,12 @@ int tase_klv_rx_feed(tase_klv_rx_t *rx, const uint8_t *data, size_t n, tase_klv_
  * completed is counted as truncated (reported with TASE_ETRUNC) and the
  * bytes after its first byte are scanned again. Afterwards the window is
  * empty (offset and counters kept). Returns packets delivered (>= 0) or
- * TASE_EARG if rx is NULL or corrupted as for tase_klv_rx_feed() (rx
- * unchanged). */
+ * TASE_EARG / TASE_EBUSY as tase_klv_rx_feed() (rx unchanged). */
 int tase_klv_rx_flush(tase_klv_rx_t *rx, tase_klv_handler_t on_packet,
                       tase_klv_error_handler_t on_error, void *user);
 
 /* Zero every counter, nothing else. Returns TASE_OK or TASE_EARG (rx
- * NULL). */
+ * NULL). Allowed from inside the scanner's own handlers. */
 int tase_klv_rx_stats_reset(tase_klv_rx_t *rx);
 
 /* ---- units (corrected formulas; reentrant, ISR-safe, no libm) ---------

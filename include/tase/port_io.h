@@ -54,11 +54,11 @@ uint32_t tase_port_elapsed_ms(uint32_t now_ms, uint32_t since_ms);
  *                n > INT_MAX (the count must fit the int result;
  *                32767 where int is 16 bits);
  *   TASE_EAGAIN / TASE_ENOBUFS  the port took nothing before the deadline
- *                (retry later; nothing was sent);
- *   TASE_EIO     the deadline passed part-way (some bytes were sent; a
- *                receiver will discard the cut frame by its checksum),
- *                also when write() claims more than it was given (a
- *                broken port);
+ *                (its own refusal code; nothing was sent: retry later);
+ *   TASE_ENOBUFS the deadline passed part-way: the port's queue stayed
+ *                full (some bytes were sent; a receiver discards the cut
+ *                frame by its checksum and finds the next one);
+ *   TASE_EIO     write() claimed more than it was given (a broken port);
  *   any other negative code the port's write() returned (at once).
  * O(n) plus the port's cost. Reentrant if the port's write is; not
  * ISR-safe unless the port's write is. */

@@ -144,7 +144,10 @@ static int configure(int fd, speed_t code)
     if (cfgetospeed(&check) != code) {
         return TASE_EUNSUPPORTED;
     }
-    (void)tcflush(fd, TCIOFLUSH);
+    /* Stale input (received before we owned the line) is dropped; output
+     * still queued by the previous owner is not ours to drop: on a pty it
+     * is that program's last command, not yet read by the peer. */
+    (void)tcflush(fd, TCIFLUSH);
     return TASE_OK;
 }
 

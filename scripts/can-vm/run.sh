@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Real SocketCAN test: boots Debian's own kernel under qemu (TCG, no KVM)
-# with a small initramfs (busybox, iproute2's ip, can-utils' candump and
+# with a small initramfs (busybox, iproute2's ip and tc, can-utils' candump and
 # cansend, the project's static agent and, when given, static builds of the
 # bench tools tase and tase-sim), and runs scripts/can-vm/init.sh in it.
 # Passes when the VM prints "CAN-VM: PASS".
@@ -41,8 +41,15 @@ if [ -z "$pkg" ]; then
 fi
 [ -n "$pkg" ] || { echo "FAIL: cannot resolve linux-image-amd64"; exit 1; }
 kdir="$cache/kernel-$pkg"
+# The modules the VM loads: CAN, raw sockets, the CAN device layer, vcan,
+# and the plug qdisc that holds frames back to fill a transmit queue.
+modules="net/can/can net/can/can-raw drivers/net/can/dev/can-dev drivers/net/can/vcan net/sched/sch_plug"
 # An older kernel left by a previous ABI is not needed any more.
 find "$cache" -maxdepth 1 -name 'kernel-*' ! -name "kernel-$pkg" -exec rm -rf {} +
+# A cache made for fewer modules is made again.
+for m in $modules; do
+    [ -f "$kdir/modules/$(basename "$m").ko" ] || rm -f "$kdir/.done"
+done
 if [ ! -f "$kdir/.done" ]; then
     rm -rf "$kdir" && mkdir -p "$kdir/deb" "$kdir/modules"
     (cd "$kdir/deb" && apt-get "${apt_opts[@]}" download "$pkg" -qq) ||
@@ -52,7 +59,7 @@ if [ ! -f "$kdir/.done" ]; then
     # Keep only what the VM needs (the unpacked package is ~400 MB).
     cp "$kdir"/x/boot/vmlinuz-* "$kdir/vmlinuz"
     mods=$(ls -d "$kdir"/x/lib/modules/* | head -1)
-    for m in net/can/can net/can/can-raw drivers/net/can/dev/can-dev drivers/net/can/vcan; do
+    for m in $modules; do
         f="$mods/kernel/$m.ko"
         if [ -f "$f" ]; then
             cp "$f" "$kdir/modules/"
@@ -74,8 +81,10 @@ mkdir -p "$root"/{bin,sbin,usr/bin,lib/modules,proc,sys,dev,tmp}
 cp /bin/busybox "$root/bin/busybox"
 cp "$kdir"/modules/*.ko "$root/lib/modules/"
 # Dynamic programs with their libraries and loader (from ldd).
-for prog in "$(command -v ip)" "$(command -v candump)" "$(command -v cansend)"; do
+for prog in "$(command -v ip)" "$(command -v tc)" "$(command -v candump)" "$(command -v cansend)"; do
     cp "$prog" "$root/bin/"
+    # busybox installs its own, smaller tc in /bin: keep iproute2's apart
+    [ "$(basename "$prog")" != tc ] || { mkdir -p "$root/usr/sbin" && cp "$prog" "$root/usr/sbin/tc"; }
     for lib in $(ldd "$prog" | grep -o '/[^ ]*'); do
         mkdir -p "$root$(dirname "$lib")"
         cp -L "$lib" "$root$lib"

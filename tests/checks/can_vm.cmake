@@ -11,9 +11,11 @@ if(TARGET tase_socketcan)
   # Static copies of the tools from the same sources (the VM has no libc).
   # Static glibc warns about getaddrinfo/NSS; the tools use neither.
   set(TASE_CAN_VM_TOOLS "")
-  if(TARGET tase_toolkit AND TARGET tase_sim_model)
-    add_executable(tase_can_vm_cli ${PROJECT_SOURCE_DIR}/tools/tase.c)
-    target_link_libraries(tase_can_vm_cli PRIVATE tase_toolkit)
+  if(TARGET tase_capture AND TARGET tase_sim_model)
+    # libpcap.a needs libdbus-1.a, and that two libsystemd calls (shim).
+    add_executable(tase_can_vm_cli ${PROJECT_SOURCE_DIR}/tools/tase.c
+                                   ${CMAKE_CURRENT_SOURCE_DIR}/vm/libsystemd_stub.c)
+    target_link_libraries(tase_can_vm_cli PRIVATE tase_capture pcap dbus-1)
     add_executable(tase_can_vm_sim ${PROJECT_SOURCE_DIR}/tools/tase_sim.c)
     target_link_libraries(tase_can_vm_sim PRIVATE tase_toolkit tase_sim_model)
     foreach(t tase_can_vm_cli tase_can_vm_sim)

@@ -11,13 +11,34 @@
  *                                    COUNT items; exit 1 on timeout
  *   agent reformat FILE              parse candump -L lines and print each
  *                                    formatted again (no timestamp change)
+ *   agent gimbal IF gimbal MS        the library's gimbal role on IF for MS
+ *                                    ms (answers setup queries, telemetry
+ *                                    at the default rates); prints READY
+ *   agent query IF host              host-role PACKET_RATE queries (typed,
+ *                                    500 ms, 2 retries) under a SIGALRM
+ *                                    every millisecond, until 300 signals
+ *                                    came (at least 20 queries); prints
+ *                                    "QUERY rc=.. ok=.. alarms=.. .."
+ *   agent fill IF host               GIMBAL_CMDs as host until the transmit
+ *                                    queue refuses one; prints "FULL rc=..
+ *                                    ms=.. sent=.. enobufs=.." (ms: that
+ *                                    last call)
+ *   agent health IF host COUNT MS    read as host until COUNT error frames
+ *                                    came or MS passed; prints READY, then
+ *                                    "BUS state=.. errors=.. ..."
  */
 #define _DEFAULT_SOURCE 1
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/time.h>
+#include <time.h>
 
 #include "tase/candump.h"
+#include "tase/codec.h"
+#include "tase/gimbal.h"
+#include "tase/host.h"
 #include "tase/socketcan.h"
 
 static int role_of(const char *s, tase_can_role_t *role)
@@ -158,6 +179,121 @@ static int do_reformat(const char *path)
     return 0;
 }
 
+static int do_gimbal(tase_socketcan_t *s, uint32_t ms)
+{
+    static tase_gimbal_t g;
+    static tase_rx_t rx;
+    tase_port_t port = tase_socketcan_port(s);
+    uint32_t t0 = tase_socketcan_now_ms(NULL);
+    struct timespec tick = {0, 1000000L};
+    if (tase_gimbal_init(&g, &port, &rx, 1, NULL, t0) != TASE_OK) {
+        return 1;
+    }
+    printf("READY\n");
+    fflush(stdout);
+    while (tase_socketcan_now_ms(NULL) - t0 < ms) {
+        (void)tase_gimbal_service(&g, tase_socketcan_now_ms(NULL));
+        (void)nanosleep(&tick, NULL);
+    }
+    printf("GIMBAL queries=%lu tx_errors=%lu\n", (unsigned long)g.stats.setup_queries,
+           (unsigned long)g.stats.tx_errors);
+    return 0;
+}
+
+static volatile sig_atomic_t alarms;
+
+static void on_alarm(int sig)
+{
+    (void)sig;
+    alarms++;
+}
+
+/* A SIGALRM every millisecond, without SA_RESTART: every wait of the
+ * query is interrupted many times over. */
+static int do_query(tase_socketcan_t *s)
+{
+    static tase_host_t h;
+    tase_port_t port = tase_socketcan_port(s);
+    tase_packet_rate_t pr;
+    struct sigaction sa;
+    struct itimerval it;
+    int rc = TASE_ESTATE;
+    int n;
+    int ok = 0;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_alarm;
+    sigemptyset(&sa.sa_mask);
+    memset(&it, 0, sizeof it);
+    it.it_interval.tv_usec = 1000;
+    it.it_value.tv_usec = 1000;
+    if (tase_host_init(&h, &port, NULL, NULL) != TASE_OK || sigaction(SIGALRM, &sa, NULL) != 0 ||
+        setitimer(ITIMER_REAL, &it, NULL) != 0) {
+        return 1;
+    }
+    /* Queries back to back until a few hundred signals have hit them. */
+    for (n = 0; n < 1000 && (n < 20 || alarms < 300); n++) {
+        memset(&pr, 0, sizeof pr);
+        rc = tase_host_transact_msg(&h, TASE_ID_PACKET_RATE, NULL, &pr, 500, 2);
+        if (rc != 16) {
+            break;
+        }
+        ok++;
+    }
+    memset(&it, 0, sizeof it);
+    (void)setitimer(ITIMER_REAL, &it, NULL);
+    printf("QUERY rc=%d ok=%d alarms=%d angle_1=%u retries=%lu errno=%d\n", rc, ok, (int)alarms,
+           pr.angle_1, (unsigned long)h.stats.retries, s->stats.last_errno);
+    return rc == 16 ? 0 : 1;
+}
+
+static int do_fill(tase_socketcan_t *s)
+{
+    static tase_host_t h;
+    tase_port_t port = tase_socketcan_port(s);
+    tase_gimbal_cmd_t cmd = {1000, -500, 0, 0, 0};
+    tase_socketcan_bus_t b;
+    int sent = 0;
+    int rc = 0;
+    uint32_t ms = 0;
+    if (tase_host_init(&h, &port, NULL, NULL) != TASE_OK) {
+        return 1;
+    }
+    while (sent < 100000) {
+        uint32_t t0 = tase_socketcan_now_ms(NULL);
+        rc = tase_host_send_msg(&h, TASE_ID_GIMBAL_CMD, &cmd);
+        ms = tase_socketcan_now_ms(NULL) - t0;
+        if (rc < 0) {
+            break;
+        }
+        sent++;
+    }
+    (void)tase_socketcan_bus(s, &b);
+    printf("FULL rc=%d ms=%lu sent=%d enobufs=%lu (%s)\n", rc, (unsigned long)ms, sent,
+           (unsigned long)b.enobufs, tase_strerror(rc));
+    return 0;
+}
+
+static int do_health(tase_socketcan_t *s, uint32_t count, uint32_t ms)
+{
+    tase_socketcan_bus_t b;
+    uint8_t buf[64];
+    uint32_t t0 = tase_socketcan_now_ms(NULL);
+    printf("READY\n");
+    fflush(stdout);
+    do {
+        if (tase_socketcan_read(s, buf, sizeof buf, 20) < 0) {
+            return 1;
+        }
+        (void)tase_socketcan_bus(s, &b);
+    } while (b.error_frames < count && tase_socketcan_now_ms(NULL) - t0 < ms);
+    printf("BUS state=%u errors=%lu bus_offs=%lu passives=%lu restarts=%lu no_acks=%lu "
+           "tec=%u rec=%u bad=%lu\n",
+           b.state, (unsigned long)b.error_frames, (unsigned long)b.bus_offs,
+           (unsigned long)b.passives, (unsigned long)b.restarts, (unsigned long)b.no_acks,
+           b.tx_error_count, b.rx_error_count, (unsigned long)s->stats.bad_frames);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     tase_socketcan_t s;
@@ -183,6 +319,15 @@ int main(int argc, char **argv)
         rc = send_what(argv[2], &s, argv[4]);
     } else if (strcmp(argv[1], "recv") == 0 && argc == 6) {
         rc = do_recv(&s, atoi(argv[4]), (uint32_t)strtoul(argv[5], NULL, 10));
+    } else if (strcmp(argv[1], "gimbal") == 0 && argc == 5) {
+        rc = do_gimbal(&s, (uint32_t)strtoul(argv[4], NULL, 10));
+    } else if (strcmp(argv[1], "query") == 0 && argc == 4) {
+        rc = do_query(&s);
+    } else if (strcmp(argv[1], "fill") == 0 && argc == 4) {
+        rc = do_fill(&s);
+    } else if (strcmp(argv[1], "health") == 0 && argc == 6) {
+        rc = do_health(&s, (uint32_t)strtoul(argv[4], NULL, 10),
+                       (uint32_t)strtoul(argv[5], NULL, 10));
     } else {
         rc = 2;
     }

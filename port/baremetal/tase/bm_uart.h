@@ -31,7 +31,10 @@
  * The port functions (tase_bm_uart_ops):
  *  write   calls hooks->tx(hw, data, n), which must send all bytes
  *          (blocking on the TX-empty flag, or queue them to a TX ring/DMA)
- *          and return 0, or a negative TASE_E* code (passed on). Returns n,
+ *          and return 0, or a negative TASE_E* code (passed on; TASE_EAGAIN
+ *          for a full TX ring makes tase_port_write_all() retry until its
+ *          deadline). The hook's longest block is this port's write
+ *          bound W (tase/port.h): n bytes at the line rate. Returns n,
  *          or TASE_EARG (ctx NULL or not initialised, data NULL with
  *          n > 0, n > INT32_MAX; the hook is not called).
  *  read    takes what the ring holds; if empty, waits until bytes arrive

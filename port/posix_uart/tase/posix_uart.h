@@ -28,17 +28,21 @@
  * descriptor is non-blocking; reads wait with poll() for at most the
  * timeout given.
  *
- * CONTRACT OF THE PORT FUNCTIONS (tase_posix_uart_ops)
+ * CONTRACT OF THE PORT FUNCTIONS (tase_posix_uart_ops; tase/port.h)
  *  write   writes all n bytes, waiting with poll() up to write_timeout_ms
- *          (default 1000 ms) while the kernel's output queue is full.
+ *          (default 1000 ms; the port's write bound W, for the whole call)
+ *          while the kernel's output queue is full. A signal (EINTR)
+ *          resumes the wait with the time left. A hung-up line fails with
+ *          TASE_EIO.
  *          Returns n, the count written when the timeout expired part-way,
  *          TASE_EAGAIN when nothing could be written in time, TASE_EIO on
  *          an OS error, TASE_EARG (ctx NULL or closed, data NULL with
  *          n > 0, n > INT32_MAX; nothing written).
- *  read    returns what is available now, or waits up to timeout_ms for
- *          the first bytes (EINTR restarts the wait with the time left).
- *          Returns the count (0 = nothing within the timeout), TASE_EIO
- *          (OS error, or the other end hung up) or TASE_EARG (ctx NULL or
+ *  read    returns what is available now, or waits up to timeout_ms in
+ *          total for the first bytes (EINTR resumes the wait with the time
+ *          left). Returns the count (0 = nothing within the timeout),
+ *          TASE_EIO (OS error, or the other end hung up: after the bytes
+ *          still queued) or TASE_EARG (ctx NULL or
  *          closed, buf NULL, cap 0). A cap above INT32_MAX reads at most
  *          INT32_MAX bytes.
  *  now_ms  CLOCK_MONOTONIC in milliseconds, modulo 2^32.
@@ -74,7 +78,8 @@ extern const tase_port_ops_t tase_posix_uart_ops;
 
 /* Open `path` (e.g. "/dev/ttyUSB0") at `baud` bits per second, raw 8N1,
  * for exclusive use (see EXCLUSIVE ACCESS), saving the device's settings
- * for close(). Any pending input and output is discarded. Returns TASE_OK
+ * for close(). Pending input (received before the open) is discarded;
+ * output a previous owner left queued is not (it is still sent). Returns TASE_OK
  * or
  *   TASE_EARG         u or path NULL;
  *   TASE_EUNSUPPORTED baud is not a standard termios rate (checked before

@@ -1,0 +1,119 @@
+/* The benchmark's synthetic streams: see streams.h. */
+#include "streams.h"
+
+#include <string.h>
+
+#include "tase/frame.h"
+#include "tase/ids.h"
+
+static uint32_t rng = 0x2545F491u;
+
+static uint8_t rnd8(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 17;
+    rng ^= rng << 5;
+    return (uint8_t)(rng >> 11);
+}
+
+static void put16(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)(v >> 8);
+    p[1] = (uint8_t)v;
+}
+
+static void put32(uint8_t *p, uint32_t v)
+{
+    put16(p, v >> 16);
+    put16(p + 2, v);
+}
+
+/* Appends one frame unless the buffer is nearly full; with `corrupt` set
+ * its Size byte is replaced by a random value. Returns 0 when full. */
+static int emit(uint8_t *buf, size_t cap, size_t *n, uint16_t id, const uint8_t *d, size_t len,
+                int corrupt)
+{
+    int r;
+    if (*n + TASE_FRAME_MAX > cap) {
+        return 0;
+    }
+    r = tase_frame_encode(&buf[*n], cap - *n, TASE_ID_GROUP(id), TASE_ID_TYPE(id), d, len);
+    if (corrupt) {
+        buf[*n + 3] = rnd8();
+    }
+    *n += (size_t)r;
+    return 1;
+}
+
+/* Telemetry as a gimbal sends it, in 50 ms steps; corrupt_size != 0
+ * corrupts the Size byte of every other frame. */
+static size_t gen_telemetry(uint8_t *buf, size_t cap, int corrupt_size)
+{
+    size_t n = 0;
+    uint32_t t;
+    unsigned k = 0, i;
+    uint8_t d[63];
+    for (t = 0;; t += 50u) {
+        if (t % 100u == 0u) {
+            put16(&d[0], 4500u + t % 1000u); /* pan, tilt, roll */
+            put16(&d[2], (uint32_t)(65536 - 1000));
+            put16(&d[4], 0);
+            if (!emit(buf, cap, &n, TASE_ID_GIMBAL_ANGLE, d, 6u, corrupt_size && (k++ & 1u))) {
+                return n;
+            }
+            memset(d, 0, 18u);
+            put32(&d[0], t);
+            for (i = 4; i < 16u; i += 2u) {
+                put16(&d[i], (uint32_t)(rnd8() % 64u)); /* small rates */
+            }
+            d[17] = 0x80u;
+            if (!emit(buf, cap, &n, TASE_ID_GIMBAL_RATE, d, 18u, corrupt_size && (k++ & 1u))) {
+                return n;
+            }
+        }
+        if (t % 250u == 0u) {
+            put32(&d[0], t);
+            put32(&d[4], 163000000u + rnd8()); /* lat, lon in mas, then the rest */
+            put32(&d[8], (uint32_t)-440000000 + rnd8());
+            for (i = 12; i < 63u; i++) {
+                d[i] = (uint8_t)((i & 3u) == 0u ? rnd8() : i);
+            }
+            if (!emit(buf, cap, &n, TASE_ID_GEOREFERENCE_DATA, d, 63u,
+                      corrupt_size && (k++ & 1u))) {
+                return n;
+            }
+        }
+    }
+}
+
+size_t bench_stream(const char *name, uint8_t *buf, size_t cap)
+{
+    size_t i;
+    if (strcmp(name, "telemetry") == 0) {
+        return gen_telemetry(buf, cap, 0);
+    }
+    if (strcmp(name, "badsize") == 0) {
+        return gen_telemetry(buf, cap, 1);
+    }
+    if (strcmp(name, "sync4") == 0 || strcmp(name, "syncrand") == 0) {
+        int r = strcmp(name, "syncrand") == 0;
+        for (i = 0; i + 4u <= cap; i += 4u) {
+            buf[i] = 0x00;
+            buf[i + 1] = 0xFF;
+            buf[i + 2] = 0x5A;
+            buf[i + 3] = r ? rnd8() : 0xFF;
+        }
+        return i;
+    }
+    if (strcmp(name, "noise") == 0) {
+        for (i = 0; i < cap; i++) {
+            buf[i] = rnd8();
+        }
+        return cap;
+    }
+    if (strcmp(name, "zeros") == 0) {
+        memset(buf, 0, cap);
+        return cap;
+    }
+    return 0;
+}

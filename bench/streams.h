@@ -1,0 +1,24 @@
+/*
+ * bench/streams.h - the deterministic byte streams of the receiver
+ * benchmark (bench_rx.c on the host, m4/bench_m4.c on Cortex-M4 in QEMU):
+ *
+ *   telemetry  GIMBAL_ANGLE + GIMBAL_RATE at 10 Hz, GEOREFERENCE_DATA at
+ *              4 Hz, back to back
+ *   badsize    the same, every other frame's Size byte random
+ *   sync4      00 FF 5A FF repeated (every sync claims 253 data bytes)
+ *   syncrand   00 FF 5A then a random Size, repeated
+ *   noise      uniformly random bytes
+ *   zeros      0x00 repeated (every byte may start a sync)
+ */
+#ifndef BENCH_STREAMS_H
+#define BENCH_STREAMS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Fills buf[0..cap) with the named stream (whole frames only) and returns
+ * its length, or 0 for an unknown name. The same bytes on every run and
+ * every target. */
+size_t bench_stream(const char *name, uint8_t *buf, size_t cap);
+
+#endif /* BENCH_STREAMS_H */

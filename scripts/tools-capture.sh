@@ -1,0 +1,222 @@
+#!/usr/bin/env bash
+# Captures end to end (issue 15 item 5): `tase decode` of pcap/pcapng
+# captures written by an independent writer (scripts/capture_util.py) from
+# the generator's test streams, malformed records, `--record` of a live
+# session with tase-sim, `tase record` of a serial line and of a two-line
+# tap, and `tase replay` through a pair of joined pseudo-terminals, byte for
+# byte and on time. (CAN recording and replay run in the CAN VM test.)
+# Usage: scripts/tools-capture.sh TASE TASE_SIM DATA_DIR
+set -uo pipefail
+TASE=$1
+SIM=$2
+DATA=$3
+U="python3 $(dirname "$0")/capture_util.py"
+dir=$(mktemp -d)
+pids=()
+cleanup() {
+    local p
+    for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
+    wait 2>/dev/null
+    rm -rf "$dir"
+}
+trap cleanup EXIT
+
+. "$(dirname "$0")/check-lib.sh"
+under_valgrind TASE SIM
+# Timing tolerances (seconds of replay jitter, ms for a --speed 0 run);
+# looser when scripts/check-valgrind.sh runs the programs under memcheck.
+tol=0.250 fast_ms=350
+[ -n "${TASE_UNDER_VALGRIND:-}" ] && tol=0.300 fast_ms=5000
+# json_int LINE KEY: the integer value of "KEY": in a JSON line
+json_int() { sed -n "s/.*\"$2\":\(-\{0,1\}[0-9][0-9]*\).*/\1/p" <<<"$1"; }
+# same_lines A B: files equal, or the diff shown
+same_lines() { diff -u "$1" "$2" | head -20; cmp -s "$1" "$2"; }
+# Each direction in stream order, exactly. Across directions the order is
+# the order the receivers decided the frames: a frame held behind a longer
+# candidate of its own direction (at most 253 bytes) may come after a
+# later frame of the other one, still with the time its last byte came.
+same_per_dir() {
+    local d
+    for d in out in; do
+        same_lines <(grep "\"dir\":\"$d\"" "$1") <(grep "\"dir\":\"$d\"" "$2") || return 1
+    done
+}
+
+# ---- decode: serial pcap of both directions, files, pipes, pcapng ----
+$U serial-pcap "$dir/noisy.pcap" 1 0.001-3 "$DATA/decode_noisy.bin:out" "$DATA/decode_noisy.bin:in"
+$U expect-serial "$dir/noisy.pcap" "$DATA/decode_noisy.jsonl:out" "$DATA/decode_noisy.jsonl:in" \
+    >"$dir/noisy.expect"
+"$TASE" decode "$dir/noisy.pcap" >"$dir/noisy.json"
+rc=$?
+check "decode of a serial pcap (both directions, 1..64-byte records): every packet with dir and time, exit 0" \
+    eval '[ $rc -eq 0 ] && same_per_dir "$dir/noisy.expect" "$dir/noisy.json"'
+"$TASE" decode - <"$dir/noisy.pcap" | cmp -s - "$dir/noisy.json"
+check "decode of the serial pcap from standard input (a file)" [ $? -eq 0 ]
+cat "$dir/noisy.pcap" | "$TASE" decode | cmp -s - "$dir/noisy.json"
+check "decode of the serial pcap through a pipe" [ $? -eq 0 ]
+editcap -F pcapng "$dir/noisy.pcap" "$dir/noisy.pcapng" >/dev/null 2>&1 &&
+    "$TASE" decode "$dir/noisy.pcapng" | cmp -s - "$dir/noisy.json"
+check "decode of the same capture as pcapng (editcap)" [ $? -eq 0 ]
+
+# ---- decode: SocketCAN pcap of the candump test log ----
+$U can-pcap "$dir/can.pcap" "$DATA/decode_candump.log"
+sed 's/"interface":"vcan0",//' "$DATA/decode_candump.jsonl" >"$dir/can.expect"
+"$TASE" decode "$dir/can.pcap" >"$dir/can.json"
+check "decode of a LINKTYPE_CAN_SOCKETCAN pcap: as the candump log (no interface name in a pcap)" \
+    same_lines "$dir/can.expect" "$dir/can.json"
+"$TASE" decode --candump "$DATA/decode_candump.log" | grep -c '"time":1700000000\.[0-9]\{6\},' >"$dir/n"
+check "decode --candump gives each packet its line's time (6 decimals): all $(wc -l <"$DATA/decode_candump.jsonl")" \
+    [ "$(cat "$dir/n")" = "$(wc -l <"$DATA/decode_candump.jsonl")" ]
+
+# ---- malformed records and files ----
+$U bad-pcap "$dir/bad.pcap"
+"$TASE" decode "$dir/bad.pcap" >"$dir/bad.json" 2>"$dir/bad.err"
+rc=$?
+check "malformed records: exit 4, records 2 and 3 named, the two good ones decoded ($(tr '\n' '|' <"$dir/bad.err"))" \
+    eval '[ $rc -eq 4 ] && [ "$(wc -l <"$dir/bad.err")" -eq 3 ] &&
+          grep -q "record 2 skipped: direction byte 0x07" "$dir/bad.err" &&
+          grep -q "record 3 skipped: no bytes after the direction byte" "$dir/bad.err" &&
+          grep -q "2 bad records (the rest was decoded)" "$dir/bad.err" &&
+          [ "$(grep -c "\"name\":\"GIMBAL_ANGLE\",\"size\":6,\"fields\":{\"pan\":1000,\"tilt\":-500,\"roll\":0}" "$dir/bad.json")" = 2 ] &&
+          grep -q "\"dir\":\"out\"" "$dir/bad.json" && grep -q "\"dir\":\"in\"" "$dir/bad.json"'
+python3 -c 'import struct,sys; open(sys.argv[1],"wb").write(struct.pack("<IHHiIII",0xA1B2C3D4,2,4,0,0,65535,1))' "$dir/eth.pcap"
+expect_error "decode of an Ethernet pcap" 1 "link type 1 (EN10MB) is neither TASE serial" \
+    "$TASE" decode "$dir/eth.pcap"
+head -c 30 "$dir/noisy.pcap" >"$dir/cut.pcap"
+expect_error "decode of a pcap cut inside a record header" 1 "cut.pcap" "$TASE" decode "$dir/cut.pcap"
+expect_error "replay of a raw byte file" 1 "is not a pcap or pcapng capture" \
+    "$TASE" replay "$DATA/decode_noisy.bin" --serial /dev/null
+expect_error "replay without a link" 2 "give either --serial DEV or --can IFACE" \
+    "$TASE" replay "$dir/noisy.pcap"
+expect_error "replay --dir sideways" 2 "bad --dir value 'sideways'" \
+    "$TASE" replay "$dir/noisy.pcap" --serial /dev/null --dir sideways
+expect_error "replay --speed -1" 2 "bad --speed value" \
+    "$TASE" replay "$dir/noisy.pcap" --serial /dev/null --speed -1
+expect_error "record without -o" 2 "record needs an output file" "$TASE" record --serial /dev/null
+expect_error "record --tap-in without --serial" 2 "needs --serial" \
+    "$TASE" record --can vcan0 --tap-in /dev/null -o "$dir/x.pcap"
+expect_error "--record on a CAN link" 2 "on CAN run 'tase record --can can0" \
+    "$TASE" query SYSTEM_VERSION --can can0 --record "$dir/x.pcap"
+expect_error "record to an unwritable file" 1 "cannot write capture" \
+    "$TASE" record --serial /dev/null -o "$dir/no/such/dir.pcap"
+
+# ---- a live session with tase-sim, recorded with --record ----
+"$SIM" --quiet --link "$dir/gimbal" --seconds 120 >"$dir/sim.log" 2>&1 &
+pids+=($!)
+for _ in $(seq 100); do [ -L "$dir/gimbal" ] && break; sleep 0.05; done
+L=(--serial "$dir/gimbal" --record "$dir/session.pcap")
+t_start=$(date +%s.%N)
+v=$("$TASE" query SYSTEM_VERSION "${L[@]}" --json)
+e=$("$TASE" send PACKET_RATE angle_1=20 "${L[@]}" --json | tail -1) # the echo
+"$TASE" monitor "${L[@]}" --json --seconds 1 >"$dir/mon.json"
+t_end=$(date +%s.%N)
+"$TASE" decode "$dir/session.pcap" >"$dir/session.json"
+rc=$?
+check "--record: three commands appended into one capture, decoded" \
+    eval '[ $rc -eq 0 ] && [ -s "$dir/session.json" ]'
+$U records "$dir/session.pcap" >"$dir/session.rec"
+check "--record: the first record is the query as sent, byte for byte (to the gimbal: 00 FF 5A 02 48 03 01 A6)" \
+    eval '[ "$(head -1 "$dir/session.rec" | cut -d" " -f2-)" = "1 00FF5A02480301A6" ]'
+q=$(grep -m1 '"name":"SYSTEM_VERSION"' "$dir/session.json")
+a=$(grep '"dir":"out"' "$dir/session.json" | grep -m1 '"name":"SYSTEM_VERSION"')
+check "--record: query (in, size 0) and answer (out) equal to what query printed" \
+    eval '[[ "$q" == *"\"dir\":\"in\",\"group\":72,\"type\":3,\"name\":\"SYSTEM_VERSION\",\"size\":0,"* ]] &&
+          [ "${a#*\"fields\"}" = "${v#*\"fields\"}" ]'
+check "--record: PACKET_RATE sent (in) and echoed (out) with angle_1 20" \
+    eval '[ "$(grep -c "\"name\":\"PACKET_RATE\",\"size\":16,\"fields\":{\"angle_1\":20," "$dir/session.json")" = 2 ] &&
+          [ "$(json_int "$e" angle_1)" = 20 ]'
+nmon=$(grep -c . "$dir/mon.json")
+ncap=$(grep '"dir":"out"' "$dir/session.json" | grep -c -e GIMBAL_ANGLE -e GIMBAL_RATE -e GEOREFERENCE_DATA)
+check "--record: the $nmon packets monitor printed are all in the capture ($ncap telemetry packets)" \
+    [ "$ncap" -ge "$nmon" ]
+python3 - "$dir/session.json" "$t_start" "$t_end" <<'PY'
+import json, sys
+from decimal import Decimal
+objs = [json.loads(l, parse_float=Decimal) for l in open(sys.argv[1])]
+lo, hi = Decimal(sys.argv[2]), Decimal(sys.argv[3])
+last = {}
+for o in objs:
+    t = o["time"]
+    assert lo <= t <= hi, (t, lo, hi)
+    assert t >= last.get(o["dir"], t), o
+    last[o["dir"]] = t
+PY
+check "--record: every time is wall-clock seconds within the session, non-decreasing per direction" [ $? -eq 0 ]
+$U can-pcap "$dir/other.pcap" "$DATA/decode_candump.log"
+expect_error "--record appending to a capture of another link type" 1 "cannot write capture" \
+    "$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/other.pcap"
+
+expect_error "record onto a full disk (/dev/full)" 1 "cannot write capture /dev/full: No space left on device" \
+    "$TASE" record --serial "$dir/gimbal" -o /dev/full --seconds 0.5
+
+# ---- tase record of the gimbal's line; SIGINT ends it cleanly ----
+"$TASE" record --serial "$dir/gimbal" -o "$dir/tele.pcap" >"$dir/rec.out" 2>&1 &
+rp=$!
+wait_for "$dir/rec.out" recording
+sleep 1.2
+kill -INT $rp
+wait $rp
+rc=$?
+"$TASE" decode "$dir/tele.pcap" >"$dir/tele.json"
+na=$(grep -c '"dir":"out".*"name":"GIMBAL_ANGLE"' "$dir/tele.json")
+nr=$($U records "$dir/tele.pcap" | grep -c .)
+check "record --serial, stopped by SIGINT: exit $rc, '$(tail -1 "$dir/rec.out")', $nr records, $na GIMBAL_ANGLE (20/s set above)" \
+    eval '[ $rc -eq 0 ] && grep -q "^recorded $nr records" "$dir/rec.out" && [ "$na" -ge 15 ] &&
+          ! grep -q "\"dir\":\"in\"" "$dir/tele.json"'
+kill "${pids[0]}"
+
+# ---- replay through joined pseudo-terminals, recorded on the other side ----
+$U pty-pair "$dir/A" "$dir/B" &
+pids+=($!)
+$U pty-pair "$dir/C" "$dir/D" &
+pids+=($!)
+for _ in $(seq 100); do [ -L "$dir/B" ] && [ -L "$dir/D" ] && break; sleep 0.05; done
+$U serial-pcap "$dir/slow.pcap" 3 40-120 "$DATA/decode_noisy.bin:out" "$DATA/decode_noisy.bin:in"
+
+# replay_to NAME REPLAY-ARGS...: record B (and D) while replaying; the
+# recorder is stopped (SIGINT) 0.2 s after the replay ends.
+replay_to() {
+    local name=$1
+    shift
+    "$TASE" record --serial "$dir/B" --tap-in "$dir/D" -o "$dir/$name.pcap" >"$dir/$name.rec" 2>&1 &
+    local rp=$!
+    wait_for "$dir/$name.rec" recording
+    "$@" >"$dir/$name.out" 2>&1
+    sleep 0.2
+    kill -INT $rp
+    wait $rp
+}
+bytes=$(wc -c <"$DATA/decode_noisy.bin")
+replay_to got "$TASE" replay "$dir/slow.pcap" --serial "$dir/A"
+check "replay (default: the gimbal's side): $(cat "$dir/got.out")" \
+    grep -q "^replayed [1-9][0-9]* of [0-9]* records ($bytes bytes)" "$dir/got.out"
+check "replay: every byte from the gimbal arrived, in order, within $tol s of its recorded time" \
+    $U timing "$dir/slow.pcap" "$dir/got.pcap" out 1 $tol
+replay_to fast "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --speed 2
+check "replay --speed 2: the same bytes at half the recorded intervals" \
+    $U timing "$dir/slow.pcap" "$dir/fast.pcap" out 2 $tol
+replay_to in "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir in
+check "replay --dir in: the bytes sent to the gimbal" \
+    $U timing "$dir/slow.pcap" "$dir/in.pcap" in 1 $tol
+start=$(date +%s%N)
+"$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --speed 0 >/dev/null
+ms=$((($(date +%s%N) - start) / 1000000))
+check "replay --speed 0 sends without waiting (${ms} ms for a 1.5 s capture)" [ "$ms" -lt "$fast_ms" ]
+
+# A two-line tap: the gimbal's line into A (recorded on B), the host's line
+# into C (recorded on D with --tap-in), both replayed at once.
+replay_both() {
+    "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out &
+    "$TASE" replay "$dir/slow.pcap" --serial "$dir/C" --dir in
+    wait $!
+}
+replay_to tap replay_both
+"$TASE" decode "$dir/tap.pcap" >"$dir/tap.json"
+for d in out in; do
+    grep "\"dir\":\"$d\"" "$dir/tap.json" | sed -E 's/"time":[0-9.]+,//; s/"dir":"[a-z]+",//' >"$dir/tap.$d"
+done
+check "record --tap-in: both lines decoded, each direction exactly the generator's packets" \
+    eval 'same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.out" && same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.in"'
+
+check_summary capture
+echo "captures: decode, record, --record, tap and replay all passed"

@@ -1,0 +1,167 @@
+/*
+ * tools/tk_capture.h - the bench tools' capture files (tools-private, Linux,
+ * libpcap). Not part of the library's API.
+ *
+ * FORMAT. Captures are pcap files written through libpcap with nanosecond
+ * timestamps (the host's wall clock, CLOCK_REALTIME, taken when the read
+ * that returned the bytes came back; for CAN the kernel's receive time).
+ * Readers take pcap and pcapng (libpcap converts the timestamps).
+ *
+ *   - Serial: link type TK_CAP_LINKTYPE_SERIAL (LINKTYPE_USER0, 147). One
+ *     record per read() (or per write of the tool's own transmissions),
+ *     byte-exact: a one-byte pseudo-header, then the bytes.
+ *         byte 0   direction: TK_CAP_FROM_GIMBAL (0x00, JSON "dir":"out")
+ *                             TK_CAP_TO_GIMBAL   (0x01, JSON "dir":"in")
+ *                  any other value is an error in the record
+ *         byte 1.. the bytes as they were read or written (at least one)
+ *   - CAN: link type LINKTYPE_CAN_SOCKETCAN (227), the standard layout
+ *     Wireshark's CAN dissector reads: 4-byte identifier with the
+ *     SocketCAN EFF/RTR/ERR flags in its top bits (big-endian), payload
+ *     length, FD flags, two reserved bytes, then the data: 16-byte records
+ *     for classic frames, 72-byte records for CAN FD frames, exactly as
+ *     the kernel's struct can_frame / canfd_frame with the identifier
+ *     stored big-endian. Every frame on the interface is recorded (error
+ *     frames included).
+ *
+ * JSON and replay use the toolkit's microsecond tk_time_t (the files keep
+ * nanoseconds). Every function prints one line and exits (tk_die) on an
+ * error it cannot recover from, like the rest of the toolkit; malformed
+ * records in a capture being read are reported to the caller instead, so a
+ * decode can go on with the rest.
+ */
+#ifndef TASE_TOOLS_TK_CAPTURE_H
+#define TASE_TOOLS_TK_CAPTURE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <time.h>
+
+#include "toolkit.h"
+
+#define TK_CAP_LINKTYPE_SERIAL 147 /* LINKTYPE_USER0: TASE serial, see above */
+#define TK_CAP_LINKTYPE_CAN 227    /* LINKTYPE_CAN_SOCKETCAN */
+#define TK_CAP_FROM_GIMBAL 0u      /* serial pseudo-header: bytes sent by the gimbal */
+#define TK_CAP_TO_GIMBAL 1u        /* serial pseudo-header: bytes sent to the gimbal */
+#define TK_CAP_CAN_HEADER 8u       /* bytes before a CAN record's data */
+#define TK_CAP_CAN_MAX 72u         /* a CAN FD record */
+
+/* Replay/record selection of directions. */
+typedef enum {
+    TK_CAP_DIR_OUT = 1, /* from the gimbal */
+    TK_CAP_DIR_IN = 2,  /* to the gimbal */
+    TK_CAP_DIR_ALL = 3  /* both; for CAN every frame, whatever its ID */
+} tk_cap_dirs_t;
+
+/* ---- writing ---- */
+
+typedef struct {
+    void *pcap;   /* pcap_t of pcap_open_dead() */
+    void *dumper; /* pcap_dumper_t */
+    const char *path;
+    int linktype;
+    unsigned long records;
+} tk_cap_writer_t;
+
+/* Create `path` (replacing it), or with `append` add to it (creating it if
+ * it does not exist; an existing file must be a nanosecond pcap of the
+ * same link type). Dies with the reason on failure. */
+void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool append);
+/* One serial record: direction byte + n (>= 1) bytes, at wall-clock time t. */
+void tk_cap_put_serial(tk_cap_writer_t *w, const struct timespec *t, unsigned dir,
+                       const uint8_t *data, size_t n);
+/* One CAN record: `rec` is a SocketCAN struct can_frame (16 bytes) or
+ * canfd_frame (72 bytes) exactly as read from a raw socket, identifier in
+ * host byte order (it is written big-endian). */
+void tk_cap_put_can(tk_cap_writer_t *w, const struct timespec *t, const uint8_t *rec, size_t n);
+/* Push buffered records to the file; dies on a write error. */
+void tk_cap_flush(tk_cap_writer_t *w);
+/* Flush and close; dies on a write error. */
+void tk_cap_close(tk_cap_writer_t *w);
+/* The same without dying (for exit handlers): returns 0 or an errno. */
+int tk_cap_finish(tk_cap_writer_t *w);
+
+/* A port that records what passes through `inner` into `w` (reads as
+ * TK_CAP_FROM_GIMBAL, accepted writes as TK_CAP_TO_GIMBAL) and is
+ * otherwise `inner` itself. `tap` must outlive the port. */
+typedef struct {
+    tase_port_t inner;
+    tk_cap_writer_t *w;
+} tk_cap_tap_t;
+tase_port_t tk_cap_tap_port(tk_cap_tap_t *tap, tase_port_t inner, tk_cap_writer_t *w);
+/* --record FILE: append this process's serial session to FILE (a tap port
+ * over `inner`, the capture closed by an exit handler, which reports a
+ * write error on stderr and exits 1). Once per run. */
+tase_port_t tk_cap_record_session(const char *path, tase_port_t inner);
+
+/* ---- reading ---- */
+
+/* Whether the first bytes of a file are a pcap or pcapng header (n >= 4). */
+bool tk_cap_is_capture(const uint8_t *head, size_t n);
+
+typedef struct {
+    void *pcap;
+    int linktype; /* TK_CAP_LINKTYPE_SERIAL or TK_CAP_LINKTYPE_CAN */
+    const char *path;
+    unsigned long index; /* records read so far */
+} tk_cap_reader_t;
+
+/* Open a capture on descriptor `fd` (a file or a pipe; not closed here),
+ * of which head[0..nhead) were read already (the caller looked at the
+ * magic): they are read again first. `path` names it in messages. Dies
+ * when libpcap cannot read it or its link type is neither of the two. */
+void tk_cap_reader_open(tk_cap_reader_t *r, int fd, const uint8_t *head, size_t nhead,
+                        const char *path);
+void tk_cap_reader_close(tk_cap_reader_t *r);
+
+typedef struct {
+    unsigned long index; /* 1-based record number in the file */
+    tk_time_t t;         /* capture time, to the microsecond */
+    /* serial records */
+    unsigned dir;        /* TK_CAP_FROM_GIMBAL or TK_CAP_TO_GIMBAL */
+    const uint8_t *data; /* valid until the next call */
+    size_t len;
+    /* CAN records */
+    uint32_t can_id; /* identifier with the SocketCAN flag bits */
+    bool can_data;   /* a classic data frame: `frame` holds it */
+    tase_can_frame_t frame;
+} tk_cap_rec_t;
+
+#define TK_CAP_END 0
+#define TK_CAP_RECORD 1
+#define TK_CAP_BAD 2 /* malformed record: `why` says what; the next call goes on */
+
+/* Next record. Returns TK_CAP_RECORD, TK_CAP_END, or TK_CAP_BAD with a
+ * reason in why[0..cap) (rec->index set). Dies on a read error or a file
+ * cut inside a record header. */
+int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap);
+
+/* ---- record and replay loops ---- */
+
+/* Record the serial device `dev` (bytes from the gimbal) and optionally a
+ * second device `tap_in` (bytes to the gimbal, the other line of a tap)
+ * into `w` until `seconds` pass or, with 0, until a signal the toolkit
+ * catches (tk_signal: SIGINT, SIGTERM, SIGHUP, the normal end of a
+ * recording). Closes `w` and prints a summary on stdout. */
+void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_in, long baud,
+                          double seconds);
+/* Record every frame of CAN interface `iface` likewise. */
+void tk_cap_record_can(tk_cap_writer_t *w, const char *iface, double seconds);
+
+/* Send the records of `r` selected by `dirs` to a serial device (the
+ * bytes) or, with `can` non-NULL, to a CAN interface (frames as recorded;
+ * serial bytes cut into frames of their direction's ID), at the capture's
+ * timing divided by `speed` (0: no waiting). Prints a summary on stdout;
+ * a caught signal stops it (the caller then exits 128 + N). Returns the
+ * number of malformed records skipped (each reported on stderr). */
+typedef struct {
+    const char *serial; /* device, or NULL */
+    long baud;
+    const char *can; /* interface, or NULL */
+    tk_cap_dirs_t dirs;
+    double speed;
+} tk_replay_opts_t;
+unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o);
+
+#endif /* TASE_TOOLS_TK_CAPTURE_H */

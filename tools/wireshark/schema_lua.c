@@ -1,0 +1,38 @@
+/* Prints the packet table of tools/wireshark/tase.lua from the library's
+ * schema (tase/schema.h), so the dissector names every packet and field
+ * exactly as `tase list` and the JSON contract do. The generated block sits
+ * between the "BEGIN GENERATED" and "END GENERATED" lines of tase.lua;
+ * scripts/check-wireshark.sh fails when they differ (`--fix` rewrites it).
+ * Usage: tase-schema-lua > block */
+#include <stdio.h>
+
+#include "tase/schema.h"
+
+int main(void)
+{
+    size_t i;
+    unsigned j;
+    puts("-- BEGIN GENERATED (tools/wireshark/schema_lua.c; do not edit by hand)");
+    puts("-- {group, type, name, data length, flags, {{field, offset, width, signed}...}}");
+    puts("-- flags: q = zero-length query form, 1 = one-byte form, t = free bytes after");
+    puts("-- the fields (CAMERA_PASS)");
+    puts("local SCHEMA = {");
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        printf("    {0x%02X, 0x%02X, \"%s\", %u, \"%s%s%s\", {", (unsigned)TASE_ID_GROUP(p->id),
+               (unsigned)TASE_ID_TYPE(p->id), tase_schema_packet_name(p), (unsigned)p->len,
+               (p->flags & TASE_LEN_QUERY) != 0u ? "q" : "",
+               (p->flags & TASE_LEN_SHORT1) != 0u ? "1" : "",
+               (p->flags & TASE_LEN_TAIL) != 0u ? "t" : "");
+        for (j = 0; j < p->nfields; j++) {
+            const tase_field_t *f = tase_schema_field(p, j);
+            printf("%s{\"%s\", %u, %u, %s},", j % 3u == 0u ? "\n        " : " ",
+                   tase_schema_field_name(p, j), (unsigned)f->offset, TASE_FIELD_WIDTH(f),
+                   TASE_FIELD_IS_SIGNED(f) ? "true" : "false");
+        }
+        puts(p->nfields > 0 ? "\n    }}," : "}},");
+    }
+    puts("}");
+    puts("-- END GENERATED");
+    return 0;
+}

@@ -1,0 +1,413 @@
+-- tase.lua: Wireshark dissector for the Cloud Cap TASE gimbal protocol
+-- (Wireshark 3.x/4.x, its Lua 5.2 API).
+--
+-- Load it for one run:
+--     wireshark -X lua_script:tools/wireshark/tase.lua capture.pcap
+--     tshark    -X lua_script:tools/wireshark/tase.lua -r capture.pcap -O tase
+-- or for good: copy it into the personal Lua plugin folder
+-- (~/.local/lib/wireshark/plugins/; Help > About > Folders shows it).
+--
+-- What it dissects:
+--   * TASE over CAN: Wireshark's own CAN dissector hands it the payload of
+--     extended frames 0x10000000 (from the gimbal, "dir" "out") and
+--     0x11000000 (to the gimbal, "dir" "in"), whose datalink bytes it
+--     reassembles per direction (and per capture interface) across frames,
+--     and the 3AX drive frames 0x12010000 (move command) and 0x12020000
+--     (status). Works on candump logs (tshark reads them directly), pcap
+--     and pcapng captures with LINKTYPE_CAN_SOCKETCAN (`tase record --can`).
+--   * `tase record --serial` captures: link type LINKTYPE_USER0 (147),
+--     each record a one-byte direction pseudo-header (0x00 from the gimbal,
+--     0x01 to the gimbal; anything else is flagged) followed by the bytes
+--     as read. Registered for that link type directly: no "DLT_USER"
+--     preference is needed.
+--
+-- Every TASE packet gets a "tase" tree named as in `tase list`, with the
+-- keys of `tase decode`'s JSON as filter fields: tase.offset, tase.dir,
+-- tase.group, tase.type, tase.name, tase.size (the data length), the
+-- packet's fields as tase.<packet name in lower case>.<field> with the raw
+-- wire integers (e.g. tase.gimbal_angle.pan), tase.data for CAMERA_PASS's
+-- camera bytes and an unknown packet's data, and tase.error "wrong length"
+-- for a valid frame whose data length its type does not accept. Filter
+-- examples: tase.name == "GIMBAL_CMD", tase.gimbal_angle.tilt < -4500.
+--
+-- Reassembly follows the library's receiver (tase/frame.h): every
+-- 00 FF 5A starts a candidate frame judged on its own bytes, a valid one is
+-- shown in the record or CAN frame that completes it, candidates that began
+-- inside a valid frame are dropped; noise and failed checksums are skipped.
+-- It tracks every candidate (the library tracks 4 before re-scanning), so
+-- on adversarial streams full of false syncs a frame can appear earlier
+-- here than in `tase decode`, never missing. tase.offset counts the bytes
+-- of the frame's direction from the start of the capture, as `tase decode`
+-- does. Wireshark 4.0's candump reader drops interface names, so a candump
+-- log with TASE traffic on several interfaces is reassembled as one bus;
+-- `tase decode --candump` keeps them apart.
+
+local tase = Proto("tase", "TASE gimbal protocol")
+local tase_serial = Proto("tase_serial", "TASE serial capture")
+
+-- BEGIN GENERATED (tools/wireshark/schema_lua.c; do not edit by hand)
+-- {group, type, name, data length, flags, {{field, offset, width, signed}...}}
+-- flags: q = zero-length query form, 1 = one-byte form, t = free bytes after
+-- the fields (CAMERA_PASS)
+local SCHEMA = {
+    {0x00, 0x80, "GIMBAL_CMD", 8, "", {
+        {"pan", 0, 2, true}, {"tilt", 2, 2, true}, {"roll", 4, 2, true},
+        {"flags", 6, 1, false}, {"impulse_time", 7, 1, false},
+    }},
+    {0x00, 0x40, "GYRO_ZERO_CMD", 0, "", {}},
+    {0x00, 0x41, "CAMERA_CMD", 10, "1", {
+        {"camera", 0, 1, false}, {"hfov", 2, 2, true}, {"focus", 4, 2, false},
+        {"exposure", 6, 1, false}, {"shutter_speed", 7, 1, false}, {"bright", 8, 1, false},
+        {"flags", 9, 1, false},
+    }},
+    {0x00, 0x81, "LEGACY_CAMERA_CMD", 8, "", {
+        {"zoom", 0, 2, false}, {"focus", 2, 2, false}, {"auto_exposure", 4, 1, false},
+        {"shutter_speed", 5, 1, false}, {"iris", 6, 1, false}, {"gain", 7, 1, false},
+    }},
+    {0x00, 0x42, "CAMERA_PASS", 4, "t", {
+        {"camera", 0, 1, false}, {"baud", 1, 1, false},
+    }},
+    {0x00, 0x43, "RETRACT_DEPLOY_CMD", 2, "", {
+        {"deploy", 0, 1, false},
+    }},
+    {0x08, 0x10, "GIMBAL_ANGLE", 6, "", {
+        {"pan", 0, 2, true}, {"tilt", 2, 2, true}, {"roll", 4, 2, true},
+    }},
+    {0x08, 0x40, "GIMBAL_RATE", 18, "", {
+        {"time", 0, 4, false}, {"pan_rate", 4, 2, true}, {"tilt_rate", 6, 2, true},
+        {"roll_rate", 8, 2, true}, {"p", 10, 2, true}, {"q", 12, 2, true},
+        {"r", 14, 2, true}, {"mode", 17, 1, false},
+    }},
+    {0x08, 0x41, "HOST_SENSOR", 20, "", {
+        {"time", 0, 4, false}, {"roll", 4, 2, true}, {"pitch", 6, 2, true},
+        {"yaw", 8, 2, true}, {"flags", 10, 1, false}, {"sample_rate", 11, 1, false},
+        {"x_accel", 12, 2, true}, {"y_accel", 14, 2, true}, {"z_accel", 16, 2, true},
+        {"tas", 18, 2, false},
+    }},
+    {0x08, 0x42, "HOST_ATTITUDE", 12, "", {
+        {"time", 0, 4, false}, {"roll", 4, 2, true}, {"pitch", 6, 2, true},
+        {"yaw", 8, 2, true}, {"flags", 10, 1, false}, {"sample_rate", 11, 1, false},
+    }},
+    {0x10, 0x10, "HOST_GPS_DATA", 32, "", {
+        {"time", 0, 4, false}, {"lat", 4, 4, true}, {"lon", 8, 4, true},
+        {"height", 12, 4, true}, {"vnorth", 16, 2, true}, {"veast", 18, 2, true},
+        {"vdown", 20, 2, true}, {"year", 22, 2, false}, {"month", 24, 1, false},
+        {"day", 25, 1, false}, {"hour", 26, 1, false}, {"minute", 27, 1, false},
+        {"second", 28, 1, false}, {"frac_second", 29, 1, false}, {"valid", 30, 1, false},
+        {"sample_rate", 31, 1, false},
+    }},
+    {0x10, 0x40, "SPOI_CMD", 19, "q", {
+        {"lat", 0, 4, true}, {"lon", 4, 4, true}, {"height", 8, 4, true},
+        {"vnorth", 12, 2, true}, {"veast", 14, 2, true}, {"vdown", 16, 2, true},
+        {"flags", 18, 1, false},
+    }},
+    {0x10, 0x41, "GEOREFERENCE_DATA", 63, "", {
+        {"time", 0, 4, false}, {"lat", 4, 4, true}, {"lon", 8, 4, true},
+        {"height", 12, 4, true}, {"vnorth", 16, 2, true}, {"veast", 18, 2, true},
+        {"vdown", 20, 2, true}, {"year", 22, 2, false}, {"month", 24, 1, false},
+        {"day", 25, 1, false}, {"hour", 26, 1, false}, {"minute", 27, 1, false},
+        {"second", 28, 1, false}, {"frac_second", 29, 1, false}, {"num_sats", 30, 1, false},
+        {"pdop", 31, 1, false}, {"status", 32, 2, false}, {"camera_roll", 34, 2, true},
+        {"camera_pitch", 36, 2, true}, {"camera_yaw", 38, 2, true}, {"hfov", 40, 2, false},
+        {"vfov", 42, 2, false}, {"focal", 44, 2, false}, {"mode", 46, 1, false},
+        {"sample_rate", 47, 1, false}, {"nav_health", 48, 2, false}, {"mount_roll", 50, 2, true},
+        {"mount_pitch", 52, 2, true}, {"mount_yaw", 54, 2, true}, {"pan", 56, 2, true},
+        {"tilt", 58, 2, true}, {"roll", 60, 2, true}, {"camera", 62, 1, false},
+    }},
+    {0x48, 0x00, "PACKET_RATE", 16, "q", {
+        {"angle_1", 0, 1, false}, {"rate_1", 1, 1, false}, {"geo_ref_1", 2, 1, false},
+        {"camera_1", 3, 1, false}, {"angle_2", 5, 1, false}, {"rate_2", 6, 1, false},
+        {"geo_ref_2", 7, 1, false}, {"camera_2", 8, 1, false}, {"angle_3", 10, 1, false},
+        {"rate_3", 11, 1, false}, {"geo_ref_3", 12, 1, false}, {"camera_3", 13, 1, false},
+        {"temporary", 15, 1, false},
+    }},
+    {0x48, 0x01, "SENSOR_FILTER", 2, "q", {
+        {"cutoff", 0, 1, false}, {"decimation", 1, 1, false},
+    }},
+    {0x48, 0x02, "AXIS_SETTING", 23, "q", {
+        {"pan_nogo_center", 0, 2, true}, {"pan_nogo_range", 2, 2, false}, {"tilt_nogo_center", 4, 2, true},
+        {"tilt_nogo_range", 6, 2, false}, {"roll_nogo_center", 8, 2, true}, {"roll_nogo_range", 10, 2, false},
+        {"pan_max_rate", 12, 1, false}, {"tilt_max_rate", 14, 1, false}, {"roll_max_rate", 15, 1, false},
+        {"pan_max_accel", 16, 1, false}, {"tilt_max_accel", 17, 1, false}, {"roll_max_accel", 18, 1, false},
+        {"pan_pos_gain", 19, 1, false}, {"tilt_pos_gain", 20, 1, false}, {"roll_pos_gain", 21, 1, false},
+        {"temporary", 22, 1, false},
+    }},
+    {0x48, 0x03, "SYSTEM_VERSION", 42, "q", {
+        {"major", 0, 1, false}, {"minor", 1, 1, false}, {"sub", 2, 1, false},
+        {"released", 3, 1, false}, {"soft_year", 4, 2, false}, {"soft_month", 6, 1, false},
+        {"soft_day", 7, 1, false}, {"board_sn", 8, 4, false}, {"board_rev", 12, 4, false},
+        {"board_config", 16, 4, false}, {"board_year", 20, 2, false}, {"board_month", 22, 1, false},
+        {"board_day", 23, 1, false}, {"camera_a", 24, 1, false}, {"max_hfov_a", 26, 2, false},
+        {"min_hfov_a", 28, 2, false}, {"camera_b", 30, 1, false}, {"max_hfov_b", 32, 2, false},
+        {"min_hfov_b", 34, 2, false}, {"camera_c", 36, 1, false}, {"max_hfov_c", 38, 2, false},
+        {"min_hfov_c", 40, 2, false},
+    }},
+    {0x48, 0x04, "NAV_SOURCE", 2, "q", {
+        {"external_attitude", 0, 1, false}, {"external_gps", 1, 1, false},
+    }},
+    {0x48, 0x05, "CAMERA_TYPE", 3, "q", {
+        {"camera_a", 0, 1, false}, {"camera_b", 1, 1, false}, {"camera_c", 2, 1, false},
+    }},
+    {0x48, 0x06, "GPS_LEVER_ARM", 6, "q", {
+        {"x", 0, 2, true}, {"y", 2, 2, true}, {"z", 4, 2, true},
+    }},
+    {0x48, 0x07, "CAMERA_ALIGN", 16, "q", {
+        {"zoom_1", 0, 2, false}, {"pan_err_1", 2, 2, true}, {"tilt_err_1", 4, 2, true},
+        {"roll_err_1", 6, 2, true}, {"zoom_2", 8, 2, false}, {"pan_err_2", 10, 2, true},
+        {"tilt_err_2", 12, 2, true}, {"roll_err_2", 14, 2, true},
+    }},
+}
+-- END GENERATED
+
+local SYNC = "\0\255\90" -- 00 FF 5A
+local DIR_NAMES = {[0] = "out", [1] = "in"} -- serial pseudo-header values
+local CAN_DIRS = {[0x10000000] = "out", [0x11000000] = "in"}
+local ID_3AX_MOVE, ID_3AX_STATUS = 0x12010000, 0x12020000
+
+local F = {
+    dir = ProtoField.string("tase.dir", "dir"),
+    offset = ProtoField.uint64("tase.offset", "offset"),
+    group = ProtoField.uint8("tase.group", "group", base.HEX),
+    type = ProtoField.uint8("tase.type", "type", base.HEX),
+    name = ProtoField.string("tase.name", "name"),
+    size = ProtoField.uint8("tase.size", "size"),
+    checksum = ProtoField.uint16("tase.checksum", "checksum", base.HEX),
+    data = ProtoField.bytes("tase.data", "data"),
+    error = ProtoField.string("tase.error", "error"),
+    move_position = ProtoField.uint8("tase.3ax_move.position", "position (0 deploy, else retract)"),
+    status_position = ProtoField.uint8("tase.3ax_status.position",
+        "position (0 deployed .. 254 retracted, 255 unknown)"),
+    status_speed = ProtoField.int8("tase.3ax_status.speed", "speed (units of 5 deg/s)"),
+    serial_dir = ProtoField.uint8("tase_serial.dir", "direction", base.HEX,
+        {[0] = "from the gimbal (out)", [1] = "to the gimbal (in)"}),
+    serial_bytes = ProtoField.bytes("tase_serial.bytes", "bytes"),
+}
+local E = {
+    bad_dir = ProtoExpert.new("tase_serial.bad_dir", "unknown direction byte",
+        expert.group.MALFORMED, expert.severity.ERROR),
+    wrong_length = ProtoExpert.new("tase.wrong_length", "wrong data length for this packet type",
+        expert.group.MALFORMED, expert.severity.WARN),
+}
+
+-- Packet table keyed by group * 256 + type, with a ProtoField per field.
+local PACKETS = {}
+local field_list = {}
+for _, f in pairs(F) do
+    if f ~= F.serial_dir and f ~= F.serial_bytes then field_list[#field_list + 1] = f end
+end
+for _, row in ipairs(SCHEMA) do
+    local p = {group = row[1], type = row[2], name = row[3], len = row[4], flags = row[5], fields = {}}
+    for _, fr in ipairs(row[6]) do
+        local abbr = "tase." .. row[3]:lower() .. "." .. fr[1]
+        local ctor = (fr[4] and "int" or "uint") .. (8 * fr[3])
+        local pf = ProtoField[ctor](abbr, fr[1])
+        p.fields[#p.fields + 1] = {name = fr[1], offset = fr[2], width = fr[3], pf = pf}
+        field_list[#field_list + 1] = pf
+    end
+    PACKETS[row[1] * 256 + row[2]] = p
+end
+tase.fields = field_list
+tase_serial.fields = {F.serial_dir, F.serial_bytes}
+tase.experts = {E.wrong_length}
+tase_serial.experts = {E.bad_dir}
+
+-- The data lengths a packet accepts (tase_schema_length_ok()).
+local function length_ok(p, len)
+    return len == p.len or (len == 0 and p.flags:find("q", 1, true) ~= nil)
+        or (len == 1 and p.flags:find("1", 1, true) ~= nil)
+        or (len >= p.len and p.flags:find("t", 1, true) ~= nil)
+end
+
+-- ---- reassembly, one stream per direction and interface ----
+
+local streams, found
+
+-- Called by Wireshark before each (re)dissection of a capture.
+local function reset()
+    streams = {} -- key -> {buf, base, cands, scanned, consumed}
+    found = {}   -- packet number -> {{off, raw}...}: the first pass's results
+end
+tase.init = reset
+reset()
+
+local function checksum_ok(raw)
+    local sum, n = 0, #raw
+    for i = 1, n - 2 do sum = sum + raw:byte(i) end
+    return sum % 65536 == raw:byte(n - 1) * 256 + raw:byte(n)
+end
+
+-- Append bytes to a stream; returns the frames they complete, in the order
+-- the library's receiver delivers them (by their last byte).
+local function feed(key, chunk)
+    local st = streams[key]
+    if st == nil then
+        st = {buf = "", base = 0, cands = {}, scanned = 0, consumed = 0}
+        streams[key] = st
+    end
+    st.buf = st.buf .. chunk
+    local top = st.base + #st.buf -- stream offset just past the last byte
+    local from = st.scanned
+    while true do
+        local i = st.buf:find(SYNC, from - st.base + 1, true)
+        if i == nil then break end
+        local s = st.base + i - 1
+        if s >= st.consumed then st.cands[#st.cands + 1] = s end
+        from = s + 1
+    end
+    st.scanned = math.max(st.scanned, top - 2)
+    local out = {}
+    while true do
+        local best, best_end, best_k
+        local k = 1
+        while k <= #st.cands do
+            local s = st.cands[k]
+            local size = st.buf:byte(s - st.base + 4)
+            if size ~= nil and size < 2 then
+                table.remove(st.cands, k) -- Size < 2: no frame
+            else
+                if size ~= nil then
+                    local e = s + size + 6
+                    if e <= top and (best_end == nil or e < best_end) then
+                        best, best_end, best_k = s, e, k
+                    end
+                end
+                k = k + 1
+            end
+        end
+        if best == nil then break end
+        local raw = st.buf:sub(best - st.base + 1, best_end - st.base)
+        if checksum_ok(raw) then
+            out[#out + 1] = {off = best, raw = raw}
+            local kept = {}
+            for _, s in ipairs(st.cands) do
+                if s < best or s >= best_end then kept[#kept + 1] = s end
+            end
+            st.cands = kept
+            st.consumed = math.max(st.consumed, best_end)
+        else
+            table.remove(st.cands, best_k)
+        end
+    end
+    local keep = math.max(st.base, top - 2)
+    if st.cands[1] ~= nil and st.cands[1] < keep then keep = st.cands[1] end
+    st.buf = st.buf:sub(keep - st.base + 1)
+    st.base = keep
+    return out
+end
+
+-- ---- display ----
+
+local function add_frame(tree, fr, dir)
+    local ftvb = ByteArray.new(fr.raw, true):tvb("TASE frame")
+    local group, ptype, sizeb = ftvb(4, 1):uint(), ftvb(5, 1):uint(), ftvb(3, 1):uint()
+    local len = sizeb - 2
+    local p = PACKETS[group * 256 + ptype]
+    local name = p and p.name or "UNKNOWN"
+    local t = tree:add(tase, ftvb(), string.format("TASE %s (0x%02X/0x%02X), %d data bytes, %s",
+        name, group, ptype, len, dir == "in" and "to the gimbal" or "from the gimbal"))
+    t:add(F.offset, ftvb(0, 3), UInt64.new(fr.off)):set_generated()
+    t:add(F.dir, dir):set_generated()
+    t:add(F.group, ftvb(4, 1))
+    t:add(F.type, ftvb(5, 1))
+    t:add(F.name, ftvb(4, 2), name)
+    t:add(F.size, ftvb(3, 1), len)
+    local data = len > 0 and ftvb(6, len) or nil
+    if p == nil then
+        if data then t:add(F.data, data) end
+    elseif not length_ok(p, len) then
+        t:add(F.error, ftvb(3, 1), "wrong length")
+        t:add_proto_expert_info(E.wrong_length)
+    else
+        for _, f in ipairs(p.fields) do
+            if f.offset + f.width > len then break end -- short forms: the fields that fit
+            t:add(f.pf, ftvb(6 + f.offset, f.width))
+        end
+        if p.flags:find("t", 1, true) then -- CAMERA_PASS: its camera bytes, maybe none
+            t:add(F.data, ftvb(6 + p.len, len - p.len))
+        end
+    end
+    t:add(F.checksum, ftvb(6 + len, 2))
+    return name
+end
+
+-- Feed a chunk of direction `dir` (first pass) and show every frame it
+-- completed; returns their names for the Info column.
+local function dissect_chunk(tvb, pinfo, tree, key, dir)
+    local frames = found[pinfo.number]
+    if frames == nil then
+        frames = tvb:len() > 0 and feed(key, tvb:raw()) or {}
+        found[pinfo.number] = frames
+    end
+    local names = {}
+    for _, fr in ipairs(frames) do names[#names + 1] = add_frame(tree, fr, dir) end
+    pinfo.cols.protocol = "TASE"
+    if #names > 0 then
+        pinfo.cols.info = dir .. " " .. table.concat(names, ", ")
+    else
+        pinfo.cols.info = string.format("%s %d datalink bytes (no complete packet)", dir, tvb:len())
+    end
+end
+
+local f_can_id = Field.new("can.id")
+local f_interface = Field.new("frame.interface_id")
+
+local function dissect_3ax(tvb, pinfo, tree, id)
+    local move = id == ID_3AX_MOVE
+    local name = move and "3AX_MOVE" or "3AX_STATUS"
+    local t = tree:add(tase, tvb(), "TASE " .. name .. (move and " (gimbal to 3AX drive)" or
+        " (3AX drive to gimbal)"))
+    t:add(F.name, name):set_generated()
+    t:add(F.size, tvb:len()):set_generated()
+    pinfo.cols.protocol = "TASE"
+    pinfo.cols.info = name
+    if tvb:len() ~= 2 then
+        t:add(F.error, "wrong length")
+        t:add_proto_expert_info(E.wrong_length)
+        return
+    end
+    if move then
+        t:add(F.move_position, tvb(0, 1))
+    else
+        t:add(F.status_position, tvb(0, 1))
+        t:add(F.status_speed, tvb(1, 1))
+    end
+end
+
+function tase.dissector(tvb, pinfo, tree)
+    local id = f_can_id()
+    id = id and id.value or 0
+    if id == ID_3AX_MOVE or id == ID_3AX_STATUS then
+        dissect_3ax(tvb, pinfo, tree, id)
+        return tvb:len()
+    end
+    local dir = CAN_DIRS[id]
+    if dir == nil then return 0 end
+    local ifid = f_interface()
+    dissect_chunk(tvb, pinfo, tree, "can:" .. tostring(ifid and ifid.value or 0) .. ":" .. dir, dir)
+    return tvb:len()
+end
+
+function tase_serial.dissector(tvb, pinfo, tree)
+    local t = tree:add(tase_serial, tvb(), "TASE serial capture record")
+    if tvb:len() < 1 then return 0 end
+    t:add(F.serial_dir, tvb(0, 1))
+    local dir = DIR_NAMES[tvb(0, 1):uint()]
+    if dir == nil then
+        t:add_proto_expert_info(E.bad_dir)
+        pinfo.cols.protocol = "TASE"
+        pinfo.cols.info = "bad direction byte"
+        return tvb:len()
+    end
+    if tvb:len() < 2 then return tvb:len() end
+    t:add(F.serial_bytes, tvb(1))
+    local ifid = f_interface()
+    dissect_chunk(tvb(1):tvb(), pinfo, tree, "serial:" .. tostring(ifid and ifid.value or 0) ..
+        ":" .. dir, dir)
+    return tvb:len()
+end
+
+local can_ids = DissectorTable.get("can.extended_id")
+for _, id in ipairs({0x10000000, 0x11000000, ID_3AX_MOVE, ID_3AX_STATUS}) do
+    can_ids:add(id, tase)
+end
+DissectorTable.get("wtap_encap"):add(wtap_encaps.USER0, tase_serial)
