@@ -24,7 +24,7 @@ static const char usage_exit[] =
     "exit status: 0 success; 1 failure (device, I/O, timeout, writing the output);\n"
     "  2 bad command line (nothing was sent); 3 the gimbal's echo differs from the\n"
     "  setting sent; 4 input not fully understood (bad candump lines, no packet\n"
-    "  found); 128+N interrupted by signal N.\n";
+    "  found); 128+N interrupted by signal N (141: the output's reader went away).\n";
 
 static const char usage_link[] =
     "link options:\n"
@@ -1263,8 +1263,9 @@ static int cmd_monitor(args_t *a)
 typedef struct {
     int fd;
     const char *name; /* for messages */
-    /* the first bytes, kept for the hint when nothing is found */
-    uint8_t head[512];
+    /* the first bytes, kept for the hint when nothing is found (one
+     * more for a terminating NUL) */
+    uint8_t head[513];
     size_t nhead;
 } input_t;
 
@@ -1298,8 +1299,9 @@ static size_t input_read(input_t *in, uint8_t *buf, size_t cap)
         ssize_t n = read(in->fd, buf, cap);
         if (n > 0) {
             size_t k = (size_t)n;
-            if (in->nhead < sizeof(in->head)) {
-                size_t c = sizeof(in->head) - in->nhead < k ? sizeof(in->head) - in->nhead : k;
+            if (in->nhead < sizeof(in->head) - 1u) {
+                size_t room = sizeof(in->head) - 1u - in->nhead;
+                size_t c = room < k ? room : k;
                 memcpy(in->head + in->nhead, buf, c);
                 in->nhead += c;
             }

@@ -27,15 +27,18 @@
 #define NCAM 3u
 
 static const char usage[] =
-    "usage: tase-sim [--link PATH | --can IFACE] [--klv-link PATH] [--seconds S]\n"
-    "                [--quiet]\n"
+    "usage: tase-sim [--link PATH [--baud N] | --can IFACE] [--klv-link PATH]\n"
+    "                [--seconds S] [--quiet]\n"
     "A simulated TASE gimbal. By default it serves the serial datalink on a new\n"
     "pseudo-terminal and prints its path; --link PATH also makes PATH a symlink to\n"
     "it. --can IFACE serves the CAN datalink on a SocketCAN interface instead.\n"
     "--klv-link PATH adds the KLV metadata output (an 87-byte packet about every\n"
     "900 ms) on a second pseudo-terminal, symlinked at PATH. It answers every In\n"
     "packet of the spec and streams GIMBAL_ANGLE, GIMBAL_RATE and GEOREFERENCE_DATA\n"
-    "at the PACKET_RATE rates. Runs until SIGINT, SIGTERM or SIGHUP, or for S\n"
+    "at the PACKET_RATE rates, never more than the link carries: on the serial\n"
+    "link (--baud, default 57600) telemetry uses at most 75% of baud/10 bytes per\n"
+    "second (the gimbal role's capacity rule), whatever PACKET_RATE asks. Runs until SIGINT, "
+    "SIGTERM or SIGHUP, or for S\n"
     "seconds, then removes its links. A link another running tase-sim holds is\n"
     "refused. Exit status: 0 success, 1 failure, 2 bad command line.\n";
 
@@ -72,25 +75,9 @@ static void logf_(const sim_t *s, uint32_t now, const char *fmt, ...)
     fflush(stdout);
 }
 
-/* Encode a typed packet and copy its data bytes (the frame's payload). */
-static int payload(uint16_t id, const void *msg, uint8_t *data, size_t cap)
-{
-    uint8_t frame[TASE_FRAME_MAX];
-    int n = tase_packet_encode(id, msg, frame, sizeof(frame));
-    if (n < (int)TASE_FRAME_OVERHEAD || (size_t)n - TASE_FRAME_OVERHEAD > cap) {
-        return n < 0 ? n : TASE_ENOSPC;
-    }
-    memcpy(data, frame + TASE_FRAME_HEADER, (size_t)n - TASE_FRAME_OVERHEAD);
-    return n - (int)TASE_FRAME_OVERHEAD;
-}
-
 static void send_packet(sim_t *s, unsigned port, uint16_t id, const void *msg)
 {
-    uint8_t data[TASE_DATA_MAX];
-    int n = payload(id, msg, data, sizeof(data));
-    if (n >= 0) {
-        (void)tase_gimbal_send(&s->g, port, TASE_ID_GROUP(id), TASE_ID_TYPE(id), data, (size_t)n);
-    }
+    (void)tase_gimbal_send_msg(&s->g, port, id, msg);
 }
 
 /* ---- setup packets ---- */
@@ -107,62 +94,29 @@ static void apply_axis(sim_t *s, const tase_axis_setting_t *a)
     s->m.axis_tilt.gain = 0.1 * a->tilt_pos_gain;
 }
 
-static void decode_setup(uint8_t type, const uint8_t *data, size_t len, void *msg)
-{
-    tase_frame_t f;
-    f.offset = 0;
-    f.group = TASE_GROUP_SETUP;
-    f.type = type;
-    f.len = (uint8_t)len;
-    f.data = data;
-    (void)tase_packet_decode(&f, msg);
-}
-
-static int apply_setup(void *user, unsigned port, uint8_t type, uint8_t *data, size_t len)
+/* Setup packets arrive resolved by the role ("do not change" fields
+ * already replaced by the settings in force). */
+static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
 {
     sim_t *s = user;
-    uint8_t cur[TASE_DATA_MAX];
-    int curlen = tase_gimbal_setup_get(&s->g, type, cur, sizeof(cur));
-    size_t i;
     uint32_t now = tase_posix_now_ms();
     (void)port;
-    if (curlen != (int)len) {
-        return -1;
-    }
-    if (type == TASE_ID_TYPE(TASE_ID_AXIS_SETTING)) {
-        /* 0xFF (0xFFFF for 16-bit values) means "do not change" */
-        tase_axis_setting_t a;
-        for (i = 0; i + 1 < 12; i += 2) {
-            if (data[i] == 0xFF && data[i + 1] == 0xFF) {
-                data[i] = cur[i];
-                data[i + 1] = cur[i + 1];
-            }
-        }
-        for (i = 12; i < len; i++) {
-            if (data[i] == 0xFF) {
-                data[i] = cur[i];
-            }
-        }
-        decode_setup(type, data, len, &a);
-        if (a.pan_max_rate == 0 || a.tilt_max_rate == 0) {
+    if (id == TASE_ID_AXIS_SETTING) {
+        const tase_axis_setting_t *a = msg;
+        if (a->pan_max_rate == 0 || a->tilt_max_rate == 0) {
             logf_(s, now, "AXIS_SETTING refused: a max rate of 0 would lock the axis");
             return -1;
         }
-        apply_axis(s, &a);
+        apply_axis(s, a);
         logf_(s, now,
               "AXIS_SETTING: pan no-go %.2f+-%.2f, tilt no-go %.2f+-%.2f, max rates "
               "%.0f/%.0f deg/s",
               s->m.axis_pan.nogo_center, s->m.axis_pan.nogo_range / 2, s->m.axis_tilt.nogo_center,
               s->m.axis_tilt.nogo_range / 2, s->m.axis_pan.max_rate, s->m.axis_tilt.max_rate);
-    } else if (type == TASE_ID_TYPE(TASE_ID_CAMERA_TYPE)) {
-        for (i = 0; i < len; i++) {
-            if (data[i] == TASE_CAMTYPE_NO_CHANGE) {
-                data[i] = cur[i];
-            }
-        }
-    } else if (type == TASE_ID_TYPE(TASE_ID_PACKET_RATE)) {
-        logf_(s, now, "PACKET_RATE: port 1 angle %u/s, rate %u/s, georef %u/s", data[0], data[1],
-              data[2]);
+    } else if (id == TASE_ID_PACKET_RATE) {
+        const tase_packet_rate_t *r = msg;
+        logf_(s, now, "PACKET_RATE: port 1 angle %u/s, rate %u/s, georef %u/s", r->angle_1,
+              r->rate_1, r->geo_ref_1);
     }
     return 0;
 }
@@ -170,8 +124,7 @@ static int apply_setup(void *user, unsigned port, uint8_t type, uint8_t *data, s
 static void set_version(sim_t *s, uint32_t now)
 {
     tase_system_version_t v;
-    uint8_t data[TASE_DATA_MAX];
-    int n;
+    tase_camera_type_t c;
     memset(&v, 0, sizeof(v));
     v.major = 2;
     v.minor = 5;
@@ -193,16 +146,14 @@ static void set_version(sim_t *s, uint32_t now)
     v.max_hfov_b = s->cam[1].max_hfov;
     v.min_hfov_b = s->cam[1].min_hfov;
     v.camera_c = s->cam[2].type;
-    n = payload(TASE_ID_SYSTEM_VERSION, &v, data, sizeof(data));
-    if (n < 0 || tase_gimbal_setup_set(&s->g, TASE_ID_TYPE(TASE_ID_SYSTEM_VERSION), data, (size_t)n,
-                                       now) != TASE_OK) {
+    if (tase_gimbal_setup_set_msg(&s->g, TASE_ID_SYSTEM_VERSION, &v, now) != TASE_OK) {
         tk_die("internal error: cannot store SYSTEM_VERSION");
     }
     /* CAMERA_TYPE reports the same cameras (the role starts at "none") */
-    data[0] = s->cam[0].type;
-    data[1] = s->cam[1].type;
-    data[2] = s->cam[2].type;
-    if (tase_gimbal_setup_set(&s->g, TASE_ID_TYPE(TASE_ID_CAMERA_TYPE), data, 3, now) != TASE_OK) {
+    c.camera_a = s->cam[0].type;
+    c.camera_b = s->cam[1].type;
+    c.camera_c = s->cam[2].type;
+    if (tase_gimbal_setup_set_msg(&s->g, TASE_ID_CAMERA_TYPE, &c, now) != TASE_OK) {
         tk_die("internal error: cannot store CAMERA_TYPE");
     }
 }
@@ -229,65 +180,63 @@ static double vfov_of(double hfov)
     return 2.0 * atan(0.75 * tan(hfov * M_PI / 360.0)) * 180.0 / M_PI; /* 4:3 image */
 }
 
-static int fill_telemetry(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
-                          uint32_t now)
+/* The role hands over a zeroed struct of the packet due. */
+static int fill_telemetry(void *user, unsigned port, uint16_t id, void *msg, uint32_t now)
 {
     sim_t *s = user;
     const sim_model_t *m = &s->m;
     if (id == TASE_ID_GIMBAL_ANGLE) {
-        tase_gimbal_angle_t a = {0, 0, 0};
-        a.pan = tase_units_deg_to_cdeg(m->pan);
-        a.tilt = tase_units_deg_to_cdeg(m->tilt);
-        return payload(id, &a, data, cap);
+        tase_gimbal_angle_t *a = msg;
+        a->pan = tase_units_deg_to_cdeg(m->pan);
+        a->tilt = tase_units_deg_to_cdeg(m->tilt);
+        return 0;
     }
     if (id == TASE_ID_GIMBAL_RATE) {
-        tase_gimbal_rate_t r;
-        memset(&r, 0, sizeof(r));
-        r.time = now - s->t0;
-        r.pan_rate = tase_units_deg_to_cdeg(m->pan_rate);
-        r.tilt_rate = tase_units_deg_to_cdeg(m->tilt_rate);
-        r.p = s->p;
-        r.q = s->q;
-        r.r = s->r;
-        r.mode = sim_mode_byte(&s->m);
-        return payload(id, &r, data, cap);
+        tase_gimbal_rate_t *r = msg;
+        r->time = now - s->t0;
+        r->pan_rate = tase_units_deg_to_cdeg(m->pan_rate);
+        r->tilt_rate = tase_units_deg_to_cdeg(m->tilt_rate);
+        r->p = s->p;
+        r->q = s->q;
+        r->r = s->r;
+        r->mode = sim_mode_byte(&s->m);
+        return 0;
     }
     if (id == TASE_ID_GEOREFERENCE_DATA) {
-        tase_georeference_t r;
-        uint8_t rates[TASE_DATA_MAX];
+        tase_georeference_t *r = msg;
+        tase_packet_rate_t rates;
         double cr, cp, cy, hfov = s->cam[s->active_cam].hfov;
-        memset(&r, 0, sizeof(r));
-        r.time = now - s->t0;
-        r.lat = tase_units_deg_to_mas(m->host.lat);
-        r.lon = tase_units_deg_to_mas(m->host.lon);
-        r.height = tase_units_m_to_cm(m->host.height);
-        r.vnorth = tase_units_sat_i16(m->host.vn * 100.0);
-        r.veast = tase_units_sat_i16(m->host.ve * 100.0);
-        r.vdown = tase_units_sat_i16(m->host.vd * 100.0);
-        gps_time(&r);
-        r.num_sats = 12;
-        r.pdop = 12;
-        r.status = TASE_BITS16_SET(0u, 0, 2, TASE_GPS_FIX_3D);
+        r->time = now - s->t0;
+        r->lat = tase_units_deg_to_mas(m->host.lat);
+        r->lon = tase_units_deg_to_mas(m->host.lon);
+        r->height = tase_units_m_to_cm(m->host.height);
+        r->vnorth = tase_units_sat_i16(m->host.vn * 100.0);
+        r->veast = tase_units_sat_i16(m->host.ve * 100.0);
+        r->vdown = tase_units_sat_i16(m->host.vd * 100.0);
+        gps_time(r);
+        r->num_sats = 12;
+        r->pdop = 12;
+        r->status = TASE_BITS16_SET(0u, 0, 2, TASE_GPS_FIX_3D);
         sim_model_camera_euler(m, &cr, &cp, &cy);
-        r.camera_roll = tase_units_deg_to_cdeg(cr);
-        r.camera_pitch = tase_units_deg_to_cdeg(cp);
-        r.camera_yaw = tase_units_deg_to_cdeg(cy);
-        r.hfov = tase_units_deg_to_cdeg_u16(hfov);
-        r.vfov = tase_units_deg_to_cdeg_u16(vfov_of(hfov));
-        r.focal = tase_units_sat_u16(100.0 * 2.4 / tan(hfov * M_PI / 360.0)); /* 4.8 mm sensor */
-        r.mode = sim_mode_byte(&s->m);
-        if (tase_gimbal_setup_get(&s->g, TASE_ID_TYPE(TASE_ID_PACKET_RATE), rates, sizeof(rates)) >=
-            13) {
-            r.sample_rate = rates[2u + 5u * port];
+        r->camera_roll = tase_units_deg_to_cdeg(cr);
+        r->camera_pitch = tase_units_deg_to_cdeg(cp);
+        r->camera_yaw = tase_units_deg_to_cdeg(cy);
+        r->hfov = tase_units_deg_to_cdeg_u16(hfov);
+        r->vfov = tase_units_deg_to_cdeg_u16(vfov_of(hfov));
+        r->focal = tase_units_sat_u16(100.0 * 2.4 / tan(hfov * M_PI / 360.0)); /* 4.8 mm sensor */
+        r->mode = sim_mode_byte(&s->m);
+        if (tase_gimbal_setup_get_msg(&s->g, TASE_ID_PACKET_RATE, &rates) >= 0) {
+            r->sample_rate =
+                port == 0u ? rates.geo_ref_1 : (port == 1u ? rates.geo_ref_2 : rates.geo_ref_3);
         }
-        r.nav_health = sim_nav_health();
-        r.mount_roll = tase_units_deg_to_cdeg(m->att.roll);
-        r.mount_pitch = tase_units_deg_to_cdeg(m->att.pitch);
-        r.mount_yaw = tase_units_deg_to_cdeg(m->att.yaw);
-        r.pan = tase_units_deg_to_cdeg(m->pan);
-        r.tilt = tase_units_deg_to_cdeg(m->tilt);
-        r.camera = s->active_cam;
-        return payload(id, &r, data, cap);
+        r->nav_health = sim_nav_health();
+        r->mount_roll = tase_units_deg_to_cdeg(m->att.roll);
+        r->mount_pitch = tase_units_deg_to_cdeg(m->att.pitch);
+        r->mount_yaw = tase_units_deg_to_cdeg(m->att.yaw);
+        r->pan = tase_units_deg_to_cdeg(m->pan);
+        r->tilt = tase_units_deg_to_cdeg(m->tilt);
+        r->camera = s->active_cam;
+        return 0;
     }
     return -1;
 }
@@ -461,6 +410,8 @@ int main(int argc, char **argv)
     static sim_t s;
     const char *link = NULL, *can = NULL, *klv_link = NULL;
     double seconds = 0.0;
+    long long baud = 57600;
+    bool baud_given = false;
     char path[256], klv_path[256];
     tk_link_t dl, kl;
     tase_port_t port, klv_port;
@@ -469,7 +420,6 @@ int main(int argc, char **argv)
     double t_end;
     int i, slave_fd = -1, klv_slave = -1;
     bool have_klv = false;
-    uint8_t axis[TASE_DATA_MAX];
     tase_axis_setting_t axs;
 
     tk_prog = "tase-sim";
@@ -492,12 +442,19 @@ int main(int argc, char **argv)
             can = argv[++i];
         } else if (strcmp(a, "--klv-link") == 0 && more) {
             klv_link = argv[++i];
+        } else if (strcmp(a, "--baud") == 0 && more) {
+            if (tk_parse_int(argv[++i], 1, 4000000, &baud, NULL) != TK_NUM_OK ||
+                !tase_posix_uart_baud_supported((uint32_t)baud)) {
+                tk_usage_error("bad --baud value '%s' (a standard serial rate)", argv[i]);
+            }
+            baud_given = true;
         } else if (strcmp(a, "--seconds") == 0 && more) {
             if (tk_parse_seconds(argv[++i], &seconds) != 0 || seconds <= 0.0) {
                 tk_usage_error("bad --seconds value '%s'", argv[i]);
             }
         } else if (a[0] == '-' && (strcmp(a, "--link") == 0 || strcmp(a, "--can") == 0 ||
-                                   strcmp(a, "--klv-link") == 0 || strcmp(a, "--seconds") == 0)) {
+                                   strcmp(a, "--klv-link") == 0 || strcmp(a, "--seconds") == 0 ||
+                                   strcmp(a, "--baud") == 0)) {
             tk_usage_error("option %s needs a value", a);
         } else {
             tk_usage_error("unknown argument '%s' (see --help)", a);
@@ -505,6 +462,9 @@ int main(int argc, char **argv)
     }
     if (link != NULL && can != NULL) {
         tk_usage_error("give either --link or --can, not both");
+    }
+    if (can != NULL && baud_given) {
+        tk_usage_error("--baud is for the serial link, not --can");
     }
     if (link != NULL && klv_link != NULL) {
         char a[PATH_MAX], b[PATH_MAX];
@@ -540,8 +500,8 @@ int main(int argc, char **argv)
     }
 
     memset(&app, 0, sizeof(app));
-    app.apply_setup = apply_setup;
-    app.fill_telemetry = fill_telemetry;
+    app.apply_setup_msg = apply_setup;
+    app.fill_telemetry_msg = fill_telemetry;
     app.on_frame = on_frame;
     app.user = &s;
     now = tase_posix_now_ms();
@@ -549,15 +509,25 @@ int main(int argc, char **argv)
     if (tase_gimbal_init(&s.g, &port, s.rx, 1, &app, now) != TASE_OK) {
         tk_die("internal error: gimbal role init failed");
     }
+    /* telemetry within what the line carries (a pty has no speed of its
+     * own: the simulated line's is --baud); a CAN bus arbitrates itself */
+    if (can == NULL &&
+        tase_gimbal_set_capacity(&s.g, 0, TASE_UART_BYTES_PER_S((uint32_t)baud)) != TASE_OK) {
+        tk_die("internal error: cannot set the link capacity");
+    }
     set_version(&s, now);
     /* the model starts from the role's stored (default) axis settings */
-    tase_gimbal_setup_get(&s.g, TASE_ID_TYPE(TASE_ID_AXIS_SETTING), axis, sizeof(axis));
-    decode_setup(TASE_ID_TYPE(TASE_ID_AXIS_SETTING), axis, 23, &axs);
+    if (tase_gimbal_setup_get_msg(&s.g, TASE_ID_AXIS_SETTING, &axs) < 0) {
+        tk_die("internal error: no AXIS_SETTING");
+    }
     apply_axis(&s, &axs);
 
     tk_catch_signals(); /* SIGINT, SIGTERM, SIGHUP stop the loop below */
 
     printf("tase-sim: simulated gimbal on %s%s", can ? "CAN interface " : "", path);
+    if (can == NULL) {
+        printf(", %lld baud", baud);
+    }
     printf(link ? " (link %s)\n" : "\n", link);
     if (have_klv) {
         printf("tase-sim: KLV output on %s (link %s)\n", klv_path, klv_link);

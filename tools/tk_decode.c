@@ -69,7 +69,7 @@ static void on_frame(void *user, const tase_frame_t *f)
 {
     tk_dec_t *d = user;
     const tk_stream_t *s = d->cur;
-    const tase_packet_desc_t *p = tase_schema_find(f->group, f->type);
+    const tase_packet_desc_t *p = tk_schema_find(f->group, f->type);
     tk_meta_t m;
     if (d->limit != 0u && d->n.frames >= d->limit) {
         return;

@@ -291,11 +291,17 @@ static const char digit_pairs[] = "000102030405060708091011121314151617181920212
                                   "6263646566676869707172737475767778798081828384858687888990919293"
                                   "949596979899";
 
+/* Digits are made right-aligned in a scratch buffer and copied with one
+ * fixed-size memcpy (a few moves, no call) when the line has room, which
+ * it always has below TK_LINE_MAX; the exact count is what advances. */
+#define NUM_SPAN 24u
+
 static void sb_u64(sb_t *b, uint64_t v)
 {
-    char t[20];
-    char *p = t + sizeof(t);
+    char t[2u * NUM_SPAN];
+    char *end = t + NUM_SPAN, *p = end;
     uint32_t w;
+    size_t n;
     while (v > 0xFFFFFFFFu) {
         unsigned r = (unsigned)(v % 100u);
         v /= 100u;
@@ -312,7 +318,13 @@ static void sb_u64(sb_t *b, uint64_t v)
     } else {
         *--p = (char)('0' + (int)w);
     }
-    sb_mem(b, p, (size_t)(t + sizeof(t) - p));
+    n = (size_t)(end - p);
+    if ((size_t)(b->end - b->p) >= NUM_SPAN) {
+        memcpy(b->p, p, NUM_SPAN); /* p + NUM_SPAN stays inside t */
+        b->p += n;
+    } else {
+        sb_mem(b, p, n);
+    }
 }
 
 static void sb_i64(sb_t *b, long long v)
@@ -459,9 +471,22 @@ static long long field_value(const uint8_t *d, unsigned width, bool is_signed)
     return (long long)u;
 }
 
+const tase_packet_desc_t *tk_schema_find(uint8_t group, uint8_t type)
+{
+    /* telemetry repeats a handful of packets: remember the last one */
+    static uint16_t last_id = 0xFFFFu; /* not an id: group 0xFF has no packets */
+    static const tase_packet_desc_t *last;
+    uint16_t id = TASE_ID(group, type);
+    if (id != last_id) {
+        last = tase_schema_find(group, type);
+        last_id = id;
+    }
+    return last;
+}
+
 static void json_frame(sb_t *b, const tk_fmt_t *fmt, const tk_meta_t *m, const tase_frame_t *f)
 {
-    const tase_packet_desc_t *p = tase_schema_find(f->group, f->type);
+    const tase_packet_desc_t *p = tk_schema_find(f->group, f->type);
     const pkt_text_t *t;
     unsigned i;
     sb_mem(b, "{\"offset\":", 10);
@@ -517,7 +542,12 @@ static void json_frame(sb_t *b, const tk_fmt_t *fmt, const tk_meta_t *m, const t
              * only the fields that fit */
             break;
         }
-        sb_mem(b, key, key_len);
+        if ((size_t)(b->end - b->p) >= sizeof(t->f[i].key)) {
+            memcpy(b->p, key, sizeof(t->f[i].key) - 1u); /* fixed size: no call */
+            b->p += key_len;
+        } else {
+            sb_mem(b, key, key_len);
+        }
         sb_i64(b, v);
     }
     sb_c(b, '}');

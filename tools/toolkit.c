@@ -215,6 +215,12 @@ void tk_stdout_flush(void)
     if (fflush(stdout) != 0 || ferror(stdout)) {
         int e = errno;
         clearerr(stdout);
+        if (e == EPIPE) {
+            /* the reader went away (`tase monitor | head`): end quietly as
+             * SIGPIPE would, but through the path that closes the links */
+            close_all_links();
+            exit(128 + SIGPIPE);
+        }
         tk_die("cannot write to standard output: %s", e ? strerror(e) : "write error");
     }
 }

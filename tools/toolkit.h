@@ -95,7 +95,9 @@ void tk_time_now(tk_time_t *t);
 /* Use a large buffer for standard output (before the first write). */
 void tk_stdout_buffered(void);
 /* Flush standard output; on any write error so far exit TK_EXIT_FAIL with
- * "cannot write to standard output: <reason>". */
+ * "cannot write to standard output: <reason>", except a reader that went
+ * away (EPIPE): then exit 128 + SIGPIPE without a message, as programs
+ * killed by SIGPIPE do (links closed first). */
 void tk_stdout_flush(void);
 
 /* ---- signals ---- */
@@ -182,6 +184,9 @@ int tk_field_parse(const tk_field_t *f, const char *s, long long *v);
 /* The packet named `name`, case-insensitive; dies with a one-line list
  * hint when unknown. */
 const tase_packet_desc_t *tk_packet_by_name(const char *name);
+/* tase_schema_find() remembering the last answer (decode looks up the
+ * same few packets millions of times). */
+const tase_packet_desc_t *tk_schema_find(uint8_t group, uint8_t type);
 /* Whether the packet carries free bytes after its fields (CAMERA_PASS). */
 bool tk_packet_has_tail(const tase_packet_desc_t *p);
 
