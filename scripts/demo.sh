@@ -78,16 +78,10 @@ show "$TASE" monitor "${link[@]}" --json --seconds 1.1 | tee "$work/mon.json"
 grep -q '"name":"GIMBAL_RATE".*"pan_rate":1000,' "$work/mon.json" ||
     fail "GIMBAL_RATE does not report the commanded 10 deg/s"
 show "$TASE" rate 0 0 "${link[@]}"
-# Commands nobody echoes are only written; the next program's open of the
-# pty flushes (port/posix_uart), which on a pty can drop bytes the simulator
-# has not read yet: give it a moment (it reads every 5 ms).
-sleep 0.1
 
 step "Host: camera B, then camera A zoomed to 10 deg of horizontal field of view"
 show "$TASE" camera B "${link[@]}"
-sleep 0.1
 show "$TASE" camera A --hfov 10 "${link[@]}"
-sleep 0.1
 echo "(every other camera setting goes as the spec's \"do not change\" value)"
 
 step "Host: a setting the gimbal refuses is not a success (exit 3 names the field)"
