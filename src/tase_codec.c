@@ -10,6 +10,8 @@
 
 #include <string.h>
 
+#include "tase_schema_layout.h"
+
 /* The member's own type is not known here, only its width: hence void. */
 static uint64_t member_load(const void *src, unsigned w)
 {
@@ -43,10 +45,11 @@ static void member_store(void *dst, unsigned w, uint64_t v)
 static void pack_fields(const tase_packet_desc_t *p, const void *msg, size_t len, uint8_t *body)
 {
     size_t i;
+    bool short_layout = tase_layout_is_short(p, len);
     for (i = 0; i < p->nfields; i++) {
         const tase_field_t *f = tase_schema_field(p, i);
         unsigned w = TASE_FIELD_WIDTH(f);
-        size_t at = (size_t)tase_field_offset(p, i, len);
+        size_t at = tase_layout_offset(f, short_layout);
         uint64_t v;
         if (at + w > len) {
             continue; /* short form: CAMERA_CMD camera byte only */
@@ -180,10 +183,11 @@ int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap)
 static void unpack_fields(const tase_packet_desc_t *p, const uint8_t *data, size_t len, void *msg)
 {
     size_t i;
+    bool short_layout = tase_layout_is_short(p, len);
     for (i = 0; i < p->nfields; i++) {
         const tase_field_t *fd = tase_schema_field(p, i);
         unsigned w = TASE_FIELD_WIDTH(fd);
-        size_t at = (size_t)tase_field_offset(p, i, len);
+        size_t at = tase_layout_offset(fd, short_layout);
         unsigned k;
         uint64_t v = 0u;
         int64_t keep;

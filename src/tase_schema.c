@@ -6,6 +6,7 @@
 #include "tase/schema.h"
 
 #include "tase/codec.h"
+#include "tase_schema_layout.h"
 
 /* Field index bookkeeping: FIRST_x / END_x are the flat field indices of
  * packet x. Each marker rewinds the counter so it takes no slot. */
@@ -196,13 +197,7 @@ int tase_field_offset(const tase_packet_desc_t *p, size_t i, size_t len)
     if (f == NULL) {
         return TASE_EARG;
     }
-    /* The short layout only exists for packets flagged for it; the field
-     * flag alone (a corrupted descriptor) never moves a field. */
-    if ((f->fmt & TASE_FIELD_SHIFT) != 0u && (p->flags & TASE_LEN_SHORT) != 0u &&
-        len + 1u == p->len && f->offset > 0u) {
-        return (int)f->offset - 1;
-    }
-    return (int)f->offset;
+    return (int)tase_layout_offset(f, tase_layout_is_short(p, len));
 }
 
 int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,

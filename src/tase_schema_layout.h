@@ -1,0 +1,30 @@
+/*
+ * Private to src/: where a field lies in a frame of a given length. One
+ * packet (AXIS_SETTING) has a second, one byte shorter layout in which the
+ * fields flagged TASE_FIELD_SHIFT sit one byte earlier (see
+ * tase_field_offset() in tase/schema.h). The codec's loops decide the
+ * layout once per frame and then place each field with no call.
+ */
+#ifndef TASE_SCHEMA_LAYOUT_H
+#define TASE_SCHEMA_LAYOUT_H
+
+#include "tase/schema.h"
+
+/* True when `len` data bytes are packet p's short layout. The field flag
+ * alone (a corrupted descriptor) never moves a field: the packet must be
+ * flagged for it too. */
+static inline bool tase_layout_is_short(const tase_packet_desc_t *p, size_t len)
+{
+    return (p->flags & TASE_LEN_SHORT) != 0u && len + 1u == p->len;
+}
+
+/* The byte offset of field f in the layout chosen above. */
+static inline size_t tase_layout_offset(const tase_field_t *f, bool short_layout)
+{
+    if (short_layout && (f->fmt & TASE_FIELD_SHIFT) != 0u && f->offset > 0u) {
+        return (size_t)f->offset - 1u;
+    }
+    return f->offset;
+}
+
+#endif /* TASE_SCHEMA_LAYOUT_H */
