@@ -324,6 +324,7 @@ class Stream:
         self.data = b""
         self.frames = []
         self.candidate_end = None  # end of the pending false candidate
+        self.candidates = []  # (start, end) of every false candidate
 
     def good(self, named):
         name, raw = named
@@ -340,12 +341,13 @@ class Stream:
         assert b"\x00\xff\x5a" not in raw
         self.data += raw
 
-    def false(self, size, fill_to=None):
-        """A false candidate claiming `size`; filler up to its end if
-        fill_to (the bytes before it are added by the caller)."""
+    def false(self, size):
+        """A false candidate whose Size byte is `size`: the frames added
+        until its end are held behind it."""
         start = len(self.data)
         self.data += false_start(size)
-        self.candidate_end = start + size + 6
+        self.candidate_end = start + size - 2 + 8
+        self.candidates.append((start, self.candidate_end))
         return start
 
     def fill_candidate(self):
@@ -364,6 +366,9 @@ class Stream:
                     fr[3] = None  # the candidate never completes
         for fr in self.frames:
             assert fr[3] is None or fr[3] <= len(self.data)
+        for start, end in self.candidates:  # each one fails its checksum
+            raw = self.data[start:end]
+            assert len(raw) < end - start or sum(raw[:-2]) & 0xFFFF != raw[-2] * 256 + raw[-1]
 
 
 # The issue 12 repro's inner frame: GIMBAL_CMD pan 90.00, tilt -10.00.
@@ -382,7 +387,7 @@ def scenario(name):
         inn.good(gimbal_cmd(1000, -500, 0xA0))
         inn.good(camera_pass(b"\x55" + INNER + b"\x66" * 12))
     elif name == "held":
-        # from the gimbal: a candidate claiming 200 data bytes hides three
+        # from the gimbal: a candidate with Size byte 200 hides three
         # frames; one frame starts inside it and ends after it; a second
         # false candidate still pending at the end hides one more.
         out.good(gimbal_angle(100, 200))

@@ -3,7 +3,8 @@
 --
 -- Load it for one run:
 --     wireshark -X lua_script:tools/wireshark/tase.lua capture.pcap
---     tshark    -X lua_script:tools/wireshark/tase.lua -r capture.pcap -O tase
+--     tshark -2 -X lua_script:tools/wireshark/tase.lua -r capture.pcap -O tase
+-- (-2: see "Each frame is shown..." below for why tshark needs two passes)
 -- or for good: copy it into the personal Lua plugin folder
 -- (~/.local/lib/wireshark/plugins/; Help > About > Folders shows it).
 --
@@ -56,10 +57,18 @@
 -- the packet of its last byte (and so another time than `tase decode`'s),
 -- and frames hidden by a candidate pending at the end of the capture are
 -- not shown. Use `tshark -2`. tase.offset counts the bytes of the frame's
--- stream from the start of the capture, as `tase decode` does. Wireshark
--- 4.0's candump reader drops interface names, so a candump log with TASE
--- traffic on several interfaces is reassembled as one bus; `tase decode
--- --candump` keeps them apart.
+-- stream from the start of the capture, as `tase decode` does.
+--
+-- Interfaces: the capture interface of a packet (frame.interface_id) is a
+-- field value, and field values exist only in a pass that builds a
+-- protocol tree; tshark -2 builds none in its first pass unless given a
+-- filter, so there every interface is reassembled as one and the second
+-- pass flags packets of another interface with the expert warning
+-- tase.interfaces_merged: for a pcapng of several interfaces run
+-- `tshark -2 -R frame`. (The CAN ID comes from pinfo.match_uint, always
+-- there.) Wireshark 4.0's candump reader drops interface names, so a
+-- candump log with TASE traffic on several interfaces is reassembled as
+-- one bus; `tase decode --candump` keeps them apart.
 
 local tase = Proto("tase", "TASE gimbal protocol")
 local tase_serial = Proto("tase_serial", "TASE serial capture")
