@@ -21,6 +21,23 @@ the tools' code, so they check it rather than repeat it.
   compare-pdml PDML JSONL          the dissector's packets (tshark -T pdml)
         against `tase decode`'s JSON lines: names, keys, field values in
         order, data bytes, errors, directions, offsets and times.
+  greedy SCENARIO FORMAT OUT EXPECT  a capture (FORMAT pcap: serial
+        records; candump: a candump log) of two directions built to test
+        the receiver's greedy scan, and EXPECT, the frames it must give
+        (one JSON line each: dir, offset, name, the packet carrying the
+        last byte, the packet that decides it or null for the end of the
+        capture, time). SCENARIO camera-pass: a CAMERA_PASS whose camera
+        bytes are a whole valid GIMBAL_CMD frame, completed records after
+        it; held: frames inside longer candidates with corrupted Size
+        bytes, split over several records, decided when the candidate
+        fails or at the end of the capture, and a CAMERA_PASS carrying a
+        frame among them.
+  expect-decode EXPECT JSONL       `tase decode`'s objects, per direction in
+        stream order, are EXPECT's frames (offset, name, time).
+  expect-pdml EXPECT PDML PASSES   the dissector's frames, packet by packet
+        with their annotations, are what EXPECT says for a tshark run with
+        PASSES 2 (-2: each frame in the packet of its last byte) or 1 (a
+        frame in the packet that decided it, none decided at the end).
   pdml-3ax PDML                    the 3AX frames the dissector showed, one
         "NAME position speed" line each ("error" for a wrong length).
   records PCAP                     one line per record: time, then (serial)
@@ -189,6 +206,11 @@ def pdml_packets(path):
     return out
 
 
+# Where a frame's last byte was and when it was decided: the dissector's
+# annotations, not JSON keys.
+HELD_FIELDS = ("decided_in", "decided_at_end", "last_byte_in")
+
+
 def proto_object(proto):
     """A dissected TASE packet as a JSON contract object (no time)."""
     o, fields = {}, {}
@@ -207,7 +229,7 @@ def proto_object(proto):
             name = show if short == "name" else name
         elif short == "data":
             o["data"] = list(bytes.fromhex(f.get("value")))
-        elif short != "checksum":
+        elif short not in ("checksum",) + HELD_FIELDS:
             pkt, field = short.split(".", 1)
             assert pkt == name.lower(), (key, name)
             fields[field] = int(show)
@@ -260,6 +282,266 @@ def compare_pdml(pdml, jsonl):
     print("compared %d packets (%s): %s" % (len(exp), ", ".join(names),
                                             "same" if bad == 0 else "%d differences" % bad))
     return 0 if bad == 0 else 1
+
+
+def frame(group, ptype, data):
+    """A TASE frame, from the wire format in docs/PROTOCOL-NOTES.md / the
+    spec: 00 FF 5A, Size = data length + 2, group, type, data, the 16-bit
+    sum of every byte before it, most significant byte first."""
+    body = bytes([0x00, 0xFF, 0x5A, len(data) + 2, group, ptype]) + bytes(data)
+    total = sum(body) & 0xFFFF
+    return body + bytes([total >> 8, total & 0xFF])
+
+
+def s16(*vals):
+    return b"".join(struct.pack(">h", v) for v in vals)
+
+
+def gimbal_angle(pan, tilt):
+    return ("GIMBAL_ANGLE", frame(0x08, 0x10, s16(pan, tilt, 0)))
+
+
+def gimbal_cmd(pan, tilt, flags):
+    return ("GIMBAL_CMD", frame(0x00, 0x80, s16(pan, tilt, 0) + bytes([flags, 0])))
+
+
+def camera_pass(camera_bytes):
+    return ("CAMERA_PASS", frame(0x00, 0x42, bytes([1, 8, 0, 0]) + camera_bytes))
+
+
+def false_start(size):
+    """Sync bytes and a Size byte claiming `size`: a frame whose Size byte
+    was corrupted upwards, or noise that looks like a header."""
+    return bytes([0x00, 0xFF, 0x5A, size, 0x08, 0x40])
+
+
+class Stream:
+    """One direction's bytes with the frames the greedy scan must find:
+    [name, offset, end, decided_at] (decided_at: the stream offset whose
+    arrival decides the frame; None: only the end of the capture)."""
+
+    def __init__(self):
+        self.data = b""
+        self.frames = []
+        self.candidate_end = None  # end of the pending false candidate
+        self.candidates = []  # (start, end) of every false candidate
+
+    def good(self, named):
+        name, raw = named
+        start = len(self.data)
+        self.data += raw
+        end = len(self.data)
+        held = self.candidate_end
+        # held behind the candidate when its last byte comes before the
+        # candidate's (the candidate has not failed yet)
+        decided = end if held is None or end > held else held
+        self.frames.append([name, start, end, decided])
+
+    def noise(self, raw):
+        assert b"\x00\xff\x5a" not in raw
+        self.data += raw
+
+    def false(self, size):
+        """A false candidate whose Size byte is `size`: the frames added
+        until its end are held behind it."""
+        start = len(self.data)
+        self.data += false_start(size)
+        self.candidate_end = start + size - 2 + 8
+        self.candidates.append((start, self.candidate_end))
+        return start
+
+    def fill_candidate(self):
+        need = self.candidate_end - len(self.data)
+        assert need > 0
+        self.noise(b"\x11" * need)
+        self.candidate_end = None
+
+    def leave_candidate(self):
+        self.candidate_end = None
+
+    def finish(self):
+        if self.candidate_end is not None and self.candidate_end > len(self.data):
+            for fr in self.frames:
+                if fr[3] == self.candidate_end:
+                    fr[3] = None  # the candidate never completes
+        for fr in self.frames:
+            assert fr[3] is None or fr[3] <= len(self.data)
+        for start, end in self.candidates:  # each one fails its checksum
+            raw = self.data[start:end]
+            assert len(raw) < end - start or sum(raw[:-2]) & 0xFFFF != raw[-2] * 256 + raw[-1]
+
+
+# The issue 12 repro's inner frame: GIMBAL_CMD pan 90.00, tilt -10.00.
+INNER = gimbal_cmd(9000, -1000, 0)[1]
+
+
+def scenario(name):
+    out, inn = Stream(), Stream()
+    if name == "camera-pass":
+        out.good(gimbal_angle(1234, -4500))
+        out.noise(b"\x07\x5a")
+        out.good(gimbal_angle(-1, 1))
+        out.good(gimbal_angle(17999, 0))
+        inn.good(("RETRACT_DEPLOY_CMD", frame(0x00, 0x43, bytes([1, 0]))))
+        inn.good(camera_pass(INNER))
+        inn.good(gimbal_cmd(1000, -500, 0xA0))
+        inn.good(camera_pass(b"\x55" + INNER + b"\x66" * 12))
+    elif name == "held":
+        # from the gimbal: a candidate with Size byte 200 hides three
+        # frames; one frame starts inside it and ends after it; a second
+        # false candidate still pending at the end hides one more.
+        out.good(gimbal_angle(100, 200))
+        start = out.false(200)
+        out.good(gimbal_angle(-300, 400))
+        out.noise(b"\x01\x02\x03")
+        out.good(("GIMBAL_RATE", frame(0x08, 0x40, struct.pack(">I", 77) + s16(1, 2, 3, 4, 5, 6)
+                                       + b"\x00\x81")))
+        out.good(gimbal_angle(500, -600))
+        out.noise(b"\x11" * (out.candidate_end - len(out.data) - 5))
+        straddle = len(out.data)
+        out.leave_candidate()
+        out.good(gimbal_angle(700, -800))  # ends after the candidate
+        assert straddle < start + 206 < len(out.data)
+        out.good(gimbal_angle(900, -1000))
+        out.false(0xF0)
+        out.good(gimbal_angle(-900, 1000))
+        out.noise(b"\x22" * 20)
+        # to the gimbal: a candidate hides a CAMERA_PASS carrying a valid
+        # GIMBAL_CMD frame (only the CAMERA_PASS counts) and a GIMBAL_CMD.
+        inn.false(144)
+        inn.good(camera_pass(INNER + b"\x66" * 12))
+        inn.good(gimbal_cmd(-2000, 300, 0x10))
+        inn.fill_candidate()
+        inn.good(gimbal_cmd(0, 0, 0xA0))
+    else:
+        raise SystemExit("unknown scenario " + name)
+    out.finish()
+    inn.finish()
+    return out, inn
+
+
+def cut_records(streams, sizes):
+    """Round-robin records of the given sizes (cycled) from each stream:
+    [(dir, stream offset of the end, bytes)]."""
+    pos = {d: 0 for d in streams}
+    out, k = [], 0
+    while any(pos[d] < len(streams[d].data) for d in streams):
+        for d in ("out", "in"):
+            data = streams[d].data
+            if pos[d] < len(data):
+                n = sizes[k % len(sizes)]
+                k += 1
+                chunk = data[pos[d]:pos[d] + n]
+                pos[d] += len(chunk)
+                out.append((d, pos[d], chunk))
+    return out
+
+
+def greedy(scen, fmt, path, expect):
+    out, inn = scenario(scen)
+    streams = {"out": out, "in": inn}
+    sizes = [5, 11, 3, 13, 8, 1, 9, 2] if fmt == "pcap" else [8, 3, 8, 1, 5, 8, 7, 2]
+    recs = cut_records(streams, sizes)
+    times = [Decimal(T0) + Decimal(n + 1) / 1000 + Decimal(7 * n) / 1000000
+             for n in range(len(recs))]
+
+    def packet_of(d, offset):
+        """the packet (1-based) carrying the byte before `offset`"""
+        for n, (rd, end, _) in enumerate(recs):
+            if rd == d and end >= offset:
+                return n + 1
+        raise AssertionError("offset %d of %s beyond the capture" % (offset, d))
+
+    lines, held_split = [], 0
+    for d in ("out", "in"):
+        for name, start, end, decided in streams[d].frames:
+            last = packet_of(d, end)
+            dec = None if decided is None else packet_of(d, decided)
+            if dec != last and packet_of(d, start + 1) != last:
+                held_split += 1
+            lines.append({"dir": d, "offset": start, "name": name, "last": last,
+                          "decided": dec, "time": str(times[last - 1].quantize(USEC))})
+    # A frame carried by a CAMERA_PASS ends records before the CAMERA_PASS
+    # does (a receiver judging candidates on their own shows it, first).
+    early = 0
+    for name, start, end, _ in inn.frames:
+        i = inn.data.find(INNER, start, end)
+        if name == "CAMERA_PASS" and i >= 0:
+            early += packet_of("in", i + len(INNER)) < packet_of("in", end)
+    assert early >= 1
+    if scen == "held":
+        assert held_split >= 3 and any(x["decided"] is None for x in lines)
+    with open(path, "wb") as f:
+        if fmt == "pcap":
+            f.write(pcap_header(LINKTYPE_SERIAL))
+            for (d, _, chunk), t in zip(recs, times):
+                ns = int((t - T0) * 10**9)
+                f.write(pcap_record(T0 + ns // 10**9, ns % 10**9, bytes([DIRS[d]]) + chunk))
+        else:
+            for (d, _, chunk), t in zip(recs, times):
+                ident = "10000000" if d == "out" else "11000000"
+                f.write(("(%s) vcan0 %s#%s\n" % (t.quantize(USEC), ident, chunk.hex().upper()))
+                        .encode())
+    with open(expect, "w") as f:
+        for x in lines:
+            f.write(json.dumps(x) + "\n")
+
+
+def expect_decode(expect, jsonl):
+    exp = [json.loads(line) for line in open(expect)]
+    got = [json.loads(line, parse_float=Decimal) for line in open(jsonl)]
+    bad = 0
+    for d in ("out", "in"):
+        e = [(x["offset"], x["name"], Decimal(x["time"]).quantize(USEC, ROUND_DOWN))
+             for x in exp if x["dir"] == d]
+        g = [(x["offset"], x["name"], x.get("time")) for x in got if x.get("dir") == d]
+        if e != g:
+            print("dir %s: tase decode printed\n  %s\nexpected\n  %s" % (d, g, e))
+            bad += 1
+    print("tase decode: %d frames as expected" % len(exp) if not bad else "tase decode differs")
+    return 1 if bad else 0
+
+
+def pdml_frames(pdml):
+    """(packet, dir, offset, name, annotation) of every TASE frame shown."""
+    out = []
+    for n, (_, protos) in enumerate(pdml_packets(pdml)):
+        for p in protos:
+            vals = {f.get("name"): f.get("show") for f in p.findall("field")}
+            if vals.get("tase.name", "").startswith("3AX_"):
+                continue
+            note = None
+            for key in HELD_FIELDS:
+                if "tase." + key in vals:
+                    note = key if key == "decided_at_end" else "%s %s" % (key, vals["tase." + key])
+            out.append((n + 1, vals.get("tase.dir"), int(vals["tase.offset"]),
+                        vals["tase.name"], note))
+    return out
+
+
+def expect_pdml(expect, pdml, passes):
+    exp = []
+    for x in map(json.loads, open(expect)):
+        last, dec = x["last"], x["decided"]
+        if passes == "2":
+            note = ("decided_at_end" if dec is None else
+                    None if dec == last else "decided_in %d" % dec)
+            exp.append((last, x["dir"], x["offset"], x["name"], note))
+        elif dec is not None:
+            exp.append((dec, x["dir"], x["offset"], x["name"],
+                        None if dec == last else "last_byte_in %d" % last))
+    exp.sort(key=lambda e: e[0])  # by packet; within one, stream order
+    got = pdml_frames(pdml)
+    if got != exp:
+        print("the dissector (%s pass%s) showed:" % (passes, "es" if passes == "2" else ""))
+        for g in got:
+            print("  " + repr(g))
+        print("expected:")
+        for e in exp:
+            print("  " + repr(e))
+        return 1
+    print("%d frames in the expected packets" % len(exp))
+    return 0
 
 
 def pdml_3ax(pdml):
@@ -319,6 +601,12 @@ def main(argv):
         pty_pair(args[0], args[1])
     elif cmd == "compare-pdml":
         return compare_pdml(args[0], args[1])
+    elif cmd == "greedy":
+        greedy(*args)
+    elif cmd == "expect-decode":
+        return expect_decode(args[0], args[1])
+    elif cmd == "expect-pdml":
+        return expect_pdml(args[0], args[1], args[2])
     elif cmd == "pdml-3ax":
         pdml_3ax(args[0])
     elif cmd == "records":

@@ -43,11 +43,27 @@ trap cleanup EXIT
 . "$here/check-lib.sh"
 under_valgrind TASE SIM
 # dissect CAPTURE [tshark args]: tshark with the dissector and a clean
-# configuration (no personal plugins or preferences), PDML on stdout
+# configuration (no personal plugins or preferences), two passes (-2: a
+# frame held behind a longer candidate is shown in the packet of its last
+# byte only on the second pass; see tase.lua's header)
+tshark_clean() {
+    HOME="$dir" XDG_CONFIG_HOME="$dir" tshark -X "lua_script:$LUA" "$@" 2>"$dir/tshark.err"
+}
 dissect() {
     local cap=$1
     shift
-    HOME="$dir" XDG_CONFIG_HOME="$dir" tshark -X "lua_script:$LUA" -r "$cap" "$@" 2>"$dir/tshark.err"
+    tshark_clean -2 -r "$cap" "$@"
+}
+# expect NAME CMD...: a capture_util check; its last line shown, all of it
+# on failure
+expect() {
+    local name=$1
+    shift
+    if "$@" >"$dir/expect.out"; then
+        ok "$name: $(tail -1 "$dir/expect.out")"
+    else
+        bad "$name: $(cat "$dir/expect.out")"
+    fi
 }
 # compare TAG NAME CAPTURE DECODE-ARGS...: the dissector against tase decode
 compare() {
@@ -85,6 +101,43 @@ $U can-pcap "$dir/can.pcap" "$DATA/decode_candump.log"
 compare canpcap "SocketCAN pcap (Wireshark's CAN dissector)" "$dir/can.pcap" "$dir/can.pcap"
 $U serial-pcap "$dir/noisy.pcap" 5 0.001-3 "$DATA/decode_noisy.bin:out" "$DATA/decode_noisy.bin:in"
 compare noisy "noisy serial capture, both directions" "$dir/noisy.pcap" "$dir/noisy.pcap"
+
+# Issue 12's greedy receiver, in both tools, on a serial capture and a
+# candump log each: a CAMERA_PASS whose camera bytes are a valid frame
+# shows only the CAMERA_PASS; frames inside longer candidates with Size
+# bytes corrupted upwards, split over several records, are held until the
+# candidate fails (or the capture ends) and shown in the packet of their
+# last byte, with its time, as `tase decode` prints them (capture_util.py
+# knows from building the streams which frames, where and decided when).
+for sc in camera-pass held; do
+    for fmt in pcap candump; do
+        cap="$dir/$sc.$fmt"
+        $U greedy "$sc" "$fmt" "$cap" "$cap.expect"
+        if [ "$fmt" = candump ]; then args=(--candump "$cap"); else args=("$cap"); fi
+        compare "$sc-$fmt" "$sc $fmt: the dissector shows what tase decode prints" "$cap" "${args[@]}"
+        expect "$sc $fmt: tase decode prints the greedy scan's frames, each with its last byte's time" \
+            $U expect-decode "$cap.expect" "$dir/$sc-$fmt.json"
+        expect "$sc $fmt: tshark -2 shows each in the packet of its last byte (held ones with tase.decided_in)" \
+            $U expect-pdml "$cap.expect" "$dir/$sc-$fmt.pdml" 2
+    done
+done
+# One pass (no -2): a held frame in the packet that decided it, with
+# tase.last_byte_in; none of those decided by the end of the capture.
+tshark_clean -r "$dir/held.pcap" -T pdml >"$dir/held-1.pdml"
+expect "held pcap, single-pass tshark: held frames in their deciding packet with tase.last_byte_in" \
+    $U expect-pdml "$dir/held.pcap.expect" "$dir/held-1.pdml" 1
+# A pcapng of two capture interfaces (the SocketCAN pcap twice, 0.3 ms
+# apart): reassembled per interface when the first pass has a protocol
+# tree (-R frame), else merged and flagged with tase.interfaces_merged.
+editcap -t 0.0003 "$dir/can.pcap" "$dir/can2.pcap" &&
+    mergecap -I none -w "$dir/two.pcapng" "$dir/can.pcap" "$dir/can2.pcap"
+n1=$(grep -c . "$dir/canpcap.json")
+n=$(dissect "$dir/two.pcapng" -R frame -T fields -e tase.offset | tr ',' '\n' | grep -c .)
+m=$(dissect "$dir/two.pcapng" -R frame -T fields -e _ws.expert.message | grep -c merged)
+check "two capture interfaces, tshark -2 -R frame: each reassembled ($n packets, twice $n1), no warning" \
+    eval '[ "$n" = $((2 * n1)) ] && [ "$m" = 0 ]'
+m=$(dissect "$dir/two.pcapng" -T fields -e _ws.expert.message | grep -c "interface merged")
+check "two capture interfaces, tshark -2 alone: the merge is flagged ($m packets)" [ "$m" -gt 0 ]
 
 # 3AX frames, values by hand from can.h: move 0 deploy / else retract;
 # status position, signed speed in 5 deg/s units; a wrong length.

@@ -3,7 +3,8 @@
 --
 -- Load it for one run:
 --     wireshark -X lua_script:tools/wireshark/tase.lua capture.pcap
---     tshark    -X lua_script:tools/wireshark/tase.lua -r capture.pcap -O tase
+--     tshark -2 -X lua_script:tools/wireshark/tase.lua -r capture.pcap -O tase
+-- (-2: see "Each frame is shown..." below for why tshark needs two passes)
 -- or for good: copy it into the personal Lua plugin folder
 -- (~/.local/lib/wireshark/plugins/; Help > About > Folders shows it).
 --
@@ -30,17 +31,44 @@
 -- for a valid frame whose data length its type does not accept. Filter
 -- examples: tase.name == "GIMBAL_CMD", tase.gimbal_angle.tilt < -4500.
 --
--- Reassembly follows the library's receiver (tase/frame.h): every
--- 00 FF 5A starts a candidate frame judged on its own bytes, a valid one is
--- shown in the record or CAN frame that completes it, candidates that began
--- inside a valid frame are dropped; noise and failed checksums are skipped.
--- It tracks every candidate (the library tracks 4 before re-scanning), so
--- on adversarial streams full of false syncs a frame can appear earlier
--- here than in `tase decode`, never missing. tase.offset counts the bytes
--- of the frame's direction from the start of the capture, as `tase decode`
--- does. Wireshark 4.0's candump reader drops interface names, so a candump
--- log with TASE traffic on several interfaces is reassembled as one bus;
--- `tase decode --candump` keeps them apart.
+-- Reassembly follows the library's receiver (tase/frame.h) exactly, so
+-- that Wireshark and `tase decode` show the same frames: per stream (the
+-- serial direction; the CAN direction per capture interface) the greedy
+-- scan from the start of the capture: at each position a complete frame
+-- with a valid checksum (00 FF 5A, Size >= 2, Size + 6 bytes) is taken and
+-- the scan continues after its last byte, anywhere else it moves on one
+-- byte. Nothing inside a shown frame is shown (a CAMERA_PASS whose camera
+-- bytes hold a valid frame gives the CAMERA_PASS only), and no frame is
+-- lost behind a corrupted Size byte, a false sync or noise.
+--
+-- Each frame is shown in the record or CAN frame that carries its LAST
+-- byte, with that packet's time: `tase decode`'s "time". A frame that lies
+-- inside a longer candidate still pending (a Size byte corrupted upwards,
+-- say) is only known once a later packet makes that candidate fail (at
+-- most 253 bytes later), so the first pass (pinfo.visited false) records
+-- per packet number which frames end there, and they are shown when the
+-- packet is dissected again: the GUI re-dissects a packet when it is
+-- selected, tshark does with -2 (two-pass analysis), and a held frame
+-- then carries tase.decided_in, the packet whose bytes decided it. A
+-- candidate still pending at the end of the capture fails as in
+-- tase_rx_flush() (tase.decided_at_end on what it was hiding). A
+-- single-pass tshark (no -2) only has the first pass: there a held frame
+-- is shown in the packet that decided it, with tase.last_byte_in naming
+-- the packet of its last byte (and so another time than `tase decode`'s),
+-- and frames hidden by a candidate pending at the end of the capture are
+-- not shown. Use `tshark -2`. tase.offset counts the bytes of the frame's
+-- stream from the start of the capture, as `tase decode` does.
+--
+-- Interfaces: the capture interface of a packet (frame.interface_id) is a
+-- field value, and field values exist only in a pass that builds a
+-- protocol tree; tshark -2 builds none in its first pass unless given a
+-- filter, so there every interface is reassembled as one and the second
+-- pass flags packets of another interface with the expert warning
+-- tase.interfaces_merged: for a pcapng of several interfaces run
+-- `tshark -2 -R frame`. (The CAN ID comes from pinfo.match_uint, always
+-- there.) Wireshark 4.0's candump reader drops interface names, so a
+-- candump log with TASE traffic on several interfaces is reassembled as
+-- one bus; `tase decode --candump` keeps them apart.
 
 local tase = Proto("tase", "TASE gimbal protocol")
 local tase_serial = Proto("tase_serial", "TASE serial capture")
@@ -174,6 +202,12 @@ local F = {
     checksum = ProtoField.uint16("tase.checksum", "checksum", base.HEX),
     data = ProtoField.bytes("tase.data", "data"),
     error = ProtoField.string("tase.error", "error"),
+    decided_in = ProtoField.framenum("tase.decided_in",
+        "held until frame (where the longer candidate covering it failed)"),
+    decided_at_end = ProtoField.bool("tase.decided_at_end",
+        "held until the end of the capture (the longer candidate covering it never completed)"),
+    last_byte_in = ProtoField.framenum("tase.last_byte_in",
+        "last byte in frame (one pass only: shown where it was decided; use tshark -2)"),
     move_position = ProtoField.uint8("tase.3ax_move.position", "position (0 deploy, else retract)"),
     status_position = ProtoField.uint8("tase.3ax_status.position",
         "position (0 deployed .. 254 retracted, 255 unknown)"),
@@ -187,6 +221,9 @@ local E = {
         expert.group.MALFORMED, expert.severity.ERROR),
     wrong_length = ProtoExpert.new("tase.wrong_length", "wrong data length for this packet type",
         expert.group.MALFORMED, expert.severity.WARN),
+    merged = ProtoExpert.new("tase.interfaces_merged", "reassembled with the streams of every " ..
+        "capture interface merged: the first pass had no protocol tree (use tshark -2 -R frame)",
+        expert.group.REASSEMBLE, expert.severity.WARN),
 }
 
 -- Packet table keyed by group * 256 + type, with a ProtoField per field.
@@ -208,7 +245,7 @@ for _, row in ipairs(SCHEMA) do
 end
 tase.fields = field_list
 tase_serial.fields = {F.serial_dir, F.serial_bytes}
-tase.experts = {E.wrong_length}
+tase.experts = {E.wrong_length, E.merged}
 tase_serial.experts = {E.bad_dir}
 
 -- The data lengths a packet accepts (tase_schema_length_ok()).
@@ -220,12 +257,19 @@ end
 
 -- ---- reassembly, one stream per direction and interface ----
 
-local streams, found
+-- The first pass's results, per packet number: the frames whose last byte
+-- the packet carries (`ended`, shown when it is dissected again) and the
+-- frames its bytes decided (`decided`, shown by a single pass). A frame is
+-- {off, raw, last = packet of its last byte, decided = deciding packet or
+-- nil (end of capture)}. `tails`: per packet, the frames an end-of-capture
+-- flush of its stream would give, recomputed while the capture grows.
+local streams, ended, decided, tails
+local ifaces -- packet number -> the capture interface its stream was keyed by
 
 -- Called by Wireshark before each (re)dissection of a capture.
 local function reset()
-    streams = {} -- key -> {buf, base, cands, scanned, consumed}
-    found = {}   -- packet number -> {{off, raw}...}: the first pass's results
+    streams = {} -- key -> {buf, base, pos, hist, dirty, tail_nums}
+    ended, decided, tails, ifaces = {}, {}, {}, {}
 end
 tase.init = reset
 reset()
@@ -236,63 +280,94 @@ local function checksum_ok(raw)
     return sum % 65536 == raw:byte(n - 1) * 256 + raw:byte(n)
 end
 
--- Append bytes to a stream; returns the frames they complete, in the order
--- the library's receiver delivers them (by their last byte).
-local function feed(key, chunk)
+-- The packet that carried the byte before stream offset `stop`.
+local function packet_of(st, stop)
+    for _, h in ipairs(st.hist) do
+        if h.stop >= stop then return h.num end
+    end
+    return st.hist[#st.hist].num
+end
+
+-- The greedy scan of st.buf (stream offsets st.base..) from st.pos,
+-- appending the frames it takes to `out`. It stops at a candidate that is
+-- not complete yet (st.pos stays on it), unless `final`: then, as at
+-- tase_rx_flush(), that candidate fails and the scan goes on after its
+-- first byte. Leaves st.pos where the next call must resume.
+local function scan(st, final, out)
+    local top = st.base + #st.buf
+    while true do
+        local i = st.buf:find(SYNC, st.pos - st.base + 1, true)
+        if i == nil then
+            st.pos = math.max(st.pos, top - 2) -- a partial sync may follow
+            return
+        end
+        local s = st.base + i - 1
+        local size = st.buf:byte(i + 3)
+        st.pos = s
+        if size ~= nil and size >= 2 and s + size + 6 <= top then
+            local raw = st.buf:sub(i, i + size + 5)
+            if checksum_ok(raw) then
+                out[#out + 1] = {off = s, raw = raw, last = packet_of(st, s + size + 6)}
+                st.pos = s + size + 6
+            else
+                st.pos = s + 1
+            end
+        elseif size ~= nil and size < 2 then
+            st.pos = s + 1 -- Size < 2: no frame
+        elseif final then
+            st.pos = s + 1 -- can no longer complete
+        else
+            return -- pending: what follows waits for it
+        end
+    end
+end
+
+-- First pass: append packet `num`'s bytes to stream `key` and record the
+-- frames they decide, in stream order.
+local function feed(key, chunk, num)
     local st = streams[key]
     if st == nil then
-        st = {buf = "", base = 0, cands = {}, scanned = 0, consumed = 0}
+        st = {buf = "", base = 0, pos = 0, hist = {}, tail_nums = {}}
         streams[key] = st
     end
     st.buf = st.buf .. chunk
-    local top = st.base + #st.buf -- stream offset just past the last byte
-    local from = st.scanned
-    while true do
-        local i = st.buf:find(SYNC, from - st.base + 1, true)
-        if i == nil then break end
-        local s = st.base + i - 1
-        if s >= st.consumed then st.cands[#st.cands + 1] = s end
-        from = s + 1
-    end
-    st.scanned = math.max(st.scanned, top - 2)
+    st.hist[#st.hist + 1] = {stop = st.base + #st.buf, num = num}
     local out = {}
-    while true do
-        local best, best_end, best_k
-        local k = 1
-        while k <= #st.cands do
-            local s = st.cands[k]
-            local size = st.buf:byte(s - st.base + 4)
-            if size ~= nil and size < 2 then
-                table.remove(st.cands, k) -- Size < 2: no frame
-            else
-                if size ~= nil then
-                    local e = s + size + 6
-                    if e <= top and (best_end == nil or e < best_end) then
-                        best, best_end, best_k = s, e, k
-                    end
+    scan(st, false, out)
+    st.buf = st.buf:sub(st.pos - st.base + 1)
+    st.base = st.pos
+    while st.hist[1] ~= nil and st.hist[1].stop <= st.base and #st.hist > 1 do
+        table.remove(st.hist, 1)
+    end
+    for _, fr in ipairs(out) do
+        fr.decided = num
+        ended[fr.last] = ended[fr.last] or {}
+        table.insert(ended[fr.last], fr)
+    end
+    decided[num] = out
+    st.dirty = true
+end
+
+-- What the end of the capture decides: for each stream fed since the last
+-- call, a flush of a copy of its state, filed by the packet of each
+-- frame's last byte (none of them has a deciding packet).
+local function settle()
+    for _, st in pairs(streams) do
+        if st.dirty then
+            for _, num in ipairs(st.tail_nums) do tails[num] = nil end
+            st.tail_nums = {}
+            local out = {}
+            scan({buf = st.buf, base = st.base, pos = st.pos, hist = st.hist}, true, out)
+            for _, fr in ipairs(out) do
+                if tails[fr.last] == nil then
+                    tails[fr.last] = {}
+                    st.tail_nums[#st.tail_nums + 1] = fr.last
                 end
-                k = k + 1
+                table.insert(tails[fr.last], fr)
             end
-        end
-        if best == nil then break end
-        local raw = st.buf:sub(best - st.base + 1, best_end - st.base)
-        if checksum_ok(raw) then
-            out[#out + 1] = {off = best, raw = raw}
-            local kept = {}
-            for _, s in ipairs(st.cands) do
-                if s < best or s >= best_end then kept[#kept + 1] = s end
-            end
-            st.cands = kept
-            st.consumed = math.max(st.consumed, best_end)
-        else
-            table.remove(st.cands, best_k)
+            st.dirty = false
         end
     end
-    local keep = math.max(st.base, top - 2)
-    if st.cands[1] ~= nil and st.cands[1] < keep then keep = st.cands[1] end
-    st.buf = st.buf:sub(keep - st.base + 1)
-    st.base = keep
-    return out
 end
 
 -- ---- display ----
@@ -327,19 +402,49 @@ local function add_frame(tree, fr, dir)
         end
     end
     t:add(F.checksum, ftvb(6 + len, 2))
-    return name
+    return name, t
 end
 
--- Feed a chunk of direction `dir` (first pass) and show every frame it
--- completed; returns their names for the Info column.
-local function dissect_chunk(tvb, pinfo, tree, key, dir)
-    local frames = found[pinfo.number]
-    if frames == nil then
-        frames = tvb:len() > 0 and feed(key, tvb:raw()) or {}
-        found[pinfo.number] = frames
+local f_interface = Field.new("frame.interface_id")
+
+-- Packet `pinfo.number` carries a chunk of direction `dir` of a `kind`
+-- ("can" or "serial") stream. First pass: feed it and show the frames it
+-- decided (what a single-pass tshark prints). Later passes: show the
+-- frames whose last byte it carries.
+local function dissect_chunk(tvb, pinfo, tree, kind, dir)
+    local num = pinfo.number
+    -- Field values exist only when the pass builds a protocol tree, which
+    -- tshark -2's first pass does not without -R/-Y: there every capture
+    -- interface is taken as interface 0.
+    local ifid = f_interface()
+    ifid = ifid and ifid.value or 0
+    local frames = {}
+    if not pinfo.visited then
+        if decided[num] == nil and tvb:len() > 0 then
+            feed(kind .. ":" .. ifid .. ":" .. dir, tvb:raw(), num)
+            ifaces[num] = ifid
+        end
+        frames = decided[num] or {}
+    else
+        settle()
+        for _, fr in ipairs(ended[num] or {}) do frames[#frames + 1] = fr end
+        for _, fr in ipairs(tails[num] or {}) do frames[#frames + 1] = fr end
+        if ifaces[num] ~= nil and ifaces[num] ~= ifid then
+            tree:add_proto_expert_info(E.merged)
+        end
     end
     local names = {}
-    for _, fr in ipairs(frames) do names[#names + 1] = add_frame(tree, fr, dir) end
+    for _, fr in ipairs(frames) do
+        local t
+        names[#names + 1], t = add_frame(tree, fr, dir)
+        if fr.last ~= num then
+            t:add(F.last_byte_in, fr.last):set_generated()
+        elseif fr.decided == nil then
+            t:add(F.decided_at_end, true):set_generated()
+        elseif fr.decided ~= num then
+            t:add(F.decided_in, fr.decided):set_generated()
+        end
+    end
     pinfo.cols.protocol = "TASE"
     if #names > 0 then
         pinfo.cols.info = dir .. " " .. table.concat(names, ", ")
@@ -347,9 +452,6 @@ local function dissect_chunk(tvb, pinfo, tree, key, dir)
         pinfo.cols.info = string.format("%s %d datalink bytes (no complete packet)", dir, tvb:len())
     end
 end
-
-local f_can_id = Field.new("can.id")
-local f_interface = Field.new("frame.interface_id")
 
 local function dissect_3ax(tvb, pinfo, tree, id)
     local move = id == ID_3AX_MOVE
@@ -374,16 +476,14 @@ local function dissect_3ax(tvb, pinfo, tree, id)
 end
 
 function tase.dissector(tvb, pinfo, tree)
-    local id = f_can_id()
-    id = id and id.value or 0
+    local id = pinfo.match_uint -- the CAN ID it was registered for
     if id == ID_3AX_MOVE or id == ID_3AX_STATUS then
         dissect_3ax(tvb, pinfo, tree, id)
         return tvb:len()
     end
     local dir = CAN_DIRS[id]
     if dir == nil then return 0 end
-    local ifid = f_interface()
-    dissect_chunk(tvb, pinfo, tree, "can:" .. tostring(ifid and ifid.value or 0) .. ":" .. dir, dir)
+    dissect_chunk(tvb, pinfo, tree, "can", dir)
     return tvb:len()
 end
 
@@ -400,9 +500,7 @@ function tase_serial.dissector(tvb, pinfo, tree)
     end
     if tvb:len() < 2 then return tvb:len() end
     t:add(F.serial_bytes, tvb(1))
-    local ifid = f_interface()
-    dissect_chunk(tvb(1):tvb(), pinfo, tree, "serial:" .. tostring(ifid and ifid.value or 0) ..
-        ":" .. dir, dir)
+    dissect_chunk(tvb(1):tvb(), pinfo, tree, "serial", dir)
     return tvb:len()
 end
 
