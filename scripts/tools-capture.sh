@@ -198,9 +198,16 @@ check "replay --speed 2: the same bytes at half the recorded intervals" \
 replay_to in "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir in
 check "replay --dir in: the bytes sent to the gimbal" \
     $U timing "$dir/slow.pcap" "$dir/in.pcap" in 1 $tol
-start=$(date +%s%N)
-"$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --speed 0 >/dev/null
-ms=$((($(date +%s%N) - start) / 1000000))
+# Recorded like the others, so that no byte of it is left in the joined
+# ptys for the next recorder to find (under load the relay can lag).
+replay_fast() {
+    local start
+    start=$(date +%s%N)
+    "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --speed 0 >/dev/null
+    echo $((($(date +%s%N) - start) / 1000000)) >"$dir/zero.ms"
+}
+replay_to zero replay_fast
+ms=$(cat "$dir/zero.ms")
 check "replay --speed 0 sends without waiting (${ms} ms for a 1.5 s capture)" [ "$ms" -lt "$fast_ms" ]
 
 # A two-line tap: the gimbal's line into A (recorded on B), the host's line
