@@ -381,10 +381,9 @@ static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
         if ((r < 0 && errno != EAGAIN && errno != EWOULDBLOCK) || hangup) {
             return TASE_EIO;
         }
+        /* With no time left poll() still runs, with a zero timeout: a
+         * caller that never waits must see a hang-up too, not an idle line. */
         left = time_left(start, timeout_ms);
-        if (left == 0) {
-            return 0;
-        }
         pfd.fd = u->fd;
         pfd.events = POLLIN;
         pfd.revents = 0;
