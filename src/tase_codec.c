@@ -190,11 +190,10 @@ static void unpack_fields(const tase_packet_desc_t *p, const uint8_t *data, size
         size_t at = tase_layout_offset(fd, short_layout);
         unsigned k;
         uint64_t v = 0u;
-        int64_t keep;
+        uint32_t keep;
         if (at + w > len) {
-            if (tase_field_keep(p, i, &keep) == TASE_OK) {
-                /* two's complement bits of the value, as stored below */
-                member_store((uint8_t *)msg + fd->member, w, (uint64_t)keep);
+            if (tase_layout_keep_bits(fd, &keep)) {
+                member_store((uint8_t *)msg + fd->member, w, keep);
             }
             continue;
         }

@@ -238,26 +238,20 @@ int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, s
 }
 
 /* All bits of an unsigned field of w (1..4, checked at build time) bytes. */
-static uint32_t all_ones(unsigned w)
-{
-    unsigned bits = 8u * w;
-    return w >= 4u ? 0xFFFFFFFFu : ((uint32_t)1u << bits) - 1u;
-}
-
 int tase_field_keep(const tase_packet_desc_t *p, size_t i, int64_t *value)
 {
     const tase_field_t *f = tase_schema_field(p, i);
-    uint32_t ones;
+    uint32_t bits;
     if (f == NULL || value == NULL) {
         return TASE_EARG;
     }
-    ones = all_ones(TASE_FIELD_WIDTH(f));
-    switch (TASE_FIELD_KEEP(f)) {
-    case TASE_FIELD_KEEP_ONES: *value = TASE_FIELD_IS_SIGNED(f) ? -1 : (int64_t)ones; break;
-    case TASE_FIELD_KEEP_ZERO: *value = 0; break;
-    case TASE_FIELD_KEEP_MSB: *value = (int64_t)(ones ^ (ones >> 1)); break; /* top bit */
-    default: return TASE_EUNKNOWN;
+    if (!tase_layout_keep_bits(f, &bits)) {
+        return TASE_EUNKNOWN;
     }
+    /* all ones of a signed field is -1 (HFOV "do not change") */
+    *value = (TASE_FIELD_KEEP(f) == TASE_FIELD_KEEP_ONES && TASE_FIELD_IS_SIGNED(f))
+                 ? -1
+                 : (int64_t)bits;
     return TASE_OK;
 }
 
