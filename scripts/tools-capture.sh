@@ -85,9 +85,14 @@ expect_error "decode of an Ethernet pcap" 1 "link type 1 (EN10MB) is neither TAS
 head -c 30 "$dir/noisy.pcap" >"$dir/cut.pcap"
 expect_error "decode of a pcap cut inside a record header" 1 "cut.pcap" "$TASE" decode "$dir/cut.pcap"
 expect_error "replay of a raw byte file" 1 "is not a pcap or pcapng capture" \
-    "$TASE" replay "$DATA/decode_noisy.bin" --serial /dev/null
+    "$TASE" replay "$DATA/decode_noisy.bin" --serial /dev/null --dir out
 expect_error "replay without a link" 2 "give either --serial DEV or --can IFACE" \
     "$TASE" replay "$dir/noisy.pcap"
+# Nothing is replayed on a default: a capture's gimbal side holds echoes a
+# gimbal takes as commands (RETRACT_DEPLOY_CMD, SPOI_CMD, setup packets).
+expect_error "replay without --dir: refused, each choice explained" 2 \
+    "replay needs --dir: out = the gimbal's side, to exercise a host (its echoes are commands to a gimbal); in = the host's commands (moves a gimbal); all = both (moves a gimbal)" \
+    "$TASE" replay "$dir/noisy.pcap" --serial /dev/null
 expect_error "replay --dir sideways" 2 "bad --dir value 'sideways'" \
     "$TASE" replay "$dir/noisy.pcap" --serial /dev/null --dir sideways
 expect_error "replay --speed -1" 2 "bad --speed value" \
@@ -187,12 +192,12 @@ replay_to() {
     wait $rp
 }
 bytes=$(wc -c <"$DATA/decode_noisy.bin")
-replay_to got "$TASE" replay "$dir/slow.pcap" --serial "$dir/A"
-check "replay (default: the gimbal's side): $(cat "$dir/got.out")" \
+replay_to got "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out
+check "replay --dir out (the gimbal's side): $(cat "$dir/got.out")" \
     grep -q "^replayed [1-9][0-9]* of [0-9]* records ($bytes bytes)" "$dir/got.out"
 check "replay: every byte from the gimbal arrived, in order, within $tol s of its recorded time" \
     $U timing "$dir/slow.pcap" "$dir/got.pcap" out 1 $tol
-replay_to fast "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --speed 2
+replay_to fast "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out --speed 2
 check "replay --speed 2: the same bytes at half the recorded intervals" \
     $U timing "$dir/slow.pcap" "$dir/fast.pcap" out 2 $tol
 replay_to in "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir in
@@ -203,7 +208,7 @@ check "replay --dir in: the bytes sent to the gimbal" \
 replay_fast() {
     local start
     start=$(date +%s%N)
-    "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --speed 0 >/dev/null
+    "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out --speed 0 >/dev/null
     echo $((($(date +%s%N) - start) / 1000000)) >"$dir/zero.ms"
 }
 replay_to zero replay_fast

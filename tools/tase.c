@@ -155,13 +155,16 @@ static const char usage_record[] =
     "'tase decode FILE' decodes it; Wireshark reads it (tools/wireshark/tase.lua).\n";
 
 static const char usage_replay[] =
-    "usage: tase replay FILE (--serial DEV [--baud N] | --can IFACE) [--speed X]\n"
-    "                   [--dir out|in|all]\n"
+    "usage: tase replay FILE (--serial DEV [--baud N] | --can IFACE) --dir out|in|all\n"
+    "                   [--speed X]\n"
     "Sends the records of the pcap capture FILE with their recorded timing (divided\n"
-    "by X, default 1; 0 sends without waiting).\n"
-    "  --dir out   what the gimbal sent (the default: plays the gimbal's side)\n"
-    "  --dir in    what was sent to the gimbal (commands: moves a real gimbal)\n"
-    "  --dir all   both; on CAN every recorded frame, whatever its ID\n"
+    "by X, default 1; 0 sends without waiting). --dir is required (no default: a\n"
+    "capture holds commands either way):\n"
+    "  --dir out   the gimbal's side, to exercise a host; it holds the gimbal's\n"
+    "              echoes of setup packets, RETRACT_DEPLOY_CMD and SPOI_CMD, which a\n"
+    "              gimbal takes as commands: never replay it into a gimbal\n"
+    "  --dir in    the host's side: the commands sent to the gimbal (moves a gimbal)\n"
+    "  --dir all   both (moves a gimbal); on CAN every recorded frame, whatever its ID\n"
     "Serial bytes go to a CAN interface as frames of their direction's ID, and the\n"
     "datalink bytes of CAN frames to a serial device; CAN FD, remote and error\n"
     "frames are not sent. A bad record is reported and skipped (exit 4).\n";
@@ -1666,7 +1669,7 @@ static int cmd_replay(args_t *a)
     size_t n;
     memset(&ro, 0, sizeof(ro));
     ro.speed = 1.0;
-    ro.dirs = TK_CAP_DIR_OUT;
+    ro.dirs = (tk_cap_dirs_t)0; /* no default: --dir is required */
     while (a->i < a->argc) {
         if (common_opt(a) || link_opt(a, &lo)) {
             continue;
@@ -1701,6 +1704,11 @@ static int cmd_replay(args_t *a)
     }
     if ((lo.serial != NULL) == (lo.can != NULL)) {
         tk_usage_error("give either --serial DEV or --can IFACE");
+    }
+    if (ro.dirs == 0) {
+        tk_usage_error("replay needs --dir: out = the gimbal's side, to exercise a host (its "
+                       "echoes are commands to a gimbal); in = the host's commands (moves a "
+                       "gimbal); all = both (moves a gimbal)");
     }
     input_open(&in, path);
     n = input_head(&in, head, sizeof(head));
