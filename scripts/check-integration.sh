@@ -116,7 +116,7 @@ echo "   clean: C99 (gcc, clang), C++98, 11, 14, 17, 20 (g++, clang++)"
 tase_step "3. add_subdirectory and FetchContent(SOURCE_DIR) from a parent with extra warnings"
 extra="-Wall -Wextra -Wfloat-equal -Wundef -Wcast-qual -Wstrict-prototypes -Wmissing-prototypes \
 -Wold-style-definition -Wbad-function-cast -Wredundant-decls -Wswitch-default -Wwrite-strings \
--Wmissing-declarations -Wdouble-promotion -Wformat=2"
+-Wmissing-declarations -Wdouble-promotion -Wformat=2 -Wlogical-op -Wduplicated-cond"
 for how in subdir fetch; do
     b="$out/$how"
     port=posix_uart

@@ -14,21 +14,15 @@ TASE=$1
 SIM=$2
 dir=$(mktemp -d)
 sim_pid=""
-fails=0
+# shellcheck source=scripts/check-lib.sh
+. "$(dirname "$0")/check-lib.sh" # ok, bad, check, under_valgrind, check_summary
+under_valgrind TASE SIM
 cleanup() {
     [ -n "$sim_pid" ] && kill "$sim_pid" 2>/dev/null
     wait 2>/dev/null
     rm -rf "$dir"
 }
 trap cleanup EXIT
-
-ok() { echo "ok   $*"; }
-bad() { echo "FAIL $*"; fails=$((fails + 1)); }
-check() {
-    local name=$1
-    shift
-    if "$@"; then ok "$name"; else bad "$name"; fi
-}
 
 # frame GROUP TYPE BYTE...: one datalink frame (spec 3.1) on stdout
 frame() {
@@ -106,5 +100,4 @@ ct=$("$TASE" query CAMERA_TYPE --serial "$dir/gimbal" --json)
 check "CAMERA_TYPE reports the simulated cameras, not \"do not change\" ($ct)" \
     test "$(json_int "$ct" camera_a)/$(json_int "$ct" camera_b)/$(json_int "$ct" camera_c)" = 68/97/255
 
-echo "$fails failure(s)"
-[ "$fails" -eq 0 ]
+check_summary "spec fidelity end to end"

@@ -345,6 +345,30 @@ static void a_hung_up_line_reads_as_eio(void **state)
     pty_close(&p);
 }
 
+/* A caller that polls (timeout 0, as a main loop or a poll()-driven tool
+ * does) must see the hang-up too, not an idle line forever. */
+static void a_hung_up_line_reads_as_eio_also_without_waiting(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a;
+    tase_port_t pa;
+    uint8_t buf[8];
+    int i;
+    (void)state;
+
+    pty_open(&p);
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 9600), TASE_OK);
+    pa = tase_posix_uart_port(&a);
+    assert_int_equal(pa.ops->read(pa.ctx, buf, sizeof buf, 0), 0); /* open, idle */
+    close(p.master);
+    p.master = -1;
+    for (i = 0; i < 3; i++) {
+        assert_int_equal(pa.ops->read(pa.ctx, buf, sizeof buf, 0), TASE_EIO);
+    }
+    tase_posix_uart_close(&a);
+    pty_close(&p);
+}
+
 static void the_clock_is_monotonic_milliseconds(void **state)
 {
     struct timespec ts = {0, 50000000L};
@@ -591,6 +615,7 @@ int main(void)
         cmocka_unit_test(permission_denied_is_eacces),
         cmocka_unit_test(write_gives_up_after_its_timeout_when_the_peer_never_reads),
         cmocka_unit_test(a_hung_up_line_reads_as_eio),
+        cmocka_unit_test(a_hung_up_line_reads_as_eio_also_without_waiting),
         cmocka_unit_test(the_clock_is_monotonic_milliseconds),
         cmocka_unit_test(bad_arguments_are_rejected),
         cmocka_unit_test(a_second_open_of_the_device_is_ebusy_until_the_first_closes),

@@ -28,7 +28,9 @@
  *     delivered frame is ever delivered. A CAMERA_PASS whose camera bytes
  *     happen to hold a complete valid frame (a GIMBAL_CMD, say) gives the
  *     CAMERA_PASS only; the frame-like bytes reach the application as
- *     camera data and nothing else;
+ *     camera data and nothing else. (A CAMERA_PASS that is itself
+ *     corrupted or cut short is no frame: a valid frame inside it is then
+ *     delivered by the next rule, as any receiver would have to);
  *   - no frame is lost behind a corrupted Size byte, a false sync or
  *     noise: when a candidate fails (Size < 2, stats.bad_size; checksum
  *     wrong, stats.checksum_errors) the scan resumes at the byte after its

@@ -68,6 +68,17 @@ static const baud_map_t baud_map[] = {
 #endif
 };
 
+/* EAGAIN or EWOULDBLOCK (equal on Linux, where testing both would be a
+ * "logical and of equal expressions" under -Wlogical-op). */
+static bool would_block(int e)
+{
+#if EAGAIN == EWOULDBLOCK
+    return e == EAGAIN;
+#else
+    return e == EAGAIN || e == EWOULDBLOCK;
+#endif
+}
+
 static bool baud_code(uint32_t baud, speed_t *code)
 {
     size_t i;
@@ -332,7 +343,7 @@ static int uart_write(void *ctx, const uint8_t *data, size_t n)
         if (w < 0 && errno == EINTR) {
             continue;
         }
-        if (w < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
+        if (w < 0 && !would_block(errno)) {
             return TASE_EIO;
         }
         {
@@ -378,13 +389,12 @@ static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
         if (r < 0 && errno == EINTR) {
             continue;
         }
-        if ((r < 0 && errno != EAGAIN && errno != EWOULDBLOCK) || hangup) {
+        if ((r < 0 && !would_block(errno)) || hangup) {
             return TASE_EIO;
         }
+        /* With no time left poll() still runs, with a zero timeout: a
+         * caller that never waits must see a hang-up too, not an idle line. */
         left = time_left(start, timeout_ms);
-        if (left == 0) {
-            return 0;
-        }
         pfd.fd = u->fd;
         pfd.events = POLLIN;
         pfd.revents = 0;

@@ -44,6 +44,17 @@ static size_t role_filter_ids(tase_can_role_t role, uint32_t ids[2])
     return 1;
 }
 
+/* EAGAIN or EWOULDBLOCK (equal on Linux, where testing both would be a
+ * "logical and of equal expressions" under -Wlogical-op). */
+static bool would_block(int e)
+{
+#if EAGAIN == EWOULDBLOCK
+    return e == EAGAIN;
+#else
+    return e == EAGAIN || e == EWOULDBLOCK;
+#endif
+}
+
 static bool role_wants(tase_can_role_t role, const tase_can_frame_t *f)
 {
     uint32_t ids[2];
@@ -291,7 +302,7 @@ static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, uint32_t d
             s->stats.last_errno = e;
             return TASE_EDOWN; /* interface down (or bus-off without auto-restart) */
         }
-        if (e != EAGAIN && e != EWOULDBLOCK && e != ENOBUFS) {
+        if (!would_block(e) && e != ENOBUFS) {
             s->stats.last_errno = e;
             return TASE_EIO;
         }
@@ -491,7 +502,7 @@ static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint
         if (errno == EINTR) {
             continue;
         }
-        if (errno != EAGAIN && errno != EWOULDBLOCK) {
+        if (!would_block(errno)) {
             s->stats.last_errno = errno;
             return TASE_EIO;
         }

@@ -42,8 +42,8 @@
  *          total for the first bytes (EINTR resumes the wait with the time
  *          left). Returns the count (0 = nothing within the timeout),
  *          TASE_EIO (OS error, or the other end hung up: after the bytes
- *          still queued) or TASE_EARG (ctx NULL or
- *          closed, buf NULL, cap 0). A cap above INT32_MAX reads at most
+ *          still queued, and also with timeout_ms 0) or TASE_EARG (ctx
+ *          NULL or closed, buf NULL, cap 0). A cap above INT32_MAX reads at most
  *          INT32_MAX bytes.
  *  now_ms  CLOCK_MONOTONIC in milliseconds, modulo 2^32.
  * One instance is used from one thread at a time; separate instances are
