@@ -309,6 +309,89 @@ else:
     ok("decode of %d dense frames: %d lines with %d write() calls (one per frame before)"
        % (want, lines, n), lines == want and n < want // 20)
 
+# ---- a gimbal of the 22-byte AXIS_SETTING kind (docs/PROTOCOL-NOTES.md S2) ----
+class FakeGimbal:
+    """A pseudo-terminal whose far end answers like a gimbal of the short
+    AXIS_SETTING layout: the zero-length query with its settings in 22
+    bytes, a 22-byte setting stored and echoed (0xFF/0xFFFF: no change),
+    any other length ignored (a strict gimbal). Every frame it got is kept."""
+
+    # 22-byte layout: no-go centre/range pan, tilt, roll (16-bit each), then
+    # max rates pan 12, tilt 13, roll 14, accelerations 15-17, gains 18-20,
+    # temporary 21
+    WIDTHS = [2] * 6 + [1] * 10
+
+    def __init__(self):
+        self.master, self.slave = os.openpty()
+        self.path = os.ttyname(self.slave)
+        self.settings = bytearray((0).to_bytes(2, "big") * 2 + (9000).to_bytes(2, "big") +
+                                  (6000).to_bytes(2, "big") + bytes(4) +
+                                  bytes([60, 60, 255, 50, 50, 255, 40, 40, 255, 0]))
+        self.got = []
+        self.stop = False
+        self.thread = threading.Thread(target=self.run, daemon=True)
+        self.thread.start()
+
+    def run(self):
+        buf = b""
+        while not self.stop:
+            if not select.select([self.master], [], [], 0.05)[0]:
+                continue
+            try:
+                buf += os.read(self.master, 4096)
+            except OSError:
+                continue
+            while True:
+                i = buf.find(b"\x00\xff\x5a")
+                if i < 0 or len(buf) < i + 4 or len(buf) < i + 6 + buf[i + 3]:
+                    break
+                size = buf[i + 3]
+                f = buf[i:i + 6 + size]
+                buf = buf[i + 6 + size:]
+                if f[:-2] and int.from_bytes(f[-2:], "big") == sum(f[:-2]) & 0xFFFF:
+                    self.frame(f[4], f[5], f[6:-2])
+
+    def frame(self, group, ptype, data):
+        self.got.append((group, ptype, bytes(data)))
+        if (group, ptype) != (0x48, 0x02):
+            return
+        if len(data) == 22:
+            off = 0
+            for w in self.WIDTHS:
+                v = data[off:off + w]
+                if off == 21 or v != b"\xff" * w:
+                    self.settings[off:off + w] = v
+                off += w
+        elif len(data) != 0:
+            return
+        os.write(self.master, frame(0x48, 0x02, bytes(self.settings)))
+
+    def close(self):
+        self.stop = True
+        self.thread.join()
+        os.close(self.master)
+        os.close(self.slave)
+
+
+fg = FakeGimbal()
+rc, out, err = run(["send", "AXIS_SETTING", "pan_max_rate=20", "--serial", fg.path, "--json"])
+sent = [o for o in jsonl(out) if o.get("dir") == "in"]
+sets = [d for g, t, d in fg.got if (g, t) == (0x48, 0x02) and d]
+ok("send AXIS_SETTING to a 22-byte gimbal: queried, sent in its 22-byte layout, echo confirmed",
+   rc == 0 and len(sent) == 1 and sent[0]["size"] == 22 and
+   sent[0]["fields"]["pan_max_rate"] == 20 and len(sets) == 1 and len(sets[0]) == 22 and
+   sets[0][12] == 20 and sets[0][13] == 255 and fg.settings[12] == 20 and fg.settings[13] == 60,
+   "exit %d %r %r %r" % (rc, err, out, fg.got))
+rc, out, err = run(["send", "AXIS_SETTING", "tilt_max_rate=30", "--len", "22", "--serial", fg.path])
+ok("send AXIS_SETTING --len 22 to a 22-byte gimbal: the fields left out kept from its answer",
+   rc == 0 and fg.settings[13] == 30 and fg.settings[12] == 20 and fg.settings[18] == 40 and
+   "echo AXIS_SETTING" in out, "exit %d %r %r" % (rc, err, out))
+rc, out, err = run(["send", "AXIS_SETTING", "pan_pos_gain=41", "--serial", fg.path])
+ok("... the text output says which layout was used",
+   rc == 0 and "22-byte layout the gimbal answered" in out and fg.settings[18] == 41,
+   "exit %d %r %r" % (rc, err, out))
+fg.close()
+
 # ---- 64-bit offsets (4 GiB through a pipe: about 1.5 s of CPU; not under memcheck) ----
 gen = ("import os,sys,fcntl\n"
        "try: fcntl.fcntl(1, 1031, 1 << 20)\n"

@@ -102,7 +102,8 @@ static const char usage_send[] =
     "    AXIS_SETTING, CAMERA_TYPE, LEGACY_CAMERA_CMD focus and shutter_speed,\n"
     "    CAMERA_PASS baud);\n"
     "  - other fields of setup packets (group 0x48): the gimbal's current settings\n"
-    "    are queried first and kept;\n"
+    "    are queried first and kept, and the packet is sent in the layout of the\n"
+    "    answer (AXIS_SETTING: 22 or 23 bytes) unless --len says otherwise;\n"
     "  - otherwise every field must be given (the error names the missing ones);\n"
     "  - --zero: fields left out without such a value are 0 instead.\n"
     "GIMBAL_CMD always needs flags (its mode; or use 'tase point' / 'tase rate').\n"
@@ -110,7 +111,8 @@ static const char usage_send[] =
     "compared with what was sent; a field that differs (a value the gimbal refused\n"
     "or changed) exits 3 naming it. --no-wait sends without waiting for anything\n"
     "(a setup packet then needs every field, or --zero). --len N sends a shorter\n"
-    "accepted form (CAMERA_CMD --len 1: change camera only).\n";
+    "accepted form (CAMERA_CMD --len 1: change camera only; AXIS_SETTING --len 22:\n"
+    "the 22-byte layout).\n";
 
 static const char usage_query[] =
     "usage: tase query NAME LINK [--json] [--timeout MS] [--retries N]\n"
@@ -577,6 +579,32 @@ static unsigned fields_within(const tase_packet_desc_t *p, size_t len)
     return i;
 }
 
+/* Move the fields set so far to the layout of `len` data bytes (a setup
+ * packet sent in the layout the gimbal answered with: AXIS_SETTING's 22 or
+ * 23 bytes; the widths are the same, offsets move). A field that does not
+ * fit `len` is dropped. */
+static void fields_relayout(fields_t *fs, size_t len)
+{
+    uint8_t data[TASE_DATA_MAX];
+    unsigned i;
+    memset(data, 0, sizeof(data));
+    for (i = 0; i < fs->p->nfields && i < sizeof(fs->given); i++) {
+        tk_field_t fd;
+        long long v;
+        if (!fs->given[i]) {
+            continue;
+        }
+        tk_field(fs->p, i, len, &fd);
+        if (fd.offset + fd.width > len || !tk_field_get(fs->p, i, fs->data, fs->len, &v)) {
+            fs->given[i] = false;
+            continue;
+        }
+        (void)tk_field_set(&fd, data, v);
+    }
+    memcpy(fs->data, data, sizeof(data));
+    fs->len = len;
+}
+
 /* Fields [0, n) left out that have a "do not change" value in the spec
  * (the schema's, tase_field_keep()) take it. */
 static void fields_keep(fields_t *fs, unsigned n)
@@ -728,7 +756,7 @@ static int cmd_send(args_t *a)
     const char *assign[64];
     size_t nassign = 0, i, len;
     unsigned nf;
-    bool setup, rmw = false;
+    bool setup, rmw = false, relaid = false;
     const tase_packet_desc_t *p;
     fields_t fs;
     session_t s;
@@ -799,9 +827,19 @@ static int cmd_send(args_t *a)
         uint8_t cur[TASE_DATA_MAX];
         unsigned k;
         int n = transact(&s, p, NULL, 0, cur, &o.r);
-        if ((size_t)n != p->len) {
-            tk_die("%s query answered with %d bytes, expected %u", name, n, (unsigned)p->len);
+        if (n <= 0 || !tase_schema_length_ok(p, (size_t)n)) {
+            tk_die("%s query answered with %d data bytes, not a length of %s; nothing was set",
+                   name, n, name);
         }
+        if (o.len < 0 && (size_t)n != len) {
+            /* the layout this gimbal uses (AXIS_SETTING's 22 bytes): send
+             * in it, as the gimbal answered, unless --len says otherwise */
+            fields_relayout(&fs, (size_t)n);
+            len = (size_t)n;
+            nf = fields_within(p, len);
+            relaid = true;
+        }
+        /* each field read at its place in the answer's own layout */
         for (k = 0; k < nf; k++) {
             long long cv;
             if (!fs.given[k] && tk_field_get(p, k, cur, (size_t)n, &cv)) {
@@ -810,6 +848,10 @@ static int cmd_send(args_t *a)
         }
     }
     send_fields(&s, &fs, len, &o);
+    if (relaid && !o.r.json) {
+        printf("  = sent in the %lu-byte layout the gimbal answered the query with\n",
+               (unsigned long)len);
+    }
     session_close(&s);
     return TK_EXIT_OK;
 }
