@@ -271,6 +271,67 @@ got = live(["decode"], angle(7, 8), "decode")
 ok("tase decode on a live input prints a packet while the writer is still open",
    b'"pan":7,' in got, repr(got[:200]))
 
+# ---- a serial device named as the input: opened raw, given back as found ----
+import signal
+import termios
+
+
+def cooked_pty(args, data, expect_lines):
+    """Run tase ARGS PTY on a pty left in its default (cooked, echoing)
+    mode, write `data` to the line once tase has the device, and stop it
+    with SIGTERM once `expect_lines` lines came out (or after 3 s).
+    Returns (exit status, output, stderr, bytes echoed back to the line's
+    far end, the slave's termios before and after)."""
+    master, slave = os.openpty()
+    path = os.ttyname(slave)
+    before = termios.tcgetattr(slave)
+    p = subprocess.Popen(VG + [TASE] + args + [path], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE)
+    deadline = time.time() + 2.0 * SLOW
+    while time.time() < deadline and termios.tcgetattr(slave)[3] & termios.ICANON:
+        time.sleep(0.01)  # tase has opened it once it is raw (old code: never)
+    time.sleep(0.05)
+    os.write(master, data)
+    echoed = b""
+    out = b""
+    os.set_blocking(p.stdout.fileno(), False)
+    deadline = time.time() + 3.0 * SLOW
+    while time.time() < deadline and out.count(b"\n") < expect_lines:
+        r = select.select([master, p.stdout], [], [], 0.05)[0]
+        if master in r:
+            echoed += os.read(master, 4096)
+        if p.stdout in r:
+            out += p.stdout.read() or b""
+    p.send_signal(signal.SIGTERM)
+    rest, err = p.communicate(timeout=10 * SLOW)
+    while select.select([master], [], [], 0.05)[0]:
+        echoed += os.read(master, 4096)
+    after = termios.tcgetattr(slave)
+    os.close(master)
+    os.close(slave)
+    err = "".join(l for l in err.decode(errors="replace").splitlines(True)
+                  if not re.match(r"==\d+== ", l))
+    return p.returncode, (out + rest).decode(errors="replace"), err, echoed, before, after
+
+
+want = run(["klv", os.path.join(os.path.dirname(noisy), "klv_noisy.bin")])[1]
+rc, out, err, echoed, before, after = cooked_pty(["klv"], klv, want.count("\n"))
+ok("tase klv PTY (cooked mode): every packet decoded, as from the file (%d of %d lines)"
+   % (out.count("\n"), want.count("\n")), out == want, "exit %d %r %r" % (rc, err, out[:300]))
+ok("... nothing echoed back towards the gimbal (%d bytes)" % len(echoed), echoed == b"")
+ok("... SIGTERM ends the live line with exit 0, the device's settings given back",
+   rc == 0 and err == "" and before == after, "exit %d %r" % (rc, err))
+rc, out, err, echoed, before, after = cooked_pty(["klv", "--baud", "9600"], klv[:87 * 3], 0)
+ok("tase klv --baud 9600 PTY accepted", rc == 0 and before == after, "exit %d %r" % (rc, err))
+want = run(["decode", noisy])[1]
+rc, out, err, echoed, before, after = cooked_pty(["decode"], open(noisy, "rb").read(),
+                                                 want.count("\n"))
+ok("tase decode PTY (cooked mode): every packet as from the file, nothing echoed, settings "
+   "given back", out == want and echoed == b"" and rc == 0 and before == after,
+   "exit %d %r %r echoed %d" % (rc, err, out[:300], len(echoed)))
+expect("--baud with a file input is refused", ["klv", "--baud", "9600", noisy], 2,
+       "--baud is for a serial device")
+
 # ---- decode writes its output in blocks, not one write() per frame ----
 # 2 MB of back-to-back GIMBAL_ANGLE frames (about 143,000) through a pipe
 # that stays open: once every frame is out, the process waits for more input

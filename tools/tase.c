@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "tase/candump.h"
@@ -15,6 +16,7 @@
 #include "toolkit.h"
 
 #define DEFAULT_BAUD 57600L
+#define KLV_BAUD 9600L /* the spec's KLV line (table 1) */
 #define DEFAULT_TIMEOUT_MS 500
 #define DEFAULT_RETRIES 2
 #define READ_CHUNK 65536u
@@ -122,7 +124,7 @@ static const char usage_query[] =
         DEFAULT_RETRIES) ") more attempts are made.\n";
 
 static const char usage_decode[] =
-    "usage: tase decode [FILE|-] [--candump] [--stats]\n"
+    "usage: tase decode [FILE|-] [--candump] [--stats] [--baud N]\n"
     "Decodes a capture of 'tase record' (pcap or pcapng; each object carries\n"
     "\"time\" and \"dir\"; a bad record is reported with its number, exit 4) or a\n"
     "raw serial byte capture (default: standard input; a live pty or\n"
@@ -134,14 +136,20 @@ static const char usage_decode[] =
     "ignored, blank and '#' lines skipped, a bad line reported with its number\n"
     "(the rest is still decoded; exit 4). --stats prints a summary line on stderr.\n"
     "When a non-empty input holds no packet, a one-line hint says why and the exit\n"
-    "status is 4.\n";
+    "status is 4. A serial device (or pty) named as FILE is opened as the link\n"
+    "commands open one: raw 8N1 at --baud N (default 57600), exclusively, its\n"
+    "settings given back at exit; SIGINT/SIGTERM/SIGHUP end it (exit 0), a hang-up\n"
+    "is an error (exit 1).\n";
 
 static const char usage_klv[] =
-    "usage: tase klv [FILE|-]\n"
+    "usage: tase klv [FILE|-] [--baud N]\n"
     "Decodes a KLV metadata byte stream (the gimbal's 9600-baud KLV line; a live\n"
     "pty is read as bytes arrive) to one JSON object per valid packet:\n"
     "{\"offset\":N,\"fields\":{raw values in tag order},\"units\":{engineering values}}.\n"
-    "Noise and damaged packets are skipped.\n";
+    "Noise and damaged packets are skipped. A serial device (or pty) named as FILE\n"
+    "is opened raw 8N1 at --baud N (default 9600, the KLV line), exclusively, its\n"
+    "settings given back at exit; SIGINT/SIGTERM/SIGHUP end it (exit 0), a hang-up\n"
+    "is an error (exit 1).\n";
 
 static const char usage_record[] =
     "usage: tase record (--serial DEV [--tap-in DEV2] [--baud N] | --can IFACE) -o FILE\n"
@@ -265,22 +273,25 @@ static bool is_arg(const args_t *a, bool numbers)
            (numbers && tk_parse_real(s, &x) == TK_NUM_OK);
 }
 
-static bool link_opt(args_t *a, link_opts_t *l)
+/* --baud N */
+static bool baud_opt(args_t *a, long *baud)
 {
     const char *v;
     long long n;
-    if (opt(a, "--serial", true, &l->serial) || opt(a, "--can", true, &l->can) ||
-        opt(a, "--record", true, &l->record)) {
-        return true;
+    if (!opt(a, "--baud", true, &v)) {
+        return false;
     }
-    if (opt(a, "--baud", true, &v)) {
-        if (tk_parse_int(v, 1, 4000000, &n, NULL) != TK_NUM_OK) {
-            tk_usage_error("bad --baud value '%s'", v);
-        }
-        l->baud = (long)n;
-        return true;
+    if (tk_parse_int(v, 1, 4000000, &n, NULL) != TK_NUM_OK) {
+        tk_usage_error("bad --baud value '%s'", v);
     }
-    return false;
+    *baud = (long)n;
+    return true;
+}
+
+static bool link_opt(args_t *a, link_opts_t *l)
+{
+    return opt(a, "--serial", true, &l->serial) || opt(a, "--can", true, &l->can) ||
+           opt(a, "--record", true, &l->record) || baud_opt(a, &l->baud);
 }
 
 static long long int_opt_value(const char *name, const char *v, long long min, long long max)
@@ -1308,49 +1319,106 @@ static int cmd_monitor(args_t *a)
 typedef struct {
     int fd;
     const char *name; /* for messages */
+    /* a serial device named as FILE, read through the POSIX UART port */
+    bool device;
+    bool hung_up; /* the device went away or hung up */
+    tk_link_t link;
+    tase_port_t port;
     /* the first bytes, kept for the hint when nothing is found (one
      * more for a terminating NUL) */
     uint8_t head[513];
     size_t nhead;
 } input_t;
 
-static void input_open(input_t *in, const char *path)
+/* Open FILE (NULL or "-": standard input). With baud > 0 a terminal named
+ * as FILE (a serial device, a pty) is opened through the POSIX UART port
+ * as the link commands open it: raw 8N1 at `baud`, exclusive, its settings
+ * given back on every exit path. */
+static void input_open(input_t *in, const char *path, long baud)
 {
+    struct stat st;
     memset(in, 0, sizeof(*in));
     if (path == NULL || strcmp(path, "-") == 0) {
         in->fd = STDIN_FILENO;
         in->name = "standard input";
         return;
     }
+    in->name = path;
+    if (baud > 0 && stat(path, &st) == 0 && S_ISCHR(st.st_mode)) {
+        int rc = tk_link_serial_try(&in->link, path, baud);
+        if (rc == TASE_OK) {
+            in->device = true;
+            in->port = tk_link_port(&in->link);
+            in->fd = in->link.uart.fd;
+            return;
+        }
+        if (rc != TASE_ENODEV) {
+            tk_link_serial_die(path, rc);
+        }
+        /* a character device that is no terminal (/dev/zero): read it */
+    }
     in->fd = open(path, O_RDONLY | O_NOCTTY);
     if (in->fd < 0) {
         tk_die("cannot open %s: %s", path, strerror(errno));
     }
-    in->name = path;
 }
 
 static void input_close(input_t *in)
 {
-    if (in->fd != STDIN_FILENO) {
+    if (in->device) {
+        tk_link_close(&in->link);
+    } else if (in->fd != STDIN_FILENO) {
         (void)close(in->fd);
     }
 }
 
-/* read() what is there now (a live pty or pipe is not made to wait for a
- * full buffer). Returns the count, 0 at the end. */
+/* After the input ended: a device that hung up is an error (what was
+ * decoded is out already). */
+static void input_check_end(const input_t *in)
+{
+    if (in->hung_up) {
+        tk_die("cannot read %s: the device went away or hung up", in->name);
+    }
+}
+
+static size_t input_keep_head(input_t *in, const uint8_t *buf, size_t k)
+{
+    if (in->nhead < sizeof(in->head) - 1u) {
+        size_t room = sizeof(in->head) - 1u - in->nhead;
+        size_t c = room < k ? room : k;
+        memcpy(in->head + in->nhead, buf, c);
+        in->nhead += c;
+    }
+    return k;
+}
+
+/* What is there now (a live pty or pipe is not made to wait for a full
+ * buffer). Returns the count, 0 at the end: end of file, or for a device
+ * a hang-up (in->hung_up) or SIGINT/SIGTERM/SIGHUP, a live line's normal
+ * end. */
 static size_t input_read(input_t *in, uint8_t *buf, size_t cap)
 {
+    while (in->device) {
+        int n;
+        if (tk_signal != 0) {
+            return 0;
+        }
+        n = in->port.ops->read(in->port.ctx, buf, cap, 100);
+        if (n > 0) {
+            return input_keep_head(in, buf, (size_t)n);
+        }
+        if (n == TASE_EIO) {
+            in->hung_up = true;
+            return 0;
+        }
+        if (n < 0) {
+            tk_die("cannot read %s: %s", in->name, tase_strerror(n));
+        }
+    }
     for (;;) {
         ssize_t n = read(in->fd, buf, cap);
         if (n > 0) {
-            size_t k = (size_t)n;
-            if (in->nhead < sizeof(in->head) - 1u) {
-                size_t room = sizeof(in->head) - 1u - in->nhead;
-                size_t c = room < k ? room : k;
-                memcpy(in->head + in->nhead, buf, c);
-                in->nhead += c;
-            }
-            return k;
+            return input_keep_head(in, buf, (size_t)n);
         }
         if (n == 0 || errno == EIO) { /* EIO: a pty whose writer went away */
             return 0;
@@ -1533,11 +1601,21 @@ static unsigned long decode_candump(input_t *in, tk_dec_t *d)
     return c.bad;
 }
 
+/* --baud given for an input that is no serial device */
+static void input_check_baud(const input_t *in, bool baud_given)
+{
+    if (baud_given && !in->device) {
+        tk_usage_error("--baud is for a serial device; %s is not one", in->name);
+    }
+}
+
 static int cmd_decode(args_t *a)
 {
     const char *path = NULL, *v;
     bool candump = false, stats = false, capture = false;
     unsigned long bad = 0;
+    long baud = DEFAULT_BAUD;
+    bool baud_given = false;
     input_t in;
     static tk_dec_t d;
     tk_fmt_t fmt = {true, false, true};
@@ -1545,7 +1623,9 @@ static int cmd_decode(args_t *a)
         if (common_opt(a)) {
             continue;
         }
-        if (opt(a, "--candump", false, &v)) {
+        if (baud_opt(a, &baud)) {
+            baud_given = true;
+        } else if (opt(a, "--candump", false, &v)) {
             candump = true;
         } else if (opt(a, "--stats", false, &v)) {
             stats = true;
@@ -1555,15 +1635,17 @@ static int cmd_decode(args_t *a)
             bad_arg(a);
         }
     }
-    input_open(&in, path);
+    input_open(&in, path, baud);
+    input_check_baud(&in, baud_given);
     tk_stdout_buffered();
     tk_dec_init(&d, &fmt, stdout);
     if (candump) {
         bad = decode_candump(&in, &d);
     } else {
         static uint8_t buf[READ_CHUNK];
-        size_t n = input_head(&in, buf, sizeof(buf));
-        if (tk_cap_is_capture(buf, n)) {
+        /* a serial line carries raw bytes, never a capture file */
+        size_t n = in.device ? input_read(&in, buf, sizeof(buf)) : input_head(&in, buf, sizeof(buf));
+        if (!in.device && tk_cap_is_capture(buf, n)) {
             capture = true;
             bad = decode_capture(&in, &d, buf, n);
         } else {
@@ -1576,6 +1658,7 @@ static int cmd_decode(args_t *a)
     if (stats) {
         tk_dec_summary(&d, stderr, "");
     }
+    input_check_end(&in);
     if (bad > 0) {
         tk_exit(TK_EXIT_INPUT, "%s: %lu bad %s%s (the rest was decoded)", in.name, bad,
                 capture ? "record" : "line", bad == 1 ? "" : "s");
@@ -1622,19 +1705,24 @@ static int cmd_klv(args_t *a)
     static tase_klv_rx_t rx;
     static uint8_t buf[READ_CHUNK];
     klv_ctx_t c = {0, 0};
+    long baud = KLV_BAUD;
+    bool baud_given = false;
     input_t in;
     size_t n;
     while (a->i < a->argc) {
         if (common_opt(a)) {
             continue;
         }
-        if (path == NULL && is_arg(a, false)) {
+        if (baud_opt(a, &baud)) {
+            baud_given = true;
+        } else if (path == NULL && is_arg(a, false)) {
             path = a->argv[a->i++];
         } else {
             bad_arg(a);
         }
     }
-    input_open(&in, path);
+    input_open(&in, path, baud);
+    input_check_baud(&in, baud_given);
     tk_stdout_buffered();
     (void)tase_klv_rx_init(&rx);
     while ((n = input_read(&in, buf, sizeof(buf))) > 0) {
@@ -1647,6 +1735,7 @@ static int cmd_klv(args_t *a)
     (void)tase_klv_rx_flush(&rx, print_klv, NULL, &c);
     input_close(&in);
     tk_stdout_flush();
+    input_check_end(&in);
     return TK_EXIT_OK;
 }
 
@@ -1752,7 +1841,7 @@ static int cmd_replay(args_t *a)
                        "echoes are commands to a gimbal); in = the host's commands (moves a "
                        "gimbal); all = both (moves a gimbal)");
     }
-    input_open(&in, path);
+    input_open(&in, path, 0);
     n = input_head(&in, head, sizeof(head));
     if (!tk_cap_is_capture(head, n)) {
         tk_die("%s is not a pcap or pcapng capture (candump logs: can-utils' canplayer "

@@ -278,15 +278,24 @@ uint32_t tk_now_ms(void)
 
 /* ---- links ---- */
 
-void tk_link_serial(tk_link_t *l, const char *path, long baud)
+int tk_link_serial_try(tk_link_t *l, const char *path, long baud)
 {
     int rc;
-    struct stat st;
     memset(l, 0, sizeof(*l));
     if (baud <= 0 || !tase_posix_uart_baud_supported((uint32_t)baud)) {
         tk_usage_error("unsupported baud rate %ld", baud);
     }
     rc = tase_posix_uart_open(&l->uart, path, (uint32_t)baud);
+    if (rc == TASE_OK) {
+        l->open = true;
+        track_link(l, true);
+    }
+    return rc;
+}
+
+void tk_link_serial_die(const char *path, int rc)
+{
+    struct stat st;
     if (rc == TASE_ENODEV && stat(path, &st) == 0) {
         tk_die("cannot open serial device %s: not a terminal (a serial device or pseudo-terminal "
                "is needed)",
@@ -295,12 +304,17 @@ void tk_link_serial(tk_link_t *l, const char *path, long baud)
         tk_die("cannot open serial device %s: %s", path, strerror(errno));
     } else if (rc == TASE_EBUSY) {
         tk_die("cannot open serial device %s: device busy: in use by another program", path);
-    } else if (rc != TASE_OK) {
-        tk_die("cannot open serial device %s: %s", path,
-               rc == TASE_EIO ? strerror(errno) : tase_strerror(rc));
     }
-    l->open = true;
-    track_link(l, true);
+    tk_die("cannot open serial device %s: %s", path,
+           rc == TASE_EIO ? strerror(errno) : tase_strerror(rc));
+}
+
+void tk_link_serial(tk_link_t *l, const char *path, long baud)
+{
+    int rc = tk_link_serial_try(l, path, baud);
+    if (rc != TASE_OK) {
+        tk_link_serial_die(path, rc);
+    }
 }
 
 void tk_link_pty(tk_link_t *l, int fd)

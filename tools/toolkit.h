@@ -123,6 +123,12 @@ typedef struct {
 /* Open a serial device (or a pty slave path) raw 8N1 at `baud`; dies with
  * a one-line reason on failure. */
 void tk_link_serial(tk_link_t *l, const char *path, long baud);
+/* The same returning the port's code instead of dying (a bad baud rate is
+ * still a usage error): TASE_OK, or TASE_ENODEV for a missing path or one
+ * that is not a terminal, TASE_EBUSY, ... (tase_posix_uart_open()). */
+int tk_link_serial_try(tk_link_t *l, const char *path, long baud);
+/* Die with the one-line reason tk_link_serial() gives for code `rc`. */
+void tk_link_serial_die(const char *path, int rc);
 /* Open a CAN interface as the host (gimbal == false) or the gimbal. */
 void tk_link_can(tk_link_t *l, const char *iface, bool gimbal);
 /* Take over an open terminal descriptor (a pty master). */
