@@ -308,6 +308,28 @@ wait $opid
 check "tase-sim removes only its own links (a link repointed meanwhile stays)" \
     eval '[ "$(readlink "$dir/own")" = /dev/null ]'
 
+# A user's own symlink at --link is never taken over (nor deleted at exit);
+# a stale link of a killed simulator (into /dev/pts/, unclaimed) is replaced.
+ln -s /dev/null "$dir/users"
+expect_error "tase-sim --link over a user's symlink: refused, naming its target" 1 \
+    "users is a symlink to /dev/null, not a link left by tase-sim" \
+    "$SIM" --link "$dir/users" --seconds 1
+check "... and the user's symlink is untouched" test "$(readlink "$dir/users")" = /dev/null
+"$SIM" --quiet --link "$dir/stale" --seconds 30 >/dev/null 2>&1 &
+kpid=$!
+for _ in $(seq 100); do [ -L "$dir/stale" ] && break; sleep 0.05; done
+kill -KILL $kpid
+wait $kpid 2>/dev/null
+old=$(readlink "$dir/stale")
+"$SIM" --link "$dir/stale" --seconds 30 >"$dir/stale.log" 2>&1 &
+kpid=$!
+for _ in $(seq 100); do grep -q -e "simulated gimbal" -e "tase-sim:" "$dir/stale.log" && break; sleep 0.05; done
+check "a killed simulator's stale link ($old) is replaced by the next one ($(head -1 "$dir/stale.log"))" \
+    eval 'grep -q "simulated gimbal on .*(link .*stale)" "$dir/stale.log" &&
+          "$TASE" query SYSTEM_VERSION --serial "$dir/stale" >/dev/null'
+kill $kpid
+wait $kpid
+
 # ---- error paths ----
 expect_error "no command" 2 "no command" "$TASE"
 expect_error "unknown command" 2 "unknown command 'frobnicate'" "$TASE" frobnicate

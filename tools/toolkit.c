@@ -502,11 +502,27 @@ int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
     *slave_fd = sfd;
     if (link != NULL) {
         if (lstat(link, &st) == 0) {
-            /* a symlink left by a simulator that died: nobody claims it */
+            char target[PATH_MAX];
+            ssize_t n;
             if (!S_ISLNK(st.st_mode)) {
                 tk_die("%s exists and is not a symlink; not replacing it", link);
             }
-            unlink(link);
+            /* Only a link of our own kind, into /dev/pts/, is replaced: the
+             * claim above is ours, so the simulator that made it is gone.
+             * Anyone else's symlink (ln -s /dev/ttyS0 PATH) is left alone. */
+            n = readlink(link, target, sizeof(target) - 1u);
+            if (n <= 0 || (size_t)n >= sizeof(target) - 1u) {
+                tk_die("cannot read symlink %s: %s", link, n < 0 ? strerror(errno) : "too long");
+            }
+            target[n] = '\0';
+            if (strncmp(target, "/dev/pts/", 9) != 0 || strchr(target + 9, '/') != NULL) {
+                tk_die("%s is a symlink to %s, not a link left by tase-sim (those lead into "
+                       "/dev/pts/); not replacing it (remove it, or choose another path)",
+                       link, target);
+            }
+            if (unlink(link) != 0) {
+                tk_die("cannot replace the stale link %s: %s", link, strerror(errno));
+            }
         }
         if (symlink(slave, link) != 0) {
             tk_die("cannot create symlink %s: %s", link, strerror(errno));

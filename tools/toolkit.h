@@ -147,9 +147,9 @@ int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n);
  * keeps open (so the master never sees a hang-up between clients). With
  * `link` non-NULL, also makes `link` a symlink to the slave. The link is
  * claimed for the life of the process first: if a running process holds
- * the claim it dies naming its pid; a symlink nobody claims (left by a
- * simulator that was killed) is replaced; a file that is not a symlink
- * never is. Dies on error. */
+ * the claim it dies naming its pid; a symlink into /dev/pts/ that nobody
+ * claims (left by a simulator that was killed) is replaced; any other
+ * symlink, and a file that is not a symlink, never is. Dies on error. */
 int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd);
 /* Remove `link` only if it is still a symlink to `slave` (ours). */
 void tk_pty_unlink(const char *link, const char *slave);
