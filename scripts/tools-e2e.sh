@@ -135,6 +135,19 @@ last=$(last_angle)
 check "... and nothing reached the gimbal: it stays at 30/-15 ($last)" \
     eval '[ "$(sim_says GIMBAL_CMD)" = "$n" ] && near "$(json_int "$last" pan)" 3000 2'
 
+# SPOI error forms are accepted but not modelled: the log says so, and the
+# gimbal stays where the last position command put it.
+quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xC0 impulse_time=0 "${L[@]}"
+quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xD0 impulse_time=0 "${L[@]}"
+sleep 0.3
+check "tase-sim logs SPOI error GIMBAL_CMDs as ignored, the mode kept ($(grep 'SPOI error' "$dir/sim.log" | head -1 | cut -c12-))" \
+    eval '[ "$(sim_says "GIMBAL_CMD: SPOI error (flags 0xC0, pan 1.00 tilt 2.00) ignored: not modelled; still in position mode, stabilised")" = 1 ] &&
+          [ "$(sim_says "GIMBAL_CMD: SPOI error rate (flags 0xD0, pan 1.00 tilt 2.00) ignored")" = 1 ] &&
+          [ "$(sim_says "GIMBAL_CMD: .* pan 1.00 tilt 2.00, stabilised$")" = 0 ]'
+last=$(last_angle)
+check "... and the gimbal stays at 30/-15 ($last)" \
+    eval 'near "$(json_int "$last" pan)" 3000 2 && near "$(json_int "$last" tilt)" -1500 2'
+
 # ---- numbers as typed, sent packets printed ----
 s1=$("$TASE" send HOST_SENSOR roll=010 pitch=+5 yaw=-0x10 --zero "${L[@]}" --json)
 check "send --json prints a packet without echo; 010 is ten, +5 five, -0x10 -16 ($s1)" \

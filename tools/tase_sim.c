@@ -301,9 +301,17 @@ static void on_frame(void *user, unsigned port, const tase_frame_t *f)
     switch (id) {
     case TASE_ID_GIMBAL_CMD: {
         const tase_gimbal_cmd_t *c = &msg.gimbal_cmd;
-        if (sim_model_command(&s->m, c->pan / 100.0, c->tilt / 100.0, c->flags,
-                              c->impulse_time / 100.0) != 0) {
+        int rc = sim_model_command(&s->m, c->pan / 100.0, c->tilt / 100.0, c->flags,
+                                   c->impulse_time / 100.0);
+        if (rc < 0) {
             logf_(s, now, "GIMBAL_CMD: unknown flags 0x%02X ignored", c->flags);
+        } else if (rc > 0) {
+            logf_(s, now,
+                  "GIMBAL_CMD: SPOI error%s (flags 0x%02X, pan %.2f tilt %.2f) ignored: not "
+                  "modelled; still in %s mode%s",
+                  c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR_RATE ? " rate" : "", c->flags,
+                  c->pan / 100.0, c->tilt / 100.0, mode_name(&s->m),
+                  s->m.stabilised ? ", stabilised" : "");
         } else {
             logf_(s, now, "GIMBAL_CMD: %s pan %.2f tilt %.2f%s", mode_name(&s->m), c->pan / 100.0,
                   c->tilt / 100.0, s->m.stabilised ? ", stabilised" : "");
