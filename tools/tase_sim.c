@@ -494,6 +494,10 @@ int main(int argc, char **argv)
     s.cam[1].hfov = 23.0;
     s.cam[2].type = TASE_CAMTYPE_NONE;
 
+    /* SIGINT, SIGTERM, SIGHUP stop the loop below; caught before the links
+     * exist, so one that comes while they are made still removes them */
+    tk_catch_signals();
+
     if (can != NULL) {
         tk_link_can(&dl, can, true);
         snprintf(path, sizeof(path), "%s", can);
@@ -529,8 +533,6 @@ int main(int argc, char **argv)
         tk_die("internal error: no AXIS_SETTING");
     }
     apply_axis(&s, &axs);
-
-    tk_catch_signals(); /* SIGINT, SIGTERM, SIGHUP stop the loop below */
 
     printf("tase-sim: simulated gimbal on %s%s", can ? "CAN interface " : "", path);
     if (can == NULL) {
