@@ -148,6 +148,19 @@ last=$(last_angle)
 check "... and the gimbal stays at 30/-15 ($last)" \
     eval 'near "$(json_int "$last" pan)" 3000 2 && near "$(json_int "$last" tilt)" -1500 2'
 
+# A command whose output cannot be written was still sent: the status (5)
+# and the message say so, so a script does not send it again.
+n=$(sim_says GIMBAL_CMD)
+expect_error "point > /dev/full: exit 5, the message says GIMBAL_CMD was sent" 5 \
+    "GIMBAL_CMD was sent; cannot write to standard output: No space left on device" \
+    sh -c 'exec "$0" point 30 -15 --serial "$1" >/dev/full' "$TASE" "$dir/gimbal"
+expect_error "point into a closed pipe: exit 5 (not a quiet 141), GIMBAL_CMD was sent" 5 \
+    "GIMBAL_CMD was sent; cannot write to standard output: Broken pipe" \
+    python3 -c 'import os,subprocess,sys; r,w=os.pipe(); os.close(r); sys.exit(subprocess.call(sys.argv[1:], stdout=w))' \
+    "$TASE" point 30 -15 "${L[@]}"
+sleep 0.2
+check "... and both reached the gimbal" test "$(sim_says GIMBAL_CMD)" = $((n + 2))
+
 # ---- numbers as typed, sent packets printed ----
 s1=$("$TASE" send HOST_SENSOR roll=010 pitch=+5 yaw=-0x10 --zero "${L[@]}" --json)
 check "send --json prints a packet without echo; 010 is ten, +5 five, -0x10 -16 ($s1)" \

@@ -23,10 +23,12 @@
 #define BAD_LINES_SHOWN 10u
 
 static const char usage_exit[] =
-    "exit status: 0 success; 1 failure (device, I/O, timeout, writing the output);\n"
+    "exit status: 0 success; 1 failure (device, I/O, timeout, writing the output;\n"
+    "  \"(NAME was sent)\" ends the line if the packet went out before);\n"
     "  2 bad command line (nothing was sent); 3 the gimbal's echo differs from the\n"
     "  setting sent; 4 input not fully understood (bad candump lines, no packet\n"
-    "  found); 128+N interrupted by signal N (141: the output's reader went away).\n";
+    "  found); 5 the packet was sent, but writing the output failed (do not send it\n"
+    "  again); 128+N interrupted by signal N (141: the output's reader went away).\n";
 
 static const char usage_link[] =
     "link options:\n"
@@ -397,6 +399,9 @@ static int transact(session_t *s, const tase_packet_desc_t *p, const uint8_t *da
     int rc = tase_host_request_start(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len,
                                      reply, TASE_DATA_MAX, r->timeout_ms, r->retries,
                                      s->port.ops->now_ms(s->port.ctx));
+    if (rc >= 0 && len > 0) {
+        tk_mark_sent(tase_schema_packet_name(p)); /* a query changes nothing */
+    }
     while (rc >= 0) {
         tk_exit_if_signalled();
         rc = tase_host_service(&s->h, 20);
@@ -425,6 +430,7 @@ static void send_frame(session_t *s, const tase_packet_desc_t *p, const uint8_t 
     if (rc < 0) {
         tk_die("cannot send %s: %s", tase_schema_packet_name(p), tase_strerror(rc));
     }
+    tk_mark_sent(tase_schema_packet_name(p));
 }
 
 /* Print a frame we sent ("dir":"in") or received ("out"); `label` starts

@@ -63,13 +63,29 @@ static void vmsg(const char *fmt, va_list ap)
     fprintf(stderr, "%s: %s\n", tk_prog, msg);
 }
 
+/* The packet this run has sent, NULL before (tk_mark_sent()). */
+static const char *sent_what;
+
+void tk_mark_sent(const char *what)
+{
+    sent_what = what;
+}
+
 static void vexit(int status, const char *fmt, va_list ap)
 {
+    char msg[448];
     /* what was printed before the error still goes out (errors ignored:
      * the error line is the one to report) */
     (void)fflush(stdout);
     close_all_links();
-    vmsg(fmt, ap);
+    vsnprintf(msg, sizeof(msg), fmt, ap);
+    if (sent_what != NULL && status != TK_EXIT_MISMATCH && status != TK_EXIT_SENT) {
+        /* a failure after the packet went out says so: a retry would send
+         * it again */
+        tk_warn("%s (%s was sent)", msg, sent_what);
+    } else {
+        tk_warn("%s", msg);
+    }
     exit(status);
 }
 
@@ -215,6 +231,13 @@ void tk_stdout_flush(void)
     if (fflush(stdout) != 0 || ferror(stdout)) {
         int e = errno;
         clearerr(stdout);
+        if (sent_what != NULL) {
+            /* the packet went out: say so, also to a closed pipe, with a
+             * status of its own, so nobody sends it again believing it was
+             * not */
+            tk_exit(TK_EXIT_SENT, "%s was sent; cannot write to standard output: %s", sent_what,
+                    e ? strerror(e) : "write error");
+        }
         if (e == EPIPE) {
             /* the reader went away (`tase monitor | head`): end quietly as
              * SIGPIPE would, but through the path that closes the links */

@@ -44,6 +44,7 @@
 #define TK_EXIT_USAGE 2    /* bad command line: nothing was sent */
 #define TK_EXIT_MISMATCH 3 /* the gimbal's echo differs from what was sent */
 #define TK_EXIT_INPUT 4    /* input not (fully) understood: bad lines, nothing found */
+#define TK_EXIT_SENT 5     /* the packet was sent, but writing the output failed */
 /* Interrupted by signal N: 128 + N (the shell's convention). */
 
 /* Program name used as the prefix of error lines. */
@@ -57,6 +58,12 @@ void tk_die(const char *fmt, ...);
 void tk_usage_error(const char *fmt, ...);
 /* The same line without exiting. */
 void tk_warn(const char *fmt, ...);
+/* Record that packet `what` (a name that outlives the run) has gone out to
+ * the device. From then on an exit through tk_exit() with status 1 or
+ * 128+N appends "(what was sent)" to its line, and a failure to write
+ * standard output (a full disk, a closed pipe) exits TK_EXIT_SENT with
+ * "what was sent; cannot write to standard output: <reason>". */
+void tk_mark_sent(const char *what);
 
 /* ---- numbers ----
  * Integers: an optional sign ('+' or '-'), then decimal digits (leading
@@ -97,7 +104,8 @@ void tk_stdout_buffered(void);
 /* Flush standard output; on any write error so far exit TK_EXIT_FAIL with
  * "cannot write to standard output: <reason>", except a reader that went
  * away (EPIPE): then exit 128 + SIGPIPE without a message, as programs
- * killed by SIGPIPE do (links closed first). */
+ * killed by SIGPIPE do (links closed first). After tk_mark_sent() both
+ * exit TK_EXIT_SENT naming the packet sent. */
 void tk_stdout_flush(void);
 
 /* ---- signals ---- */
