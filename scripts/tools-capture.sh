@@ -168,7 +168,26 @@ nr=$($U records "$dir/tele.pcap" | grep -c .)
 check "record --serial, stopped by SIGINT: exit $rc, '$(tail -1 "$dir/rec.out")', $nr records, $na GIMBAL_ANGLE (20/s set above)" \
     eval '[ $rc -eq 0 ] && grep -q "^recorded $nr records" "$dir/rec.out" && [ "$na" -ge 15 ] &&
           ! grep -q "\"dir\":\"in\"" "$dir/tele.json"'
+
+# ---- the recorded device goes away: record stops (it spun at 75% CPU) ----
+"$TASE" record --serial "$dir/gimbal" -o "$dir/gone.pcap" >"$dir/gone.out" 2>"$dir/gone.err" &
+rp=$!
+wait_for "$dir/gone.out" recording
+sleep 0.3
 kill "${pids[0]}"
+for _ in $(seq 40); do kill -0 $rp 2>/dev/null || break; sleep 0.05; done
+if kill -0 $rp 2>/dev/null; then
+    cpu=$(ps -o time= -p $rp)
+    kill -INT $rp
+fi
+wait $rp
+rc=$?
+"$TASE" decode "$dir/gone.pcap" >"$dir/gone.json"
+check "record when the device hangs up: stops within 2 s, exit $rc, '$(cat "$dir/gone.err")'${cpu:+ (still running, CPU $cpu)}" \
+    eval '[ $rc -eq 1 ] && [ "$(grep -vc "^==" "$dir/gone.err")" = 1 ] &&
+          grep -q "^tase: cannot read .*gimbal: the device went away or hung up$" "$dir/gone.err"'
+check "... the records so far kept and closed: '$(cat "$dir/gone.out" | tail -1)', $(grep -c . "$dir/gone.json") packets decoded" \
+    eval 'grep -q "^recorded [1-9][0-9]* records" "$dir/gone.out" && grep -q GIMBAL_ANGLE "$dir/gone.json"'
 
 # ---- replay through joined pseudo-terminals, recorded on the other side ----
 $U pty-pair "$dir/A" "$dir/B" &

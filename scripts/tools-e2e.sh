@@ -356,6 +356,36 @@ check "a killed simulator's stale link ($old) is replaced by the next one ($(hea
 kill $kpid
 wait $kpid
 
+# ---- the device goes away (the simulator exits): said so, never a bare I/O error ----
+# dying_sim: a simulator on $dir/dying, its pid in $dpid
+dying_sim() {
+    "$SIM" --quiet --link "$dir/dying" --seconds 30 >/dev/null 2>&1 &
+    dpid=$!
+    for _ in $(seq 100); do [ -L "$dir/dying" ] && break; sleep 0.05; done
+}
+dying_sim
+"$TASE" monitor --serial "$dir/dying" >/dev/null 2>"$dir/hang.err" &
+mpid=$!
+sleep "$settle"
+kill $dpid
+wait $dpid
+wait $mpid
+rc=$?
+check "monitor when the device hangs up: exit $rc, its summary, then why ($(tr '\n' '|' <"$dir/hang.err"))" \
+    eval '[ $rc = 1 ] && [ "$(grep -vc "^==" "$dir/hang.err")" = 2 ] &&
+          grep -q "^tase: summary: [1-9][0-9]* frames" "$dir/hang.err" &&
+          grep -q "^tase: cannot read .*dying: the device went away or hung up$" "$dir/hang.err"'
+dying_sim
+"$TASE" retract --serial "$dir/dying" --wait 5 >/dev/null 2>"$dir/hang.err" &
+rpid=$!
+sleep "$settle"
+kill $dpid
+wait $dpid
+wait $rpid
+rc=$?
+check "retract --wait when the device hangs up: exit $rc, why, and that the command went out ($(cat "$dir/hang.err"))" \
+    eval '[ $rc = 1 ] && grep -q "^tase: cannot read .*dying: the device went away or hung up (RETRACT_DEPLOY_CMD was sent)$" "$dir/hang.err"'
+
 # ---- error paths ----
 expect_error "no command" 2 "no command" "$TASE"
 expect_error "unknown command" 2 "unknown command 'frobnicate'" "$TASE" frobnicate

@@ -93,6 +93,8 @@ static const char usage_monitor[] =
     "packets, S seconds, or on SIGINT/SIGTERM/SIGHUP (exit 0), and prints a summary\n"
     "line on stderr (frames, checksum errors, bad sizes, wrong lengths, unknown,\n"
     "bytes discarded; on CAN the bus state and error counts the port reports).\n"
+    "A device that goes away or hangs up also stops it: the summary, then\n"
+    "'cannot read DEV: the device went away or hung up' (exit 1).\n"
     "On CAN, --time is the kernel's receive time of the frame.\n";
 
 static const char usage_send[] =
@@ -374,11 +376,13 @@ typedef struct {
     tk_link_t link;
     tase_port_t port;
     tase_host_t h;
+    const char *name; /* the device or interface, for messages */
 } session_t;
 
 static void session_open(session_t *s, const link_opts_t *lo, tase_rx_handler_t on_frame,
                          void *user)
 {
+    s->name = lo->serial != NULL ? lo->serial : lo->can;
     open_link(lo, &s->link, &s->port);
     if (tase_host_init(&s->h, &s->port, on_frame, user) != TASE_OK) {
         tk_die("internal error: host role init failed");
@@ -389,6 +393,21 @@ static void session_close(session_t *s)
 {
     tk_link_close(&s->link);
     tk_stdout_flush();
+}
+
+/* Die: reading the session's link failed with `rc` (a hang-up says so). */
+static void session_read_failed(const session_t *s, int rc)
+{
+    tk_die("cannot read %s: %s", s->name, tk_link_error(&s->link, rc));
+}
+
+/* Service the session's port for up to wait_ms; dies when reading fails. */
+static void session_service(session_t *s, uint32_t wait_ms)
+{
+    int rc = tase_host_service(&s->h, wait_ms);
+    if (rc < 0) {
+        session_read_failed(s, rc);
+    }
 }
 
 /* Wait for the answer to a request, servicing the port so a signal is
@@ -404,10 +423,7 @@ static int transact(session_t *s, const tase_packet_desc_t *p, const uint8_t *da
     }
     while (rc >= 0) {
         tk_exit_if_signalled();
-        rc = tase_host_service(&s->h, 20);
-        if (rc < 0) {
-            break;
-        }
+        session_service(s, 20);
         rc = tase_host_poll(&s->h, s->port.ops->now_ms(s->port.ctx));
         if (rc != TASE_EAGAIN) {
             break;
@@ -419,7 +435,8 @@ static int transact(session_t *s, const tase_packet_desc_t *p, const uint8_t *da
                (unsigned)r->retries + 1u, r->retries ? "s" : "", (unsigned long)r->timeout_ms);
     }
     if (rc < 0) {
-        tk_die("%s request failed: %s", tase_schema_packet_name(p), tase_strerror(rc));
+        tk_die("%s request failed on %s: %s", tase_schema_packet_name(p), s->name,
+               tk_link_error(&s->link, rc));
     }
     return rc;
 }
@@ -428,7 +445,8 @@ static void send_frame(session_t *s, const tase_packet_desc_t *p, const uint8_t 
 {
     int rc = tase_host_send(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len);
     if (rc < 0) {
-        tk_die("cannot send %s: %s", tase_schema_packet_name(p), tase_strerror(rc));
+        tk_die("cannot send %s to %s: %s", tase_schema_packet_name(p), s->name,
+               tk_link_error(&s->link, rc));
     }
     tk_mark_sent(tase_schema_packet_name(p));
 }
@@ -1167,9 +1185,7 @@ static int retract_deploy(args_t *a, bool deploy)
     t_end = tk_now_s() + wait;
     while (wait > 0.0 && !e.seen && tk_now_s() < t_end) {
         tk_exit_if_signalled();
-        if (tase_host_service(&s.h, 20) < 0) {
-            tk_die("link read failed");
-        }
+        session_service(&s, 20);
     }
     if (wait > 0.0 && !e.seen) {
         tk_die("timeout: no RETRACT_DEPLOY_CMD echo within %g s (the move is not complete)", wait);
@@ -1253,6 +1269,7 @@ static int cmd_monitor(args_t *a)
     tk_stream_t *st;
     static uint8_t buf[4096];
     char extra[192] = "";
+    int failed = 0;
     while (a->i < a->argc) {
         if (common_opt(a) || link_opt(a, &lo)) {
             continue;
@@ -1282,10 +1299,10 @@ static int cmd_monitor(args_t *a)
            tk_signal == 0) {
         int n = port.ops->read(port.ctx, buf, sizeof(buf), 50);
         if (n < 0) {
-            if (tk_signal != 0) {
-                break;
+            if (tk_signal == 0) {
+                failed = n; /* a hang-up, most likely: the summary, then why */
             }
-            tk_die("link read failed: %s", tase_strerror(n));
+            break;
         }
         if (n > 0) {
             tk_time_t now;
@@ -1317,6 +1334,10 @@ static int cmd_monitor(args_t *a)
     tk_link_close(&link);
     tk_stdout_flush();
     tk_dec_summary(&d, stderr, extra);
+    if (failed != 0) {
+        tk_die("cannot read %s: %s", lo.serial != NULL ? lo.serial : lo.can,
+               tk_link_error(&link, failed));
+    }
     return TK_EXIT_OK;
 }
 

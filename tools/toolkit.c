@@ -401,6 +401,17 @@ void tk_link_close(tk_link_t *l)
     }
 }
 
+const char *tk_link_error(const tk_link_t *l, int rc)
+{
+    if (rc == TASE_EIO && !l->is_can) {
+        return "the device went away or hung up";
+    }
+    if (rc == TASE_EDOWN && l->is_can) {
+        return "the interface went down";
+    }
+    return tase_strerror(rc);
+}
+
 int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n)
 {
     size_t done = 0;

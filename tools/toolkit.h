@@ -146,6 +146,12 @@ tase_port_t tk_link_port(tk_link_t *l);
 /* Close (safe to call twice). */
 void tk_link_close(tk_link_t *l);
 
+/* Why a read or write of an open link failed with port code `rc`, for a
+ * message: on a serial link TASE_EIO is "the device went away or hung up"
+ * (the port reports a hang-up so), on CAN TASE_EDOWN "the interface went
+ * down"; otherwise tase_strerror(rc). */
+const char *tk_link_error(const tk_link_t *l, int rc);
+
 /* Write a whole buffer through a port, waiting while it is busy. Returns
  * 0 or a negative TASE_E* code. */
 int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n);
