@@ -357,32 +357,27 @@ kill $kpid
 wait $kpid
 
 # ---- the device goes away (the simulator exits): said so, never a bare I/O error ----
-# dying_sim: a simulator on $dir/dying, its pid in $dpid
-dying_sim() {
+# hang_up TASE-ARGS...: tase ARGS on a simulator of its own, stopped while
+# tase runs; sets rc to tase's status, its stderr in $dir/hang.err
+hang_up() {
+    local dpid tpid
     "$SIM" --quiet --link "$dir/dying" --seconds 30 >/dev/null 2>&1 &
     dpid=$!
     for _ in $(seq 100); do [ -L "$dir/dying" ] && break; sleep 0.05; done
+    "$TASE" "$@" --serial "$dir/dying" >/dev/null 2>"$dir/hang.err" &
+    tpid=$!
+    sleep "$settle"
+    kill $dpid
+    wait $dpid
+    wait $tpid
+    rc=$?
 }
-dying_sim
-"$TASE" monitor --serial "$dir/dying" >/dev/null 2>"$dir/hang.err" &
-mpid=$!
-sleep "$settle"
-kill $dpid
-wait $dpid
-wait $mpid
-rc=$?
+hang_up monitor
 check "monitor when the device hangs up: exit $rc, its summary, then why ($(tr '\n' '|' <"$dir/hang.err"))" \
     eval '[ $rc = 1 ] && [ "$(grep -vc "^==" "$dir/hang.err")" = 2 ] &&
           grep -q "^tase: summary: [1-9][0-9]* frames" "$dir/hang.err" &&
           grep -q "^tase: cannot read .*dying: the device went away or hung up$" "$dir/hang.err"'
-dying_sim
-"$TASE" retract --serial "$dir/dying" --wait 5 >/dev/null 2>"$dir/hang.err" &
-rpid=$!
-sleep "$settle"
-kill $dpid
-wait $dpid
-wait $rpid
-rc=$?
+hang_up retract --wait 5
 check "retract --wait when the device hangs up: exit $rc, why, and that the command went out ($(cat "$dir/hang.err"))" \
     eval '[ $rc = 1 ] && grep -q "^tase: cannot read .*dying: the device went away or hung up (RETRACT_DEPLOY_CMD was sent)$" "$dir/hang.err"'
 
