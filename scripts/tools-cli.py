@@ -219,6 +219,15 @@ expect("noise only: hint and exit 4", ["decode", write("noise.bin", bytes(range(
        "no TASE packet found")
 rc, out, err = run(["decode", write("empty.bin", b"")])
 ok("an empty input is no error", rc == 0 and out == "" and err == "", err)
+# klv follows decode's rule
+expect("klv of a text file: hint and exit 4", ["klv", write("passwd", "root:x:0:0:root:/root:/bin/bash\n")],
+       4, r"no KLV packet found in .*passwd: it is text, not a KLV byte stream")
+expect("klv of the TASE datalink: hint and exit 4", ["klv", noisy], 4,
+       r"no KLV packet found in .*decode_noisy.bin: it looks like the TASE datalink \('tase decode'")
+expect("klv of noise: hint and exit 4", ["klv", os.path.join(TMP, "noise.bin")], 4,
+       r"no KLV packet found in .*noise.bin \(not a capture of the gimbal's KLV line\?\)")
+rc, out, err = run(["klv", os.path.join(TMP, "empty.bin")])
+ok("klv of an empty input is no error", rc == 0 and out == "" and err == "", err)
 rc, out, err = run(["decode", "--stats", noisy])
 ok("decode --stats prints the counters on stderr",
    rc == 0 and re.search(r"summary: 12 frames \(1 unknown, 1 wrong length\), 1 checksum errors, "

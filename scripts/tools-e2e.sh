@@ -236,6 +236,14 @@ check "KLV output: $nk packets in 2.5 s (about one per 900 ms)" eval '[ $nk -ge 
 check "KLV packet carries the simulated pan (90 deg = raw 16384)" \
     grep -q '"pan":1638[3-5],' <<<"$k"
 
+# ---- monitor on a line that carries no TASE frame (the KLV pty) ----
+"$TASE" monitor --serial "$dir/klv" --seconds 1.5 >"$dir/out" 2>"$dir/mon.err"
+rc=$?
+check "monitor of bytes without a frame: exit $rc, the summary and a hint ($(tr '\n' '|' <"$dir/mon.err"))" \
+    eval '[ $rc = 4 ] && [ ! -s "$dir/out" ] && [ "$(grep -vc "^==" "$dir/mon.err")" = 2 ] &&
+          grep -q "^tase: summary: 0 frames .* of [1-9][0-9]* bytes discarded" "$dir/mon.err" &&
+          grep -q "^tase: no TASE frame in the [1-9][0-9]* bytes received on .*klv: a wrong --baud (57600), or not the gimbal.s datalink port (its KLV line?)$" "$dir/mon.err"'
+
 # ---- human-readable monitor ----
 t=$("$TASE" monitor "${L[@]}" --count 3 --units 2>/dev/null)
 check "monitor prints readable lines with units" grep -q '^GIMBAL_ANGLE pan=[-0-9]* ([-0-9.]* deg) ' <<<"$t"

@@ -94,7 +94,8 @@ static const char usage_monitor[] =
     "line on stderr (frames, checksum errors, bad sizes, wrong lengths, unknown,\n"
     "bytes discarded; on CAN the bus state and error counts the port reports).\n"
     "A device that goes away or hangs up also stops it: the summary, then\n"
-    "'cannot read DEV: the device went away or hung up' (exit 1).\n"
+    "'cannot read DEV: the device went away or hung up' (exit 1). Bytes received\n"
+    "but no frame found: the summary and a one-line hint (exit 4).\n"
     "On CAN, --time is the kernel's receive time of the frame.\n";
 
 static const char usage_send[] =
@@ -150,7 +151,8 @@ static const char usage_klv[] =
     "Decodes a KLV metadata byte stream (the gimbal's 9600-baud KLV line; a live\n"
     "pty is read as bytes arrive) to one JSON object per valid packet:\n"
     "{\"offset\":N,\"fields\":{raw values in tag order},\"units\":{engineering values}}.\n"
-    "Noise and damaged packets are skipped. A serial device (or pty) named as FILE\n"
+    "Noise and damaged packets are skipped; a non-empty input without a packet is\n"
+    "reported with a one-line hint (exit 4). A serial device (or pty) named as FILE\n"
     "is opened raw 8N1 at --baud N (default 9600, the KLV line), exclusively, its\n"
     "settings given back at exit; SIGINT/SIGTERM/SIGHUP end it (exit 0), a hang-up\n"
     "is an error (exit 1).\n";
@@ -1338,6 +1340,18 @@ static int cmd_monitor(args_t *a)
         tk_die("cannot read %s: %s", lo.serial != NULL ? lo.serial : lo.can,
                tk_link_error(&link, failed));
     }
+    if (d.n.frames == 0 && d.n.bytes > 0) {
+        if (link.is_can) {
+            tk_exit(TK_EXIT_INPUT,
+                    "no TASE frame in the %llu datalink bytes received on %s (ID 10000000 "
+                    "frames that never formed a valid frame)",
+                    (unsigned long long)d.n.bytes, lo.can);
+        }
+        tk_exit(TK_EXIT_INPUT,
+                "no TASE frame in the %llu bytes received on %s: a wrong --baud (%ld), or not "
+                "the gimbal's datalink port (its KLV line?)",
+                (unsigned long long)d.n.bytes, lo.serial, lo.baud);
+    }
     return TK_EXIT_OK;
 }
 
@@ -1458,19 +1472,26 @@ static size_t input_read(input_t *in, uint8_t *buf, size_t cap)
     }
 }
 
+/* Whether the first bytes of an input are all printable text. */
+static bool input_is_text(const input_t *in)
+{
+    size_t i;
+    for (i = 0; i < in->nhead; i++) {
+        uint8_t c = in->head[i];
+        if (!((c >= 0x20 && c < 0x7F) || c == '\n' || c == '\r' || c == '\t')) {
+            return false;
+        }
+    }
+    return in->nhead > 0;
+}
+
 /* What the start of an input that held no packet looks like. */
 static const char *input_guess(const input_t *in, bool candump)
 {
-    size_t i, text = 0, eol;
+    size_t eol;
     const char *s = (const char *)in->head;
     tase_candump_rec_t rec;
     for (eol = 0; eol < in->nhead && s[eol] != '\n'; eol++) {
-    }
-    for (i = 0; i < in->nhead; i++) {
-        if ((in->head[i] >= 0x20 && in->head[i] < 0x7F) || s[i] == '\n' || s[i] == '\r' ||
-            s[i] == '\t') {
-            text++;
-        }
     }
     if (!candump && tase_candump_parse(s, eol, &rec) != TASE_EFORMAT) {
         return ": it looks like a candump log (add --candump)";
@@ -1479,7 +1500,7 @@ static const char *input_guess(const input_t *in, bool candump)
         return ": it looks like candump's screen output; record a log with 'candump -L' "
                "(or -l) and decode it with --candump";
     }
-    if (!candump && in->nhead > 0 && text == in->nhead) {
+    if (!candump && input_is_text(in)) {
         return ": it is text, not a raw serial capture";
     }
     if (candump) {
@@ -1701,11 +1722,32 @@ static int cmd_decode(args_t *a)
 typedef struct {
     uint64_t base64;
     uint32_t base32;
+    uint64_t packets;
 } klv_ctx_t;
+
+/* What an input that held no KLV packet looks like. */
+static const char *klv_guess(const input_t *in)
+{
+    static const uint8_t sync[3] = {TASE_SYNC1, TASE_SYNC2, TASE_SYNC3};
+    size_t i;
+    if (input_is_text(in)) {
+        return ": it is text, not a KLV byte stream";
+    }
+    if (tk_cap_is_capture(in->head, in->nhead)) {
+        return ": it is a pcap capture ('tase decode' reads those)";
+    }
+    for (i = 0; i + 3u <= in->nhead; i++) {
+        if (memcmp(in->head + i, sync, sizeof(sync)) == 0) {
+            return ": it looks like the TASE datalink ('tase decode' reads that)";
+        }
+    }
+    return " (not a capture of the gimbal's KLV line?)";
+}
 
 static void print_klv(void *user, uint32_t offset, const tase_klv_t *k)
 {
-    const klv_ctx_t *c = user;
+    klv_ctx_t *c = user;
+    c->packets++;
     printf("{\"offset\":%llu,\"fields\":{\"utc\":%llu,\"lat\":%ld,\"lon\":%ld,\"alt\":%u,"
            "\"pan\":%u,\"tilt\":%d,\"heading\":%u,\"pitch\":%d,\"roll\":%d,\"vnorth\":%d,"
            "\"veast\":%d,\"hfov\":%u,\"vfov\":%u,\"gps_status\":%u},",
@@ -1731,7 +1773,7 @@ static int cmd_klv(args_t *a)
     const char *path = NULL;
     static tase_klv_rx_t rx;
     static uint8_t buf[READ_CHUNK];
-    klv_ctx_t c = {0, 0};
+    klv_ctx_t c = {0, 0, 0};
     long baud = KLV_BAUD;
     bool baud_given = false;
     input_t in;
@@ -1763,6 +1805,9 @@ static int cmd_klv(args_t *a)
     input_close(&in);
     tk_stdout_flush();
     input_check_end(&in);
+    if (c.packets == 0 && in.nhead > 0) {
+        tk_exit(TK_EXIT_INPUT, "no KLV packet found in %s%s", in.name, klv_guess(&in));
+    }
     return TK_EXIT_OK;
 }
 
