@@ -148,6 +148,25 @@ expect("camera: bad name", ["camera", "D"] + L, 2, "bad camera 'D'")
 expect("camera: nothing to do", ["camera"] + L, 2, "expected a camera")
 expect("spoi: latitude range", ["spoi", "91", "0", "0"] + L, 2, r"out of range -90\.\.90 deg")
 
+# ---- options: each value once, and a value is never the next option ----
+expect("--serial given twice is refused", ["monitor", "--serial", "/a", "--serial", "/b"], 2,
+       "option --serial given twice")
+expect("--timeout given twice (as --timeout=N) is refused",
+       ["query", "SYSTEM_VERSION", "--timeout", "100", "--timeout=200"] + L, 2,
+       "option --timeout given twice")
+expect("record -o and --output together are refused",
+       ["record", "--serial", "/a", "-o", "x.pcap", "--output", "y.pcap"], 2,
+       "option -o/--output given twice")
+expect("camera --hfov followed by an option: the value is missing",
+       ["camera", "--hfov", "--serial", "/dev/ttyUSB9"], 2, "option --hfov needs a value")
+expect("a negative number is still a value", ["camera", "--hfov", "-5"] + L, 2,
+       r"bad --hfov '-5': out of range")
+expect("tase-sim --link given twice is refused",
+       [SIM, "--link", os.path.join(TMP, "a"), "--link", os.path.join(TMP, "b"), "--seconds", "1"],
+       2, "option --link given twice")
+expect("tase-sim --link followed by an option: the value is missing",
+       [SIM, "--link", "--quiet", "--seconds", "1"], 2, "option --link needs a value")
+
 # ---- messages ----
 expect("--serial /dev/null: not a terminal (it exists)",
        ["query", "SYSTEM_VERSION", "--serial", "/dev/null"], 1,

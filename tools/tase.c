@@ -190,6 +190,8 @@ static const char usage_list[] = "usage: tase list\nLists every packet: group, t
 
 /* ---- command-line parsing ---- */
 
+#define SEEN_MAX 16
+
 typedef struct {
     int argc;
     char **argv;
@@ -197,6 +199,9 @@ typedef struct {
     bool dashdash; /* "--" seen: the rest are arguments */
     const char *usage;
     unsigned extra; /* USAGE_* sections appended to --help */
+    /* options with a value given so far: each at most once */
+    const char *seen[SEEN_MAX];
+    unsigned nseen;
 } args_t;
 
 #define USAGE_LINK 1u
@@ -222,8 +227,25 @@ static void print_usage(const args_t *a)
     tk_stdout_flush();
 }
 
+/* An option with a value is given once: a second one is an error, not
+ * the silent winner. */
+static void opt_once(args_t *a, const char *name)
+{
+    unsigned k;
+    for (k = 0; k < a->nseen; k++) {
+        if (strcmp(a->seen[k], name) == 0) {
+            tk_usage_error("option %s given twice", name);
+        }
+    }
+    if (a->nseen < SEEN_MAX) {
+        a->seen[a->nseen++] = name;
+    }
+}
+
 /* If argv[i] is option `name` (with "--name V" or "--name=V" when has_arg),
- * consume it and return true; *val gets the value. */
+ * consume it and return true; *val gets the value. A separate value that
+ * starts with "--" is the next option, so the value is missing (numbers
+ * such as -5 are values). */
 static bool opt(args_t *a, const char *name, bool has_arg, const char **val)
 {
     const char *s = a->argv[a->i];
@@ -233,15 +255,17 @@ static bool opt(args_t *a, const char *name, bool has_arg, const char **val)
     }
     if (s[n] == '\0') {
         if (has_arg) {
-            if (a->i + 1 >= a->argc) {
+            if (a->i + 1 >= a->argc || strncmp(a->argv[a->i + 1], "--", 2) == 0) {
                 tk_usage_error("option %s needs a value", name);
             }
+            opt_once(a, name);
             *val = a->argv[++a->i];
         }
         a->i++;
         return true;
     }
     if (s[n] == '=' && has_arg) {
+        opt_once(a, name);
         *val = s + n + 1;
         a->i++;
         return true;
@@ -1823,8 +1847,14 @@ static int cmd_record(args_t *a)
         if (common_opt(a) || link_opt(a, &lo)) {
             continue;
         }
-        if (opt(a, "-o", true, &out) || opt(a, "--output", true, &out) ||
-            opt(a, "--tap-in", true, &tap_in)) {
+        if (opt(a, "-o", true, &v) || opt(a, "--output", true, &v)) {
+            if (out != NULL) {
+                tk_usage_error("option -o/--output given twice");
+            }
+            out = v;
+            continue;
+        }
+        if (opt(a, "--tap-in", true, &tap_in)) {
             continue;
         }
         if (opt(a, "--seconds", true, &v)) {

@@ -433,7 +433,15 @@ int main(int argc, char **argv)
     tk_prog = "tase-sim";
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
-        bool more = i + 1 < argc;
+        /* a value that starts with "--" is the next option: missing */
+        bool more = i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0;
+        /* each option with a value at most once */
+        if ((strcmp(a, "--link") == 0 && link != NULL) || (strcmp(a, "--can") == 0 && can != NULL) ||
+            (strcmp(a, "--klv-link") == 0 && klv_link != NULL) ||
+            (strcmp(a, "--baud") == 0 && baud_given) ||
+            (strcmp(a, "--seconds") == 0 && seconds > 0.0)) {
+            tk_usage_error("option %s given twice", a);
+        }
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             fputs(usage, stdout);
             tk_stdout_flush();
