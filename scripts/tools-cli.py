@@ -147,6 +147,8 @@ expect("point: negative numbers are arguments", ["point", "-10", "-5.5"] + L, 1,
 expect("camera: bad name", ["camera", "D"] + L, 2, "bad camera 'D'")
 expect("camera: nothing to do", ["camera"] + L, 2, "expected a camera")
 expect("spoi: latitude range", ["spoi", "91", "0", "0"] + L, 2, r"out of range -90\.\.90 deg")
+expect("spoi: the height range in plain numbers", ["spoi", "45", "7", "100000000"] + L, 2,
+       r"bad height '100000000': out of range -21474836\.48\.\.21474836\.47 m$")
 
 # ---- options: each value once, and a value is never the next option ----
 expect("--serial given twice is refused", ["monitor", "--serial", "/a", "--serial", "/b"], 2,

@@ -220,7 +220,14 @@ check "20 back-to-back gyro-zero commands from 20 programs all reach the gimbal"
 quiet "$TASE" camera A --hfov 10 "${L[@]}"
 geo=$("$TASE" monitor "${L[@]}" --json --seconds 1.2 2>/dev/null | grep '"GEOREFERENCE_DATA"' | tail -1)
 check "tase camera A --hfov 10 shows in GEOREFERENCE_DATA" test "$(json_int "$geo" hfov)" = 1000
-quiet "$TASE" camera B "${L[@]}"
+n=$(sim_says CAMERA_CMD)
+expect_error "tase camera C on a gimbal without camera C: refused (SYSTEM_VERSION says none), nothing sent" 1 \
+    "the gimbal has no camera C (SYSTEM_VERSION: type 0xFF, none); CAMERA_CMD was not sent" \
+    "$TASE" camera C "${L[@]}"
+out=$("$TASE" camera B "${L[@]}")
+check "... and camera B, which it has, is selected ($out)" \
+    eval 'grep -q "= camera B selected (type 97 in SYSTEM_VERSION)" <<<"$out" && sleep 0.1 &&
+          [ "$(sim_says CAMERA_CMD)" = $((n + 1)) ]' 
 out=$("$TASE" send CAMERA_CMD hfov=1500 "${L[@]}" --json 2>&1)
 check "send CAMERA_CMD hfov=1500: the fields left out go as \"do not change\" ($out)" \
     grep -q '"fields":{"camera":255,"hfov":1500,"focus":65535,"exposure":255,"shutter_speed":255,"bright":255,"flags":128}' <<<"$out"
@@ -296,6 +303,9 @@ check "monitor on SIGHUP (its terminal closed): exit $rc, device as found" \
 kill -STOP "$sim_pid"
 expect_error "query timeout" 1 "timeout: no answer to PACKET_RATE after 2 attempts" \
     "$TASE" query PACKET_RATE "${L[@]}" --timeout 100 --retries 1
+expect_error "send timeout on its query: says the setting was not sent" 1 \
+    "timeout: no answer to PACKET_RATE after 2 attempts of 100 ms (only the query went out, to read the settings the fields left out keep; the new setting was not sent)$" \
+    "$TASE" send PACKET_RATE angle_1=5 "${L[@]}" --timeout 100 --retries 1
 "$TASE" query PACKET_RATE "${L[@]}" --timeout 20000 >/dev/null 2>"$dir/sig.err" &
 qpid=$!
 sleep "$settle"

@@ -61,11 +61,14 @@ static const char usage_rate[] =
     "command. 'tase rate 0 0' stops. Prints what it sent.\n";
 
 static const char usage_camera[] =
-    "usage: tase camera [A|B|C] [--hfov DEG | --zoom X] LINK [--json]\n"
+    "usage: tase camera [A|B|C] [--hfov DEG | --zoom X] LINK [--json] [request options]\n"
     "CAMERA_CMD. A camera alone selects it (the 1-byte form: nothing else changes).\n"
     "--hfov DEG sets the horizontal field of view (0.01..327.67 deg), --zoom X the\n"
     "zoom ratio (1..327.68); every other camera setting is sent as \"do not change\"\n"
-    "(and the active camera too, unless one is named). Prints what it sent.\n";
+    "(and the active camera too, unless one is named). Prints what it sent.\n"
+    "CAMERA_CMD has no echo: a named camera is first looked up in the gimbal's\n"
+    "SYSTEM_VERSION, and one the gimbal does not have (type 0xFF) is refused with\n"
+    "nothing sent (exit 1).\n";
 
 static const char usage_gyro[] = "usage: tase gyro-zero LINK [--json]\n"
                                  "GYRO_ZERO_CMD: the gimbal zeroes its rate gyros. Send it only "
@@ -437,9 +440,10 @@ static void session_service(session_t *s, uint32_t wait_ms)
 }
 
 /* Wait for the answer to a request, servicing the port so a signal is
- * seen within 20 ms; dies with the reason on failure. */
-static int transact(session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
-                    uint8_t *reply, const req_opts_t *r)
+ * seen within 20 ms; dies with the reason on failure, `note` (or NULL)
+ * added to a timeout's message. */
+static int transact_note(session_t *s, const tase_packet_desc_t *p, const uint8_t *data,
+                         size_t len, uint8_t *reply, const req_opts_t *r, const char *note)
 {
     int rc = tase_host_request_start(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len,
                                      reply, TASE_DATA_MAX, r->timeout_ms, r->retries,
@@ -457,14 +461,21 @@ static int transact(session_t *s, const tase_packet_desc_t *p, const uint8_t *da
         rc = 0;
     }
     if (rc == TASE_ETIMEOUT) {
-        tk_die("timeout: no answer to %s after %u attempt%s of %lu ms", tase_schema_packet_name(p),
-               (unsigned)r->retries + 1u, r->retries ? "s" : "", (unsigned long)r->timeout_ms);
+        tk_die("timeout: no answer to %s after %u attempt%s of %lu ms%s", tase_schema_packet_name(p),
+               (unsigned)r->retries + 1u, r->retries ? "s" : "", (unsigned long)r->timeout_ms,
+               note != NULL ? note : "");
     }
     if (rc < 0) {
         tk_die("%s request failed on %s: %s", tase_schema_packet_name(p), s->name,
                tk_link_error(&s->link, rc));
     }
     return rc;
+}
+
+static int transact(session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
+                    uint8_t *reply, const req_opts_t *r)
+{
+    return transact_note(s, p, data, len, reply, r, NULL);
 }
 
 static void send_frame(session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len)
@@ -887,7 +898,9 @@ static int cmd_send(args_t *a)
     if (rmw) {
         uint8_t cur[TASE_DATA_MAX];
         unsigned k;
-        int n = transact(&s, p, NULL, 0, cur, &o.r);
+        int n = transact_note(&s, p, NULL, 0, cur, &o.r,
+                              " (only the query went out, to read the settings the fields left "
+                              "out keep; the new setting was not sent)");
         if (n <= 0 || !tase_schema_length_ok(p, (size_t)n)) {
             tk_die("%s query answered with %d data bytes, not a length of %s; nothing was set",
                    name, n, name);
@@ -956,15 +969,33 @@ static int cmd_query(args_t *a)
 
 /* ---- verbs ---- */
 
+/* x as a plain decimal number (no exponent; at most two decimals, no
+ * trailing zeros): -21474836.48, 180, 0.01. */
+static const char *plain_number(double x, char *buf, size_t cap)
+{
+    size_t n;
+    snprintf(buf, cap, "%.2f", x);
+    n = strlen(buf);
+    while (n > 0 && buf[n - 1] == '0') {
+        buf[--n] = '\0';
+    }
+    if (n > 0 && buf[n - 1] == '.') {
+        buf[--n] = '\0';
+    }
+    return buf;
+}
+
 /* A decimal number argument in [lo, hi] (what names it in messages). */
 static double real_arg(const char *what, const char *v, double lo, double hi, const char *unit)
 {
     double x;
+    char a[48], b[48];
     if (tk_parse_real(v, &x) != TK_NUM_OK) {
         tk_usage_error("bad %s '%s': not a number (decimal, e.g. -12.5)", what, v);
     }
     if (!(x >= lo && x <= hi)) {
-        tk_usage_error("bad %s '%s': out of range %g..%g %s", what, v, lo, hi, unit);
+        tk_usage_error("bad %s '%s': out of range %s..%s %s", what, v,
+                       plain_number(lo, a, sizeof(a)), plain_number(hi, b, sizeof(b)), unit);
     }
     return x;
 }
@@ -1105,6 +1136,32 @@ static int camera_index(const char *s)
     return -1;
 }
 
+/* The type of camera `cam` (0..2) in the gimbal's SYSTEM_VERSION; dies
+ * when the gimbal has none there, before CAMERA_CMD is sent. */
+static int camera_type(session_t *s, int cam, const req_opts_t *r)
+{
+    static const char *const fields[] = {"camera_a", "camera_b", "camera_c"};
+    const tase_packet_desc_t *sv = tase_schema_find(TASE_ID_GROUP(TASE_ID_SYSTEM_VERSION),
+                                                    TASE_ID_TYPE(TASE_ID_SYSTEM_VERSION));
+    uint8_t reply[TASE_DATA_MAX];
+    long long type = -1;
+    int n = transact_note(s, sv, NULL, 0, reply, r,
+                          " (the query asks which cameras the gimbal has; CAMERA_CMD was not "
+                          "sent)");
+    if (!tk_field_get(sv, (unsigned)tase_schema_field_index(sv, fields[cam]), reply, (size_t)n,
+                      &type)) {
+        tk_die("SYSTEM_VERSION answered with %d data bytes, no camera types; CAMERA_CMD was not "
+               "sent",
+               n);
+    }
+    if (type == TASE_CAMTYPE_NONE) {
+        tk_die("the gimbal has no camera %c (SYSTEM_VERSION: type 0xFF, none); CAMERA_CMD was not "
+               "sent",
+               "ABC"[cam]);
+    }
+    return (int)type;
+}
+
 static int cmd_camera(args_t *a)
 {
     const tase_packet_desc_t *p = tase_schema_find(0x00, 0x41);
@@ -1112,7 +1169,7 @@ static int cmd_camera(args_t *a)
     send_opts_t o;
     fields_t fs;
     session_t s;
-    int cam = -1;
+    int cam = -1, camtype = -1;
     long long hfov = 0;
     size_t len;
     char what[96];
@@ -1151,11 +1208,17 @@ static int cmd_camera(args_t *a)
     }
     fields_keep(&fs, fields_within(p, len)); /* everything else: "do not change" */
     session_open(&s, &v.lo, NULL, NULL);
+    if (cam >= 0) {
+        /* CAMERA_CMD has no echo: a camera the gimbal does not have would
+         * be "selected" with nothing to confirm it, so ask first */
+        camtype = camera_type(&s, cam, &v.r);
+    }
     send_fields(&s, &fs, len, &o);
     if (!v.r.json) {
-        char sel[32] = "active camera unchanged";
+        char sel[64] = "active camera unchanged";
         if (cam >= 0) {
-            snprintf(sel, sizeof(sel), "camera %c%s", "ABC"[cam], what[0] ? "" : " selected");
+            snprintf(sel, sizeof(sel), "camera %c%s (type %d in SYSTEM_VERSION)", "ABC"[cam],
+                     what[0] ? "" : " selected", camtype);
         }
         printf("  = %s%s%s\n", sel, what, what[0] ? ", other settings unchanged" : "");
     }
@@ -2008,7 +2071,8 @@ typedef struct {
 static const command_t commands[] = {
     {"point", cmd_point, usage_point, USAGE_LINK, "point at pan/tilt angles (degrees)"},
     {"rate", cmd_rate, usage_rate, USAGE_LINK, "turn at pan/tilt rates (degrees per second)"},
-    {"camera", cmd_camera, usage_camera, USAGE_LINK, "select a camera, set its HFOV or zoom"},
+    {"camera", cmd_camera, usage_camera, USAGE_LINK | USAGE_REQ,
+     "select a camera, set its HFOV or zoom"},
     {"gyro-zero", cmd_gyro_zero, usage_gyro, USAGE_LINK, "zero the gimbal's rate gyros"},
     {"deploy", cmd_deploy, usage_deploy, USAGE_LINK, "deploy the retract/deploy mechanism"},
     {"retract", cmd_retract, usage_deploy, USAGE_LINK, "retract it"},
