@@ -101,6 +101,16 @@ check "send PACKET_RATE prints the gimbal's echo" \
     test "$(json_int "$e" angle_1)/$(json_int "$e" rate_1)/$(json_int "$e" geo_ref_1)" = 20/5/2
 q=$("$TASE" query PACKET_RATE "${L[@]}" --json)
 check "PACKET_RATE persists (query after set)" test "$(json_int "$q" angle_1)" = 20
+# temporary left out is 1 (not written to non-volatile storage), and says so
+out=$("$TASE" send PACKET_RATE angle_1=20 "${L[@]}")
+check "send PACKET_RATE without temporary: sent temporary=1, the output says it is not stored" \
+    eval 'grep -q "^sent PACKET_RATE .* temporary=1$" <<<"$out" &&
+          grep -q "temporary=1 (the default): not written to the gimbal.s non-volatile storage" <<<"$out" &&
+          sleep 0.1 && [ "$(sim_says "PACKET_RATE: .* (temporary)$")" = 2 ]'
+out=$("$TASE" send PACKET_RATE angle_1=20 temporary=0 "${L[@]}")
+check "send PACKET_RATE temporary=0: sent as asked, to be stored" \
+    eval 'grep -q "^sent PACKET_RATE .* temporary=0$" <<<"$out" && ! grep -q "the default" <<<"$out" &&
+          sleep 0.1 && [ "$(sim_says "PACKET_RATE: .* (a gimbal would store it in non-volatile memory)$")" = 1 ]' 
 check "read-modify-write kept the other ports' rates" test "$(json_int "$q" angle_2)" = 10
 t0=$(date +%s)
 mon=$("$TASE" monitor "${L[@]}" --json --time --units --seconds 2 2>"$dir/mon.err")

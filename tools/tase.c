@@ -116,6 +116,9 @@ static const char usage_send[] =
     "    answer (AXIS_SETTING: 22 or 23 bytes) unless --len says otherwise;\n"
     "  - otherwise every field must be given (the error names the missing ones);\n"
     "  - --zero: fields left out without such a value are 0 instead.\n"
+    "temporary (PACKET_RATE, AXIS_SETTING) left out is 1: the setting lasts until\n"
+    "the gimbal is powered off. temporary=0 makes the gimbal write it to its\n"
+    "non-volatile storage (spec 4.4.1, 4.4.3), where it survives power cycles.\n"
     "GIMBAL_CMD always needs flags (its mode; or use 'tase point' / 'tase rate').\n"
     "Setup packets are echoed by the gimbal: the echo is awaited, printed and\n"
     "compared with what was sent; a field that differs (a value the gimbal refused\n"
@@ -816,7 +819,9 @@ static void send_fields(session_t *s, const fields_t *fs, size_t len, const send
     print_packet(p, fs->data, len, o->r.json, "in", "sent");
     print_packet(p, reply, (size_t)n, o->r.json, "out", "echo");
     if (len > 0) {
-        confirm_echo(fs, len, reply, n, NULL);
+        /* `temporary` tells the gimbal what to do with this packet (store
+         * it or not); it is no setting in force, so its echo proves nothing */
+        confirm_echo(fs, len, reply, n, "temporary");
     }
 }
 
@@ -828,7 +833,8 @@ static int cmd_send(args_t *a)
     const char *assign[64];
     size_t nassign = 0, i, len;
     unsigned nf;
-    bool setup, rmw = false, relaid = false;
+    bool setup, rmw = false, relaid = false, temp_default = false;
+    int tfi;
     const tase_packet_desc_t *p;
     fields_t fs;
     session_t s;
@@ -874,6 +880,14 @@ static int cmd_send(args_t *a)
         tk_usage_error("%s does not accept a data length of %lu", name, (unsigned long)len);
     }
     nf = fields_within(p, len);
+    tfi = tase_schema_field_index(p, "temporary");
+    if (setup && tfi >= 0 && (unsigned)tfi < nf && !fs.given[tfi]) {
+        /* A setup packet with temporary 0 is written to the gimbal's
+         * non-volatile storage (spec 4.4.1, 4.4.3): a bench change is kept
+         * for this power cycle only unless temporary=0 asks to store it. */
+        fields_set(&fs, "temporary", TASE_SETUP_TEMPORARY);
+        temp_default = true;
+    }
     if (p->id == TASE_ID_GIMBAL_CMD && len > 0) {
         int fi = tase_schema_field_index(p, "flags");
         if (!fs.given[fi]) {
@@ -925,6 +939,10 @@ static int cmd_send(args_t *a)
     if (relaid && !o.r.json) {
         printf("  = sent in the %lu-byte layout the gimbal answered the query with\n",
                (unsigned long)len);
+    }
+    if (temp_default && !o.r.json) {
+        printf("  = temporary=1 (the default): not written to the gimbal's non-volatile "
+               "storage; temporary=0 stores it\n");
     }
     session_close(&s);
     return TK_EXIT_OK;

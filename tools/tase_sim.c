@@ -94,6 +94,14 @@ static void apply_axis(sim_t *s, const tase_axis_setting_t *a)
     s->m.axis_tilt.gain = 0.1 * a->tilt_pos_gain;
 }
 
+/* What a real gimbal does with a setup packet's `temporary` byte (the
+ * simulator keeps every setting for its run only). */
+static const char *storage(uint8_t temporary)
+{
+    return temporary == TASE_SETUP_TEMPORARY ? "temporary"
+                                             : "a gimbal would store it in non-volatile memory";
+}
+
 /* Setup packets arrive resolved by the role ("do not change" fields
  * already replaced by the settings in force). */
 static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
@@ -110,13 +118,14 @@ static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
         apply_axis(s, a);
         logf_(s, now,
               "AXIS_SETTING: pan no-go %.2f+-%.2f, tilt no-go %.2f+-%.2f, max rates "
-              "%.0f/%.0f deg/s",
+              "%.0f/%.0f deg/s (%s)",
               s->m.axis_pan.nogo_center, s->m.axis_pan.nogo_range / 2, s->m.axis_tilt.nogo_center,
-              s->m.axis_tilt.nogo_range / 2, s->m.axis_pan.max_rate, s->m.axis_tilt.max_rate);
+              s->m.axis_tilt.nogo_range / 2, s->m.axis_pan.max_rate, s->m.axis_tilt.max_rate,
+              storage(a->temporary));
     } else if (id == TASE_ID_PACKET_RATE) {
         const tase_packet_rate_t *r = msg;
-        logf_(s, now, "PACKET_RATE: port 1 angle %u/s, rate %u/s, georef %u/s", r->angle_1,
-              r->rate_1, r->geo_ref_1);
+        logf_(s, now, "PACKET_RATE: port 1 angle %u/s, rate %u/s, georef %u/s (%s)", r->angle_1,
+              r->rate_1, r->geo_ref_1, storage(r->temporary));
     }
     return 0;
 }
