@@ -249,5 +249,10 @@ done
 check "record --tap-in: both lines decoded, each direction exactly the generator's packets" \
     eval 'same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.out" && same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.in"'
 
+# (last: no recorder follows to find its bytes in the joined ptys)
+expect_error "replay > /dev/full: exit 5, the message says data was sent" 5 \
+    "replayed data was sent; cannot write to standard output: No space left on device" \
+    sh -c 'exec "$0" replay "$1" --serial "$2" --dir out --speed 0 >/dev/full' "$TASE" "$dir/slow.pcap" "$dir/A"
+
 check_summary capture
 echo "captures: decode, record, --record, tap and replay all passed"

@@ -669,7 +669,9 @@ static void replay_send(replay_t *rp, const tk_cap_reader_t *r, const tk_cap_rec
     } else {
         send_bytes(rp, rec->frame.data, rec->frame.dlc, (unsigned)can_frame_dir(&rec->frame));
     }
-    rp->sent++;
+    if (rp->sent++ == 0) {
+        tk_mark_sent("replayed data"); /* later failures say so */
+    }
 }
 
 unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
