@@ -351,8 +351,9 @@ ok("tase klv PTY (cooked mode): every packet decoded, as from the file (%d of %d
 ok("... nothing echoed back towards the gimbal (%d bytes)" % len(echoed), echoed == b"")
 ok("... SIGTERM ends the live line with exit 0, the device's settings given back",
    rc == 0 and err == "" and before == after, "exit %d %r" % (rc, err))
-rc, out, err, echoed, before, after = cooked_pty(["klv", "--baud", "9600"], klv[:87 * 3], 0)
-ok("tase klv --baud 9600 PTY accepted", rc == 0 and before == after, "exit %d %r" % (rc, err))
+rc, out, err, echoed, before, after = cooked_pty(["klv", "--baud", "9600"], klv, want.count("\n"))
+ok("tase klv --baud 9600 PTY accepted", rc == 0 and out == want and before == after,
+   "exit %d %r" % (rc, err))
 want = run(["decode", noisy])[1]
 rc, out, err, echoed, before, after = cooked_pty(["decode"], open(noisy, "rb").read(),
                                                  want.count("\n"))

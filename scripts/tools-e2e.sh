@@ -145,8 +145,8 @@ last=$(last_angle)
 check "... and nothing reached the gimbal: it stays at 30/-15 ($last)" \
     eval '[ "$(sim_says GIMBAL_CMD)" = "$n" ] && near "$(json_int "$last" pan)" 3000 2'
 
-# SPOI error forms are accepted but not modelled: the log says so, and the
-# gimbal stays where the last position command put it.
+# SPOI error forms are accepted but not modelled: the log says so (that
+# the model's state is unchanged is tests/test_sim_model.c's).
 quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xC0 impulse_time=0 "${L[@]}"
 quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xD0 impulse_time=0 "${L[@]}"
 sleep 0.3
@@ -154,9 +154,6 @@ check "tase-sim logs SPOI error GIMBAL_CMDs as ignored, the mode kept ($(grep 'S
     eval '[ "$(sim_says "GIMBAL_CMD: SPOI error (flags 0xC0, pan 1.00 tilt 2.00) ignored: not modelled; still in position mode, stabilised")" = 1 ] &&
           [ "$(sim_says "GIMBAL_CMD: SPOI error rate (flags 0xD0, pan 1.00 tilt 2.00) ignored")" = 1 ] &&
           [ "$(sim_says "GIMBAL_CMD: .* pan 1.00 tilt 2.00, stabilised$")" = 0 ]'
-last=$(last_angle)
-check "... and the gimbal stays at 30/-15 ($last)" \
-    eval 'near "$(json_int "$last" pan)" 3000 2 && near "$(json_int "$last" tilt)" -1500 2'
 
 # A command whose output cannot be written was still sent: the status (5)
 # and the message say so, so a script does not send it again.
@@ -254,7 +251,7 @@ check "KLV packet carries the simulated pan (90 deg = raw 16384)" \
     grep -q '"pan":1638[3-5],' <<<"$k"
 
 # ---- monitor on a line that carries no TASE frame (the KLV pty) ----
-"$TASE" monitor --serial "$dir/klv" --seconds 1.5 >"$dir/out" 2>"$dir/mon.err"
+"$TASE" monitor --serial "$dir/klv" --seconds 1.2 >"$dir/out" 2>"$dir/mon.err"
 rc=$?
 check "monitor of bytes without a frame: exit $rc, the summary and a hint ($(tr '\n' '|' <"$dir/mon.err"))" \
     eval '[ $rc = 4 ] && [ ! -s "$dir/out" ] && [ "$(grep -vc "^==" "$dir/mon.err")" = 2 ] &&
@@ -314,7 +311,7 @@ kill -STOP "$sim_pid"
 expect_error "query timeout" 1 "timeout: no answer to PACKET_RATE after 2 attempts" \
     "$TASE" query PACKET_RATE "${L[@]}" --timeout 100 --retries 1
 expect_error "send timeout on its query: says the setting was not sent" 1 \
-    "timeout: no answer to PACKET_RATE after 2 attempts of 100 ms (only the query went out, to read the settings the fields left out keep; the new setting was not sent)$" \
+    "timeout: no answer to PACKET_RATE after 2 attempts of 100 ms (only the query went out, to read the gimbal's settings; the new setting was not sent)$" \
     "$TASE" send PACKET_RATE angle_1=5 "${L[@]}" --timeout 100 --retries 1
 "$TASE" query PACKET_RATE "${L[@]}" --timeout 20000 >/dev/null 2>"$dir/sig.err" &
 qpid=$!

@@ -113,7 +113,8 @@ static const char usage_send[] =
     "    CAMERA_PASS baud);\n"
     "  - other fields of setup packets (group 0x48): the gimbal's current settings\n"
     "    are queried first and kept, and the packet is sent in the layout of the\n"
-    "    answer (AXIS_SETTING: 22 or 23 bytes) unless --len says otherwise;\n"
+    "    answer (AXIS_SETTING: 22 or 23 bytes, so it is always queried first)\n"
+    "    unless --len says otherwise;\n"
     "  - otherwise every field must be given (the error names the missing ones);\n"
     "  - --zero: fields left out without such a value are 0 instead.\n"
     "temporary (PACKET_RATE, AXIS_SETTING) left out is 1: the setting lasts until\n"
@@ -908,13 +909,19 @@ static int cmd_send(args_t *a)
                            name, setup ? " with --no-wait (nothing is queried)" : "", missing);
         }
     }
+    if (setup && !o.no_wait && o.len < 0 && (p->flags & TASE_LEN_SHORT) != 0u) {
+        /* a packet of two layouts (AXIS_SETTING, PROTOCOL-NOTES S2): the
+         * query's answer tells which one this gimbal uses, even when
+         * every field is given */
+        rmw = true;
+    }
     session_open(&s, &lo, NULL, NULL);
     if (rmw) {
         uint8_t cur[TASE_DATA_MAX];
         unsigned k;
         int n = transact_note(&s, p, NULL, 0, cur, &o.r,
-                              " (only the query went out, to read the settings the fields left "
-                              "out keep; the new setting was not sent)");
+                              " (only the query went out, to read the gimbal's settings; the "
+                              "new setting was not sent)");
         if (n <= 0 || !tase_schema_length_ok(p, (size_t)n)) {
             tk_die("%s query answered with %d data bytes, not a length of %s; nothing was set",
                    name, n, name);
