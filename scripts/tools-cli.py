@@ -309,7 +309,8 @@ import termios
 def cooked_pty(args, data, expect_lines):
     """Run tase ARGS PTY on a pty left in its default (cooked, echoing)
     mode, write `data` to the line once tase has the device, and stop it
-    with SIGTERM once `expect_lines` lines came out (or after 3 s).
+    with SIGTERM once `expect_lines` lines came out, or nothing more came
+    for 0.4 s (frames the receiver holds come out at the end), or after 3 s.
     Returns (exit status, output, stderr, bytes echoed back to the line's
     far end, the slave's termios before and after)."""
     master, slave = os.openpty()
@@ -326,12 +327,16 @@ def cooked_pty(args, data, expect_lines):
     out = b""
     os.set_blocking(p.stdout.fileno(), False)
     deadline = time.time() + 3.0 * SLOW
-    while time.time() < deadline and out.count(b"\n") < expect_lines:
+    last = time.time()
+    while time.time() < deadline and out.count(b"\n") < expect_lines and \
+            time.time() - last < 0.4 * SLOW:
         r = select.select([master, p.stdout], [], [], 0.05)[0]
         if master in r:
             echoed += os.read(master, 4096)
+            last = time.time()
         if p.stdout in r:
             out += p.stdout.read() or b""
+            last = time.time()
     p.send_signal(signal.SIGTERM)
     rest, err = p.communicate(timeout=10 * SLOW)
     while select.select([master], [], [], 0.05)[0]:
