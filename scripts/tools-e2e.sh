@@ -382,18 +382,21 @@ kill $kpid
 wait $kpid
 
 # ---- the device goes away (the simulator exits): said so, never a bare I/O error ----
-# hang_up TASE-ARGS...: tase ARGS on a simulator of its own, stopped while
-# tase runs; sets rc to tase's status, its stderr in $dir/hang.err
+# hang_up [--frozen] TASE-ARGS...: tase ARGS on a simulator of its own,
+# which exits while tase runs (--frozen: it never answers, stopped from the
+# start, then killed); sets rc to tase's status, its stderr in $dir/hang.err
 hang_up() {
-    local dpid tpid
-    "$SIM" --quiet --link "$dir/dying" --seconds 30 >/dev/null 2>&1 &
+    local dpid tpid frozen=""
+    [ "$1" = --frozen ] && frozen=1 && shift
+    "$SIM" --quiet --link "$dir/dying" --seconds 60 >/dev/null 2>&1 &
     dpid=$!
     for _ in $(seq 100); do [ -L "$dir/dying" ] && break; sleep 0.05; done
+    [ -n "$frozen" ] && kill -STOP $dpid
     "$TASE" "$@" --serial "$dir/dying" >/dev/null 2>"$dir/hang.err" &
     tpid=$!
     sleep "$settle"
-    kill $dpid
-    wait $dpid
+    kill ${frozen:+-KILL} $dpid
+    wait $dpid 2>/dev/null
     wait $tpid
     rc=$?
 }
@@ -402,7 +405,9 @@ check "monitor when the device hangs up: exit $rc, its summary, then why ($(tr '
     eval '[ $rc = 1 ] && [ "$(grep -vc "^==" "$dir/hang.err")" = 2 ] &&
           grep -q "^tase: summary: [1-9][0-9]* frames" "$dir/hang.err" &&
           grep -q "^tase: cannot read .*dying: the device went away or hung up$" "$dir/hang.err"'
-hang_up retract --wait 5
+# (frozen, so that the move's echo cannot end the wait first however slow
+# the run; the killed simulator's stale link is replaced by the next one)
+hang_up --frozen retract --wait 30
 check "retract --wait when the device hangs up: exit $rc, why, and that the command went out ($(cat "$dir/hang.err"))" \
     eval '[ $rc = 1 ] && grep -q "^tase: cannot read .*dying: the device went away or hung up (RETRACT_DEPLOY_CMD was sent)$" "$dir/hang.err"'
 

@@ -446,8 +446,8 @@ static void session_service(session_t *s, uint32_t wait_ms)
 /* Wait for the answer to a request, servicing the port so a signal is
  * seen within 20 ms; dies with the reason on failure, `note` (or NULL)
  * added to a timeout's message. */
-static int transact_note(session_t *s, const tase_packet_desc_t *p, const uint8_t *data,
-                         size_t len, uint8_t *reply, const req_opts_t *r, const char *note)
+static int transact_note(session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
+                         uint8_t *reply, const req_opts_t *r, const char *note)
 {
     int rc = tase_host_request_start(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len,
                                      reply, TASE_DATA_MAX, r->timeout_ms, r->retries,
@@ -465,9 +465,9 @@ static int transact_note(session_t *s, const tase_packet_desc_t *p, const uint8_
         rc = 0;
     }
     if (rc == TASE_ETIMEOUT) {
-        tk_die("timeout: no answer to %s after %u attempt%s of %lu ms%s", tase_schema_packet_name(p),
-               (unsigned)r->retries + 1u, r->retries ? "s" : "", (unsigned long)r->timeout_ms,
-               note != NULL ? note : "");
+        tk_die("timeout: no answer to %s after %u attempt%s of %lu ms%s",
+               tase_schema_packet_name(p), (unsigned)r->retries + 1u, r->retries ? "s" : "",
+               (unsigned long)r->timeout_ms, note != NULL ? note : "");
     }
     if (rc < 0) {
         tk_die("%s request failed on %s: %s", tase_schema_packet_name(p), s->name,
@@ -1804,7 +1804,8 @@ static int cmd_decode(args_t *a)
     } else {
         static uint8_t buf[READ_CHUNK];
         /* a serial line carries raw bytes, never a capture file */
-        size_t n = in.device ? input_read(&in, buf, sizeof(buf)) : input_head(&in, buf, sizeof(buf));
+        size_t n =
+            in.device ? input_read(&in, buf, sizeof(buf)) : input_head(&in, buf, sizeof(buf));
         if (!in.device && tk_cap_is_capture(buf, n)) {
             capture = true;
             bad = decode_capture(&in, &d, buf, n);

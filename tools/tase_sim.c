@@ -445,7 +445,8 @@ int main(int argc, char **argv)
         /* a value that starts with "--" is the next option: missing */
         bool more = i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0;
         /* each option with a value at most once */
-        if ((strcmp(a, "--link") == 0 && link != NULL) || (strcmp(a, "--can") == 0 && can != NULL) ||
+        if ((strcmp(a, "--link") == 0 && link != NULL) ||
+            (strcmp(a, "--can") == 0 && can != NULL) ||
             (strcmp(a, "--klv-link") == 0 && klv_link != NULL) ||
             (strcmp(a, "--baud") == 0 && baud_given) ||
             (strcmp(a, "--seconds") == 0 && seconds > 0.0)) {
