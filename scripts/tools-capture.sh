@@ -85,9 +85,14 @@ expect_error "decode of an Ethernet pcap" 1 "link type 1 (EN10MB) is neither TAS
 head -c 30 "$dir/noisy.pcap" >"$dir/cut.pcap"
 expect_error "decode of a pcap cut inside a record header" 1 "cut.pcap" "$TASE" decode "$dir/cut.pcap"
 expect_error "replay of a raw byte file" 1 "is not a pcap or pcapng capture" \
-    "$TASE" replay "$DATA/decode_noisy.bin" --serial /dev/null
+    "$TASE" replay "$DATA/decode_noisy.bin" --serial /dev/null --dir out
 expect_error "replay without a link" 2 "give either --serial DEV or --can IFACE" \
     "$TASE" replay "$dir/noisy.pcap"
+# Nothing is replayed on a default: a capture's gimbal side holds echoes a
+# gimbal takes as commands (RETRACT_DEPLOY_CMD, SPOI_CMD, setup packets).
+expect_error "replay without --dir: refused, each choice explained" 2 \
+    "replay needs --dir: out = the gimbal's side, to exercise a host (its echoes are commands to a gimbal); in = the host's commands (moves a gimbal); all = both (moves a gimbal)" \
+    "$TASE" replay "$dir/noisy.pcap" --serial /dev/null
 expect_error "replay --dir sideways" 2 "bad --dir value 'sideways'" \
     "$TASE" replay "$dir/noisy.pcap" --serial /dev/null --dir sideways
 expect_error "replay --speed -1" 2 "bad --speed value" \
@@ -163,7 +168,26 @@ nr=$($U records "$dir/tele.pcap" | grep -c .)
 check "record --serial, stopped by SIGINT: exit $rc, '$(tail -1 "$dir/rec.out")', $nr records, $na GIMBAL_ANGLE (20/s set above)" \
     eval '[ $rc -eq 0 ] && grep -q "^recorded $nr records" "$dir/rec.out" && [ "$na" -ge 15 ] &&
           ! grep -q "\"dir\":\"in\"" "$dir/tele.json"'
+
+# ---- the recorded device goes away: record stops (it spun at 75% CPU) ----
+"$TASE" record --serial "$dir/gimbal" -o "$dir/gone.pcap" >"$dir/gone.out" 2>"$dir/gone.err" &
+rp=$!
+wait_for "$dir/gone.out" recording
+sleep 0.3
 kill "${pids[0]}"
+for _ in $(seq 40); do kill -0 $rp 2>/dev/null || break; sleep 0.05; done
+if kill -0 $rp 2>/dev/null; then
+    cpu=$(ps -o time= -p $rp)
+    kill -INT $rp
+fi
+wait $rp
+rc=$?
+"$TASE" decode "$dir/gone.pcap" >"$dir/gone.json"
+check "record when the device hangs up: stops within 2 s, exit $rc, '$(cat "$dir/gone.err")'${cpu:+ (still running, CPU $cpu)}" \
+    eval '[ $rc -eq 1 ] && [ "$(grep -vc "^==" "$dir/gone.err")" = 1 ] &&
+          grep -q "^tase: cannot read .*gimbal: the device went away or hung up$" "$dir/gone.err"'
+check "... the records so far kept and closed: '$(cat "$dir/gone.out" | tail -1)', $(grep -c . "$dir/gone.json") packets decoded" \
+    eval 'grep -q "^recorded [1-9][0-9]* records" "$dir/gone.out" && grep -q GIMBAL_ANGLE "$dir/gone.json"'
 
 # ---- replay through joined pseudo-terminals, recorded on the other side ----
 $U pty-pair "$dir/A" "$dir/B" &
@@ -187,12 +211,12 @@ replay_to() {
     wait $rp
 }
 bytes=$(wc -c <"$DATA/decode_noisy.bin")
-replay_to got "$TASE" replay "$dir/slow.pcap" --serial "$dir/A"
-check "replay (default: the gimbal's side): $(cat "$dir/got.out")" \
+replay_to got "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out
+check "replay --dir out (the gimbal's side): $(cat "$dir/got.out")" \
     grep -q "^replayed [1-9][0-9]* of [0-9]* records ($bytes bytes)" "$dir/got.out"
 check "replay: every byte from the gimbal arrived, in order, within $tol s of its recorded time" \
     $U timing "$dir/slow.pcap" "$dir/got.pcap" out 1 $tol
-replay_to fast "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --speed 2
+replay_to fast "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out --speed 2
 check "replay --speed 2: the same bytes at half the recorded intervals" \
     $U timing "$dir/slow.pcap" "$dir/fast.pcap" out 2 $tol
 replay_to in "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir in
@@ -203,7 +227,7 @@ check "replay --dir in: the bytes sent to the gimbal" \
 replay_fast() {
     local start
     start=$(date +%s%N)
-    "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --speed 0 >/dev/null
+    "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out --speed 0 >/dev/null
     echo $((($(date +%s%N) - start) / 1000000)) >"$dir/zero.ms"
 }
 replay_to zero replay_fast
@@ -224,6 +248,11 @@ for d in out in; do
 done
 check "record --tap-in: both lines decoded, each direction exactly the generator's packets" \
     eval 'same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.out" && same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.in"'
+
+# (last: no recorder follows to find its bytes in the joined ptys)
+expect_error "replay > /dev/full: exit 5, the message says data was sent" 5 \
+    "replayed data was sent; cannot write to standard output: No space left on device" \
+    sh -c 'exec "$0" replay "$1" --serial "$2" --dir out --speed 0 >/dev/full' "$TASE" "$dir/slow.pcap" "$dir/A"
 
 check_summary capture
 echo "captures: decode, record, --record, tap and replay all passed"

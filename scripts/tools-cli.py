@@ -147,6 +147,27 @@ expect("point: negative numbers are arguments", ["point", "-10", "-5.5"] + L, 1,
 expect("camera: bad name", ["camera", "D"] + L, 2, "bad camera 'D'")
 expect("camera: nothing to do", ["camera"] + L, 2, "expected a camera")
 expect("spoi: latitude range", ["spoi", "91", "0", "0"] + L, 2, r"out of range -90\.\.90 deg")
+expect("spoi: the height range in plain numbers", ["spoi", "45", "7", "100000000"] + L, 2,
+       r"bad height '100000000': out of range -21474836\.48\.\.21474836\.47 m$")
+
+# ---- options: each value once, and a value is never the next option ----
+expect("--serial given twice is refused", ["monitor", "--serial", "/a", "--serial", "/b"], 2,
+       "option --serial given twice")
+expect("--timeout given twice (as --timeout=N) is refused",
+       ["query", "SYSTEM_VERSION", "--timeout", "100", "--timeout=200"] + L, 2,
+       "option --timeout given twice")
+expect("record -o and --output together are refused",
+       ["record", "--serial", "/a", "-o", "x.pcap", "--output", "y.pcap"], 2,
+       "option -o/--output given twice")
+expect("camera --hfov followed by an option: the value is missing",
+       ["camera", "--hfov", "--serial", "/dev/ttyUSB9"], 2, "option --hfov needs a value")
+expect("a negative number is still a value", ["camera", "--hfov", "-5"] + L, 2,
+       r"bad --hfov '-5': out of range")
+expect("tase-sim --link given twice is refused",
+       [SIM, "--link", os.path.join(TMP, "a"), "--link", os.path.join(TMP, "b"), "--seconds", "1"],
+       2, "option --link given twice")
+expect("tase-sim --link followed by an option: the value is missing",
+       [SIM, "--link", "--quiet", "--seconds", "1"], 2, "option --link needs a value")
 
 # ---- messages ----
 expect("--serial /dev/null: not a terminal (it exists)",
@@ -219,6 +240,15 @@ expect("noise only: hint and exit 4", ["decode", write("noise.bin", bytes(range(
        "no TASE packet found")
 rc, out, err = run(["decode", write("empty.bin", b"")])
 ok("an empty input is no error", rc == 0 and out == "" and err == "", err)
+# klv follows decode's rule
+expect("klv of a text file: hint and exit 4", ["klv", write("passwd", "root:x:0:0:root:/root:/bin/bash\n")],
+       4, r"no KLV packet found in .*passwd: it is text, not a KLV byte stream")
+expect("klv of the TASE datalink: hint and exit 4", ["klv", noisy], 4,
+       r"no KLV packet found in .*decode_noisy.bin: it looks like the TASE datalink \('tase decode'")
+expect("klv of noise: hint and exit 4", ["klv", os.path.join(TMP, "noise.bin")], 4,
+       r"no KLV packet found in .*noise.bin \(not a capture of the gimbal's KLV line\?\)")
+rc, out, err = run(["klv", os.path.join(TMP, "empty.bin")])
+ok("klv of an empty input is no error", rc == 0 and out == "" and err == "", err)
 rc, out, err = run(["decode", "--stats", noisy])
 ok("decode --stats prints the counters on stderr",
    rc == 0 and re.search(r"summary: 12 frames \(1 unknown, 1 wrong length\), 1 checksum errors, "
@@ -271,6 +301,73 @@ got = live(["decode"], angle(7, 8), "decode")
 ok("tase decode on a live input prints a packet while the writer is still open",
    b'"pan":7,' in got, repr(got[:200]))
 
+# ---- a serial device named as the input: opened raw, given back as found ----
+import signal
+import termios
+
+
+def cooked_pty(args, data, expect_lines):
+    """Run tase ARGS PTY on a pty left in its default (cooked, echoing)
+    mode, write `data` to the line once tase has the device, and stop it
+    with SIGTERM once `expect_lines` lines came out, or nothing more came
+    for 0.4 s (frames the receiver holds come out at the end), or after 3 s.
+    Returns (exit status, output, stderr, bytes echoed back to the line's
+    far end, the slave's termios before and after)."""
+    master, slave = os.openpty()
+    path = os.ttyname(slave)
+    before = termios.tcgetattr(slave)
+    p = subprocess.Popen(VG + [TASE] + args + [path], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE)
+    deadline = time.time() + 2.0 * SLOW
+    while time.time() < deadline and termios.tcgetattr(slave)[3] & termios.ICANON:
+        time.sleep(0.01)  # tase has opened it once it is raw (old code: never)
+    time.sleep(0.05)
+    os.write(master, data)
+    echoed = b""
+    out = b""
+    os.set_blocking(p.stdout.fileno(), False)
+    deadline = time.time() + 3.0 * SLOW
+    last = time.time()
+    while time.time() < deadline and out.count(b"\n") < expect_lines and \
+            time.time() - last < 0.4 * SLOW:
+        r = select.select([master, p.stdout], [], [], 0.05)[0]
+        if master in r:
+            echoed += os.read(master, 4096)
+            last = time.time()
+        if p.stdout in r:
+            out += p.stdout.read() or b""
+            last = time.time()
+    p.send_signal(signal.SIGTERM)
+    rest, err = p.communicate(timeout=10 * SLOW)
+    while select.select([master], [], [], 0.05)[0]:
+        echoed += os.read(master, 4096)
+    after = termios.tcgetattr(slave)
+    os.close(master)
+    os.close(slave)
+    err = "".join(l for l in err.decode(errors="replace").splitlines(True)
+                  if not re.match(r"==\d+== ", l))
+    return p.returncode, (out + rest).decode(errors="replace"), err, echoed, before, after
+
+
+want = run(["klv", os.path.join(os.path.dirname(noisy), "klv_noisy.bin")])[1]
+rc, out, err, echoed, before, after = cooked_pty(["klv"], klv, want.count("\n"))
+ok("tase klv PTY (cooked mode): every packet decoded, as from the file (%d of %d lines)"
+   % (out.count("\n"), want.count("\n")), out == want, "exit %d %r %r" % (rc, err, out[:300]))
+ok("... nothing echoed back towards the gimbal (%d bytes)" % len(echoed), echoed == b"")
+ok("... SIGTERM ends the live line with exit 0, the device's settings given back",
+   rc == 0 and err == "" and before == after, "exit %d %r" % (rc, err))
+rc, out, err, echoed, before, after = cooked_pty(["klv", "--baud", "9600"], klv, want.count("\n"))
+ok("tase klv --baud 9600 PTY accepted", rc == 0 and out == want and before == after,
+   "exit %d %r" % (rc, err))
+want = run(["decode", noisy])[1]
+rc, out, err, echoed, before, after = cooked_pty(["decode"], open(noisy, "rb").read(),
+                                                 want.count("\n"))
+ok("tase decode PTY (cooked mode): every packet as from the file, nothing echoed, settings "
+   "given back", out == want and echoed == b"" and rc == 0 and before == after,
+   "exit %d %r %r echoed %d" % (rc, err, out[:300], len(echoed)))
+expect("--baud with a file input is refused", ["klv", "--baud", "9600", noisy], 2,
+       "--baud is for a serial device")
+
 # ---- decode writes its output in blocks, not one write() per frame ----
 # 2 MB of back-to-back GIMBAL_ANGLE frames (about 143,000) through a pipe
 # that stays open: once every frame is out, the process waits for more input
@@ -308,6 +405,89 @@ if n is None:
 else:
     ok("decode of %d dense frames: %d lines with %d write() calls (one per frame before)"
        % (want, lines, n), lines == want and n < want // 20)
+
+# ---- a gimbal of the 22-byte AXIS_SETTING kind (docs/PROTOCOL-NOTES.md S2) ----
+class FakeGimbal:
+    """A pseudo-terminal whose far end answers like a gimbal of the short
+    AXIS_SETTING layout: the zero-length query with its settings in 22
+    bytes, a 22-byte setting stored and echoed (0xFF/0xFFFF: no change),
+    any other length ignored (a strict gimbal). Every frame it got is kept."""
+
+    # 22-byte layout: no-go centre/range pan, tilt, roll (16-bit each), then
+    # max rates pan 12, tilt 13, roll 14, accelerations 15-17, gains 18-20,
+    # temporary 21
+    WIDTHS = [2] * 6 + [1] * 10
+
+    def __init__(self):
+        self.master, self.slave = os.openpty()
+        self.path = os.ttyname(self.slave)
+        self.settings = bytearray((0).to_bytes(2, "big") * 2 + (9000).to_bytes(2, "big") +
+                                  (6000).to_bytes(2, "big") + bytes(4) +
+                                  bytes([60, 60, 255, 50, 50, 255, 40, 40, 255, 0]))
+        self.got = []
+        self.stop = False
+        self.thread = threading.Thread(target=self.run, daemon=True)
+        self.thread.start()
+
+    def run(self):
+        buf = b""
+        while not self.stop:
+            if not select.select([self.master], [], [], 0.05)[0]:
+                continue
+            try:
+                buf += os.read(self.master, 4096)
+            except OSError:
+                continue
+            while True:
+                i = buf.find(b"\x00\xff\x5a")
+                if i < 0 or len(buf) < i + 4 or len(buf) < i + 6 + buf[i + 3]:
+                    break
+                size = buf[i + 3]
+                f = buf[i:i + 6 + size]
+                buf = buf[i + 6 + size:]
+                if f[:-2] and int.from_bytes(f[-2:], "big") == sum(f[:-2]) & 0xFFFF:
+                    self.frame(f[4], f[5], f[6:-2])
+
+    def frame(self, group, ptype, data):
+        self.got.append((group, ptype, bytes(data)))
+        if (group, ptype) != (0x48, 0x02):
+            return
+        if len(data) == 22:
+            off = 0
+            for w in self.WIDTHS:
+                v = data[off:off + w]
+                if off == 21 or v != b"\xff" * w:
+                    self.settings[off:off + w] = v
+                off += w
+        elif len(data) != 0:
+            return
+        os.write(self.master, frame(0x48, 0x02, bytes(self.settings)))
+
+    def close(self):
+        self.stop = True
+        self.thread.join()
+        os.close(self.master)
+        os.close(self.slave)
+
+
+fg = FakeGimbal()
+rc, out, err = run(["send", "AXIS_SETTING", "pan_max_rate=20", "--serial", fg.path, "--json"])
+sent = [o for o in jsonl(out) if o.get("dir") == "in"]
+sets = [d for g, t, d in fg.got if (g, t) == (0x48, 0x02) and d]
+ok("send AXIS_SETTING to a 22-byte gimbal: queried, sent in its 22-byte layout, echo confirmed",
+   rc == 0 and len(sent) == 1 and sent[0]["size"] == 22 and
+   sent[0]["fields"]["pan_max_rate"] == 20 and len(sets) == 1 and len(sets[0]) == 22 and
+   sets[0][12] == 20 and sets[0][13] == 255 and fg.settings[12] == 20 and fg.settings[13] == 60,
+   "exit %d %r %r %r" % (rc, err, out, fg.got))
+rc, out, err = run(["send", "AXIS_SETTING", "tilt_max_rate=30", "--len", "22", "--serial", fg.path])
+ok("send AXIS_SETTING --len 22 to a 22-byte gimbal: the fields left out kept from its answer",
+   rc == 0 and fg.settings[13] == 30 and fg.settings[12] == 20 and fg.settings[18] == 40 and
+   "echo AXIS_SETTING" in out, "exit %d %r %r" % (rc, err, out))
+rc, out, err = run(["send", "AXIS_SETTING", "pan_pos_gain=41", "--serial", fg.path])
+ok("... the text output says which layout was used",
+   rc == 0 and "22-byte layout the gimbal answered" in out and fg.settings[18] == 41,
+   "exit %d %r %r" % (rc, err, out))
+fg.close()
 
 # ---- 64-bit offsets (4 GiB through a pipe: about 1.5 s of CPU; not under memcheck) ----
 gen = ("import os,sys,fcntl\n"

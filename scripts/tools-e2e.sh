@@ -101,6 +101,16 @@ check "send PACKET_RATE prints the gimbal's echo" \
     test "$(json_int "$e" angle_1)/$(json_int "$e" rate_1)/$(json_int "$e" geo_ref_1)" = 20/5/2
 q=$("$TASE" query PACKET_RATE "${L[@]}" --json)
 check "PACKET_RATE persists (query after set)" test "$(json_int "$q" angle_1)" = 20
+# temporary left out is 1 (not written to non-volatile storage), and says so
+out=$("$TASE" send PACKET_RATE angle_1=20 "${L[@]}")
+check "send PACKET_RATE without temporary: sent temporary=1, the output says it is not stored" \
+    eval 'grep -q "^sent PACKET_RATE .* temporary=1$" <<<"$out" &&
+          grep -q "temporary=1 (the default): not written to the gimbal.s non-volatile storage" <<<"$out" &&
+          sleep 0.1 && [ "$(sim_says "PACKET_RATE: .* (temporary)$")" = 2 ]'
+out=$("$TASE" send PACKET_RATE angle_1=20 temporary=0 "${L[@]}")
+check "send PACKET_RATE temporary=0: sent as asked, to be stored" \
+    eval 'grep -q "^sent PACKET_RATE .* temporary=0$" <<<"$out" && ! grep -q "the default" <<<"$out" &&
+          sleep 0.1 && [ "$(sim_says "PACKET_RATE: .* (a gimbal would store it in non-volatile memory)$")" = 1 ]' 
 check "read-modify-write kept the other ports' rates" test "$(json_int "$q" angle_2)" = 10
 t0=$(date +%s)
 mon=$("$TASE" monitor "${L[@]}" --json --time --units --seconds 2 2>"$dir/mon.err")
@@ -134,6 +144,29 @@ sleep 0.3
 last=$(last_angle)
 check "... and nothing reached the gimbal: it stays at 30/-15 ($last)" \
     eval '[ "$(sim_says GIMBAL_CMD)" = "$n" ] && near "$(json_int "$last" pan)" 3000 2'
+
+# SPOI error forms are accepted but not modelled: the log says so (that
+# the model's state is unchanged is tests/test_sim_model.c's).
+quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xC0 impulse_time=0 "${L[@]}"
+quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xD0 impulse_time=0 "${L[@]}"
+sleep 0.3
+check "tase-sim logs SPOI error GIMBAL_CMDs as ignored, the mode kept ($(grep 'SPOI error' "$dir/sim.log" | head -1 | cut -c12-))" \
+    eval '[ "$(sim_says "GIMBAL_CMD: SPOI error (flags 0xC0, pan 1.00 tilt 2.00) ignored: not modelled; still in position mode, stabilised")" = 1 ] &&
+          [ "$(sim_says "GIMBAL_CMD: SPOI error rate (flags 0xD0, pan 1.00 tilt 2.00) ignored")" = 1 ] &&
+          [ "$(sim_says "GIMBAL_CMD: .* pan 1.00 tilt 2.00, stabilised$")" = 0 ]'
+
+# A command whose output cannot be written was still sent: the status (5)
+# and the message say so, so a script does not send it again.
+n=$(sim_says GIMBAL_CMD)
+expect_error "point > /dev/full: exit 5, the message says GIMBAL_CMD was sent" 5 \
+    "GIMBAL_CMD was sent; cannot write to standard output: No space left on device" \
+    sh -c 'exec "$0" point 30 -15 --serial "$1" >/dev/full' "$TASE" "$dir/gimbal"
+expect_error "point into a closed pipe: exit 5 (not a quiet 141), GIMBAL_CMD was sent" 5 \
+    "GIMBAL_CMD was sent; cannot write to standard output: Broken pipe" \
+    python3 -c 'import os,subprocess,sys; r,w=os.pipe(); os.close(r); sys.exit(subprocess.call(sys.argv[1:], stdout=w))' \
+    "$TASE" point 30 -15 "${L[@]}"
+sleep 0.2
+check "... and both reached the gimbal" test "$(sim_says GIMBAL_CMD)" = $((n + 2))
 
 # ---- numbers as typed, sent packets printed ----
 s1=$("$TASE" send HOST_SENSOR roll=010 pitch=+5 yaw=-0x10 --zero "${L[@]}" --json)
@@ -194,7 +227,14 @@ check "20 back-to-back gyro-zero commands from 20 programs all reach the gimbal"
 quiet "$TASE" camera A --hfov 10 "${L[@]}"
 geo=$("$TASE" monitor "${L[@]}" --json --seconds 1.2 2>/dev/null | grep '"GEOREFERENCE_DATA"' | tail -1)
 check "tase camera A --hfov 10 shows in GEOREFERENCE_DATA" test "$(json_int "$geo" hfov)" = 1000
-quiet "$TASE" camera B "${L[@]}"
+n=$(sim_says CAMERA_CMD)
+expect_error "tase camera C on a gimbal without camera C: refused (SYSTEM_VERSION says none), nothing sent" 1 \
+    "the gimbal has no camera C (SYSTEM_VERSION: type 0xFF, none); CAMERA_CMD was not sent" \
+    "$TASE" camera C "${L[@]}"
+out=$("$TASE" camera B "${L[@]}")
+check "... and camera B, which it has, is selected ($out)" \
+    eval 'grep -q "= camera B selected (type 97 in SYSTEM_VERSION)" <<<"$out" && sleep 0.1 &&
+          [ "$(sim_says CAMERA_CMD)" = $((n + 1)) ]' 
 out=$("$TASE" send CAMERA_CMD hfov=1500 "${L[@]}" --json 2>&1)
 check "send CAMERA_CMD hfov=1500: the fields left out go as \"do not change\" ($out)" \
     grep -q '"fields":{"camera":255,"hfov":1500,"focus":65535,"exposure":255,"shutter_speed":255,"bright":255,"flags":128}' <<<"$out"
@@ -209,6 +249,14 @@ nk=$(grep -c '"fields":{"utc"' <<<"$k")
 check "KLV output: $nk packets in 2.5 s (about one per 900 ms)" eval '[ $nk -ge 2 ] && [ $nk -le 4 ]'
 check "KLV packet carries the simulated pan (90 deg = raw 16384)" \
     grep -q '"pan":1638[3-5],' <<<"$k"
+
+# ---- monitor on a line that carries no TASE frame (the KLV pty) ----
+"$TASE" monitor --serial "$dir/klv" --seconds 1.2 >"$dir/out" 2>"$dir/mon.err"
+rc=$?
+check "monitor of bytes without a frame: exit $rc, the summary and a hint ($(tr '\n' '|' <"$dir/mon.err"))" \
+    eval '[ $rc = 4 ] && [ ! -s "$dir/out" ] && [ "$(grep -vc "^==" "$dir/mon.err")" = 2 ] &&
+          grep -q "^tase: summary: 0 frames .* of [1-9][0-9]* bytes discarded" "$dir/mon.err" &&
+          grep -q "^tase: no TASE frame in the [1-9][0-9]* bytes received on .*klv: a wrong --baud (57600), or not the gimbal.s datalink port (its KLV line?)$" "$dir/mon.err"'
 
 # ---- human-readable monitor ----
 t=$("$TASE" monitor "${L[@]}" --count 3 --units 2>/dev/null)
@@ -262,6 +310,9 @@ check "monitor on SIGHUP (its terminal closed): exit $rc, device as found" \
 kill -STOP "$sim_pid"
 expect_error "query timeout" 1 "timeout: no answer to PACKET_RATE after 2 attempts" \
     "$TASE" query PACKET_RATE "${L[@]}" --timeout 100 --retries 1
+expect_error "send timeout on its query: says the setting was not sent" 1 \
+    "timeout: no answer to PACKET_RATE after 2 attempts of 100 ms (only the query went out, to read the gimbal's settings; the new setting was not sent)$" \
+    "$TASE" send PACKET_RATE angle_1=5 "${L[@]}" --timeout 100 --retries 1
 "$TASE" query PACKET_RATE "${L[@]}" --timeout 20000 >/dev/null 2>"$dir/sig.err" &
 qpid=$!
 sleep "$settle"
@@ -307,6 +358,58 @@ kill -TERM $opid
 wait $opid
 check "tase-sim removes only its own links (a link repointed meanwhile stays)" \
     eval '[ "$(readlink "$dir/own")" = /dev/null ]'
+
+# A user's own symlink at --link is never taken over (nor deleted at exit);
+# a stale link of a killed simulator (into /dev/pts/, unclaimed) is replaced.
+ln -s /dev/null "$dir/users"
+expect_error "tase-sim --link over a user's symlink: refused, naming its target" 1 \
+    "users is a symlink to /dev/null, not a link left by tase-sim" \
+    "$SIM" --link "$dir/users" --seconds 1
+check "... and the user's symlink is untouched" test "$(readlink "$dir/users")" = /dev/null
+"$SIM" --quiet --link "$dir/stale" --seconds 30 >/dev/null 2>&1 &
+kpid=$!
+for _ in $(seq 100); do [ -L "$dir/stale" ] && break; sleep 0.05; done
+kill -KILL $kpid
+wait $kpid 2>/dev/null
+old=$(readlink "$dir/stale")
+"$SIM" --link "$dir/stale" --seconds 30 >"$dir/stale.log" 2>&1 &
+kpid=$!
+for _ in $(seq 100); do grep -q -e "simulated gimbal" -e "tase-sim:" "$dir/stale.log" && break; sleep 0.05; done
+check "a killed simulator's stale link ($old) is replaced by the next one ($(head -1 "$dir/stale.log"))" \
+    eval 'grep -q "simulated gimbal on .*(link .*stale)" "$dir/stale.log" &&
+          "$TASE" query SYSTEM_VERSION --serial "$dir/stale" >/dev/null'
+kill $kpid
+wait $kpid
+
+# ---- the device goes away (the simulator exits): said so, never a bare I/O error ----
+# hang_up [--frozen] TASE-ARGS...: tase ARGS on a simulator of its own,
+# which exits while tase runs (--frozen: it never answers, stopped from the
+# start, then killed); sets rc to tase's status, its stderr in $dir/hang.err
+hang_up() {
+    local dpid tpid frozen=""
+    [ "$1" = --frozen ] && frozen=1 && shift
+    "$SIM" --quiet --link "$dir/dying" --seconds 60 >/dev/null 2>&1 &
+    dpid=$!
+    for _ in $(seq 100); do [ -L "$dir/dying" ] && break; sleep 0.05; done
+    [ -n "$frozen" ] && kill -STOP $dpid
+    "$TASE" "$@" --serial "$dir/dying" >/dev/null 2>"$dir/hang.err" &
+    tpid=$!
+    sleep "$settle"
+    kill ${frozen:+-KILL} $dpid
+    wait $dpid 2>/dev/null
+    wait $tpid
+    rc=$?
+}
+hang_up monitor
+check "monitor when the device hangs up: exit $rc, its summary, then why ($(tr '\n' '|' <"$dir/hang.err"))" \
+    eval '[ $rc = 1 ] && [ "$(grep -vc "^==" "$dir/hang.err")" = 2 ] &&
+          grep -q "^tase: summary: [1-9][0-9]* frames" "$dir/hang.err" &&
+          grep -q "^tase: cannot read .*dying: the device went away or hung up$" "$dir/hang.err"'
+# (frozen, so that the move's echo cannot end the wait first however slow
+# the run; the killed simulator's stale link is replaced by the next one)
+hang_up --frozen retract --wait 30
+check "retract --wait when the device hangs up: exit $rc, why, and that the command went out ($(cat "$dir/hang.err"))" \
+    eval '[ $rc = 1 ] && grep -q "^tase: cannot read .*dying: the device went away or hung up (RETRACT_DEPLOY_CMD was sent)$" "$dir/hang.err"'
 
 # ---- error paths ----
 expect_error "no command" 2 "no command" "$TASE"

@@ -161,6 +161,20 @@ static void unknown_gimbal_flags_are_rejected(void **state)
     near(m.cmd_pan, 0.0, 0.0);
 }
 
+static void spoi_error_forms_are_accepted_and_change_nothing(void **state)
+{
+    sim_model_t m;
+    (void)state;
+    sim_model_init(&m);
+    assert_int_equal(sim_model_command(&m, 30.0, -10.0, 0x20, 0.0), 0);
+    assert_int_equal(sim_model_command(&m, 1.0, 2.0, 0xC0, 0.0), 1);
+    assert_int_equal(sim_model_command(&m, 1.0, 2.0, 0xD0, 0.0), 1);
+    assert_int_equal(m.mode, SIM_MODE_POSITION);
+    assert_false(m.stabilised);
+    near(m.cmd_pan, 30.0, 0.0);
+    near(m.cmd_tilt, -10.0, 0.0);
+}
+
 static void spoi_angles_level_host(void **state)
 {
     sim_pos_t host = {0.0, 0.0, 100.0, 0.0, 0.0, 0.0};
@@ -289,6 +303,7 @@ int main(void)
         cmocka_unit_test(position_goes_round_the_nogo_zone),
         cmocka_unit_test(position_target_inside_nogo_goes_to_nearest_edge),
         cmocka_unit_test(unknown_gimbal_flags_are_rejected),
+        cmocka_unit_test(spoi_error_forms_are_accepted_and_change_nothing),
         cmocka_unit_test(spoi_angles_level_host),
         cmocka_unit_test(spoi_angles_account_for_latitude_and_attitude),
         cmocka_unit_test(spoi_mode_drives_axes_to_the_target),

@@ -107,7 +107,7 @@ int sim_model_command(sim_model_t *m, double pan, double tilt, uint8_t flags, do
     case 0x30:
     case 0xB0: mode = SIM_MODE_IMPULSE; break;
     case 0xC0:
-    case 0xD0: return 0;
+    case 0xD0: return 1; /* SPOI error forms: not modelled */
     default: return -1;
     }
     stab = (flags & 0x80u) != 0 || flags == 0x02 || flags == 0x03;

@@ -98,9 +98,9 @@ typedef struct {
 void sim_model_init(sim_model_t *m);
 
 /* GIMBAL_CMD flags (spec table 5) to a command. pan/tilt in degrees or
- * deg/s, impulse_s in seconds. Returns 0, or -1 for an unknown flags value
- * (state unchanged). SPOI error flags (0xC0, 0xD0) are accepted and
- * ignored. */
+ * deg/s, impulse_s in seconds. Returns 0 (the model follows it), 1 for the
+ * SPOI error forms (flags 0xC0, 0xD0: accepted but not modelled, state
+ * unchanged), or -1 for an unknown flags value (state unchanged). */
 int sim_model_command(sim_model_t *m, double pan, double tilt, uint8_t flags, double impulse_s);
 
 /* Point at a location (switches to SPOI mode). */

@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "tase/candump.h"
@@ -15,16 +16,19 @@
 #include "toolkit.h"
 
 #define DEFAULT_BAUD 57600L
+#define KLV_BAUD 9600L /* the spec's KLV line (table 1) */
 #define DEFAULT_TIMEOUT_MS 500
 #define DEFAULT_RETRIES 2
 #define READ_CHUNK 65536u
 #define BAD_LINES_SHOWN 10u
 
 static const char usage_exit[] =
-    "exit status: 0 success; 1 failure (device, I/O, timeout, writing the output);\n"
+    "exit status: 0 success; 1 failure (device, I/O, timeout, writing the output;\n"
+    "  \"(NAME was sent)\" ends the line if the packet went out before);\n"
     "  2 bad command line (nothing was sent); 3 the gimbal's echo differs from the\n"
     "  setting sent; 4 input not fully understood (bad candump lines, no packet\n"
-    "  found); 128+N interrupted by signal N (141: the output's reader went away).\n";
+    "  found); 5 the packet was sent, but writing the output failed (do not send it\n"
+    "  again); 128+N interrupted by signal N (141: the output's reader went away).\n";
 
 static const char usage_link[] =
     "link options:\n"
@@ -57,11 +61,14 @@ static const char usage_rate[] =
     "command. 'tase rate 0 0' stops. Prints what it sent.\n";
 
 static const char usage_camera[] =
-    "usage: tase camera [A|B|C] [--hfov DEG | --zoom X] LINK [--json]\n"
+    "usage: tase camera [A|B|C] [--hfov DEG | --zoom X] LINK [--json] [request options]\n"
     "CAMERA_CMD. A camera alone selects it (the 1-byte form: nothing else changes).\n"
     "--hfov DEG sets the horizontal field of view (0.01..327.67 deg), --zoom X the\n"
     "zoom ratio (1..327.68); every other camera setting is sent as \"do not change\"\n"
-    "(and the active camera too, unless one is named). Prints what it sent.\n";
+    "(and the active camera too, unless one is named). Prints what it sent.\n"
+    "CAMERA_CMD has no echo: a named camera is first looked up in the gimbal's\n"
+    "SYSTEM_VERSION, and one the gimbal does not have (type 0xFF) is refused with\n"
+    "nothing sent (exit 1).\n";
 
 static const char usage_gyro[] = "usage: tase gyro-zero LINK [--json]\n"
                                  "GYRO_ZERO_CMD: the gimbal zeroes its rate gyros. Send it only "
@@ -89,6 +96,9 @@ static const char usage_monitor[] =
     "packets, S seconds, or on SIGINT/SIGTERM/SIGHUP (exit 0), and prints a summary\n"
     "line on stderr (frames, checksum errors, bad sizes, wrong lengths, unknown,\n"
     "bytes discarded; on CAN the bus state and error counts the port reports).\n"
+    "A device that goes away or hangs up also stops it: the summary, then\n"
+    "'cannot read DEV: the device went away or hung up' (exit 1). Bytes received\n"
+    "but no frame found: the summary and a one-line hint (exit 4).\n"
     "On CAN, --time is the kernel's receive time of the frame.\n";
 
 static const char usage_send[] =
@@ -102,15 +112,21 @@ static const char usage_send[] =
     "    AXIS_SETTING, CAMERA_TYPE, LEGACY_CAMERA_CMD focus and shutter_speed,\n"
     "    CAMERA_PASS baud);\n"
     "  - other fields of setup packets (group 0x48): the gimbal's current settings\n"
-    "    are queried first and kept;\n"
+    "    are queried first and kept, and the packet is sent in the layout of the\n"
+    "    answer (AXIS_SETTING: 22 or 23 bytes, so it is always queried first)\n"
+    "    unless --len says otherwise;\n"
     "  - otherwise every field must be given (the error names the missing ones);\n"
     "  - --zero: fields left out without such a value are 0 instead.\n"
+    "temporary (PACKET_RATE, AXIS_SETTING) left out is 1: the setting lasts until\n"
+    "the gimbal is powered off. temporary=0 makes the gimbal write it to its\n"
+    "non-volatile storage (spec 4.4.1, 4.4.3), where it survives power cycles.\n"
     "GIMBAL_CMD always needs flags (its mode; or use 'tase point' / 'tase rate').\n"
     "Setup packets are echoed by the gimbal: the echo is awaited, printed and\n"
     "compared with what was sent; a field that differs (a value the gimbal refused\n"
     "or changed) exits 3 naming it. --no-wait sends without waiting for anything\n"
     "(a setup packet then needs every field, or --zero). --len N sends a shorter\n"
-    "accepted form (CAMERA_CMD --len 1: change camera only).\n";
+    "accepted form (CAMERA_CMD --len 1: change camera only; AXIS_SETTING --len 22:\n"
+    "the 22-byte layout).\n";
 
 static const char usage_query[] =
     "usage: tase query NAME LINK [--json] [--timeout MS] [--retries N]\n"
@@ -120,7 +136,7 @@ static const char usage_query[] =
         DEFAULT_RETRIES) ") more attempts are made.\n";
 
 static const char usage_decode[] =
-    "usage: tase decode [FILE|-] [--candump] [--stats]\n"
+    "usage: tase decode [FILE|-] [--candump] [--stats] [--baud N]\n"
     "Decodes a capture of 'tase record' (pcap or pcapng; each object carries\n"
     "\"time\" and \"dir\"; a bad record is reported with its number, exit 4) or a\n"
     "raw serial byte capture (default: standard input; a live pty or\n"
@@ -132,14 +148,21 @@ static const char usage_decode[] =
     "ignored, blank and '#' lines skipped, a bad line reported with its number\n"
     "(the rest is still decoded; exit 4). --stats prints a summary line on stderr.\n"
     "When a non-empty input holds no packet, a one-line hint says why and the exit\n"
-    "status is 4.\n";
+    "status is 4. A serial device (or pty) named as FILE is opened as the link\n"
+    "commands open one: raw 8N1 at --baud N (default 57600), exclusively, its\n"
+    "settings given back at exit; SIGINT/SIGTERM/SIGHUP end it (exit 0), a hang-up\n"
+    "is an error (exit 1).\n";
 
 static const char usage_klv[] =
-    "usage: tase klv [FILE|-]\n"
+    "usage: tase klv [FILE|-] [--baud N]\n"
     "Decodes a KLV metadata byte stream (the gimbal's 9600-baud KLV line; a live\n"
     "pty is read as bytes arrive) to one JSON object per valid packet:\n"
     "{\"offset\":N,\"fields\":{raw values in tag order},\"units\":{engineering values}}.\n"
-    "Noise and damaged packets are skipped.\n";
+    "Noise and damaged packets are skipped; a non-empty input without a packet is\n"
+    "reported with a one-line hint (exit 4). A serial device (or pty) named as FILE\n"
+    "is opened raw 8N1 at --baud N (default 9600, the KLV line), exclusively, its\n"
+    "settings given back at exit; SIGINT/SIGTERM/SIGHUP end it (exit 0), a hang-up\n"
+    "is an error (exit 1).\n";
 
 static const char usage_record[] =
     "usage: tase record (--serial DEV [--tap-in DEV2] [--baud N] | --can IFACE) -o FILE\n"
@@ -155,13 +178,16 @@ static const char usage_record[] =
     "'tase decode FILE' decodes it; Wireshark reads it (tools/wireshark/tase.lua).\n";
 
 static const char usage_replay[] =
-    "usage: tase replay FILE (--serial DEV [--baud N] | --can IFACE) [--speed X]\n"
-    "                   [--dir out|in|all]\n"
+    "usage: tase replay FILE (--serial DEV [--baud N] | --can IFACE) --dir out|in|all\n"
+    "                   [--speed X]\n"
     "Sends the records of the pcap capture FILE with their recorded timing (divided\n"
-    "by X, default 1; 0 sends without waiting).\n"
-    "  --dir out   what the gimbal sent (the default: plays the gimbal's side)\n"
-    "  --dir in    what was sent to the gimbal (commands: moves a real gimbal)\n"
-    "  --dir all   both; on CAN every recorded frame, whatever its ID\n"
+    "by X, default 1; 0 sends without waiting). --dir is required (no default: a\n"
+    "capture holds commands either way):\n"
+    "  --dir out   the gimbal's side, to exercise a host; it holds the gimbal's\n"
+    "              echoes of setup packets, RETRACT_DEPLOY_CMD and SPOI_CMD, which a\n"
+    "              gimbal takes as commands: never replay it into a gimbal\n"
+    "  --dir in    the host's side: the commands sent to the gimbal (moves a gimbal)\n"
+    "  --dir all   both (moves a gimbal); on CAN every recorded frame, whatever its ID\n"
     "Serial bytes go to a CAN interface as frames of their direction's ID, and the\n"
     "datalink bytes of CAN frames to a serial device; CAN FD, remote and error\n"
     "frames are not sent. A bad record is reported and skipped (exit 4).\n";
@@ -171,6 +197,8 @@ static const char usage_list[] = "usage: tase list\nLists every packet: group, t
 
 /* ---- command-line parsing ---- */
 
+#define SEEN_MAX 16
+
 typedef struct {
     int argc;
     char **argv;
@@ -178,6 +206,9 @@ typedef struct {
     bool dashdash; /* "--" seen: the rest are arguments */
     const char *usage;
     unsigned extra; /* USAGE_* sections appended to --help */
+    /* options with a value given so far: each at most once */
+    const char *seen[SEEN_MAX];
+    unsigned nseen;
 } args_t;
 
 #define USAGE_LINK 1u
@@ -203,8 +234,25 @@ static void print_usage(const args_t *a)
     tk_stdout_flush();
 }
 
+/* An option with a value is given once: a second one is an error, not
+ * the silent winner. */
+static void opt_once(args_t *a, const char *name)
+{
+    unsigned k;
+    for (k = 0; k < a->nseen; k++) {
+        if (strcmp(a->seen[k], name) == 0) {
+            tk_usage_error("option %s given twice", name);
+        }
+    }
+    if (a->nseen < SEEN_MAX) {
+        a->seen[a->nseen++] = name;
+    }
+}
+
 /* If argv[i] is option `name` (with "--name V" or "--name=V" when has_arg),
- * consume it and return true; *val gets the value. */
+ * consume it and return true; *val gets the value. A separate value that
+ * starts with "--" is the next option, so the value is missing (numbers
+ * such as -5 are values). */
 static bool opt(args_t *a, const char *name, bool has_arg, const char **val)
 {
     const char *s = a->argv[a->i];
@@ -214,15 +262,17 @@ static bool opt(args_t *a, const char *name, bool has_arg, const char **val)
     }
     if (s[n] == '\0') {
         if (has_arg) {
-            if (a->i + 1 >= a->argc) {
+            if (a->i + 1 >= a->argc || strncmp(a->argv[a->i + 1], "--", 2) == 0) {
                 tk_usage_error("option %s needs a value", name);
             }
+            opt_once(a, name);
             *val = a->argv[++a->i];
         }
         a->i++;
         return true;
     }
     if (s[n] == '=' && has_arg) {
+        opt_once(a, name);
         *val = s + n + 1;
         a->i++;
         return true;
@@ -260,22 +310,25 @@ static bool is_arg(const args_t *a, bool numbers)
            (numbers && tk_parse_real(s, &x) == TK_NUM_OK);
 }
 
-static bool link_opt(args_t *a, link_opts_t *l)
+/* --baud N */
+static bool baud_opt(args_t *a, long *baud)
 {
     const char *v;
     long long n;
-    if (opt(a, "--serial", true, &l->serial) || opt(a, "--can", true, &l->can) ||
-        opt(a, "--record", true, &l->record)) {
-        return true;
+    if (!opt(a, "--baud", true, &v)) {
+        return false;
     }
-    if (opt(a, "--baud", true, &v)) {
-        if (tk_parse_int(v, 1, 4000000, &n, NULL) != TK_NUM_OK) {
-            tk_usage_error("bad --baud value '%s'", v);
-        }
-        l->baud = (long)n;
-        return true;
+    if (tk_parse_int(v, 1, 4000000, &n, NULL) != TK_NUM_OK) {
+        tk_usage_error("bad --baud value '%s'", v);
     }
-    return false;
+    *baud = (long)n;
+    return true;
+}
+
+static bool link_opt(args_t *a, link_opts_t *l)
+{
+    return opt(a, "--serial", true, &l->serial) || opt(a, "--can", true, &l->can) ||
+           opt(a, "--record", true, &l->record) || baud_opt(a, &l->baud);
 }
 
 static long long int_opt_value(const char *name, const char *v, long long min, long long max)
@@ -356,11 +409,13 @@ typedef struct {
     tk_link_t link;
     tase_port_t port;
     tase_host_t h;
+    const char *name; /* the device or interface, for messages */
 } session_t;
 
 static void session_open(session_t *s, const link_opts_t *lo, tase_rx_handler_t on_frame,
                          void *user)
 {
+    s->name = lo->serial != NULL ? lo->serial : lo->can;
     open_link(lo, &s->link, &s->port);
     if (tase_host_init(&s->h, &s->port, on_frame, user) != TASE_OK) {
         tk_die("internal error: host role init failed");
@@ -373,20 +428,36 @@ static void session_close(session_t *s)
     tk_stdout_flush();
 }
 
+/* Die: reading the session's link failed with `rc` (a hang-up says so). */
+static void session_read_failed(const session_t *s, int rc)
+{
+    tk_die("cannot read %s: %s", s->name, tk_link_error(&s->link, rc));
+}
+
+/* Service the session's port for up to wait_ms; dies when reading fails. */
+static void session_service(session_t *s, uint32_t wait_ms)
+{
+    int rc = tase_host_service(&s->h, wait_ms);
+    if (rc < 0) {
+        session_read_failed(s, rc);
+    }
+}
+
 /* Wait for the answer to a request, servicing the port so a signal is
- * seen within 20 ms; dies with the reason on failure. */
-static int transact(session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
-                    uint8_t *reply, const req_opts_t *r)
+ * seen within 20 ms; dies with the reason on failure, `note` (or NULL)
+ * added to a timeout's message. */
+static int transact_note(session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
+                         uint8_t *reply, const req_opts_t *r, const char *note)
 {
     int rc = tase_host_request_start(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len,
                                      reply, TASE_DATA_MAX, r->timeout_ms, r->retries,
                                      s->port.ops->now_ms(s->port.ctx));
+    if (rc >= 0 && len > 0) {
+        tk_mark_sent(tase_schema_packet_name(p)); /* a query changes nothing */
+    }
     while (rc >= 0) {
         tk_exit_if_signalled();
-        rc = tase_host_service(&s->h, 20);
-        if (rc < 0) {
-            break;
-        }
+        session_service(s, 20);
         rc = tase_host_poll(&s->h, s->port.ops->now_ms(s->port.ctx));
         if (rc != TASE_EAGAIN) {
             break;
@@ -394,21 +465,31 @@ static int transact(session_t *s, const tase_packet_desc_t *p, const uint8_t *da
         rc = 0;
     }
     if (rc == TASE_ETIMEOUT) {
-        tk_die("timeout: no answer to %s after %u attempt%s of %lu ms", tase_schema_packet_name(p),
-               (unsigned)r->retries + 1u, r->retries ? "s" : "", (unsigned long)r->timeout_ms);
+        tk_die("timeout: no answer to %s after %u attempt%s of %lu ms%s",
+               tase_schema_packet_name(p), (unsigned)r->retries + 1u, r->retries ? "s" : "",
+               (unsigned long)r->timeout_ms, note != NULL ? note : "");
     }
     if (rc < 0) {
-        tk_die("%s request failed: %s", tase_schema_packet_name(p), tase_strerror(rc));
+        tk_die("%s request failed on %s: %s", tase_schema_packet_name(p), s->name,
+               tk_link_error(&s->link, rc));
     }
     return rc;
+}
+
+static int transact(session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
+                    uint8_t *reply, const req_opts_t *r)
+{
+    return transact_note(s, p, data, len, reply, r, NULL);
 }
 
 static void send_frame(session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len)
 {
     int rc = tase_host_send(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len);
     if (rc < 0) {
-        tk_die("cannot send %s: %s", tase_schema_packet_name(p), tase_strerror(rc));
+        tk_die("cannot send %s to %s: %s", tase_schema_packet_name(p), s->name,
+               tk_link_error(&s->link, rc));
     }
+    tk_mark_sent(tase_schema_packet_name(p));
 }
 
 /* Print a frame we sent ("dir":"in") or received ("out"); `label` starts
@@ -574,6 +655,32 @@ static unsigned fields_within(const tase_packet_desc_t *p, size_t len)
     return i;
 }
 
+/* Move the fields set so far to the layout of `len` data bytes (a setup
+ * packet sent in the layout the gimbal answered with: AXIS_SETTING's 22 or
+ * 23 bytes; the widths are the same, offsets move). A field that does not
+ * fit `len` is dropped. */
+static void fields_relayout(fields_t *fs, size_t len)
+{
+    uint8_t data[TASE_DATA_MAX];
+    unsigned i;
+    memset(data, 0, sizeof(data));
+    for (i = 0; i < fs->p->nfields && i < sizeof(fs->given); i++) {
+        tk_field_t fd;
+        long long v;
+        if (!fs->given[i]) {
+            continue;
+        }
+        tk_field(fs->p, i, len, &fd);
+        if (fd.offset + fd.width > len || !tk_field_get(fs->p, i, fs->data, fs->len, &v)) {
+            fs->given[i] = false;
+            continue;
+        }
+        (void)tk_field_set(&fd, data, v);
+    }
+    memcpy(fs->data, data, sizeof(data));
+    fs->len = len;
+}
+
 /* Fields [0, n) left out that have a "do not change" value in the spec
  * (the schema's, tase_field_keep()) take it. */
 static void fields_keep(fields_t *fs, unsigned n)
@@ -713,7 +820,9 @@ static void send_fields(session_t *s, const fields_t *fs, size_t len, const send
     print_packet(p, fs->data, len, o->r.json, "in", "sent");
     print_packet(p, reply, (size_t)n, o->r.json, "out", "echo");
     if (len > 0) {
-        confirm_echo(fs, len, reply, n, NULL);
+        /* `temporary` tells the gimbal what to do with this packet (store
+         * it or not); it is no setting in force, so its echo proves nothing */
+        confirm_echo(fs, len, reply, n, "temporary");
     }
 }
 
@@ -725,7 +834,8 @@ static int cmd_send(args_t *a)
     const char *assign[64];
     size_t nassign = 0, i, len;
     unsigned nf;
-    bool setup, rmw = false;
+    bool setup, rmw = false, relaid = false, temp_default = false;
+    int tfi;
     const tase_packet_desc_t *p;
     fields_t fs;
     session_t s;
@@ -771,6 +881,14 @@ static int cmd_send(args_t *a)
         tk_usage_error("%s does not accept a data length of %lu", name, (unsigned long)len);
     }
     nf = fields_within(p, len);
+    tfi = tase_schema_field_index(p, "temporary");
+    if (setup && tfi >= 0 && (unsigned)tfi < nf && !fs.given[tfi]) {
+        /* A setup packet with temporary 0 is written to the gimbal's
+         * non-volatile storage (spec 4.4.1, 4.4.3): a bench change is kept
+         * for this power cycle only unless temporary=0 asks to store it. */
+        fields_set(&fs, "temporary", TASE_SETUP_TEMPORARY);
+        temp_default = true;
+    }
     if (p->id == TASE_ID_GIMBAL_CMD && len > 0) {
         int fi = tase_schema_field_index(p, "flags");
         if (!fs.given[fi]) {
@@ -791,14 +909,32 @@ static int cmd_send(args_t *a)
                            name, setup ? " with --no-wait (nothing is queried)" : "", missing);
         }
     }
+    if (setup && !o.no_wait && o.len < 0 && (p->flags & TASE_LEN_SHORT) != 0u) {
+        /* a packet of two layouts (AXIS_SETTING, PROTOCOL-NOTES S2): the
+         * query's answer tells which one this gimbal uses, even when
+         * every field is given */
+        rmw = true;
+    }
     session_open(&s, &lo, NULL, NULL);
     if (rmw) {
         uint8_t cur[TASE_DATA_MAX];
         unsigned k;
-        int n = transact(&s, p, NULL, 0, cur, &o.r);
-        if ((size_t)n != p->len) {
-            tk_die("%s query answered with %d bytes, expected %u", name, n, (unsigned)p->len);
+        int n = transact_note(&s, p, NULL, 0, cur, &o.r,
+                              " (only the query went out, to read the gimbal's settings; the "
+                              "new setting was not sent)");
+        if (n <= 0 || !tase_schema_length_ok(p, (size_t)n)) {
+            tk_die("%s query answered with %d data bytes, not a length of %s; nothing was set",
+                   name, n, name);
         }
+        if (o.len < 0 && (size_t)n != len) {
+            /* the layout this gimbal uses (AXIS_SETTING's 22 bytes): send
+             * in it, as the gimbal answered, unless --len says otherwise */
+            fields_relayout(&fs, (size_t)n);
+            len = (size_t)n;
+            nf = fields_within(p, len);
+            relaid = true;
+        }
+        /* each field read at its place in the answer's own layout */
         for (k = 0; k < nf; k++) {
             long long cv;
             if (!fs.given[k] && tk_field_get(p, k, cur, (size_t)n, &cv)) {
@@ -807,6 +943,14 @@ static int cmd_send(args_t *a)
         }
     }
     send_fields(&s, &fs, len, &o);
+    if (relaid && !o.r.json) {
+        printf("  = sent in the %lu-byte layout the gimbal answered the query with\n",
+               (unsigned long)len);
+    }
+    if (temp_default && !o.r.json) {
+        printf("  = temporary=1 (the default): not written to the gimbal's non-volatile "
+               "storage; temporary=0 stores it\n");
+    }
     session_close(&s);
     return TK_EXIT_OK;
 }
@@ -850,15 +994,33 @@ static int cmd_query(args_t *a)
 
 /* ---- verbs ---- */
 
+/* x as a plain decimal number (no exponent; at most two decimals, no
+ * trailing zeros): -21474836.48, 180, 0.01. */
+static const char *plain_number(double x, char *buf, size_t cap)
+{
+    size_t n;
+    snprintf(buf, cap, "%.2f", x);
+    n = strlen(buf);
+    while (n > 0 && buf[n - 1] == '0') {
+        buf[--n] = '\0';
+    }
+    if (n > 0 && buf[n - 1] == '.') {
+        buf[--n] = '\0';
+    }
+    return buf;
+}
+
 /* A decimal number argument in [lo, hi] (what names it in messages). */
 static double real_arg(const char *what, const char *v, double lo, double hi, const char *unit)
 {
     double x;
+    char a[48], b[48];
     if (tk_parse_real(v, &x) != TK_NUM_OK) {
         tk_usage_error("bad %s '%s': not a number (decimal, e.g. -12.5)", what, v);
     }
     if (!(x >= lo && x <= hi)) {
-        tk_usage_error("bad %s '%s': out of range %g..%g %s", what, v, lo, hi, unit);
+        tk_usage_error("bad %s '%s': out of range %s..%s %s", what, v,
+                       plain_number(lo, a, sizeof(a)), plain_number(hi, b, sizeof(b)), unit);
     }
     return x;
 }
@@ -999,6 +1161,32 @@ static int camera_index(const char *s)
     return -1;
 }
 
+/* The type of camera `cam` (0..2) in the gimbal's SYSTEM_VERSION; dies
+ * when the gimbal has none there, before CAMERA_CMD is sent. */
+static int camera_type(session_t *s, int cam, const req_opts_t *r)
+{
+    static const char *const fields[] = {"camera_a", "camera_b", "camera_c"};
+    const tase_packet_desc_t *sv = tase_schema_find(TASE_ID_GROUP(TASE_ID_SYSTEM_VERSION),
+                                                    TASE_ID_TYPE(TASE_ID_SYSTEM_VERSION));
+    uint8_t reply[TASE_DATA_MAX];
+    long long type = -1;
+    int n = transact_note(s, sv, NULL, 0, reply, r,
+                          " (the query asks which cameras the gimbal has; CAMERA_CMD was not "
+                          "sent)");
+    if (!tk_field_get(sv, (unsigned)tase_schema_field_index(sv, fields[cam]), reply, (size_t)n,
+                      &type)) {
+        tk_die("SYSTEM_VERSION answered with %d data bytes, no camera types; CAMERA_CMD was not "
+               "sent",
+               n);
+    }
+    if (type == TASE_CAMTYPE_NONE) {
+        tk_die("the gimbal has no camera %c (SYSTEM_VERSION: type 0xFF, none); CAMERA_CMD was not "
+               "sent",
+               "ABC"[cam]);
+    }
+    return (int)type;
+}
+
 static int cmd_camera(args_t *a)
 {
     const tase_packet_desc_t *p = tase_schema_find(0x00, 0x41);
@@ -1006,7 +1194,7 @@ static int cmd_camera(args_t *a)
     send_opts_t o;
     fields_t fs;
     session_t s;
-    int cam = -1;
+    int cam = -1, camtype = -1;
     long long hfov = 0;
     size_t len;
     char what[96];
@@ -1045,11 +1233,17 @@ static int cmd_camera(args_t *a)
     }
     fields_keep(&fs, fields_within(p, len)); /* everything else: "do not change" */
     session_open(&s, &v.lo, NULL, NULL);
+    if (cam >= 0) {
+        /* CAMERA_CMD has no echo: a camera the gimbal does not have would
+         * be "selected" with nothing to confirm it, so ask first */
+        camtype = camera_type(&s, cam, &v.r);
+    }
     send_fields(&s, &fs, len, &o);
     if (!v.r.json) {
-        char sel[32] = "active camera unchanged";
+        char sel[64] = "active camera unchanged";
         if (cam >= 0) {
-            snprintf(sel, sizeof(sel), "camera %c%s", "ABC"[cam], what[0] ? "" : " selected");
+            snprintf(sel, sizeof(sel), "camera %c%s (type %d in SYSTEM_VERSION)", "ABC"[cam],
+                     what[0] ? "" : " selected", camtype);
         }
         printf("  = %s%s%s\n", sel, what, what[0] ? ", other settings unchanged" : "");
     }
@@ -1105,9 +1299,7 @@ static int retract_deploy(args_t *a, bool deploy)
     t_end = tk_now_s() + wait;
     while (wait > 0.0 && !e.seen && tk_now_s() < t_end) {
         tk_exit_if_signalled();
-        if (tase_host_service(&s.h, 20) < 0) {
-            tk_die("link read failed");
-        }
+        session_service(&s, 20);
     }
     if (wait > 0.0 && !e.seen) {
         tk_die("timeout: no RETRACT_DEPLOY_CMD echo within %g s (the move is not complete)", wait);
@@ -1191,6 +1383,7 @@ static int cmd_monitor(args_t *a)
     tk_stream_t *st;
     static uint8_t buf[4096];
     char extra[192] = "";
+    int failed = 0;
     while (a->i < a->argc) {
         if (common_opt(a) || link_opt(a, &lo)) {
             continue;
@@ -1220,10 +1413,10 @@ static int cmd_monitor(args_t *a)
            tk_signal == 0) {
         int n = port.ops->read(port.ctx, buf, sizeof(buf), 50);
         if (n < 0) {
-            if (tk_signal != 0) {
-                break;
+            if (tk_signal == 0) {
+                failed = n; /* a hang-up, most likely: the summary, then why */
             }
-            tk_die("link read failed: %s", tase_strerror(n));
+            break;
         }
         if (n > 0) {
             tk_time_t now;
@@ -1255,6 +1448,22 @@ static int cmd_monitor(args_t *a)
     tk_link_close(&link);
     tk_stdout_flush();
     tk_dec_summary(&d, stderr, extra);
+    if (failed != 0) {
+        tk_die("cannot read %s: %s", lo.serial != NULL ? lo.serial : lo.can,
+               tk_link_error(&link, failed));
+    }
+    if (d.n.frames == 0 && d.n.bytes > 0) {
+        if (link.is_can) {
+            tk_exit(TK_EXIT_INPUT,
+                    "no TASE frame in the %llu datalink bytes received on %s (ID 10000000 "
+                    "frames that never formed a valid frame)",
+                    (unsigned long long)d.n.bytes, lo.can);
+        }
+        tk_exit(TK_EXIT_INPUT,
+                "no TASE frame in the %llu bytes received on %s: a wrong --baud (%ld), or not "
+                "the gimbal's datalink port (its KLV line?)",
+                (unsigned long long)d.n.bytes, lo.serial, lo.baud);
+    }
     return TK_EXIT_OK;
 }
 
@@ -1263,49 +1472,106 @@ static int cmd_monitor(args_t *a)
 typedef struct {
     int fd;
     const char *name; /* for messages */
+    /* a serial device named as FILE, read through the POSIX UART port */
+    bool device;
+    bool hung_up; /* the device went away or hung up */
+    tk_link_t link;
+    tase_port_t port;
     /* the first bytes, kept for the hint when nothing is found (one
      * more for a terminating NUL) */
     uint8_t head[513];
     size_t nhead;
 } input_t;
 
-static void input_open(input_t *in, const char *path)
+/* Open FILE (NULL or "-": standard input). With baud > 0 a terminal named
+ * as FILE (a serial device, a pty) is opened through the POSIX UART port
+ * as the link commands open it: raw 8N1 at `baud`, exclusive, its settings
+ * given back on every exit path. */
+static void input_open(input_t *in, const char *path, long baud)
 {
+    struct stat st;
     memset(in, 0, sizeof(*in));
     if (path == NULL || strcmp(path, "-") == 0) {
         in->fd = STDIN_FILENO;
         in->name = "standard input";
         return;
     }
+    in->name = path;
+    if (baud > 0 && stat(path, &st) == 0 && S_ISCHR(st.st_mode)) {
+        int rc = tk_link_serial_try(&in->link, path, baud);
+        if (rc == TASE_OK) {
+            in->device = true;
+            in->port = tk_link_port(&in->link);
+            in->fd = in->link.uart.fd;
+            return;
+        }
+        if (rc != TASE_ENODEV) {
+            tk_link_serial_die(path, rc);
+        }
+        /* a character device that is no terminal (/dev/zero): read it */
+    }
     in->fd = open(path, O_RDONLY | O_NOCTTY);
     if (in->fd < 0) {
         tk_die("cannot open %s: %s", path, strerror(errno));
     }
-    in->name = path;
 }
 
 static void input_close(input_t *in)
 {
-    if (in->fd != STDIN_FILENO) {
+    if (in->device) {
+        tk_link_close(&in->link);
+    } else if (in->fd != STDIN_FILENO) {
         (void)close(in->fd);
     }
 }
 
-/* read() what is there now (a live pty or pipe is not made to wait for a
- * full buffer). Returns the count, 0 at the end. */
+/* After the input ended: a device that hung up is an error (what was
+ * decoded is out already). */
+static void input_check_end(const input_t *in)
+{
+    if (in->hung_up) {
+        tk_die("cannot read %s: the device went away or hung up", in->name);
+    }
+}
+
+static size_t input_keep_head(input_t *in, const uint8_t *buf, size_t k)
+{
+    if (in->nhead < sizeof(in->head) - 1u) {
+        size_t room = sizeof(in->head) - 1u - in->nhead;
+        size_t c = room < k ? room : k;
+        memcpy(in->head + in->nhead, buf, c);
+        in->nhead += c;
+    }
+    return k;
+}
+
+/* What is there now (a live pty or pipe is not made to wait for a full
+ * buffer). Returns the count, 0 at the end: end of file, or for a device
+ * a hang-up (in->hung_up) or SIGINT/SIGTERM/SIGHUP, a live line's normal
+ * end. */
 static size_t input_read(input_t *in, uint8_t *buf, size_t cap)
 {
+    while (in->device) {
+        int n;
+        if (tk_signal != 0) {
+            return 0;
+        }
+        n = in->port.ops->read(in->port.ctx, buf, cap, 100);
+        if (n > 0) {
+            return input_keep_head(in, buf, (size_t)n);
+        }
+        if (n == TASE_EIO) {
+            in->hung_up = true;
+            return 0;
+        }
+        if (n < 0) {
+            tk_die("cannot read %s: %s", in->name, tase_strerror(n));
+        }
+    }
     for (;;) {
         ssize_t n = read(in->fd, buf, cap);
         if (n > 0) {
-            size_t k = (size_t)n;
-            if (in->nhead < sizeof(in->head) - 1u) {
-                size_t room = sizeof(in->head) - 1u - in->nhead;
-                size_t c = room < k ? room : k;
-                memcpy(in->head + in->nhead, buf, c);
-                in->nhead += c;
-            }
-            return k;
+            return input_keep_head(in, buf, (size_t)n);
         }
         if (n == 0 || errno == EIO) { /* EIO: a pty whose writer went away */
             return 0;
@@ -1318,19 +1584,26 @@ static size_t input_read(input_t *in, uint8_t *buf, size_t cap)
     }
 }
 
+/* Whether the first bytes of an input are all printable text. */
+static bool input_is_text(const input_t *in)
+{
+    size_t i;
+    for (i = 0; i < in->nhead; i++) {
+        uint8_t c = in->head[i];
+        if (!((c >= 0x20 && c < 0x7F) || c == '\n' || c == '\r' || c == '\t')) {
+            return false;
+        }
+    }
+    return in->nhead > 0;
+}
+
 /* What the start of an input that held no packet looks like. */
 static const char *input_guess(const input_t *in, bool candump)
 {
-    size_t i, text = 0, eol;
+    size_t eol;
     const char *s = (const char *)in->head;
     tase_candump_rec_t rec;
     for (eol = 0; eol < in->nhead && s[eol] != '\n'; eol++) {
-    }
-    for (i = 0; i < in->nhead; i++) {
-        if ((in->head[i] >= 0x20 && in->head[i] < 0x7F) || s[i] == '\n' || s[i] == '\r' ||
-            s[i] == '\t') {
-            text++;
-        }
     }
     if (!candump && tase_candump_parse(s, eol, &rec) != TASE_EFORMAT) {
         return ": it looks like a candump log (add --candump)";
@@ -1339,7 +1612,7 @@ static const char *input_guess(const input_t *in, bool candump)
         return ": it looks like candump's screen output; record a log with 'candump -L' "
                "(or -l) and decode it with --candump";
     }
-    if (!candump && in->nhead > 0 && text == in->nhead) {
+    if (!candump && input_is_text(in)) {
         return ": it is text, not a raw serial capture";
     }
     if (candump) {
@@ -1488,11 +1761,21 @@ static unsigned long decode_candump(input_t *in, tk_dec_t *d)
     return c.bad;
 }
 
+/* --baud given for an input that is no serial device */
+static void input_check_baud(const input_t *in, bool baud_given)
+{
+    if (baud_given && !in->device) {
+        tk_usage_error("--baud is for a serial device; %s is not one", in->name);
+    }
+}
+
 static int cmd_decode(args_t *a)
 {
     const char *path = NULL, *v;
     bool candump = false, stats = false, capture = false;
     unsigned long bad = 0;
+    long baud = DEFAULT_BAUD;
+    bool baud_given = false;
     input_t in;
     static tk_dec_t d;
     tk_fmt_t fmt = {true, false, true};
@@ -1500,7 +1783,9 @@ static int cmd_decode(args_t *a)
         if (common_opt(a)) {
             continue;
         }
-        if (opt(a, "--candump", false, &v)) {
+        if (baud_opt(a, &baud)) {
+            baud_given = true;
+        } else if (opt(a, "--candump", false, &v)) {
             candump = true;
         } else if (opt(a, "--stats", false, &v)) {
             stats = true;
@@ -1510,15 +1795,18 @@ static int cmd_decode(args_t *a)
             bad_arg(a);
         }
     }
-    input_open(&in, path);
+    input_open(&in, path, baud);
+    input_check_baud(&in, baud_given);
     tk_stdout_buffered();
     tk_dec_init(&d, &fmt, stdout);
     if (candump) {
         bad = decode_candump(&in, &d);
     } else {
         static uint8_t buf[READ_CHUNK];
-        size_t n = input_head(&in, buf, sizeof(buf));
-        if (tk_cap_is_capture(buf, n)) {
+        /* a serial line carries raw bytes, never a capture file */
+        size_t n =
+            in.device ? input_read(&in, buf, sizeof(buf)) : input_head(&in, buf, sizeof(buf));
+        if (!in.device && tk_cap_is_capture(buf, n)) {
             capture = true;
             bad = decode_capture(&in, &d, buf, n);
         } else {
@@ -1531,6 +1819,7 @@ static int cmd_decode(args_t *a)
     if (stats) {
         tk_dec_summary(&d, stderr, "");
     }
+    input_check_end(&in);
     if (bad > 0) {
         tk_exit(TK_EXIT_INPUT, "%s: %lu bad %s%s (the rest was decoded)", in.name, bad,
                 capture ? "record" : "line", bad == 1 ? "" : "s");
@@ -1546,11 +1835,32 @@ static int cmd_decode(args_t *a)
 typedef struct {
     uint64_t base64;
     uint32_t base32;
+    uint64_t packets;
 } klv_ctx_t;
+
+/* What an input that held no KLV packet looks like. */
+static const char *klv_guess(const input_t *in)
+{
+    static const uint8_t sync[3] = {TASE_SYNC1, TASE_SYNC2, TASE_SYNC3};
+    size_t i;
+    if (input_is_text(in)) {
+        return ": it is text, not a KLV byte stream";
+    }
+    if (tk_cap_is_capture(in->head, in->nhead)) {
+        return ": it is a pcap capture ('tase decode' reads those)";
+    }
+    for (i = 0; i + 3u <= in->nhead; i++) {
+        if (memcmp(in->head + i, sync, sizeof(sync)) == 0) {
+            return ": it looks like the TASE datalink ('tase decode' reads that)";
+        }
+    }
+    return " (not a capture of the gimbal's KLV line?)";
+}
 
 static void print_klv(void *user, uint32_t offset, const tase_klv_t *k)
 {
-    const klv_ctx_t *c = user;
+    klv_ctx_t *c = user;
+    c->packets++;
     printf("{\"offset\":%llu,\"fields\":{\"utc\":%llu,\"lat\":%ld,\"lon\":%ld,\"alt\":%u,"
            "\"pan\":%u,\"tilt\":%d,\"heading\":%u,\"pitch\":%d,\"roll\":%d,\"vnorth\":%d,"
            "\"veast\":%d,\"hfov\":%u,\"vfov\":%u,\"gps_status\":%u},",
@@ -1576,20 +1886,25 @@ static int cmd_klv(args_t *a)
     const char *path = NULL;
     static tase_klv_rx_t rx;
     static uint8_t buf[READ_CHUNK];
-    klv_ctx_t c = {0, 0};
+    klv_ctx_t c = {0, 0, 0};
+    long baud = KLV_BAUD;
+    bool baud_given = false;
     input_t in;
     size_t n;
     while (a->i < a->argc) {
         if (common_opt(a)) {
             continue;
         }
-        if (path == NULL && is_arg(a, false)) {
+        if (baud_opt(a, &baud)) {
+            baud_given = true;
+        } else if (path == NULL && is_arg(a, false)) {
             path = a->argv[a->i++];
         } else {
             bad_arg(a);
         }
     }
-    input_open(&in, path);
+    input_open(&in, path, baud);
+    input_check_baud(&in, baud_given);
     tk_stdout_buffered();
     (void)tase_klv_rx_init(&rx);
     while ((n = input_read(&in, buf, sizeof(buf))) > 0) {
@@ -1602,6 +1917,10 @@ static int cmd_klv(args_t *a)
     (void)tase_klv_rx_flush(&rx, print_klv, NULL, &c);
     input_close(&in);
     tk_stdout_flush();
+    input_check_end(&in);
+    if (c.packets == 0 && in.nhead > 0) {
+        tk_exit(TK_EXIT_INPUT, "no KLV packet found in %s%s", in.name, klv_guess(&in));
+    }
     return TK_EXIT_OK;
 }
 
@@ -1617,8 +1936,14 @@ static int cmd_record(args_t *a)
         if (common_opt(a) || link_opt(a, &lo)) {
             continue;
         }
-        if (opt(a, "-o", true, &out) || opt(a, "--output", true, &out) ||
-            opt(a, "--tap-in", true, &tap_in)) {
+        if (opt(a, "-o", true, &v) || opt(a, "--output", true, &v)) {
+            if (out != NULL) {
+                tk_usage_error("option -o/--output given twice");
+            }
+            out = v;
+            continue;
+        }
+        if (opt(a, "--tap-in", true, &tap_in)) {
             continue;
         }
         if (opt(a, "--seconds", true, &v)) {
@@ -1666,7 +1991,7 @@ static int cmd_replay(args_t *a)
     size_t n;
     memset(&ro, 0, sizeof(ro));
     ro.speed = 1.0;
-    ro.dirs = TK_CAP_DIR_OUT;
+    ro.dirs = (tk_cap_dirs_t)0; /* no default: --dir is required */
     while (a->i < a->argc) {
         if (common_opt(a) || link_opt(a, &lo)) {
             continue;
@@ -1702,7 +2027,12 @@ static int cmd_replay(args_t *a)
     if ((lo.serial != NULL) == (lo.can != NULL)) {
         tk_usage_error("give either --serial DEV or --can IFACE");
     }
-    input_open(&in, path);
+    if (ro.dirs == 0) {
+        tk_usage_error("replay needs --dir: out = the gimbal's side, to exercise a host (its "
+                       "echoes are commands to a gimbal); in = the host's commands (moves a "
+                       "gimbal); all = both (moves a gimbal)");
+    }
+    input_open(&in, path, 0);
     n = input_head(&in, head, sizeof(head));
     if (!tk_cap_is_capture(head, n)) {
         tk_die("%s is not a pcap or pcapng capture (candump logs: can-utils' canplayer "
@@ -1767,7 +2097,8 @@ typedef struct {
 static const command_t commands[] = {
     {"point", cmd_point, usage_point, USAGE_LINK, "point at pan/tilt angles (degrees)"},
     {"rate", cmd_rate, usage_rate, USAGE_LINK, "turn at pan/tilt rates (degrees per second)"},
-    {"camera", cmd_camera, usage_camera, USAGE_LINK, "select a camera, set its HFOV or zoom"},
+    {"camera", cmd_camera, usage_camera, USAGE_LINK | USAGE_REQ,
+     "select a camera, set its HFOV or zoom"},
     {"gyro-zero", cmd_gyro_zero, usage_gyro, USAGE_LINK, "zero the gimbal's rate gyros"},
     {"deploy", cmd_deploy, usage_deploy, USAGE_LINK, "deploy the retract/deploy mechanism"},
     {"retract", cmd_retract, usage_deploy, USAGE_LINK, "retract it"},

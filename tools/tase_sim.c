@@ -94,6 +94,14 @@ static void apply_axis(sim_t *s, const tase_axis_setting_t *a)
     s->m.axis_tilt.gain = 0.1 * a->tilt_pos_gain;
 }
 
+/* What a real gimbal does with a setup packet's `temporary` byte (the
+ * simulator keeps every setting for its run only). */
+static const char *storage(uint8_t temporary)
+{
+    return temporary == TASE_SETUP_TEMPORARY ? "temporary"
+                                             : "a gimbal would store it in non-volatile memory";
+}
+
 /* Setup packets arrive resolved by the role ("do not change" fields
  * already replaced by the settings in force). */
 static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
@@ -110,13 +118,14 @@ static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
         apply_axis(s, a);
         logf_(s, now,
               "AXIS_SETTING: pan no-go %.2f+-%.2f, tilt no-go %.2f+-%.2f, max rates "
-              "%.0f/%.0f deg/s",
+              "%.0f/%.0f deg/s (%s)",
               s->m.axis_pan.nogo_center, s->m.axis_pan.nogo_range / 2, s->m.axis_tilt.nogo_center,
-              s->m.axis_tilt.nogo_range / 2, s->m.axis_pan.max_rate, s->m.axis_tilt.max_rate);
+              s->m.axis_tilt.nogo_range / 2, s->m.axis_pan.max_rate, s->m.axis_tilt.max_rate,
+              storage(a->temporary));
     } else if (id == TASE_ID_PACKET_RATE) {
         const tase_packet_rate_t *r = msg;
-        logf_(s, now, "PACKET_RATE: port 1 angle %u/s, rate %u/s, georef %u/s", r->angle_1,
-              r->rate_1, r->geo_ref_1);
+        logf_(s, now, "PACKET_RATE: port 1 angle %u/s, rate %u/s, georef %u/s (%s)", r->angle_1,
+              r->rate_1, r->geo_ref_1, storage(r->temporary));
     }
     return 0;
 }
@@ -301,9 +310,17 @@ static void on_frame(void *user, unsigned port, const tase_frame_t *f)
     switch (id) {
     case TASE_ID_GIMBAL_CMD: {
         const tase_gimbal_cmd_t *c = &msg.gimbal_cmd;
-        if (sim_model_command(&s->m, c->pan / 100.0, c->tilt / 100.0, c->flags,
-                              c->impulse_time / 100.0) != 0) {
+        int rc = sim_model_command(&s->m, c->pan / 100.0, c->tilt / 100.0, c->flags,
+                                   c->impulse_time / 100.0);
+        if (rc < 0) {
             logf_(s, now, "GIMBAL_CMD: unknown flags 0x%02X ignored", c->flags);
+        } else if (rc > 0) {
+            logf_(s, now,
+                  "GIMBAL_CMD: SPOI error%s (flags 0x%02X, pan %.2f tilt %.2f) ignored: not "
+                  "modelled; still in %s mode%s",
+                  c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR_RATE ? " rate" : "", c->flags,
+                  c->pan / 100.0, c->tilt / 100.0, mode_name(&s->m),
+                  s->m.stabilised ? ", stabilised" : "");
         } else {
             logf_(s, now, "GIMBAL_CMD: %s pan %.2f tilt %.2f%s", mode_name(&s->m), c->pan / 100.0,
                   c->tilt / 100.0, s->m.stabilised ? ", stabilised" : "");
@@ -425,7 +442,16 @@ int main(int argc, char **argv)
     tk_prog = "tase-sim";
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
-        bool more = i + 1 < argc;
+        /* a value that starts with "--" is the next option: missing */
+        bool more = i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0;
+        /* each option with a value at most once */
+        if ((strcmp(a, "--link") == 0 && link != NULL) ||
+            (strcmp(a, "--can") == 0 && can != NULL) ||
+            (strcmp(a, "--klv-link") == 0 && klv_link != NULL) ||
+            (strcmp(a, "--baud") == 0 && baud_given) ||
+            (strcmp(a, "--seconds") == 0 && seconds > 0.0)) {
+            tk_usage_error("option %s given twice", a);
+        }
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             fputs(usage, stdout);
             tk_stdout_flush();
@@ -486,6 +512,10 @@ int main(int argc, char **argv)
     s.cam[1].hfov = 23.0;
     s.cam[2].type = TASE_CAMTYPE_NONE;
 
+    /* SIGINT, SIGTERM, SIGHUP stop the loop below; caught before the links
+     * exist, so one that comes while they are made still removes them */
+    tk_catch_signals();
+
     if (can != NULL) {
         tk_link_can(&dl, can, true);
         snprintf(path, sizeof(path), "%s", can);
@@ -521,8 +551,6 @@ int main(int argc, char **argv)
         tk_die("internal error: no AXIS_SETTING");
     }
     apply_axis(&s, &axs);
-
-    tk_catch_signals(); /* SIGINT, SIGTERM, SIGHUP stop the loop below */
 
     printf("tase-sim: simulated gimbal on %s%s", can ? "CAN interface " : "", path);
     if (can == NULL) {

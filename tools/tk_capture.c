@@ -419,7 +419,8 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_i
     tase_port_t ports[2];
     struct pollfd pfd[2];
     unsigned long bytes = 0;
-    size_t n = tap_in != NULL ? 2u : 1u, i;
+    size_t n = tap_in != NULL ? 2u : 1u, i, failed_dev = 0;
+    int failed = 0;
     double t_end = seconds > 0.0 ? tk_now_s() + seconds : 0.0;
     uint8_t buf[READ_CHUNK];
     tk_link_serial(&links[0], dev, baud);
@@ -432,7 +433,7 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_i
         pfd[i].fd = links[i].uart.fd;
         pfd[i].events = POLLIN;
     }
-    while (tk_signal == 0) {
+    while (tk_signal == 0 && failed == 0) {
         int timeout = ms_left(t_end), pr;
         if (timeout == 0) {
             break;
@@ -441,17 +442,18 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_i
         if (pr < 0 && errno != EINTR) {
             tk_die("cannot wait for %s: %s", dev, strerror(errno));
         }
-        for (i = 0; pr > 0 && i < n; i++) {
+        for (i = 0; pr > 0 && i < n && failed == 0; i++) {
             int got;
             struct timespec t;
             if (pfd[i].revents == 0) {
                 continue;
             }
+            /* a hang-up wakes poll() too: the read then reports it */
             got = ports[i].ops->read(ports[i].ctx, buf, sizeof(buf), 0);
             clock_gettime(CLOCK_REALTIME, &t);
             if (got < 0) {
-                tk_die("cannot read %s: %s", i == 0 ? dev : tap_in,
-                       got == TASE_EIO ? "the device went away or hung up" : tase_strerror(got));
+                failed = got; /* what was recorded is kept: close, then say why */
+                failed_dev = i;
             }
             if (got > 0) {
                 tk_cap_put_serial(w, &t, i == 0 ? TK_CAP_FROM_GIMBAL : TK_CAP_TO_GIMBAL, buf,
@@ -467,6 +469,10 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_i
     tk_cap_close(w);
     print_recorded(w, bytes, "bytes");
     tk_stdout_flush();
+    if (failed != 0) {
+        tk_die("cannot read %s: %s", failed_dev == 0 ? dev : tap_in,
+               tk_link_error(&links[failed_dev], failed));
+    }
 }
 
 /* A raw socket on `iface` that receives every frame, error frames and CAN
@@ -663,7 +669,9 @@ static void replay_send(replay_t *rp, const tk_cap_reader_t *r, const tk_cap_rec
     } else {
         send_bytes(rp, rec->frame.data, rec->frame.dlc, (unsigned)can_frame_dir(&rec->frame));
     }
-    rp->sent++;
+    if (rp->sent++ == 0) {
+        tk_mark_sent("replayed data"); /* later failures say so */
+    }
 }
 
 unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)

@@ -63,13 +63,29 @@ static void vmsg(const char *fmt, va_list ap)
     fprintf(stderr, "%s: %s\n", tk_prog, msg);
 }
 
+/* The packet this run has sent, NULL before (tk_mark_sent()). */
+static const char *sent_what;
+
+void tk_mark_sent(const char *what)
+{
+    sent_what = what;
+}
+
 static void vexit(int status, const char *fmt, va_list ap)
 {
+    char msg[448];
     /* what was printed before the error still goes out (errors ignored:
      * the error line is the one to report) */
     (void)fflush(stdout);
     close_all_links();
-    vmsg(fmt, ap);
+    vsnprintf(msg, sizeof(msg), fmt, ap);
+    if (sent_what != NULL && status != TK_EXIT_MISMATCH && status != TK_EXIT_SENT) {
+        /* a failure after the packet went out says so: a retry would send
+         * it again */
+        tk_warn("%s (%s was sent)", msg, sent_what);
+    } else {
+        tk_warn("%s", msg);
+    }
     exit(status);
 }
 
@@ -215,6 +231,13 @@ void tk_stdout_flush(void)
     if (fflush(stdout) != 0 || ferror(stdout)) {
         int e = errno;
         clearerr(stdout);
+        if (sent_what != NULL) {
+            /* the packet went out: say so, also to a closed pipe, with a
+             * status of its own, so nobody sends it again believing it was
+             * not */
+            tk_exit(TK_EXIT_SENT, "%s was sent; cannot write to standard output: %s", sent_what,
+                    e ? strerror(e) : "write error");
+        }
         if (e == EPIPE) {
             /* the reader went away (`tase monitor | head`): end quietly as
              * SIGPIPE would, but through the path that closes the links */
@@ -278,15 +301,24 @@ uint32_t tk_now_ms(void)
 
 /* ---- links ---- */
 
-void tk_link_serial(tk_link_t *l, const char *path, long baud)
+int tk_link_serial_try(tk_link_t *l, const char *path, long baud)
 {
     int rc;
-    struct stat st;
     memset(l, 0, sizeof(*l));
     if (baud <= 0 || !tase_posix_uart_baud_supported((uint32_t)baud)) {
         tk_usage_error("unsupported baud rate %ld", baud);
     }
     rc = tase_posix_uart_open(&l->uart, path, (uint32_t)baud);
+    if (rc == TASE_OK) {
+        l->open = true;
+        track_link(l, true);
+    }
+    return rc;
+}
+
+void tk_link_serial_die(const char *path, int rc)
+{
+    struct stat st;
     if (rc == TASE_ENODEV && stat(path, &st) == 0) {
         tk_die("cannot open serial device %s: not a terminal (a serial device or pseudo-terminal "
                "is needed)",
@@ -295,12 +327,17 @@ void tk_link_serial(tk_link_t *l, const char *path, long baud)
         tk_die("cannot open serial device %s: %s", path, strerror(errno));
     } else if (rc == TASE_EBUSY) {
         tk_die("cannot open serial device %s: device busy: in use by another program", path);
-    } else if (rc != TASE_OK) {
-        tk_die("cannot open serial device %s: %s", path,
-               rc == TASE_EIO ? strerror(errno) : tase_strerror(rc));
     }
-    l->open = true;
-    track_link(l, true);
+    tk_die("cannot open serial device %s: %s", path,
+           rc == TASE_EIO ? strerror(errno) : tase_strerror(rc));
+}
+
+void tk_link_serial(tk_link_t *l, const char *path, long baud)
+{
+    int rc = tk_link_serial_try(l, path, baud);
+    if (rc != TASE_OK) {
+        tk_link_serial_die(path, rc);
+    }
 }
 
 void tk_link_pty(tk_link_t *l, int fd)
@@ -362,6 +399,17 @@ void tk_link_close(tk_link_t *l)
     } else {
         (void)tase_posix_uart_close(&l->uart);
     }
+}
+
+const char *tk_link_error(const tk_link_t *l, int rc)
+{
+    if (rc == TASE_EIO && !l->is_can) {
+        return "the device went away or hung up";
+    }
+    if (rc == TASE_EDOWN && l->is_can) {
+        return "the interface went down";
+    }
+    return tase_strerror(rc);
 }
 
 int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n)
@@ -488,11 +536,27 @@ int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
     *slave_fd = sfd;
     if (link != NULL) {
         if (lstat(link, &st) == 0) {
-            /* a symlink left by a simulator that died: nobody claims it */
+            char target[PATH_MAX];
+            ssize_t n;
             if (!S_ISLNK(st.st_mode)) {
                 tk_die("%s exists and is not a symlink; not replacing it", link);
             }
-            unlink(link);
+            /* Only a link of our own kind, into /dev/pts/, is replaced: the
+             * claim above is ours, so the simulator that made it is gone.
+             * Anyone else's symlink (ln -s /dev/ttyS0 PATH) is left alone. */
+            n = readlink(link, target, sizeof(target) - 1u);
+            if (n <= 0 || (size_t)n >= sizeof(target) - 1u) {
+                tk_die("cannot read symlink %s: %s", link, n < 0 ? strerror(errno) : "too long");
+            }
+            target[n] = '\0';
+            if (strncmp(target, "/dev/pts/", 9) != 0 || strchr(target + 9, '/') != NULL) {
+                tk_die("%s is a symlink to %s, not a link left by tase-sim (those lead into "
+                       "/dev/pts/); not replacing it (remove it, or choose another path)",
+                       link, target);
+            }
+            if (unlink(link) != 0) {
+                tk_die("cannot replace the stale link %s: %s", link, strerror(errno));
+            }
         }
         if (symlink(slave, link) != 0) {
             tk_die("cannot create symlink %s: %s", link, strerror(errno));

@@ -44,6 +44,7 @@
 #define TK_EXIT_USAGE 2    /* bad command line: nothing was sent */
 #define TK_EXIT_MISMATCH 3 /* the gimbal's echo differs from what was sent */
 #define TK_EXIT_INPUT 4    /* input not (fully) understood: bad lines, nothing found */
+#define TK_EXIT_SENT 5     /* the packet was sent, but writing the output failed */
 /* Interrupted by signal N: 128 + N (the shell's convention). */
 
 /* Program name used as the prefix of error lines. */
@@ -57,6 +58,12 @@ void tk_die(const char *fmt, ...);
 void tk_usage_error(const char *fmt, ...);
 /* The same line without exiting. */
 void tk_warn(const char *fmt, ...);
+/* Record that packet `what` (a name that outlives the run) has gone out to
+ * the device. From then on an exit through tk_exit() with status 1 or
+ * 128+N appends "(what was sent)" to its line, and a failure to write
+ * standard output (a full disk, a closed pipe) exits TK_EXIT_SENT with
+ * "what was sent; cannot write to standard output: <reason>". */
+void tk_mark_sent(const char *what);
 
 /* ---- numbers ----
  * Integers: an optional sign ('+' or '-'), then decimal digits (leading
@@ -97,7 +104,8 @@ void tk_stdout_buffered(void);
 /* Flush standard output; on any write error so far exit TK_EXIT_FAIL with
  * "cannot write to standard output: <reason>", except a reader that went
  * away (EPIPE): then exit 128 + SIGPIPE without a message, as programs
- * killed by SIGPIPE do (links closed first). */
+ * killed by SIGPIPE do (links closed first). After tk_mark_sent() both
+ * exit TK_EXIT_SENT naming the packet sent. */
 void tk_stdout_flush(void);
 
 /* ---- signals ---- */
@@ -123,6 +131,12 @@ typedef struct {
 /* Open a serial device (or a pty slave path) raw 8N1 at `baud`; dies with
  * a one-line reason on failure. */
 void tk_link_serial(tk_link_t *l, const char *path, long baud);
+/* The same returning the port's code instead of dying (a bad baud rate is
+ * still a usage error): TASE_OK, or TASE_ENODEV for a missing path or one
+ * that is not a terminal, TASE_EBUSY, ... (tase_posix_uart_open()). */
+int tk_link_serial_try(tk_link_t *l, const char *path, long baud);
+/* Die with the one-line reason tk_link_serial() gives for code `rc`. */
+void tk_link_serial_die(const char *path, int rc);
 /* Open a CAN interface as the host (gimbal == false) or the gimbal. */
 void tk_link_can(tk_link_t *l, const char *iface, bool gimbal);
 /* Take over an open terminal descriptor (a pty master). */
@@ -131,6 +145,12 @@ void tk_link_pty(tk_link_t *l, int fd);
 tase_port_t tk_link_port(tk_link_t *l);
 /* Close (safe to call twice). */
 void tk_link_close(tk_link_t *l);
+
+/* Why a read or write of an open link failed with port code `rc`, for a
+ * message: on a serial link TASE_EIO is "the device went away or hung up"
+ * (the port reports a hang-up so), on CAN TASE_EDOWN "the interface went
+ * down"; otherwise tase_strerror(rc). */
+const char *tk_link_error(const tk_link_t *l, int rc);
 
 /* Write a whole buffer through a port, waiting while it is busy. Returns
  * 0 or a negative TASE_E* code. */
@@ -141,9 +161,9 @@ int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n);
  * keeps open (so the master never sees a hang-up between clients). With
  * `link` non-NULL, also makes `link` a symlink to the slave. The link is
  * claimed for the life of the process first: if a running process holds
- * the claim it dies naming its pid; a symlink nobody claims (left by a
- * simulator that was killed) is replaced; a file that is not a symlink
- * never is. Dies on error. */
+ * the claim it dies naming its pid; a symlink into /dev/pts/ that nobody
+ * claims (left by a simulator that was killed) is replaced; any other
+ * symlink, and a file that is not a symlink, never is. Dies on error. */
 int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd);
 /* Remove `link` only if it is still a symlink to `slave` (ours). */
 void tk_pty_unlink(const char *link, const char *slave);
