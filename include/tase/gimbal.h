@@ -222,7 +222,7 @@ typedef struct {
  * is NULL leaves that port absent: nothing is sent there), app is copied
  * (NULL: no callbacks), setup packets take their defaults and every
  * stream is anchored at now_ms (first packets one period later).
- * rx is the caller's array of nports receivers (328 bytes each), one per
+ * rx is the caller's array of nports receivers (296 bytes each on x86-64), one per
  * port, used by tase_gimbal_feed() and tase_gimbal_service(); init
  * initialises them and the gimbal keeps the pointer. Pass NULL when the
  * application runs its own receiver and hands frames over with
