@@ -226,16 +226,25 @@ bool tase_host_busy(const tase_host_t *h)
     return h != NULL && h->state == HOST_WAITING;
 }
 
-int tase_host_service(tase_host_t *h, uint32_t wait_ms)
+/* The port checks of the calls that read (service, transact): TASE_OK when it can be used. */
+static int port_ok(const tase_host_t *h)
 {
-    uint8_t buf[HOST_SERVICE_CHUNK];
-    int n;
-
     if (h == NULL || h->port.ops == NULL) {
         return TASE_EARG;
     }
     if (h->port.ops->read == NULL || h->port.ops->now_ms == NULL) {
         return TASE_EUNSUPPORTED;
+    }
+    return TASE_OK;
+}
+
+int tase_host_service(tase_host_t *h, uint32_t wait_ms)
+{
+    uint8_t buf[HOST_SERVICE_CHUNK];
+    int n = port_ok(h);
+
+    if (n != TASE_OK) {
+        return n;
     }
     n = h->port.ops->read(h->port.ctx, buf, sizeof buf, wait_ms);
     if (n > (int)sizeof buf) {
@@ -266,22 +275,10 @@ static int transact_wait(tase_host_t *h)
     }
 }
 
-/* The port checks of the blocking calls: TASE_OK when it can be used. */
-static int transact_port_ok(const tase_host_t *h)
-{
-    if (h == NULL || h->port.ops == NULL) {
-        return TASE_EARG;
-    }
-    if (h->port.ops->read == NULL || h->port.ops->now_ms == NULL) {
-        return TASE_EUNSUPPORTED;
-    }
-    return TASE_OK;
-}
-
 int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len,
                        uint8_t *reply, size_t reply_cap, uint32_t timeout_ms, uint8_t retries)
 {
-    int r = transact_port_ok(h);
+    int r = port_ok(h);
     if (r != TASE_OK) {
         return r;
     }
@@ -293,7 +290,7 @@ int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_
 int tase_host_transact_msg(tase_host_t *h, uint16_t id, const void *msg, void *reply_msg,
                            uint32_t timeout_ms, uint8_t retries)
 {
-    int r = transact_port_ok(h);
+    int r = port_ok(h);
     if (r != TASE_OK) {
         return r;
     }
