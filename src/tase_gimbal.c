@@ -7,6 +7,7 @@
 #include "tase/ids.h"
 #include "tase/port_io.h"
 #include "tase/schema.h"
+#include "tase_schema_layout.h"
 
 #define SETUP_SYSTEM_VERSION 0x03u
 #define SETUP_PACKET_RATE 0x00u
@@ -229,16 +230,18 @@ static void setup_copy(const tase_packet_desc_t *p, const uint8_t *src, size_t s
                        uint8_t *dst, size_t dst_len, const uint8_t *cur)
 {
     size_t i;
+    bool src_short = tase_layout_is_short(p, src_len);
+    bool dst_short = tase_layout_is_short(p, dst_len);
     (void)memset(dst, 0, dst_len);
     for (i = 0; i < p->nfields; i++) {
-        unsigned w = TASE_FIELD_WIDTH(tase_schema_field(p, i));
-        const uint8_t *from = &src[tase_field_offset(p, i, src_len)];
+        const tase_field_t *f = tase_schema_field(p, i);
+        const uint8_t *from = &src[tase_layout_offset(f, src_short)];
         int64_t v;
         if (cur != NULL && tase_field_get(p, i, src, src_len, &v) == TASE_OK &&
             tase_field_is_keep(p, i, v)) {
-            from = &cur[tase_field_offset(p, i, p->len)];
+            from = &cur[tase_layout_offset(f, false)]; /* stored: table layout */
         }
-        (void)memcpy(&dst[tase_field_offset(p, i, dst_len)], from, w);
+        (void)memcpy(&dst[tase_layout_offset(f, dst_short)], from, TASE_FIELD_WIDTH(f));
     }
 }
 

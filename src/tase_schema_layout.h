@@ -2,8 +2,8 @@
  * Private to src/: where a field lies in a frame of a given length. One
  * packet (AXIS_SETTING) has a second, one byte shorter layout in which the
  * fields flagged TASE_FIELD_SHIFT sit one byte earlier (see
- * tase_field_offset() in tase/schema.h). The codec's loops decide the
- * layout once per frame and then place each field with no call; the
+ * tase_field_offset() in tase/schema.h). The codec and the gimbal role decide the
+ * layout once per packet and then place each field with no call; the
  * "do not change" bits of a field are read the same way, so that the
  * receive path (dispatch -> decode) calls no schema function per field
  * and its stack stays one frame deep.
