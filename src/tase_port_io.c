@@ -60,12 +60,10 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n)
     return (int)n;
 }
 
-int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *data,
-                         size_t len)
+/* The end of both send helpers: an encoder's result n (checked first, as
+ * port_io.h documents), then the port, then the write. */
+static int send_encoded(const tase_port_t *port, const uint8_t *buf, int n)
 {
-    uint8_t buf[TASE_FRAME_MAX];
-    int n = tase_frame_encode(buf, sizeof buf, group, type, data, len);
-
     if (n < 0) {
         return n;
     }
@@ -75,19 +73,22 @@ int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, c
     return tase_port_write_all(port, buf, (size_t)n);
 }
 
+int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *data,
+                         size_t len)
+{
+    uint8_t buf[TASE_FRAME_MAX];
+    int n = tase_frame_encode(buf, sizeof buf, group, type, data, len);
+
+    return send_encoded(port, buf, n);
+}
+
 int tase_port_send_msg(const tase_port_t *port, uint16_t id, const void *msg)
 {
     uint8_t buf[TASE_FRAME_MAX];
     int n = msg != NULL ? tase_packet_encode(id, msg, buf, sizeof buf)
                         : tase_packet_encode_len(id, NULL, 0u, buf, sizeof buf);
 
-    if (n < 0) {
-        return n;
-    }
-    if (port == NULL) {
-        return TASE_EARG;
-    }
-    return tase_port_write_all(port, buf, (size_t)n);
+    return send_encoded(port, buf, n);
 }
 
 int tase_port_count_tx(int r, uint32_t *sent, uint32_t *errors)
