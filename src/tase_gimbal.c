@@ -84,10 +84,13 @@ static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
     }
 }
 
-/* Telemetry's share of a port's capacity, bytes/s (0: no limit). */
+/* Telemetry's share of a port's capacity, bytes/s, in 32-bit arithmetic
+ * (no 64-bit division helper linked): whole hundreds, then the rest. */
 static uint32_t telemetry_budget(const tase_gimbal_t *g, unsigned p)
 {
-    return (uint32_t)(((uint64_t)g->capacity[p] * TASE_GIMBAL_TELEMETRY_SHARE) / 100u);
+    uint32_t c = g->capacity[p];
+    return (c / 100u) * TASE_GIMBAL_TELEMETRY_SHARE +
+           (c % 100u) * TASE_GIMBAL_TELEMETRY_SHARE / 100u;
 }
 
 /* Whether this due slot of stream s fits the port's budget. When the
@@ -98,7 +101,7 @@ static uint32_t telemetry_budget(const tase_gimbal_t *g, unsigned p)
 static bool within_budget(tase_gimbal_t *g, unsigned p, tase_gimbal_sched_t *st)
 {
     uint32_t budget = telemetry_budget(g, p);
-    if (g->capacity[p] == 0u || g->demand[p] <= budget) {
+    if (g->demand[p] <= budget) {
         return true;
     }
     st->acc += budget;
@@ -109,12 +112,18 @@ static bool within_budget(tase_gimbal_t *g, unsigned p, tase_gimbal_sched_t *st)
     return true;
 }
 
+/* A port's default capacity: its byte rate, or the slowest line's. */
+static uint32_t port_capacity(const tase_port_t *port)
+{
+    return port->bytes_per_s != 0u ? port->bytes_per_s : TASE_RX_SLOWEST_RATE;
+}
+
 int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per_s)
 {
     if (g == NULL || port >= TASE_GIMBAL_PORTS) {
         return TASE_EARG;
     }
-    g->capacity[port] = bytes_per_s;
+    g->capacity[port] = bytes_per_s != 0u ? bytes_per_s : port_capacity(&g->port[port]);
     pace_port(g, port);
     return TASE_OK;
 }
@@ -157,11 +166,15 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
     for (i = 0; i < nports; i++) {
         g->port[i] = ports[i];
     }
+    for (i = 0; i < TASE_GIMBAL_PORTS; i++) {
+        g->capacity[i] = port_capacity(&g->port[i]);
+    }
     if (rx != NULL) {
         g->rx = rx;
         g->nrx = (uint8_t)nports;
         for (i = 0; i < nports; i++) {
             (void)tase_rx_init(&rx[i]);
+            (void)tase_rx_set_timing(&rx[i], ports[i].bytes_per_s, 0u);
         }
     }
     if (app != NULL) {
@@ -408,6 +421,8 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
                      uint32_t now_ms)
 {
     feed_ctx_t c;
+    int r;
+    int t;
     if (g == NULL) {
         return TASE_EARG;
     }
@@ -420,7 +435,13 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
     c.g = g;
     c.port = port;
     c.now_ms = now_ms;
-    return tase_rx_feed(&g->rx[port], bytes, n, gimbal_rx, &c);
+    r = tase_rx_feed(&g->rx[port], bytes, n, gimbal_rx, &c);
+    if (r < 0) {
+        return r;
+    }
+    /* the bytes' arrival, or (n == 0) a look that found the line quiet */
+    t = tase_rx_tick(&g->rx[port], now_ms, gimbal_rx, &c);
+    return t < 0 ? t : r + t;
 }
 
 /* Move a stream to the first slot strictly after now_ms (a late poll
@@ -550,10 +571,14 @@ int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
         for (i = 0; i < SERVICE_READS; i++) {
             int n = g->port[p].ops->read(g->port[p].ctx, buf, sizeof buf, 0);
             /* More than asked: a broken port; skipped like a read error. */
-            if (n <= 0 || n > (int)sizeof buf) {
+            if (n < 0 || n > (int)sizeof buf) {
                 break;
             }
+            /* n == 0: nothing waiting, the receiver's time bound hears it */
             (void)tase_gimbal_feed(g, p, buf, (size_t)n, now_ms);
+            if (n == 0) {
+                break;
+            }
         }
     }
     return tase_gimbal_poll(g, now_ms);

@@ -17,6 +17,7 @@ int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on
     }
     (void)memset(h, 0, sizeof *h);
     (void)tase_rx_init(&h->rx);
+    (void)tase_rx_set_timing(&h->rx, port->bytes_per_s, 0u);
     h->port = *port;
     h->on_frame = on_frame;
     h->user = user;
@@ -178,11 +179,18 @@ static void host_rx(void *user, const tase_frame_t *frame)
 
 int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_ms)
 {
-    (void)now_ms;
+    int r;
+    int t;
     if (h == NULL) {
         return TASE_EARG;
     }
-    return tase_rx_feed(&h->rx, bytes, n, host_rx, h);
+    r = tase_rx_feed(&h->rx, bytes, n, host_rx, h);
+    if (r < 0) {
+        return r;
+    }
+    /* the bytes' arrival, or (n == 0) a look that found the line quiet */
+    t = tase_rx_tick(&h->rx, now_ms, host_rx, h);
+    return t < 0 ? t : r + t;
 }
 
 int tase_host_poll(tase_host_t *h, uint32_t now_ms)
@@ -241,16 +249,20 @@ static int port_ok(const tase_host_t *h)
 int tase_host_service(tase_host_t *h, uint32_t wait_ms)
 {
     uint8_t buf[HOST_SERVICE_CHUNK];
+    uint32_t bound;
     int n = port_ok(h);
 
     if (n != TASE_OK) {
         return n;
     }
-    n = h->port.ops->read(h->port.ctx, buf, sizeof buf, wait_ms);
+    /* Wake up by the receiver's quiet limit, so that an empty read ticks
+     * it in time (tase/frame.h, TIME BOUND). */
+    bound = tase_rx_quiet_ms(&h->rx, h->port.ops->now_ms(h->port.ctx));
+    n = h->port.ops->read(h->port.ctx, buf, sizeof buf, wait_ms < bound ? wait_ms : bound);
     if (n > (int)sizeof buf) {
         return TASE_EIO; /* a port claiming more than asked is broken */
     }
-    if (n > 0) {
+    if (n >= 0) {
         (void)tase_host_feed(h, buf, (size_t)n, h->port.ops->now_ms(h->port.ctx));
     }
     return n;

@@ -159,6 +159,7 @@ static inline tase_port_t fault_port(fault_port_t *f)
     tase_port_t p;
     p.ops = &fault_ops;
     p.ctx = f;
+    p.bytes_per_s = f->inner.bytes_per_s;
     return p;
 }
 

@@ -9,7 +9,8 @@
  * is reported with seen_at = the number of bytes fed when it was decided,
  * which is what the receiver's stats.bytes_in must read inside its
  * callback, however the stream is split into calls. ref_advance(r, true)
- * is end of input (tase_rx_flush()): an undecided position holds no frame.
+ * is end of input (tase_rx_flush()): an undecided position holds no frame;
+ * ref_quiet() is a quiet time past the time bound, which decides the same.
  *
  * Static functions only: include it once per program.
  */
@@ -108,6 +109,14 @@ static void ref_feed_to(ref_t *r, size_t upto)
         r->st.bytes_in++;
         ref_advance(r, false);
     }
+}
+
+/* A quiet time longer than the quiet limit of whatever is pending
+ * (frame.h, TIME BOUND): everything pending fails, as at end of input,
+ * and the stream goes on. */
+static void ref_quiet(ref_t *r)
+{
+    ref_advance(r, true);
 }
 
 #endif /* TASE_TESTS_RX_REFERENCE_H */

@@ -1015,6 +1015,233 @@ static void receiver_matches_the_reference_greedy_scan(void **state)
     free(want);
 }
 
+/* ---- the time bound (issue 27) ----------------------------------------- */
+
+#define RATE_57600 5760u /* bytes per second at 57600 baud 8N1 */
+
+/* A GIMBAL_CMD point 0 0 (flags 0xA0), as `tase point 0 0` sends it. */
+static size_t point_zero(uint8_t *out)
+{
+    static const uint8_t cmd[8] = {0, 0, 0, 0, 0, 0, 0xA0, 0};
+    int n = tase_frame_encode(out, TASE_FRAME_MAX, 0x00, 0x80, cmd, sizeof cmd);
+    assert_int_equal(n, 16);
+    return (size_t)n;
+}
+
+/* Issue 27's repro: 00 FF 5A FF (a false sync claiming 257 more bytes),
+ * then a command, then silence. Without a tick the command waits for 241
+ * bytes that never come; with ticks it is delivered once the line has been
+ * quiet for the time the held candidate's 241 missing bytes need at
+ * 57600 baud (42 ms), and not a millisecond before. */
+static void four_bytes_of_noise_delay_a_command_only_up_to_the_bound(void **state)
+{
+    static const uint8_t noise[4] = {0x00, 0xFF, 0x5A, 0xFF};
+    uint8_t cmd[TASE_FRAME_MAX];
+    size_t n = point_zero(cmd);
+    uint32_t t0 = 0xFFFFFFF0u; /* the clock wraps during the test */
+    uint32_t limit = (241u * 1000u + RATE_57600 - 1u) / RATE_57600; /* 42 */
+    tase_rx_t rx;
+    recorder_t *r = new_recorder(&rx);
+    (void)state;
+    assert_int_equal(tase_rx_set_timing(&rx, RATE_57600, 0), TASE_OK);
+    assert_int_equal(tase_rx_tick(&rx, t0 - 1000u, record, r), 0);
+    assert_int_equal(tase_rx_quiet_ms(&rx, t0), UINT32_MAX); /* nothing held */
+    assert_int_equal(tase_rx_feed(&rx, noise, sizeof noise, record, r), 0);
+    assert_int_equal(tase_rx_feed(&rx, cmd, n, record, r), 0);
+    assert_int_equal(tase_rx_quiet_ms(&rx, t0), 0u); /* fed, not yet ticked */
+    assert_int_equal(tase_rx_tick(&rx, t0, record, r), 0);
+    assert_int_equal(tase_rx_quiet_ms(&rx, t0), limit + 1u);
+    assert_int_equal(tase_rx_quiet_ms(&rx, t0 + 30u), limit + 1u - 30u);
+    /* without a tick nothing comes, however long the silence */
+    assert_int_equal(r->n, 0);
+    assert_int_equal(tase_rx_tick(&rx, t0 + limit, record, r), 0);
+    assert_int_equal(r->n, 0);
+    assert_int_equal(tase_rx_quiet_ms(&rx, t0 + limit + 1u), 0u);
+    assert_int_equal(tase_rx_tick(&rx, t0 + limit + 1u, record, r), 1);
+    assert_int_equal(r->n, 1);
+    assert_int_equal(r->f[0].offset, 4);
+    assert_int_equal(r->f[0].type, 0x80);
+    assert_int_equal(r->f[0].seen_at, 4 + n);
+    assert_int_equal(rx.stats.bytes_discarded, 4);
+    assert_int_equal(tase_rx_quiet_ms(&rx, t0 + limit + 1u), UINT32_MAX);
+    /* the receiver goes on: the next frame is delivered at its last byte */
+    assert_int_equal(tase_rx_feed(&rx, cmd, n, record, r), 1);
+    assert_int_equal(r->f[1].offset, 4 + n);
+    /* within 50 ms of the command's last byte at 57600 baud (issue 27) */
+    assert_true(limit + 1u <= 50u);
+    free(r);
+}
+
+/* The limit is the larger of the margin and the time of the remaining
+ * bytes; the default rate is a 9600-baud line's, the default margin
+ * TASE_RX_QUIET_MS. */
+static void quiet_limit_is_remaining_bytes_at_the_rate_or_the_margin(void **state)
+{
+    static const uint8_t short_sync[4] = {0x00, 0xFF, 0x5A, 0x05}; /* 7 more */
+    static const uint8_t long_sync[4] = {0x00, 0xFF, 0x5A, 0xFF};  /* 257 more */
+    static const uint8_t partial[2] = {0x00, 0xFF};
+    tase_rx_t rx;
+    (void)state;
+    assert_int_equal(tase_rx_init(&rx), TASE_OK);
+    /* defaults: 960 bytes/s, margin TASE_RX_QUIET_MS */
+    assert_int_equal(tase_rx_feed(&rx, long_sync, 4, NULL, NULL), 0);
+    assert_int_equal(tase_rx_tick(&rx, 100u, NULL, NULL), 0);
+    assert_int_equal(tase_rx_quiet_ms(&rx, 100u), (257u * 1000u + 959u) / 960u + 1u);
+    assert_int_equal(tase_rx_init(&rx), TASE_OK);
+    assert_int_equal(tase_rx_feed(&rx, short_sync, 4, NULL, NULL), 0);
+    assert_int_equal(tase_rx_tick(&rx, 100u, NULL, NULL), 0);
+    assert_int_equal(tase_rx_quiet_ms(&rx, 100u), TASE_RX_QUIET_MS + 1u); /* 8 ms < margin */
+    assert_int_equal(tase_rx_set_timing(&rx, 100000u, 3u), TASE_OK);
+    assert_int_equal(tase_rx_quiet_ms(&rx, 100u), 3u + 1u);
+    assert_int_equal(tase_rx_set_timing(&rx, 10u, 0u), TASE_OK); /* 0: the default margin */
+    assert_int_equal(tase_rx_quiet_ms(&rx, 100u), 700u + 1u);
+    /* a partial sync: as many bytes as a maximal frame */
+    assert_int_equal(tase_rx_init(&rx), TASE_OK);
+    assert_int_equal(tase_rx_set_timing(&rx, 1000u, 5u), TASE_OK);
+    assert_int_equal(tase_rx_feed(&rx, partial, 2, NULL, NULL), 0);
+    assert_int_equal(tase_rx_tick(&rx, 0u, NULL, NULL), 0);
+    assert_int_equal(tase_rx_quiet_ms(&rx, 0u), 259u + 1u);
+    assert_int_equal(tase_rx_tick(&rx, 260u, NULL, NULL), 0);
+    assert_int_equal(rx.len, 0);
+    assert_int_equal(rx.stats.bytes_discarded, 2);
+    /* timing survives flush and a counter reset, not init */
+    assert_int_equal(tase_rx_flush(&rx, NULL, NULL), 0);
+    assert_int_equal(tase_rx_stats_reset(&rx), TASE_OK);
+    assert_int_equal(rx.rate, 1000u);
+    assert_int_equal(rx.margin_ms, 5u);
+    assert_int_equal(tase_rx_init(&rx), TASE_OK);
+    assert_int_equal(rx.rate, 0u);
+    assert_int_equal(rx.margin_ms, TASE_RX_QUIET_MS);
+    assert_int_equal(tase_rx_set_timing(NULL, 1u, 1u), TASE_EARG);
+    assert_int_equal(tase_rx_tick(NULL, 0u, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_rx_quiet_ms(NULL, 0u), UINT32_MAX);
+}
+
+/* A real frame is never cut: its bytes may come in bursts separated by
+ * pauses up to the larger of the margin and the time its remaining bytes
+ * need (a USB-serial adapter's latency timer), each tick seeing the line
+ * quiet right up to the limit. A stale clock sample (earlier than the
+ * last activity) counts as no time passed. */
+static void a_real_frame_paused_up_to_the_limit_is_never_cut(void **state)
+{
+    uint8_t f[TASE_FRAME_MAX];
+    size_t n, pos = 0;
+    uint32_t now = 5000u;
+    tase_rx_t rx;
+    recorder_t *r = new_recorder(&rx);
+    (void)state;
+    rng_state = 77;
+    n = make_frame(f, 0x10, 0x41, TASE_DATA_MAX);
+    assert_int_equal(tase_rx_set_timing(&rx, RATE_57600, 16u), TASE_OK);
+    while (pos < n) {
+        size_t k = (n - pos < 62u) ? n - pos : 62u; /* FTDI-sized bursts */
+        uint32_t wait;
+        assert_int_equal(tase_rx_feed(&rx, f + pos, k, record, r), (pos + k == n) ? 1 : 0);
+        pos += k;
+        assert_int_equal(tase_rx_tick(&rx, now, record, r), 0);
+        if (pos == n) {
+            break;
+        }
+        wait = tase_rx_quiet_ms(&rx, now);
+        assert_true(wait >= 17u && wait != UINT32_MAX);
+        assert_int_equal(tase_rx_tick(&rx, now - 100u, record, r), 0); /* stale */
+        now += wait - 1u; /* the longest pause that must not cut it */
+        assert_int_equal(tase_rx_tick(&rx, now, record, r), 0);
+        assert_int_equal(r->n, 0);
+    }
+    assert_int_equal(r->n, 1);
+    assert_int_equal(r->f[0].len, TASE_DATA_MAX);
+    assert_int_equal(rx.stats.checksum_errors, 0);
+    assert_int_equal(rx.stats.bytes_discarded, 0);
+    free(r);
+}
+
+/* Bytes that arrive after a quiet time do not extend a stale candidate:
+ * noise with two false syncs, then a read that finds nothing ten seconds
+ * later (its tick settles both), then a command, delivered at its last
+ * byte. */
+static void an_empty_read_after_the_limit_settles_stale_candidates(void **state)
+{
+    static const uint8_t noise[10] = {0x13, 0x00, 0xFF, 0x5A, 0xC8, 0x77, 0x00, 0xFF, 0x5A, 0xFE};
+    uint8_t cmd[TASE_FRAME_MAX];
+    size_t n = point_zero(cmd);
+    tase_rx_t rx;
+    recorder_t *r = new_recorder(&rx);
+    (void)state;
+    assert_int_equal(tase_rx_set_timing(&rx, TASE_UART_BYTES_PER_S(9600), 0), TASE_OK);
+    assert_int_equal(tase_rx_feed(&rx, noise, sizeof noise, record, r), 0);
+    assert_int_equal(tase_rx_tick(&rx, 1000u, record, r), 0);
+    assert_int_equal(tase_rx_tick(&rx, 11000u, record, r), 0); /* nothing hidden */
+    assert_int_equal(rx.len, 0);
+    assert_int_equal(tase_rx_feed(&rx, cmd, n, record, r), 1);
+    assert_int_equal(r->f[0].offset, sizeof noise);
+    assert_int_equal(r->f[0].seen_at, sizeof noise + n);
+    free(r);
+}
+
+/* The differential test with quiet times: the stream is fed in chunks,
+ * ticked after each at an unchanged clock (no quiet), and at random points
+ * the line goes quiet, either briefly (below the margin: nothing may
+ * change) or past any limit (everything pending fails, as in the
+ * reference). Frames, offsets, seen_at and counters agree after every
+ * call. */
+static void receiver_matches_the_reference_with_quiet_times(void **state)
+{
+    static uint8_t buf[1 << 16];
+    tase_rx_t rx;
+    recorder_t *got = new_recorder(&rx);
+    recorder_t *want = new_recorder(&rx);
+    size_t n, pos, seed, quiet = 0, brief = 0;
+    ref_t ref;
+    (void)state;
+    for (seed = 1; seed <= 4; seed++) {
+        uint32_t now = 0xFFFF0000u;
+        rng_state = (uint32_t)(seed * 0x6A09E667u);
+        n = build_mixed_stream(buf, sizeof(buf));
+        assert_int_equal(tase_rx_init(&rx), TASE_OK);
+        assert_int_equal(tase_rx_set_timing(&rx, RATE_57600, 0), TASE_OK);
+        got->n = 0;
+        want->n = 0;
+        ref_init(&ref, buf, ref_record, want);
+        pos = 0;
+        while (pos < n) {
+            size_t chunk = 1u + rnd() % ((rnd() % 4u == 0u) ? 300u : 8u);
+            size_t before = got->n;
+            int r;
+            if (chunk > n - pos) {
+                chunk = n - pos;
+            }
+            r = (chunk == 1u) ? tase_rx_push(&rx, buf[pos], record, got)
+                              : tase_rx_feed(&rx, buf + pos, chunk, record, got);
+            assert_int_equal(r, (int)(got->n - before));
+            pos += chunk;
+            ref_feed_to(&ref, pos);
+            assert_int_equal(tase_rx_tick(&rx, now, record, got), 0);
+            if (rnd() % 16u == 0u) {
+                now += TASE_RX_QUIET_MS; /* brief: never past a limit */
+                assert_int_equal(tase_rx_tick(&rx, now, record, got), 0);
+                brief++;
+            } else if (rnd() % 16u == 0u) {
+                before = got->n;
+                now += 100000u;
+                r = tase_rx_tick(&rx, now, record, got);
+                assert_int_equal(r, (int)(got->n - before));
+                ref_quiet(&ref);
+                quiet += rx.len == 0u;
+            }
+            assert_memory_equal(&rx.stats, &ref.st, sizeof(ref.st));
+            assert_int_equal(got->n, want->n);
+        }
+        assert_int_equal(tase_rx_flush(&rx, record, got) >= 0, 1);
+        ref_advance(&ref, true);
+        assert_memory_equal(&rx.stats, &ref.st, sizeof(ref.st));
+        assert_same_frames(got, want);
+    }
+    assert_true(quiet > 100u && brief > 100u);
+    free(got);
+    free(want);
+}
+
 static void sync_inside_a_delivered_frame_starts_nothing(void **state)
 {
     tase_rx_t rx;
@@ -1099,7 +1326,7 @@ static void push_one_byte_at_a_time_equals_feeding_one_buffer(void **state)
 
 /* ---- re-entrancy ------------------------------------------------------ */
 
-enum { RE_NONE, RE_FEED, RE_PUSH, RE_FLUSH, RE_RESET, RE_INIT };
+enum { RE_NONE, RE_FEED, RE_PUSH, RE_FLUSH, RE_TICK, RE_TIMING, RE_RESET, RE_INIT };
 enum { OP_FEED, OP_PUSH_EACH, OP_FLUSH, OP_END };
 
 typedef struct {
@@ -1132,11 +1359,13 @@ static void reenter(void *user, const tase_frame_t *fr)
     case RE_FEED: r = tase_rx_feed(e->rx, frame, sizeof(frame), reenter, e); break;
     case RE_PUSH: r = tase_rx_push(e->rx, 0x00, reenter, e); break;
     case RE_FLUSH: r = tase_rx_flush(e->rx, reenter, e); break;
+    case RE_TICK: r = tase_rx_tick(e->rx, 999999u, reenter, e); break;
+    case RE_TIMING: r = tase_rx_set_timing(e->rx, 1u, 1u); break;
     case RE_RESET: r = tase_rx_stats_reset(e->rx); break;
     case RE_INIT: r = (e->calls == 1u) ? tase_rx_init(e->rx) : TASE_OK; break;
     default: break;
     }
-    if (e->action == RE_FEED || e->action == RE_PUSH || e->action == RE_FLUSH) {
+    if (e->action >= RE_FEED && e->action <= RE_TIMING) {
         assert_int_equal(r, TASE_EBUSY);
         assert_memory_equal(&before, e->rx, sizeof(before));
         assert_memory_equal(view, fr->data, fr->len);
@@ -1375,6 +1604,11 @@ int main(void)
         cmocka_unit_test(camera_pass_carrying_a_frame_gives_only_the_camera_pass),
         cmocka_unit_test(frames_inside_a_valid_frame_are_data_and_outside_it_are_frames),
         cmocka_unit_test(receiver_matches_the_reference_greedy_scan),
+        cmocka_unit_test(four_bytes_of_noise_delay_a_command_only_up_to_the_bound),
+        cmocka_unit_test(quiet_limit_is_remaining_bytes_at_the_rate_or_the_margin),
+        cmocka_unit_test(a_real_frame_paused_up_to_the_limit_is_never_cut),
+        cmocka_unit_test(an_empty_read_after_the_limit_settles_stale_candidates),
+        cmocka_unit_test(receiver_matches_the_reference_with_quiet_times),
         cmocka_unit_test(sync_inside_a_delivered_frame_starts_nothing),
         cmocka_unit_test(counters_only_reset_on_request),
         cmocka_unit_test(every_call_from_inside_the_callback_is_refused_or_safe),

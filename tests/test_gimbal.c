@@ -126,6 +126,7 @@ static fix_t *make(uint32_t now, unsigned nports, bool with_fill)
     for (i = 0; i < 3; i++) {
         ports[i].ops = &fake_ops;
         ports[i].ctx = &x->port[i];
+        ports[i].bytes_per_s = 100000u; /* a fake port carries any rate the tests ask */
     }
     assert_int_equal(tase_gimbal_init(&x->g, ports, x->rx, nports, &app, now), TASE_OK);
     return x;
@@ -607,9 +608,9 @@ static void absent_ports_get_nothing_and_bad_arguments_are_rejected(void **state
 {
     fix_t *x = make(0, 1, true);
     tase_gimbal_t g;
-    tase_port_t bad = {&fake_ops, NULL};
+    tase_port_t bad = {&fake_ops, NULL, 0};
     tase_port_ops_t no_write = {NULL, NULL, NULL};
-    tase_port_t nw = {&no_write, NULL};
+    tase_port_t nw = {&no_write, NULL, 0};
     uint8_t d[16];
     (void)state;
 
@@ -714,7 +715,7 @@ static void frames_from_absent_ports_and_without_callbacks_are_only_counted(void
 {
     tase_gimbal_t g;
     fake_port_t *fp = calloc(1, sizeof *fp);
-    tase_port_t ports[2] = {{NULL, NULL}, {&fake_ops, NULL}};
+    tase_port_t ports[2] = {{NULL, NULL, 0}, {&fake_ops, NULL, 0}};
     uint8_t d[16] = {1, 2, 3};
     tase_frame_t setup = {0, 0x48, 0x00, 16, d};
     tase_frame_t cmd = {0, 0x00, 0x80, 8, d};
@@ -954,6 +955,7 @@ static typed_fix_t *make_typed(void)
     assert_non_null(x);
     port.ops = &fake_ops;
     port.ctx = &x->fp;
+    port.bytes_per_s = 100000u;
     memset(&app, 0, sizeof app);
     app.fill_telemetry_msg = typed_fill;
     app.apply_setup_msg = typed_apply;
@@ -1087,7 +1089,7 @@ static void init_refuses_both_forms_of_a_callback(void **state)
 {
     static tase_gimbal_t g;
     fake_port_t *fp = calloc(1, sizeof *fp);
-    tase_port_t port = {&fake_ops, fp};
+    tase_port_t port = {&fake_ops, fp, 0};
     tase_gimbal_app_t app;
     (void)state;
     memset(&app, 0, sizeof app);
@@ -1179,15 +1181,17 @@ typedef struct {
 
 /* PACKET_RATE 255/255/255 on a 9600-baud line (960 B/s, 4 KB driver
  * queue), polled every millisecond for 6 s; at 4 s the host queries
- * PACKET_RATE. */
-static line_run_t run_on_a_9600_baud_line(uint32_t capacity)
+ * PACKET_RATE. The port states port_rate bytes/s (0: unknown); capacity
+ * is set with tase_gimbal_set_capacity() unless it is NO_CALL. */
+#define NO_CALL 1u
+static line_run_t run_on_a_9600_baud_line(uint32_t port_rate, uint32_t capacity)
 {
     static line_t l;
     static tase_gimbal_t g;
     static tase_rx_t rx;
     static const uint8_t fast[16] = {255, 255, 255, 0, 0, 255, 255, 255, 0, 0, 255, 255, 255};
     line_run_t out;
-    tase_port_t port = {&line_ops, &l};
+    tase_port_t port = {&line_ops, &l, port_rate};
     tase_gimbal_app_t app;
     uint8_t q[8];
     uint32_t t;
@@ -1201,7 +1205,9 @@ static line_run_t run_on_a_9600_baud_line(uint32_t capacity)
     app.fill_telemetry_msg = zero_fill;
     app.user = out.per_stream;
     assert_int_equal(tase_gimbal_init(&g, &port, &rx, 1, &app, 0), TASE_OK);
-    assert_int_equal(tase_gimbal_set_capacity(&g, 0, capacity), TASE_OK);
+    if (capacity != NO_CALL) {
+        assert_int_equal(tase_gimbal_set_capacity(&g, 0, capacity), TASE_OK);
+    }
     assert_int_equal(tase_gimbal_setup_set(&g, 0x00, fast, sizeof fast, 0), TASE_OK);
     n = tase_frame_encode(q, sizeof q, 0x48, 0x00, NULL, 0);
     for (t = 1; t <= 6000u; t++) {
@@ -1227,18 +1233,31 @@ static line_run_t run_on_a_9600_baud_line(uint32_t capacity)
 
 static void an_echo_gets_through_an_over_rate_schedule_within_the_host_timeout(void **state)
 {
-    line_run_t slow, paced;
+    line_run_t slow, paced, by_default, unknown;
     (void)state;
     /* The issue's numbers first, to show the model is the real thing: no
-     * capacity given, the queue fills, an echo waits seconds. */
-    slow = run_on_a_9600_baud_line(0u);
-    print_message("no capacity: echo after %u ms, a poll blocked up to %u ms\n",
+     * limit on the capacity, the queue fills, an echo waits seconds. */
+    slow = run_on_a_9600_baud_line(0u, UINT32_MAX);
+    print_message("no limit: echo after %u ms, a poll blocked up to %u ms\n",
                   (unsigned)slow.echo_delay_ms, (unsigned)slow.worst_poll_ms);
     assert_true(slow.echo_delay_ms > 3000u);
     assert_true(slow.worst_poll_ms > 50u);
+    /* Issue 25 item 10: the default set-up (no tase_gimbal_set_capacity()
+     * call, as in examples/firmware) is safe: the capacity is the port's
+     * byte rate, and a port that does not state one is taken as the
+     * slowest line of the spec. (Before, the default was "no limit": the
+     * run above.) */
+    by_default = run_on_a_9600_baud_line(TASE_UART_BYTES_PER_S(9600), NO_CALL);
+    unknown = run_on_a_9600_baud_line(0u, NO_CALL);
+    print_message("by default: echo after %u ms (port states 960 B/s), %u ms (port states none)\n",
+                  (unsigned)by_default.echo_delay_ms, (unsigned)unknown.echo_delay_ms);
+    assert_true(by_default.echo_delay_ms < 500u);
+    assert_int_equal(by_default.worst_poll_ms, 0);
+    assert_true(unknown.echo_delay_ms < 500u);
+    assert_int_equal(unknown.worst_poll_ms, 0);
     /* With the line's capacity the echo leaves well within the host's
      * default 500 ms, and no write blocks the loop. */
-    paced = run_on_a_9600_baud_line(TASE_UART_BYTES_PER_S(9600));
+    paced = run_on_a_9600_baud_line(0u, TASE_UART_BYTES_PER_S(9600));
     print_message("960 B/s: echo after %u ms, a poll blocked up to %u ms, %lu bytes in 6 s, "
                   "%u/%u/%u frames, %u slots over capacity\n",
                   (unsigned)paced.echo_delay_ms, (unsigned)paced.worst_poll_ms,
@@ -1286,7 +1305,7 @@ static void capacity_is_per_port_and_checks_its_arguments(void **state)
 static void a_stuck_port_costs_one_frame_bound_per_poll(void **state)
 {
     fake_port_t *f = calloc(1, sizeof *f);
-    tase_port_t inner = {&fake_ops, f};
+    tase_port_t inner = {&fake_ops, f, 0};
     fault_port_t fp;
     tase_port_t p;
     static tase_gimbal_t g;
@@ -1320,7 +1339,7 @@ static void a_stuck_port_costs_one_frame_bound_per_poll(void **state)
 static void the_gimbal_keeps_its_bounds_under_random_faults(void **state)
 {
     fake_port_t *f = calloc(1, sizeof *f);
-    tase_port_t inner = {&fake_ops, f};
+    tase_port_t inner = {&fake_ops, f, 0};
     static tase_gimbal_t g;
     static tase_rx_t rx;
     uint8_t q[8];

@@ -39,6 +39,7 @@ static int setup(void **state)
     assert_non_null(x);
     p.ops = &fake_ops;
     p.ctx = &x->port;
+    p.bytes_per_s = TASE_UART_BYTES_PER_S(57600);
     assert_int_equal(tase_host_init(&x->host, &p, on_other, x), TASE_OK);
     *state = x;
     return 0;
@@ -300,7 +301,7 @@ static void bad_arguments_are_rejected(void **state)
 {
     fix_t *x = *state;
     uint8_t reply[8];
-    tase_port_t p = {NULL, NULL};
+    tase_port_t p = {NULL, NULL, 0};
     tase_host_t h;
     (void)state;
     assert_int_equal(tase_host_init(NULL, &p, NULL, NULL), TASE_EARG);
@@ -326,7 +327,7 @@ static void service_and_transact_need_a_readable_port_with_a_clock(void **state)
 {
     fix_t *x = *state;
     tase_host_t h;
-    tase_port_t p = {&write_only_ops, &x->port};
+    tase_port_t p = {&write_only_ops, &x->port, 0};
     uint8_t reply[8];
     assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_OK);
     assert_int_equal(tase_host_service(&h, 10), TASE_EUNSUPPORTED);
@@ -366,7 +367,7 @@ static void transact_gives_back_a_read_error_and_cancels_the_request(void **stat
 {
     fix_t *x = *state;
     tase_host_t h;
-    tase_port_t p = {&failing_read_ops, &x->port};
+    tase_port_t p = {&failing_read_ops, &x->port, 0};
     uint8_t reply[8];
     assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_OK);
     assert_int_equal(tase_host_transact(&h, 0x48, 0x01, NULL, 0, reply, sizeof reply, 100, 3),
@@ -401,7 +402,7 @@ static void init_rejects_a_port_without_write(void **state)
     static const tase_port_ops_t no_write = {NULL, fake_read, fake_now};
     fix_t *x = *state;
     tase_host_t h;
-    tase_port_t p = {&no_write, &x->port};
+    tase_port_t p = {&no_write, &x->port, 0};
     memset(&h, 0x5A, sizeof h);
     assert_int_equal(tase_host_init(&h, NULL, NULL, NULL), TASE_EARG);
     assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_EARG);
@@ -445,8 +446,8 @@ static void host_api_rejects_bad_arguments(void **state)
     static tase_host_t copy;
     static const uint8_t req[4] = {1, 2, 3, 4};
     uint8_t reply[8];
-    tase_port_t port = {&fake_ops, &fp};
-    tase_port_t no_write = {&liar_ops, &fp};
+    tase_port_t port = {&fake_ops, &fp, 0};
+    tase_port_t no_write = {&liar_ops, &fp, 0};
     tase_port_ops_t ops_no_write = {NULL, fake_read, fake_now};
     (void)state;
 
@@ -726,7 +727,7 @@ static void transact_keeps_its_contract_under_random_faults(void **state)
     uint32_t seed;
     for (seed = 1; seed <= 1500u; seed++) {
         fault_port_t fp;
-        tase_port_t inner = {&fake_ops, &x->port};
+        tase_port_t inner = {&fake_ops, &x->port, 0};
         tase_port_t p;
         tase_host_t h;
         uint8_t reply[64];

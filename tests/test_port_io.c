@@ -24,7 +24,7 @@ static fake_port_t *new_fake(void)
 static void write_all_reassembles_partial_writes(void **state)
 {
     fake_port_t *f = new_fake();
-    tase_port_t p = {&fake_ops, f};
+    tase_port_t p = {&fake_ops, f, 0};
     uint8_t data[100];
     size_t i;
     (void)state;
@@ -66,7 +66,7 @@ static const tase_port_ops_t stingy_ops = {stingy_write, NULL, NULL};
 static void write_all_reports_eagain_when_nothing_went_out(void **state)
 {
     stingy_t s = {0, 0, 0};
-    tase_port_t p = {&stingy_ops, &s};
+    tase_port_t p = {&stingy_ops, &s, 0};
     (void)state;
     assert_int_equal(tase_port_write_all(&p, (const uint8_t *)"abcd", 4), TASE_EAGAIN);
     assert_int_equal(s.calls, TASE_PORT_WRITE_TRIES); /* bounded, no endless spin */
@@ -75,7 +75,7 @@ static void write_all_reports_eagain_when_nothing_went_out(void **state)
 static void write_all_reports_a_full_queue_when_a_frame_was_cut(void **state)
 {
     stingy_t s = {3, 0, 0};
-    tase_port_t p = {&stingy_ops, &s};
+    tase_port_t p = {&stingy_ops, &s, 0};
     (void)state;
     assert_int_equal(tase_port_write_all(&p, (const uint8_t *)"abcdef", 6), TASE_ENOBUFS);
     assert_int_equal(s.taken, 3);
@@ -84,7 +84,7 @@ static void write_all_reports_a_full_queue_when_a_frame_was_cut(void **state)
 static void write_all_passes_hard_errors_on_at_once(void **state)
 {
     fake_port_t *f = new_fake();
-    tase_port_t p = {&fake_ops, f};
+    tase_port_t p = {&fake_ops, f, 0};
     (void)state;
     f->write_result = TASE_EDOWN;
     assert_int_equal(tase_port_write_all(&p, (const uint8_t *)"ab", 2), TASE_EDOWN);
@@ -96,7 +96,7 @@ static void write_all_passes_hard_errors_on_at_once(void **state)
 static void send_frame_writes_one_encoded_frame(void **state)
 {
     fake_port_t *f = new_fake();
-    tase_port_t p = {&fake_ops, f};
+    tase_port_t p = {&fake_ops, f, 0};
     uint8_t want[TASE_FRAME_MAX];
     int n;
     (void)state;
@@ -113,9 +113,9 @@ static void write_all_rejects_incomplete_ports_and_lengths_beyond_int(void **sta
 {
     static const tase_port_ops_t no_write = {NULL, NULL, NULL};
     stingy_t s = {100, 0, 0};
-    tase_port_t p = {&stingy_ops, &s};
-    tase_port_t no_ops = {NULL, &s};
-    tase_port_t nw = {&no_write, &s};
+    tase_port_t p = {&stingy_ops, &s, 0};
+    tase_port_t no_ops = {NULL, &s, 0};
+    tase_port_t nw = {&no_write, &s, 0};
     (void)state;
     assert_int_equal(tase_port_write_all(&no_ops, (const uint8_t *)"ab", 2), TASE_EARG);
     assert_int_equal(tase_port_write_all(&nw, (const uint8_t *)"ab", 2), TASE_EARG);
@@ -148,7 +148,7 @@ static const tase_port_ops_t fixed_ops = {fixed_write, NULL, NULL};
 static void write_all_rejects_a_port_claiming_more_than_asked(void **state)
 {
     fixed_t x = {1, 0};
-    tase_port_t p = {&fixed_ops, &x};
+    tase_port_t p = {&fixed_ops, &x, 0};
     (void)state;
     assert_int_equal(tase_port_write_all(&p, (const uint8_t *)"abc", 3), TASE_EIO);
     assert_int_equal(x.calls, 1);
@@ -157,7 +157,7 @@ static void write_all_rejects_a_port_claiming_more_than_asked(void **state)
 static void write_all_counts_zero_and_enobufs_as_no_progress(void **state)
 {
     fixed_t zero = {0, 0}, full = {TASE_ENOBUFS, 0};
-    tase_port_t pz = {&fixed_ops, &zero}, pf = {&fixed_ops, &full};
+    tase_port_t pz = {&fixed_ops, &zero, 0}, pf = {&fixed_ops, &full, 0};
     (void)state;
     /* a port that takes 0 bytes forever: EAGAIN (nothing sent), bounded */
     assert_int_equal(tase_port_write_all(&pz, (const uint8_t *)"abc", 3), TASE_EAGAIN);
@@ -170,7 +170,7 @@ static void write_all_counts_zero_and_enobufs_as_no_progress(void **state)
 static void send_frame_checks_the_frame_before_the_port(void **state)
 {
     fake_port_t *f = new_fake();
-    tase_port_t p = {&fake_ops, f};
+    tase_port_t p = {&fake_ops, f, 0};
     static const uint8_t big[300];
     (void)state;
     assert_int_equal(tase_port_send_frame(NULL, 0x48, 0x00, NULL, 0), TASE_EARG);
@@ -209,9 +209,9 @@ static void port_io_api_rejects_bad_arguments(void **state)
     static fake_port_t fp;
     static const uint8_t data[4] = {1, 2, 3, 4};
     static const tase_port_ops_t no_write = {NULL, fake_read, fake_now};
-    tase_port_t port = {&fake_ops, &fp};
-    tase_port_t no_ops = {NULL, &fp};
-    tase_port_t bad_ops = {&no_write, &fp};
+    tase_port_t port = {&fake_ops, &fp, 0};
+    tase_port_t no_ops = {NULL, &fp, 0};
+    tase_port_t bad_ops = {&no_write, &fp, 0};
     (void)state;
 
     memset(&fp, 0, sizeof fp);
@@ -240,7 +240,7 @@ static void port_io_api_rejects_bad_arguments(void **state)
 static void a_stuck_port_costs_one_write_bound_per_frame_not_64(void **state)
 {
     fake_port_t *f = new_fake();
-    tase_port_t inner = {&fake_ops, f};
+    tase_port_t inner = {&fake_ops, f, 0};
     fault_port_t fp;
     tase_port_t p;
     const uint32_t bounds[3] = {1000u, 100u, 20u};
@@ -271,7 +271,7 @@ static void a_stuck_port_costs_one_write_bound_per_frame_not_64(void **state)
 static void write_all_keeps_its_contract_under_random_faults(void **state)
 {
     fake_port_t *f = new_fake();
-    tase_port_t inner = {&fake_ops, f};
+    tase_port_t inner = {&fake_ops, f, 0};
     uint8_t data[TASE_FRAME_MAX];
     uint32_t seed;
     size_t k;
@@ -334,7 +334,7 @@ static void elapsed_is_wrap_safe_and_a_stale_sample_is_no_time(void **state)
 static void send_msg_writes_the_codec_frame_and_checks_it_first(void **state)
 {
     fake_port_t *f = new_fake();
-    tase_port_t p = {&fake_ops, f};
+    tase_port_t p = {&fake_ops, f, 0};
     tase_gimbal_angle_t a = {100, -200, 0};
     uint8_t want[TASE_FRAME_MAX];
     int n;

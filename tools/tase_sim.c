@@ -523,6 +523,12 @@ int main(int argc, char **argv)
         tk_link_pty(&dl, tk_pty_open(path, sizeof(path), link, &slave_fd));
     }
     port = tk_link_port(&dl);
+    if (can == NULL) {
+        /* a pty has no speed of its own: the simulated line's is --baud; the
+         * gimbal role sizes telemetry (its capacity) and the receiver's time
+         * bound by it */
+        port.bytes_per_s = TASE_UART_BYTES_PER_S((uint32_t)baud);
+    }
     if (klv_link != NULL) {
         tk_link_pty(&kl, tk_pty_open(klv_path, sizeof(klv_path), klv_link, &klv_slave));
         klv_port = tk_link_port(&kl);
@@ -538,12 +544,6 @@ int main(int argc, char **argv)
     s.t0 = now;
     if (tase_gimbal_init(&s.g, &port, s.rx, 1, &app, now) != TASE_OK) {
         tk_die("internal error: gimbal role init failed");
-    }
-    /* telemetry within what the line carries (a pty has no speed of its
-     * own: the simulated line's is --baud); a CAN bus arbitrates itself */
-    if (can == NULL &&
-        tase_gimbal_set_capacity(&s.g, 0, TASE_UART_BYTES_PER_S((uint32_t)baud)) != TASE_OK) {
-        tk_die("internal error: cannot set the link capacity");
     }
     set_version(&s, now);
     /* the model starts from the role's stored (default) axis settings */

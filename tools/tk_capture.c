@@ -162,6 +162,7 @@ tase_port_t tk_cap_tap_port(tk_cap_tap_t *tap, tase_port_t inner, tk_cap_writer_
     tap->w = w;
     p.ops = &tap_ops;
     p.ctx = tap;
+    p.bytes_per_s = inner.bytes_per_s;
     return p;
 }
 

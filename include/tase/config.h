@@ -31,6 +31,11 @@
  *       count for a port whose clock does not move (tase/port_io.h).
  *       Both are used only inside the library: the values the library
  *       was built with are the ones that apply.
+ *   TASE_RX_QUIET_MS (default 20, 1..65535)  the margin of the
+ *       receiver's time bound, the longest pause inside a real frame as a
+ *       receiver sees it (tase/frame.h, TIME BOUND); the value the library
+ *       was built with is what tase_rx_init() sets, and
+ *       tase_rx_set_timing() changes it per receiver.
  *   TASE_RING_BARRIER()  the bare-metal ring's barrier hook (tase/ring.h),
  *       used only inside port/baremetal/tase_ring.c.
  *   TASE_RX_CANDIDATES (1..16, default 4)  NO EFFECT since 0.2.0: the
@@ -75,6 +80,13 @@
 #endif
 #if TASE_RX_CANDIDATES < 1 || TASE_RX_CANDIDATES > 16
 #error "TASE_RX_CANDIDATES must be 1..16"
+#endif
+
+#ifndef TASE_RX_QUIET_MS
+#define TASE_RX_QUIET_MS 20u
+#endif
+#if TASE_RX_QUIET_MS < 1 || TASE_RX_QUIET_MS > 65535
+#error "TASE_RX_QUIET_MS must be 1..65535"
 #endif
 
 #ifndef TASE_PORT_WRITE_TIMEOUT_MS

@@ -75,6 +75,46 @@
  * docs/DESIGN.md for why the 272-byte target of the original brief cannot
  * hold with 32-bit counters in the instance.
  *
+ * TIME BOUND. A held candidate waits for its last byte, and with it every
+ * frame inside it. On a link that goes quiet (a command link: a few
+ * frames, then silence) that byte may never come: four bytes of noise,
+ * 00 FF 5A FF, claim 257 more, and the frames after them would wait until
+ * 257 more bytes arrived. tase_rx_tick() bounds that in time: a held
+ * candidate (or partial sync) that has seen no new byte for longer than
+ * its QUIET LIMIT is judged false, exactly as at end of input
+ * (tase_rx_flush()): the frames inside it are delivered, in stream order,
+ * and the stream goes on (offsets and counters run on). The quiet limit
+ * of what is held is
+ *     max(time its remaining bytes need at the link's byte rate, margin)
+ * where the remaining bytes are those up to the held candidate's last
+ * byte (for a partial sync, up to a maximal frame's), the byte rate is
+ * set with tase_rx_set_timing() (0, the default after tase_rx_init(), is
+ * taken as TASE_RX_SLOWEST_RATE, 960 bytes/s: a 9600-baud line, the
+ * slowest of the spec) and the margin is TASE_RX_QUIET_MS (20 ms unless
+ * configured, or set per receiver). A real frame never pauses that long:
+ * its sender writes it contiguously, so its bytes come at the line's rate,
+ * and the margin covers what the receiving side adds (an OS scheduling a
+ * reader late, a USB-serial adapter delivering in bursts: FTDI parts every
+ * 16 ms by default). A frame followed by silence is thus delivered at most
+ * max(249 byte times, margin) after its last byte (a frame inside a held
+ * candidate ends at least 12 bytes after the candidate began), plus the
+ * time until the next tick: 44 ms at 57600 baud, 260 ms at 9600 (and the
+ * margin, when it is the larger).
+ * The receiver reads no clock: the caller passes its time (a port's
+ * now_ms, monotonic, modulo 2^32) to tase_rx_tick(), which it calls
+ *   - after every tase_rx_feed()/tase_rx_push() of bytes received at
+ *     now_ms (the tick notes that the line was active), and
+ *   - after every read that found no byte waiting (the line was quiet
+ *     until now_ms): this tick settles what has been quiet for too long.
+ * Never tick while received bytes wait unread (a ring buffer not yet
+ * drained): the tick would count their time as quiet. A caller that
+ * blocks in a read waits at most tase_rx_quiet_ms(), so that an empty read
+ * and its tick come by the limit, and bytes arriving later cannot extend
+ * a stale candidate. The host and gimbal roles (tase/host.h,
+ * tase/gimbal.h) do all of this from their ports' clocks and byte rates;
+ * a receiver that is never ticked behaves as before (a held candidate
+ * waits for its bytes).
+ *
  * STATISTICS are 32-bit counters in the instance. The receiver only ever
  * increments them; tase_rx_stats_reset() (and tase_rx_init()) are the only
  * things that clear them. Counters wrap modulo 2^32.
@@ -152,19 +192,28 @@ typedef struct {
 /* Receiver instance. Treat every field except `stats` as private. */
 typedef struct {
     tase_rx_stats_t stats;
+    /* The time bound (TIME BOUND above): the link's byte rate and margin
+     * (tase_rx_set_timing()), stats.bytes_in at the last tase_rx_tick()
+     * and the now_ms of the last tick that saw new bytes (`ticked` says
+     * whether those two are set yet). */
+    uint32_t rate;
+    uint32_t tick_bytes;
+    uint32_t quiet_since;
+    uint16_t margin_ms;
+    uint8_t ticked;
     /* buf[0..len) holds nothing, a partial sync, or the earliest pending
      * candidate from its first byte; `end` is the index of that
      * candidate's last byte (0 when none is held, and during a call);
      * `busy` is set while a call (and so its callback) runs. */
+    uint8_t busy;
     uint16_t len;
     uint16_t end;
-    uint8_t busy;
     uint8_t buf[TASE_FRAME_MAX];
 } tase_rx_t;
 
 /* Upper bound on sizeof(tase_rx_t) (the same on 32- and 64-bit targets:
  * the instance holds no pointers), enforced at compile time in tase_frame.c. */
-#define TASE_RX_SIZE_BUDGET 296u
+#define TASE_RX_SIZE_BUDGET 312u
 
 /* Called once per valid frame, in stream order. See RE-ENTRANCY above for
  * what it may call on the same receiver. */
@@ -228,6 +277,41 @@ int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *
  * a new stream. Returns frames delivered (>= 0), or TASE_EARG /
  * TASE_EBUSY as tase_rx_feed() (receiver unchanged). */
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user);
+
+/* The byte rate taken when none is set: 9600 baud 8N1. */
+#define TASE_RX_SLOWEST_RATE 960u
+
+/* Set the byte rate of the receiver's link (bytes per second, e.g.
+ * TASE_UART_BYTES_PER_S(57600); 0: unknown, taken as
+ * TASE_RX_SLOWEST_RATE) and the margin of its time bound in ms (0: the
+ * default TASE_RX_QUIET_MS). Returns TASE_OK, TASE_EARG (rx NULL) or
+ * TASE_EBUSY (inside a callback of this receiver; nothing changed). Kept
+ * by tase_rx_flush() and tase_rx_stats_reset(), reset by tase_rx_init().
+ * O(1). */
+int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms);
+
+/* The receiver's clock input (TIME BOUND above), with the caller's time
+ * now_ms: call it after feeding bytes received at now_ms and after a read
+ * that found nothing waiting. If bytes were fed since the previous tick,
+ * notes the line as active at now_ms and returns 0. Otherwise, if
+ * something is held and the line has been quiet for longer than its
+ * quiet limit, settles it like tase_rx_flush() (the receiver is then
+ * empty; counters kept) and returns the number of frames delivered; else
+ * returns 0. The first tick after tase_rx_init() only notes the time. A
+ * now_ms earlier than the noted time (a stale sample: a difference of
+ * 2^31 or more) counts as no time passed. Returns TASE_EARG / TASE_EBUSY
+ * as tase_rx_flush() (receiver unchanged). Longest block: as
+ * tase_rx_flush() when it settles, O(1) otherwise. */
+int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, void *user);
+
+/* How long (ms from now_ms) the caller may wait for bytes before it must
+ * call tase_rx_tick() for the time bound to hold: 0 when a tick is due
+ * (bytes fed since the last tick, or the limit has passed), UINT32_MAX
+ * when nothing is held (no bound to keep), else what is left of the quiet
+ * limit. A blocking reader waits at most this long (the roles' service
+ * calls do). UINT32_MAX for rx NULL. O(1), reentrant; allowed from the
+ * callback. */
+uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms);
 
 /* Zero every counter, nothing else. Returns TASE_OK or TASE_EARG (rx
  * NULL). Allowed from inside the receiver's own callback. */

@@ -88,16 +88,28 @@
  * written beyond what the link carries pile up in the driver's transmit
  * queue, where an echo written later waits behind them (4.3 s behind a
  * 4 KB tty queue at 9600 baud: longer than a host's retries), and every
- * write blocks until the queue has room. So the application states each
- * port's capacity (tase_gimbal_set_capacity(), e.g.
- * TASE_UART_BYTES_PER_S(9600)), and telemetry may use at most
- * TASE_GIMBAL_TELEMETRY_SHARE percent of it, the rest staying free for
- * answers. When the rates ask for more, every stream of that port sends
+ * write blocks until the queue has room. So each port has a capacity in
+ * bytes per second: by default the byte rate its tase_port_t states
+ * (bytes_per_s, filled by the ports' *_port() functions, e.g.
+ * TASE_UART_BYTES_PER_S(9600) for a 9600-baud line), or, when the port
+ * states none, the slowest line of the spec (960 B/s); no set-up can leave
+ * a port without one. tase_gimbal_set_capacity() overrides it. Telemetry
+ * may use at most TASE_GIMBAL_TELEMETRY_SHARE percent of it, the rest
+ * staying free for answers. When the rates ask for more, every stream of that port sends
  * the same fraction of its due slots, spread evenly, and skips the rest
  * (stats.slots_over_capacity); the stored and echoed PACKET_RATE stay
  * what the host asked for. The transmit queue then stays short, and an
- * answer leaves within a few frame times. Capacity 0 (the default) means
- * unknown: no limit.
+ * answer leaves within a few frame times (25 ms at 9600 baud and
+ * 255/255/255, measured in tests/test_gimbal.c, against 4.3 s without a
+ * limit).
+ *
+ * NOISE. Each port's receiver has the time bound of tase/frame.h (TIME
+ * BOUND), at the port's byte rate: line noise that leaves a candidate held
+ * (00 FF 5A FF claims 257 bytes) delays the commands after it by at most
+ * the bound (44 ms at 57600 baud, 260 ms at 9600), never until more bytes
+ * come. tase_gimbal_service() applies it by itself; an application that
+ * feeds its own bytes calls tase_gimbal_feed() with n == 0 when it finds
+ * its receive buffer empty (see there).
  *
  * LONGEST BLOCK. Each frame write blocks at most the port's frame bound
  * (port_io.h: TASE_PORT_WRITE_TIMEOUT_MS + the port's W). A port whose
@@ -142,10 +154,6 @@ extern "C" {
 #ifndef TASE_GIMBAL_TELEMETRY_SHARE
 #define TASE_GIMBAL_TELEMETRY_SHARE 75u
 #endif
-
-/* Bytes per second an asynchronous serial line carries at `baud` with
- * 10 bits per byte (8N1: start, 8 data, stop). */
-#define TASE_UART_BYTES_PER_S(baud) ((uint32_t)(baud) / 10u)
 
 /* Application callbacks; any may be NULL. `user` is passed back. */
 typedef struct {
@@ -213,7 +221,7 @@ typedef struct {
     tase_rx_t *rx;                       /* caller's receivers, or NULL */
     uint8_t nrx;                         /* how many */
     tase_gimbal_sched_t sched[TASE_GIMBAL_PORTS][TASE_GIMBAL_STREAMS];
-    uint32_t capacity[TASE_GIMBAL_PORTS]; /* bytes/s, 0 = no limit */
+    uint32_t capacity[TASE_GIMBAL_PORTS]; /* bytes/s */
     uint32_t demand[TASE_GIMBAL_PORTS];   /* telemetry bytes/s the rates ask */
     uint8_t setup[TASE_GIMBAL_SETUP_BYTES];
 } tase_gimbal_t;
@@ -222,9 +230,11 @@ typedef struct {
  * is NULL leaves that port absent: nothing is sent there), app is copied
  * (NULL: no callbacks), setup packets take their defaults and every
  * stream is anchored at now_ms (first packets one period later).
- * rx is the caller's array of nports receivers (296 bytes each on x86-64), one per
+ * rx is the caller's array of nports receivers (312 bytes each), one per
  * port, used by tase_gimbal_feed() and tase_gimbal_service(); init
- * initialises them and the gimbal keeps the pointer. Pass NULL when the
+ * initialises them, sets each one's time bound to its port's byte rate
+ * (tase_rx_set_timing()) and keeps the pointer. Each port's telemetry
+ * capacity starts at its byte rate (PRIORITY AND CAPACITY). Pass NULL when the
  * application runs its own receiver and hands frames over with
  * tase_gimbal_handle_frame() (firmware that dispatches every frame
  * itself saves the RAM). Returns TASE_OK, or TASE_EARG (g NULL, ports
@@ -233,10 +243,14 @@ typedef struct {
 int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, size_t nports,
                      const tase_gimbal_app_t *app, uint32_t now_ms);
 
-/* Feed bytes received on port index `port` into that port's receiver.
- * Answers setup packets and calls on_frame for the rest. Returns frames
- * received (>= 0), TASE_EARG (g NULL, port >= nports, bytes NULL with
- * n > 0) or TASE_ESTATE (initialised without receivers).
+/* Feed bytes received on port index `port` at now_ms into that port's
+ * receiver. Answers setup packets and calls on_frame for the rest. now_ms
+ * also drives the receiver's time bound (NOISE above): call it with n == 0
+ * (bytes may be NULL) whenever a look at the port's receive buffer found
+ * nothing waiting, so that frames held behind noise come out once the line
+ * has been quiet for the bound. Never with bytes still waiting unread.
+ * Returns frames received (>= 0), TASE_EARG (g NULL, port >= nports,
+ * bytes NULL with n > 0) or TASE_ESTATE (initialised without receivers).
  * Worst case O(n * TASE_FRAME_MAX). */
 int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
                      uint32_t now_ms);
@@ -248,10 +262,12 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
                              uint32_t now_ms);
 
-/* Set the capacity of port index `port` in bytes per second (0: unknown,
- * no limit; the default), e.g. TASE_UART_BYTES_PER_S(9600) for a
- * 9600-baud line. See PRIORITY AND CAPACITY. Takes effect at the next due
- * slot. Returns TASE_OK or TASE_EARG (g NULL, port >= 3). O(1). */
+/* Set the capacity of port index `port` in bytes per second, e.g.
+ * TASE_UART_BYTES_PER_S(9600) for a 9600-baud line; 0 goes back to the
+ * default (the port's bytes_per_s, or 960 when it states none); UINT32_MAX
+ * is no limit in practice. See PRIORITY AND CAPACITY. Takes effect at the
+ * next due slot. Returns TASE_OK or TASE_EARG (g NULL, port >= 3).
+ * O(1). */
 int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per_s);
 
 /* Send every telemetry packet that is due at now_ms (at most one per
@@ -263,7 +279,8 @@ int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per
 int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
 
 /* Read whatever each present port has ready (timeout 0, ports with a
- * read function), feed it, then tase_gimbal_poll(). Returns the poll
+ * read function), feed it (a read that finds nothing ticks the port's
+ * receiver: NOISE above), then tase_gimbal_poll(). Returns the poll
  * result, TASE_EARG (g NULL), or TASE_ESTATE when a port has a read function but
  * the gimbal was initialised without receivers. A port read error is
  * skipped (the port may

@@ -182,10 +182,15 @@ int tase_host_query_start(tase_host_t *h, uint8_t group, uint8_t type, uint8_t *
 
 /* Feed received bytes (from the port, a ring buffer, a capture). Frames
  * complete the pending request or go to on_frame. now_ms is not used for
- * matching (a reply fed before the deadline poll always wins) and is
- * accepted for symmetry with the gimbal role. Returns the number of
+ * matching (a reply fed before the deadline poll always wins). Returns the
+ * number of
  * frames received (>= 0) or TASE_EARG (h NULL, bytes NULL with n > 0).
- * Worst case O(n * TASE_FRAME_MAX), see tase_rx_feed(). */
+ * now_ms is when the bytes arrived: it drives the receiver's time bound
+ * (tase/frame.h, TIME BOUND), so call it with n == 0 too whenever a look
+ * at your receive buffer found it empty; frames held behind noise are then
+ * delivered once the line has been quiet for the bound (at the port's
+ * byte rate, tase_port_t.bytes_per_s). Worst case O(n * TASE_FRAME_MAX),
+ * see tase_rx_feed(). */
 int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_ms);
 
 /* Hand over one frame received some other way (e.g. reassembled from
@@ -216,7 +221,10 @@ int tase_host_cancel(tase_host_t *h);
 bool tase_host_busy(const tase_host_t *h);
 
 /* Read once from the port, waiting at most wait_ms, and feed what
- * arrived (time from port->ops->now_ms). Returns bytes read (>= 0), a
+ * arrived (time from port->ops->now_ms). While the receiver holds a
+ * candidate, the wait ends by its quiet limit instead, so that the time
+ * bound holds (tase/frame.h, TIME BOUND): a call may return 0 early,
+ * never late. Returns bytes read (>= 0), a
  * port error, TASE_EIO (the port's read() claimed more bytes than asked;
  * nothing fed), TASE_EUNSUPPORTED (port has no read or now_ms) or
  * TASE_EARG (h NULL, or never initialised: no port ops). Uses 64 bytes of

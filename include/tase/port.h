@@ -81,6 +81,14 @@ typedef struct {
 typedef struct {
     const tase_port_ops_t *ops;
     void *ctx;
+    /* The link's byte rate in bytes per second (TASE_UART_BYTES_PER_S(baud)
+     * for an 8N1 UART), or 0 when the port does not know it. The roles use
+     * it for the receiver's time bound (tase/frame.h, TIME BOUND) and the
+     * gimbal's telemetry capacity (tase/gimbal.h); 0 makes both assume the
+     * slowest line of the spec, 9600 baud, which is safe but slow. The
+     * ports' *_port() functions fill it; set it yourself for a port of
+     * your own. */
+    uint32_t bytes_per_s;
 } tase_port_t;
 
 #endif /* TASE_PORT_H */

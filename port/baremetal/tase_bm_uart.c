@@ -63,7 +63,12 @@ int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_fra
         }
         frames += r;
     }
-    return frames;
+    /* The ring is drained (or the budget spent right after feeding): the
+     * receiver's time bound hears of the activity, or of the quiet. */
+    {
+        int r = tase_rx_tick(rx, u->hooks->millis(u->hw), on_frame, user);
+        return r < 0 ? r : frames + r;
+    }
 }
 
 static int bm_write(void *ctx, const uint8_t *data, size_t n)
@@ -124,5 +129,6 @@ tase_port_t tase_bm_uart_port(tase_bm_uart_t *u)
     tase_port_t p;
     p.ops = &tase_bm_uart_ops;
     p.ctx = u;
+    p.bytes_per_s = 0u; /* the UART's rate is the application's: set it */
     return p;
 }

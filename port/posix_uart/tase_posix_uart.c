@@ -426,5 +426,6 @@ tase_port_t tase_posix_uart_port(tase_posix_uart_t *u)
     tase_port_t p;
     p.ops = &tase_posix_uart_ops;
     p.ctx = u;
+    p.bytes_per_s = (u != NULL) ? TASE_UART_BYTES_PER_S(u->baud) : 0u;
     return p;
 }

@@ -647,5 +647,6 @@ tase_port_t tase_socketcan_port(tase_socketcan_t *s)
     tase_port_t p;
     p.ops = &tase_socketcan_ops;
     p.ctx = s;
+    p.bytes_per_s = TASE_SOCKETCAN_BYTES_PER_S;
     return p;
 }

@@ -329,6 +329,7 @@ static void int_width(void)
     int r;
     port.ops = &ops;
     port.ctx = NULL;
+    port.bytes_per_s = 0u;
     r = tase_port_write_all(&port, &one, 1);
     check(r == 1, "write_all 1 byte", (uint32_t)r);
     if ((size_t)INT_MAX < (size_t)-1) { /* a count that does not fit the result */

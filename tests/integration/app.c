@@ -70,6 +70,7 @@ static int write_deadline_agrees(void)
     tase_port_t port;
     port.ops = &ops;
     port.ctx = &sp;
+    port.bytes_per_s = 0u;
     return tase_port_write_all(&port, data, sizeof data) < 0 &&
            sp.taken == (size_t)TASE_PORT_WRITE_TIMEOUT_MS;
 }

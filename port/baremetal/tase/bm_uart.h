@@ -112,10 +112,19 @@ void tase_bm_uart_rx_isr(tase_bm_uart_t *u, uint8_t byte);
  * handler corrupts it midway, the chunk being fed is lost and the rest
  * stays in the ring). Bounded: stops after one ring capacity's worth of
  * bytes even if the ISR keeps adding, so the main loop cannot be
- * starved. */
+ * starved. Then ticks the receiver (tase_rx_tick() with hooks->millis()):
+ * after draining, its time bound hears that the line was active or has
+ * been quiet (tase/frame.h, TIME BOUND): noise that leaves a candidate
+ * held cannot keep the frames after it from being delivered for longer
+ * than the bound, provided poll runs at least every few milliseconds. Set
+ * the receiver's byte rate with tase_rx_set_timing(). */
 int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_frame, void *user);
 
-/* The tase_port_t of u: {&tase_bm_uart_ops, u}. */
+/* The tase_port_t of u: {&tase_bm_uart_ops, u, 0}. The template does not
+ * know the UART's baud rate: set the port's bytes_per_s yourself
+ * (p.bytes_per_s = TASE_UART_BYTES_PER_S(57600)) so that the roles size
+ * the receiver's time bound and the gimbal's telemetry capacity by it;
+ * left 0, they assume the spec's slowest line (9600 baud). */
 tase_port_t tase_bm_uart_port(tase_bm_uart_t *u);
 
 #ifdef __cplusplus

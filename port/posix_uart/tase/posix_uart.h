@@ -118,8 +118,9 @@ int tase_posix_uart_attach(tase_posix_uart_t *u, int fd, uint32_t baud);
  * (the fd is gone anyway). */
 int tase_posix_uart_close(tase_posix_uart_t *u);
 
-/* The tase_port_t of an open instance: {&tase_posix_uart_ops, u}. With u
- * NULL or closed its write/read return TASE_EARG. */
+/* The tase_port_t of an open instance: {&tase_posix_uart_ops, u, the
+ * byte rate of its baud (TASE_UART_BYTES_PER_S(u->baud))}. With u NULL or
+ * closed its write/read return TASE_EARG. */
 tase_port_t tase_posix_uart_port(tase_posix_uart_t *u);
 
 /* True if `baud` is a rate tase_posix_uart_open() accepts (any value may

@@ -163,7 +163,13 @@ int tase_socketcan_adopt(tase_socketcan_t *s, int fd, tase_can_role_t role, unsi
 /* Close the descriptor if owned. Safe to call twice; s NULL is ignored. */
 void tase_socketcan_close(tase_socketcan_t *s);
 
-/* The port view: ops = &tase_socketcan_ops, ctx = s. */
+/* The byte rate the port states (tase_port_t.bytes_per_s): CAN at
+ * 1 Mbit/s (spec 5) carries 8 datalink bytes per extended frame of at most
+ * 160 bits with stuffing, about 50,000 bytes per second. */
+#define TASE_SOCKETCAN_BYTES_PER_S 50000u
+
+/* The port view: ops = &tase_socketcan_ops, ctx = s, bytes_per_s
+ * TASE_SOCKETCAN_BYTES_PER_S. */
 tase_port_t tase_socketcan_port(tase_socketcan_t *s);
 extern const tase_port_ops_t tase_socketcan_ops;
 
