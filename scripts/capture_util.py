@@ -101,13 +101,37 @@ def cut(data, rng):
     return out
 
 
+def cut_at_frames(data, jsonl):
+    """Records that end where the expected frames (jsonl: offset, size)
+    end, the noise before each frame with it, as a sender writes a frame:
+    whole, at the line's rate."""
+    out, i = [], 0
+    for line in open(jsonl):
+        o = json.loads(line)
+        end = o["offset"] + o["size"] + 8
+        out.append(data[i:end])
+        i = end
+    if i < len(data):
+        out.append(data[i:])
+    return out
+
+
 def serial_pcap(out, seed, gaps, specs):
+    """A serial capture of the streams SPEC (FILE.bin:DIR), records of 1..64
+    bytes from either direction at random, GAPS ms ("LO-HI") apart. Gaps a
+    live receiver would see as the line going quiet (HI >= 20 ms, its time
+    bound's margin) come only where a frame ended (FILE.jsonl beside the
+    .bin has the frames): no sender pauses inside a frame."""
     rng = random.Random(int(seed))
     lo, hi = (int(Decimal(x) * 1000000) for x in gaps.split("-"))
     queues = []
     for spec in specs:
         path, d = spec.rsplit(":", 1)
-        queues.append((DIRS[d], cut(open(path, "rb").read(), rng)))
+        data = open(path, "rb").read()
+        if hi >= 20 * 1000000:
+            queues.append((DIRS[d], cut_at_frames(data, path[:-4] + ".jsonl")))
+        else:
+            queues.append((DIRS[d], cut(data, rng)))
     ns = 0
     with open(out, "wb") as f:
         f.write(pcap_header(LINKTYPE_SERIAL))
@@ -420,6 +444,27 @@ def scenario(name):
     return out, inn
 
 
+def quiet(out, gap):
+    """Issue 27: a serial capture (from the gimbal) whose first record is
+    the false sync 00 FF 5A FF followed by a GIMBAL_CMD, the second, `gap`
+    seconds later, the bytes that complete the false sync as a valid
+    261-byte frame (type 0x00/0xFF) and a GIMBAL_ANGLE. A live receiver
+    whose quiet limit is below the gap judged the false sync on its own,
+    so the GIMBAL_CMD, then the GIMBAL_ANGLE; with a shorter gap the
+    261-byte frame (hiding the GIMBAL_CMD), then the GIMBAL_ANGLE."""
+    inner = gimbal_cmd(9000, -1000, 0xA0)[1]
+    cand = frame(0x00, 0xFF, inner[2:] + bytes(253 - len(inner) + 2))
+    assert cand[:4] == bytes([0x00, 0xFF, 0x5A, 0xFF]) and cand[4:4 + len(inner)] == inner
+    first = cand[:4 + len(inner)]
+    rest = cand[4 + len(inner):] + gimbal_angle(100, 200)[1]
+    ns = int(Decimal(gap) * 10**9)
+    with open(out, "wb") as f:
+        f.write(pcap_header(LINKTYPE_SERIAL))
+        f.write(pcap_record(T0, 1000000, bytes([DIRS["out"]]) + first))
+        f.write(pcap_record(T0 + (1000000 + ns) // 10**9, (1000000 + ns) % 10**9,
+                            bytes([DIRS["out"]]) + rest))
+
+
 def cut_records(streams, sizes):
     """Round-robin records of the given sizes (cycled) from each stream:
     [(dir, stream offset of the end, bytes)]."""
@@ -595,6 +640,8 @@ def main(argv):
         expect_serial(args[0], args[1:])
     elif cmd == "can-pcap":
         can_pcap(args[0], args[1])
+    elif cmd == "quiet":
+        quiet(args[0], args[1])
     elif cmd == "bad-pcap":
         bad_pcap(args[0])
     elif cmd == "pty-pair":

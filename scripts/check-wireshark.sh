@@ -65,11 +65,13 @@ expect() {
         bad "$name: $(cat "$dir/expect.out")"
     fi
 }
-# compare TAG NAME CAPTURE DECODE-ARGS...: the dissector against tase decode
+# compare TAG NAME CAPTURE DECODE-ARGS...: the dissector (with tshark
+# options dissect_opts) against tase decode
+dissect_opts=()
 compare() {
     local tag=$1 name=$2 cap=$3
     shift 3
-    if ! dissect "$cap" -T pdml >"$dir/$tag.pdml"; then
+    if ! dissect "$cap" "${dissect_opts[@]}" -T pdml >"$dir/$tag.pdml"; then
         bad "$name: tshark failed: $(grep -v "Running as user" "$dir/tshark.err" | head -3)"
         return
     fi
@@ -101,6 +103,28 @@ $U can-pcap "$dir/can.pcap" "$DATA/decode_candump.log"
 compare canpcap "SocketCAN pcap (Wireshark's CAN dissector)" "$dir/can.pcap" "$dir/can.pcap"
 $U serial-pcap "$dir/noisy.pcap" 5 0.001-3 "$DATA/decode_noisy.bin:out" "$DATA/decode_noisy.bin:in"
 compare noisy "noisy serial capture, both directions" "$dir/noisy.pcap" "$dir/noisy.pcap"
+
+# Issue 27: a gap in the record times ends a held candidate in both tools
+# as the live receiver's time bound did: after the false sync 00 FF 5A FF
+# and a GIMBAL_CMD, the 241 bytes still claimed need 42 ms at 57600 baud
+# (251 ms at 9600), so a longer gap shows the GIMBAL_CMD, a shorter one
+# the 261-byte frame the later bytes complete (capture_util.py quiet).
+# want_quiet TAG FIRST: the first frame tase decode printed for TAG
+want_quiet() { [ "$(head -1 "$dir/$1.json" | sed 's/.*"name":"\([A-Z_]*\)".*/\1/')" = "$2" ]; }
+for gap in 1 0.030 0.2; do
+    $U quiet "$dir/quiet-$gap.pcap" "$gap"
+done
+compare quiet1 "1 s gap after noise at 57600 baud" "$dir/quiet-1.pcap" "$dir/quiet-1.pcap"
+check "... it ended the false candidate: the GIMBAL_CMD is shown" want_quiet quiet1 GIMBAL_CMD
+compare quiet30 "30 ms gap at 57600 baud" "$dir/quiet-0.030.pcap" "$dir/quiet-0.030.pcap"
+check "... below the limit: the 261-byte frame the later bytes complete" want_quiet quiet30 UNKNOWN
+compare quiet200 "200 ms gap at 57600 baud" "$dir/quiet-0.2.pcap" "$dir/quiet-0.2.pcap"
+check "... past the limit: the GIMBAL_CMD" want_quiet quiet200 GIMBAL_CMD
+dissect_opts=(-o tase.baud:9600)
+compare quiet200s "200 ms gap at 9600 baud (tshark -o tase.baud:9600, decode --baud 9600)" \
+    "$dir/quiet-0.2.pcap" "$dir/quiet-0.2.pcap" --baud 9600
+check "... below the limit there: the 261-byte frame" want_quiet quiet200s UNKNOWN
+dissect_opts=()
 
 # Issue 12's greedy receiver, in both tools, on a serial capture and a
 # candump log each: a CAMERA_PASS whose camera bytes are a valid frame

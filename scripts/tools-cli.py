@@ -349,6 +349,43 @@ def cooked_pty(args, data, expect_lines):
     return p.returncode, (out + rest).decode(errors="replace"), err, echoed, before, after
 
 
+def after_noise(args):
+    """Issue 27: run tase ARGS PTY; once tase has the line, its far end
+    writes the false sync 00 FF 5A FF and a GIMBAL_ANGLE, then nothing.
+    Returns (seconds until tase printed a line, or None within 2 s; the
+    output)."""
+    master, slave = os.openpty()
+    path = os.ttyname(slave)
+    p = subprocess.Popen(VG + [TASE] + args + [path], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE)
+    deadline = time.time() + 2.0 * SLOW
+    while time.time() < deadline and termios.tcgetattr(slave)[3] & termios.ICANON:
+        time.sleep(0.01)
+    time.sleep(0.05)
+    t0 = time.time()
+    os.write(master, bytes([0x00, 0xFF, 0x5A, 0xFF]) + angle(7, 8))
+    out, took = b"", None
+    os.set_blocking(p.stdout.fileno(), False)
+    while time.time() < t0 + 2.0 * SLOW and b"\n" not in out:
+        if select.select([p.stdout], [], [], 0.005)[0]:
+            out += p.stdout.read() or b""
+    if b"\n" in out:
+        took = time.time() - t0
+    p.send_signal(signal.SIGTERM)
+    p.communicate(timeout=10 * SLOW)
+    os.close(master)
+    os.close(slave)
+    return took, out.decode(errors="replace")
+
+
+# 57600 baud: the 257 bytes the false sync claims, less the frame's 14,
+# take 43 ms; 200 ms leaves room for a loaded machine.
+for what, args in (("monitor", ["monitor", "--json", "--serial"]), ("decode", ["decode"])):
+    took, out = after_noise(args)
+    ok("tase %s: a frame after noise, then silence, is printed within 200 ms (%s)"
+       % (what, "never" if took is None else "%.0f ms" % (took * 1000)),
+       took is not None and took < 0.2 * SLOW and '"pan":7,' in out, out[:200])
+
 want = run(["klv", os.path.join(os.path.dirname(noisy), "klv_noisy.bin")])[1]
 rc, out, err, echoed, before, after = cooked_pty(["klv"], klv, want.count("\n"))
 ok("tase klv PTY (cooked mode): every packet decoded, as from the file (%d of %d lines)"

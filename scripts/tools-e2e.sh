@@ -145,6 +145,35 @@ last=$(last_angle)
 check "... and nothing reached the gimbal: it stays at 30/-15 ($last)" \
     eval '[ "$(sim_says GIMBAL_CMD)" = "$n" ] && near "$(json_int "$last" pan)" 3000 2'
 
+# ---- issue 27: four bytes of noise (00 FF 5A FF, a false sync claiming
+# 257 more bytes) must not make the link deaf: the gimbal's receiver judges
+# the held candidate false once the line has been quiet for its limit ----
+noise() {
+    python3 -c 'import os, sys
+fd = os.open(sys.argv[1], os.O_WRONLY | os.O_NOCTTY)
+os.write(fd, bytes([0x00, 0xFF, 0x5A, 0xFF]))
+os.close(fd)' "$dir/gimbal"
+}
+ms() { date +%s%3N; }
+noise
+t0=$(ms)
+v=$("$TASE" query SYSTEM_VERSION "${L[@]}" --json --retries 0 2>&1)
+rc=$?
+t1=$(ms)
+check "after noise a query is answered within 100 ms at 57600 baud (exit $rc, $((t1 - t0)) ms)" \
+    eval '[ $rc = 0 ] && [ $((t1 - t0)) -le $((100 * slow)) ] && grep -q "\"SYSTEM_VERSION\"" <<<"$v"'
+bad_q=0
+for _ in 1 2 3; do
+    quiet "$TASE" query PACKET_RATE "${L[@]}" --retries 0 || bad_q=$((bad_q + 1))
+done
+check "... and so are the next queries ($bad_q of 3 failed)" test $bad_q = 0
+n=$(sim_says "GIMBAL_CMD: position pan 30.00 tilt -15.00")
+noise
+quiet "$TASE" point 30 -15 "${L[@]}"
+sleep "$(awk "BEGIN { print 0.1 * $slow }")"
+check "after noise tase point is carried out within 100 ms, not when 257 more bytes came" \
+    test "$(sim_says "GIMBAL_CMD: position pan 30.00 tilt -15.00")" = $((n + 1))
+
 # SPOI error forms are accepted but not modelled: the log says so (that
 # the model's state is unchanged is tests/test_sim_model.c's).
 quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xC0 impulse_time=0 "${L[@]}"

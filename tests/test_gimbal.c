@@ -797,6 +797,55 @@ static void service_reads_every_port_feeds_it_and_polls(void **state)
     free(x);
 }
 
+/* Issue 27: noise before a command on a quiet link. Four bytes 00 FF 5A FF
+ * claim a 261-byte frame; the GIMBAL_CMD and the PACKET_RATE query after
+ * them, then silence. Fed by the application (tase_gimbal_feed(), n == 0
+ * for an empty read) and read by tase_gimbal_service(): both hand the
+ * command over once the line has been quiet for the receiver's limit
+ * (here the 20 ms margin: the fake port carries 100,000 B/s), not when
+ * 257 more bytes have come. */
+static void noise_before_a_command_delays_it_only_up_to_the_quiet_limit(void **state)
+{
+    static const uint8_t noise[4] = {0x00, 0xFF, 0x5A, 0xFF};
+    uint8_t cmd[8] = {0x30, 0, 0, 0, 0, 0, 0, 0};
+    uint8_t fr[2 * TASE_FRAME_MAX];
+    uint8_t g, t, d[TASE_DATA_MAX];
+    fix_t *x = make(0, 1, false);
+    int n, m;
+    (void)state;
+
+    n = tase_frame_encode(fr, sizeof fr, 0x00, 0x80, cmd, sizeof cmd);
+    m = tase_frame_encode(fr + n, sizeof fr - (size_t)n, 0x48, 0x00, NULL, 0);
+    assert_true(n > 0 && m > 0);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, noise, sizeof noise, 10), 0);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, fr, (size_t)(n + m), 11), 0);
+    assert_int_equal(x->others, 0); /* held behind the false candidate */
+    assert_int_equal(tase_rx_quiet_ms(&x->rx[0], 11), 21);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, NULL, 0, 31), 0); /* 20 ms: still held */
+    assert_int_equal(x->others, 0);
+    assert_int_equal(tase_rx_quiet_ms(&x->rx[0], 31), 1);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, NULL, 0, 32), 2); /* past it: both frames */
+    assert_int_equal(x->others, 1);
+    assert_int_equal(x->other_type, 0x80);
+    assert_int_equal(only_frame(&x->port[0], &g, &t, d), 16); /* the PACKET_RATE answer */
+    assert_int_equal(g, 0x48);
+    assert_int_equal(t, 0x00);
+    assert_int_equal(tase_rx_quiet_ms(&x->rx[0], 32), UINT32_MAX);
+    assert_int_equal(x->rx[0].stats.bytes_in, sizeof noise + (size_t)(n + m));
+
+    /* The same through tase_gimbal_service() on the fake port. */
+    fake_push(&x->port[0], noise, sizeof noise);
+    fake_push(&x->port[0], fr, (size_t)n);
+    assert_int_equal(tase_gimbal_service(&x->g, 1000), 0);
+    assert_int_equal(x->others, 1);
+    assert_int_equal(tase_gimbal_service(&x->g, 1020), 0);
+    assert_int_equal(x->others, 1);
+    assert_int_equal(tase_gimbal_service(&x->g, 1021), 0);
+    assert_int_equal(x->others, 2);
+    assert_int_equal(x->other_type, 0x80);
+    free(x);
+}
+
 /* A port whose read() claims one byte more than it was given room for. */
 static int overclaiming_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
 {
@@ -1424,6 +1473,7 @@ int main(void)
         cmocka_unit_test(every_function_rejects_null_and_out_of_range_arguments),
         cmocka_unit_test(frames_from_absent_ports_and_without_callbacks_are_only_counted),
         cmocka_unit_test(service_reads_every_port_feeds_it_and_polls),
+        cmocka_unit_test(noise_before_a_command_delays_it_only_up_to_the_quiet_limit),
         cmocka_unit_test(typed_telemetry_is_encoded_from_the_filled_structs),
         cmocka_unit_test(a_typed_setting_is_decoded_applied_stored_and_echoed),
         cmocka_unit_test(typed_setup_set_and_send_msg),

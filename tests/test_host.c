@@ -285,6 +285,48 @@ static void transact_blocks_until_the_scripted_gimbal_answers(void **state)
     assert_true(x->port.now - 777u < 520u);
 }
 
+/* Issue 27: noise before the echo on a quiet 57600-baud link. The four
+ * bytes 00 FF 5A FF claim a 261-byte frame; the echo comes inside it,
+ * then nothing. tase_host_service() wakes by the receiver's quiet limit
+ * (233 remaining bytes at 5760 B/s: 41 ms) instead of the caller's wait,
+ * and its empty read settles the false candidate: the transaction
+ * completes within 50 ms of the echo's last byte, not at its timeout. */
+static void noise_before_the_echo_delays_it_only_up_to_the_quiet_limit(void **state)
+{
+    static const uint8_t noise[4] = {0x00, 0xFF, 0x5A, 0xFF};
+    fix_t *x = *state;
+    uint8_t reply[64];
+    uint8_t fr[TASE_FRAME_MAX];
+    int n;
+
+    memcpy(x->port.reply, noise, sizeof noise);
+    n = tase_frame_encode(x->port.reply + 4, sizeof x->port.reply - 4u, 0x48, 0x03, rates, 16);
+    assert_int_equal(n, 24);
+    x->port.nreply = 4u + (size_t)n;
+    x->port.reply_after = 1;
+    x->port.now = 777;
+    n = tase_host_transact(&x->host, 0x48, 0x03, NULL, 0, reply, sizeof reply, 1000, 0);
+    assert_int_equal(n, 16);
+    assert_memory_equal(reply, rates, 16);
+    /* read at 777 (+1 ms on the fake port), then quiet for 41 ms + 1 */
+    assert_int_equal(x->port.now, 777u + 1u + 42u);
+
+    /* service alone: a stray frame behind noise reaches on_frame by the
+     * limit, and the wait asked for (1000 ms) is cut to it */
+    x->port.now = 5000;
+    fake_push(&x->port, noise, sizeof noise);
+    n = tase_frame_encode(fr, sizeof fr, 0x00, 0x80, rates, 8);
+    fake_push(&x->port, fr, (size_t)n);
+    assert_int_equal(tase_host_service(&x->host, 1000), 4 + n);
+    assert_int_equal(x->others, 0);
+    assert_int_equal(tase_host_service(&x->host, 1000), 0);
+    assert_int_equal(x->others, 1);
+    assert_int_equal(x->last_type, 0x80);
+    assert_true(x->port.now - 5001u <= 45u);                /* 241 bytes at 5760 B/s, plus 1 */
+    assert_int_equal(tase_host_service(&x->host, 1000), 0); /* nothing held: the full wait */
+    assert_true(x->port.now - 5001u >= 1000u);
+}
+
 static void transact_times_out_after_all_attempts(void **state)
 {
     fix_t *x = *state;
@@ -805,6 +847,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(transact_blocks_until_the_scripted_gimbal_answers, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(transact_times_out_after_all_attempts, setup, teardown),
+        cmocka_unit_test_setup_teardown(noise_before_the_echo_delays_it_only_up_to_the_quiet_limit,
+                                        setup, teardown),
         cmocka_unit_test_setup_teardown(bad_arguments_are_rejected, setup, teardown),
         cmocka_unit_test_setup_teardown(service_and_transact_need_a_readable_port_with_a_clock,
                                         setup, teardown),

@@ -151,7 +151,10 @@ static const char usage_decode[] =
     "status is 4. A serial device (or pty) named as FILE is opened as the link\n"
     "commands open one: raw 8N1 at --baud N (default 57600), exclusively, its\n"
     "settings given back at exit; SIGINT/SIGTERM/SIGHUP end it (exit 0), a hang-up\n"
-    "is an error (exit 1).\n";
+    "is an error (exit 1). As a live receiver does, a candidate frame the line\n"
+    "went quiet on is judged false after its remaining bytes' time at the line's\n"
+    "rate (a capture's: --baud; CAN: 1 Mbit/s), at least 20 ms: on a device by\n"
+    "the clock, in a capture or candump log by the gaps in the record times.\n";
 
 static const char usage_klv[] =
     "usage: tase klv [FILE|-] [--baud N]\n"
@@ -1407,11 +1410,14 @@ static int cmd_monitor(args_t *a)
     open_link(&lo, &link, &port);
     tk_dec_init(&d, &fmt, stdout);
     d.limit = (uint64_t)limit;
+    d.serial_rate = port.bytes_per_s;
     st = tk_dec_stream(&d, "", NULL);
     t_end = tk_now_s() + seconds;
     while ((limit == 0 || d.n.frames < (uint64_t)limit) && (seconds == 0.0 || tk_now_s() < t_end) &&
            tk_signal == 0) {
-        int n = port.ops->read(port.ctx, buf, sizeof(buf), 50);
+        /* wake by the receiver's quiet limit (tase/frame.h, TIME BOUND) */
+        uint32_t wait = tase_rx_quiet_ms(&st->rx, port.ops->now_ms(port.ctx));
+        int n = port.ops->read(port.ctx, buf, sizeof(buf), wait < 50u ? wait : 50u);
         if (n < 0) {
             if (tk_signal == 0) {
                 failed = n; /* a hang-up, most likely: the summary, then why */
@@ -1428,8 +1434,9 @@ static int cmd_monitor(args_t *a)
                 tk_time_now(&now);
             }
             tk_dec_bytes(&d, st, buf, (size_t)n, fmt.time ? &now : NULL);
-            tk_stdout_flush();
         }
+        tk_dec_tick(&d, st, port.ops->now_ms(port.ctx)); /* arrival, or quiet until now */
+        tk_stdout_flush();
     }
     if (link.is_can) {
         tase_socketcan_bus_t bus;
@@ -1477,6 +1484,9 @@ typedef struct {
     bool hung_up; /* the device went away or hung up */
     tk_link_t link;
     tase_port_t port;
+    /* a device's stream, ticked by its reads (tase/frame.h, TIME BOUND) */
+    tk_dec_t *dec;
+    tk_stream_t *st;
     /* the first bytes, kept for the hint when nothing is found (one
      * more for a terminating NUL) */
     uint8_t head[513];
@@ -1556,9 +1566,16 @@ static size_t input_read(input_t *in, uint8_t *buf, size_t cap)
         if (tk_signal != 0) {
             return 0;
         }
-        n = in->port.ops->read(in->port.ctx, buf, cap, 100);
+        uint32_t wait = in->st != NULL
+                            ? tase_rx_quiet_ms(&in->st->rx, in->port.ops->now_ms(in->port.ctx))
+                            : 100u;
+        n = in->port.ops->read(in->port.ctx, buf, cap, wait < 100u ? wait : 100u);
         if (n > 0) {
             return input_keep_head(in, buf, (size_t)n);
+        }
+        if (n == 0 && in->st != NULL) { /* quiet until now */
+            tk_dec_tick(in->dec, in->st, in->port.ops->now_ms(in->port.ctx));
+            tk_stdout_flush(); /* what it settled goes out now */
         }
         if (n == TASE_EIO) {
             in->hung_up = true;
@@ -1636,8 +1653,15 @@ static size_t input_head(input_t *in, uint8_t *buf, size_t cap)
 static void decode_raw(input_t *in, tk_dec_t *d, uint8_t *buf, size_t cap, size_t n)
 {
     tk_stream_t *s = tk_dec_stream(d, "", NULL);
+    if (in->device) { /* a live line: the receiver's time bound applies */
+        in->dec = d;
+        in->st = s;
+    }
     while (n > 0) {
         tk_dec_bytes(d, s, buf, n, NULL);
+        if (in->device) {
+            tk_dec_tick(d, s, in->port.ops->now_ms(in->port.ctx));
+        }
         tk_stdout_flush(); /* a live input's frames go out as they come */
         n = input_read(in, buf, cap);
     }
@@ -1762,10 +1786,10 @@ static unsigned long decode_candump(input_t *in, tk_dec_t *d)
 }
 
 /* --baud given for an input that is no serial device */
-static void input_check_baud(const input_t *in, bool baud_given)
+static void input_check_baud(const input_t *in, bool baud_given, const char *or_capture)
 {
     if (baud_given && !in->device) {
-        tk_usage_error("--baud is for a serial device; %s is not one", in->name);
+        tk_usage_error("--baud is for a serial device%s; %s is not one", or_capture, in->name);
     }
 }
 
@@ -1796,10 +1820,14 @@ static int cmd_decode(args_t *a)
         }
     }
     input_open(&in, path, baud);
-    input_check_baud(&in, baud_given);
     tk_stdout_buffered();
     tk_dec_init(&d, &fmt, stdout);
+    /* a capture's record times are the receivers' clock: a gap in them
+     * ends a held candidate as it did on the live line, at --baud */
+    d.by_time = true;
+    d.serial_rate = TASE_UART_BYTES_PER_S((uint32_t)baud);
     if (candump) {
+        input_check_baud(&in, baud_given, " or a serial capture");
         bad = decode_candump(&in, &d);
     } else {
         static uint8_t buf[READ_CHUNK];
@@ -1807,9 +1835,10 @@ static int cmd_decode(args_t *a)
         size_t n =
             in.device ? input_read(&in, buf, sizeof(buf)) : input_head(&in, buf, sizeof(buf));
         if (!in.device && tk_cap_is_capture(buf, n)) {
-            capture = true;
+            capture = true; /* --baud: the rate of its serial line */
             bad = decode_capture(&in, &d, buf, n);
         } else {
+            input_check_baud(&in, baud_given, " or a serial capture");
             decode_raw(&in, &d, buf, sizeof(buf), n);
         }
     }
@@ -1904,7 +1933,7 @@ static int cmd_klv(args_t *a)
         }
     }
     input_open(&in, path, baud);
-    input_check_baud(&in, baud_given);
+    input_check_baud(&in, baud_given, "");
     tk_stdout_buffered();
     (void)tase_klv_rx_init(&rx);
     while ((n = input_read(&in, buf, sizeof(buf))) > 0) {

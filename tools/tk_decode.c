@@ -10,6 +10,7 @@ void tk_dec_init(tk_dec_t *d, const tk_fmt_t *fmt, FILE *out)
     memset(d, 0, sizeof(*d));
     d->fmt = *fmt;
     d->out = out;
+    d->serial_rate = TASE_UART_BYTES_PER_S(57600);
 }
 
 static bool same_dir(const char *a, const char *b)
@@ -35,6 +36,7 @@ tk_stream_t *tk_dec_stream(tk_dec_t *d, const char *iface, const char *dir)
     strncpy(s->iface, iface, sizeof(s->iface) - 1u);
     s->dir = dir;
     (void)tase_rx_init(&s->rx);
+    (void)tase_rx_set_timing(&s->rx, d->serial_rate, 0u);
     return s;
 }
 
@@ -108,8 +110,26 @@ static void begin(tk_dec_t *d, tk_stream_t *s, const tk_time_t *time)
     d->time = time;
 }
 
+void tk_dec_tick(tk_dec_t *d, tk_stream_t *s, uint32_t now_ms)
+{
+    begin(d, s, s->timed ? &s->last : NULL);
+    (void)tase_rx_tick(&s->rx, now_ms, on_frame, d);
+    account(d, s);
+    flush_out(d);
+}
+
+/* A record time on the receivers' millisecond clock (modulo 2^32). */
+static uint32_t time_ms(const tk_time_t *t)
+{
+    return (uint32_t)((uint64_t)t->sec * 1000u + t->usec / 1000u);
+}
+
 void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n, const tk_time_t *time)
 {
+    if (d->by_time && time != NULL) {
+        /* the line was quiet from the last record until this one */
+        tk_dec_tick(d, s, time_ms(time));
+    }
     if (time != NULL) {
         s->last = *time;
         s->timed = true;
@@ -130,6 +150,9 @@ void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n, co
         account(d, s);
         data += k;
         n -= k;
+    }
+    if (d->by_time && time != NULL) {
+        tk_dec_tick(d, s, time_ms(time)); /* notes the bytes' arrival */
     }
     flush_out(d);
 }
@@ -152,6 +175,7 @@ bool tk_dec_can(tk_dec_t *d, const char *iface, const tase_can_frame_t *f, const
     if (s == NULL) {
         return false;
     }
+    (void)tase_rx_set_timing(&s->rx, TASE_SOCKETCAN_BYTES_PER_S, 0u);
     tk_dec_bytes(d, s, f->data, (size_t)n, time);
     return true;
 }

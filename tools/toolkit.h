@@ -285,6 +285,14 @@ typedef struct {
     tk_fmt_t fmt;
     FILE *out;
     uint64_t limit; /* stop printing after this many frames, 0 none */
+    /* The receivers' time bound (tase/frame.h, TIME BOUND): with by_time,
+     * the times given to tk_dec_bytes()/tk_dec_can() are the clock (a
+     * capture's record times: a gap in them settles a held candidate as
+     * the live receiver did); otherwise the caller ticks (tk_dec_tick()).
+     * serial_rate is a serial stream's byte rate (CAN streams: the
+     * SocketCAN port's). Set both before the first stream is made. */
+    bool by_time;
+    uint32_t serial_rate;
     tk_counts_t n;
     size_t nstreams;
     tk_stream_t stream[TK_STREAMS_MAX];
@@ -298,7 +306,8 @@ typedef struct {
     char obuf[1u << 16];
 } tk_dec_t;
 
-/* Initialise: no streams, counters zero, output to `out` in `fmt`. */
+/* Initialise: no streams, counters zero, output to `out` in `fmt`,
+ * ticked by the caller, serial streams at 57600 baud. */
 void tk_dec_init(tk_dec_t *d, const tk_fmt_t *fmt, FILE *out);
 /* The stream of (iface, dir), created on first use ("" / NULL for a
  * serial line); NULL when TK_STREAMS_MAX streams exist already. `dir` must
@@ -313,6 +322,11 @@ void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n,
  * direction, others are only counted. Returns false when no stream could
  * be created (too many interfaces). */
 bool tk_dec_can(tk_dec_t *d, const char *iface, const tase_can_frame_t *f, const tk_time_t *time);
+/* The receiver's clock (tase_rx_tick()): call after feeding bytes that
+ * arrived at now_ms and after a read that found the line quiet until
+ * now_ms; a candidate held past its quiet limit is settled and its frames
+ * written out. */
+void tk_dec_tick(tk_dec_t *d, tk_stream_t *s, uint32_t now_ms);
 /* End of input: settle every stream's pending frames. */
 void tk_dec_finish(tk_dec_t *d);
 /* One summary line on `out` ("tase: summary: N frames, ..." and `extra`). */

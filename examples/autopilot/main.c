@@ -583,6 +583,7 @@ int main(void)
 
     r = tase_bm_uart_init(&uart, ring_storage, sizeof ring_storage, &hooks, NULL);
     port = tase_bm_uart_port(&uart);
+    port.bytes_per_s = TASE_UART_BYTES_PER_S(57600); /* the gimbal line: the time bound */
     if (r != TASE_OK || (r = link_init(&m.link, &port, handlers, on_other, on_error, &m)) != 0) {
         printf("FAIL init: %s\n", tase_strerror(r));
         return 1;

@@ -12,12 +12,16 @@
  * application (gimbal.c) registers typed handlers in a ROM table; the
  * setup handler passes setup packets on to the gimbal role, which answers
  * queries and echoes settings through the same port, whose TX hook
- * appends to a buffer.
+ * appends to a buffer. Once the line goes quiet for 100 ms right after
+ * noise that looks like a sync with Size 255 and a GIMBAL_CMD: the
+ * receiver's time bound (tase/frame.h, TIME BOUND; ticked by
+ * tase_bm_uart_poll()) delivers the command 22 ms after its last byte,
+ * not when 241 more bytes have come.
  *
  * After the simulated run the image checks everything against stream.h,
  * whose expectations come from an independent Python model: every clean
  * frame (offset, id, length, route: typed handler / error hook / default
- * handler, decoded fields), the receiver's counters, and, through a second
+ * handler, decoded fields, the tick that delivers it), the receiver's counters, and, through a second
  * receiver and the typed decoder as a host would see them, every reply and
  * telemetry frame with its time and contents. It prints a summary with
  * its own flash/RAM/stack numbers through semihosting and exits 0 when
@@ -50,8 +54,17 @@ static volatile uint32_t ticks, uart_pos;
 /* What the UART's receive interrupt would do with each byte. */
 void SysTick_Handler(void)
 {
+    static uint32_t paused;
     uint32_t i;
+    if (uart_pos == STREAM_PAUSE_AT && paused < STREAM_PAUSE_MS) {
+        paused++; /* the line is quiet */
+        ticks++;
+        return;
+    }
     for (i = 0; i < STREAM_BYTES_PER_TICK && uart_pos < sizeof(stream_bytes); i++) {
+        if (uart_pos == STREAM_PAUSE_AT && paused < STREAM_PAUSE_MS) {
+            break;
+        }
         tase_bm_uart_rx_isr(&uart, stream_bytes[uart_pos]);
         uart_pos++;
     }
@@ -98,6 +111,7 @@ static void check(int ok, const char *what, long got, long want)
 typedef struct {
     size_t frames;
     size_t routes[3];
+    uint32_t now; /* the main loop's tick */
 } seen_t;
 
 static void on_trace(void *user, const tase_frame_t *f, unsigned route, const int64_t *v, size_t n)
@@ -123,6 +137,9 @@ static void on_trace(void *user, const tase_frame_t *f, unsigned route, const in
               memcmp(f->data, &stream_bytes[e->offset + 6u], e->len) == 0,
           "frame data matches the recording (frame #)", (long)k, (long)k);
     check(route == e->route, "frame route", (long)route, e->route);
+    /* delivered at the tick the model says, held frames and the time
+     * bound's settling included */
+    check(s->now == e->tick, "frame delivered at tick", (long)s->now, (long)e->tick);
     check(n == e->nfields, "decoded field count", (long)n, e->nfields);
     for (i = 0; i < n && i < e->nfields; i++) {
         check(v[i] == expect_values[e->first + i], "decoded field value", (long)v[i],
@@ -252,6 +269,10 @@ int main(void)
     check(tase_bm_uart_init(&uart, ring_storage, sizeof ring_storage, &uart_hooks, NULL) == TASE_OK,
           "tase_bm_uart_init", 0, 0);
     port = tase_bm_uart_port(&uart);
+    /* The UART's byte rate: sizes the gimbal's telemetry capacity and the
+     * receiver's time bound (tase/frame.h, TIME BOUND). */
+    port.bytes_per_s = STREAM_LINE_BYTES_PER_S;
+    (void)tase_rx_set_timing(&rx, port.bytes_per_s, 0u);
     check(gimbal_app_init(&app, &port, &rx.stats, on_trace, &seen, 0u) == TASE_OK,
           "gimbal_app_init", 0, 0);
 
@@ -275,6 +296,7 @@ int main(void)
         }
         last = now;
         app.now_ms = now;
+        seen.now = now;
         (void)tase_gimbal_poll(&app.role, now);
         (void)tase_bm_uart_poll(&uart, &rx, tase_dispatch_frame, &app.dispatch);
         if (ticks != now) {

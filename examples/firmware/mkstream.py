@@ -23,34 +23,47 @@ def frame(group, ptype, data):
     return body + [s >> 8, s & 0xFF]
 
 
-def model(stream):
+def model(stream, arrive, pause_at, settle_after):
     """Reference receiver: the greedy scan of include/tase/frame.h. From the
     start of the stream, where a complete frame with a valid checksum
     begins it is taken and the scan continues after its last byte;
     anywhere else the scan moves on one byte. A frame is delivered once the
     bytes that decide it are in: its own last byte, or the last byte of an
     earlier candidate whose failure released it (a frame inside a pending
-    candidate is held until that candidate fails). Returns the frames
-    (start, group, type, data length, index of the deciding byte), the
-    checksum and Size errors, and the bytes not in a delivered frame."""
+    candidate is held until that candidate fails). TIME BOUND: a candidate
+    still pending when the line goes quiet (before byte `pause_at`, and at
+    the end of the stream) fails once the line has been quiet for longer
+    than its quiet limit: settle_after(bytes it still needs) ticks after
+    the tick of its last byte that came, if that is before the line speaks
+    again. `arrive(i)` is the tick that feeds byte i. Returns the frames
+    (start, group, type, data length, tick delivering it), the checksum
+    and Size errors, and the bytes not in a delivered frame."""
     out, csum_err, bad_size = [], 0, 0
     pos, decided, n = 0, 0, len(stream)
+    settled = None  # (first byte after the quiet, the tick it settled at)
     while pos < n:
+        if settled is not None and pos >= settled[0]:
+            settled = None
         if stream[pos:pos + 3] == SYNC and pos + 3 < n:
             size = stream[pos + 3]
             e = pos + size + 5  # index of the candidate's last byte
+            quiet_at = pause_at if pos < pause_at <= e else (n if e >= n else None)
+            if settled is None and quiet_at is not None:
+                at = arrive(quiet_at - 1) + settle_after(e + 1 - quiet_at)
+                if quiet_at == n or at < arrive(quiet_at):
+                    settled = (quiet_at, at)  # judged false before it completes
             if size < 2:
                 bad_size += 1
+            elif settled is not None and e >= settled[0]:
+                decided = max(decided, settled[1])  # can no longer complete
             elif e < n:
-                decided = max(decided, e)
+                decided = max(decided, arrive(e))
                 want = (stream[e - 1] << 8) | stream[e]
                 if sum(stream[pos:e - 1]) & 0xFFFF == want:
                     out.append((pos, stream[pos + 4], stream[pos + 5], size - 2, decided))
                     pos = e + 1
                     continue
                 csum_err += 1
-            else:
-                decided = n - 1  # settled by tase_rx_flush() at end of input
         pos += 1
     return out, csum_err, bad_size, n - sum(f[3] + 8 for f in out)
 
@@ -61,6 +74,19 @@ def model(stream):
 
 BYTES_PER_TICK = 12  # the simulated UART interrupt delivers 12 bytes per 1 ms tick
 RUN_MS = 1000        # the main loop polls the gimbal at t = 1 .. RUN_MS
+PAUSE_MS = 100       # the line is quiet this long once, after noise and a command
+# The receiver's time bound (include/tase/frame.h, TIME BOUND) as the
+# image sets it: 115200 baud (11,520 bytes/s), the 20 ms default margin.
+LINE_BYTES_PER_S = 11520
+QUIET_MS = 20
+
+
+def settle_after(left):
+    """Ticks after the last byte at which a held candidate still needing
+    `left` bytes is judged false: the first tick quiet for longer than
+    max(the bytes' time at the line's rate, the margin)."""
+    limit = max(-(-left * 1000 // LINE_BYTES_PER_S), QUIET_MS)
+    return limit + 1
 
 # Big-endian layouts of the packets in the stream (spec tables 5, 14, 20,
 # 21, 24): one letter per field, x = reserved byte.
@@ -204,6 +230,15 @@ def main():
         noise(rnd.randrange(3, 40))
         stream.extend(SYNC + [rnd.randrange(2, 256)])
     noise(300)  # outlasts the false syncs' claimed sizes
+    # Issue 27: noise that looks like a sync with Size 255 (257 more bytes
+    # claimed), a GIMBAL_CMD, then the line goes quiet for PAUSE_MS: the
+    # command comes out by the time bound, not when 257 more bytes came.
+    noise((-len(stream) - 4 - 16) % BYTES_PER_TICK)
+    stream.extend([0x00, 0xFF, 0x5A, 0xFF])
+    quiet_cmd = len(stream)
+    clean(0x00, 0x80, [0x03, 0xE8, 0x07, 0xD0, 0, 0, 0xA0, 0])  # GIMBAL_CMD 10.00/20.00
+    pause_at = len(stream)
+    assert pause_at % BYTES_PER_TICK == 0
     corrupt(0x08, 0x41, list(range(18)), lambda f: f.__setitem__(len(f) - 1, f[-1] ^ 1))
     clean(0x48, 0x01, [], [80, 3])                       # SENSOR_FILTER query: kept
     clean(0x48, 0x00, [], rates_new)                     # PACKET_RATE query: the new rates
@@ -212,9 +247,14 @@ def main():
         noise(rnd.randrange(0, 8))
     stream.extend(frame(0x48, 0x00, [])[:5])             # incomplete at end of input
 
-    found, csum_err, bad_size, discarded = model(stream)
+    def arrive(i):
+        return i // BYTES_PER_TICK + 1 + (PAUSE_MS if i >= pause_at else 0)
+
+    found, csum_err, bad_size, discarded = model(stream, arrive, pause_at, settle_after)
     assert [f[:4] for f in found] == intended, (found, intended)
-    assert len(stream) <= BYTES_PER_TICK * RUN_MS
+    assert arrive(len(stream) - 1) <= RUN_MS
+    quiet_tick = [f[4] for f in found if f[0] == quiet_cmd][0]
+    assert quiet_tick == arrive(pause_at - 1) + settle_after(261 - 20), quiet_tick
 
     # What each frame must reach the application as, and when.
     rows, values, events = [], [], {}
@@ -225,9 +265,9 @@ def main():
         fmt = LAYOUT.get((g, t), (None, 0))[0]
         if r == ROUTE_TYPED and fmt is not None:  # a query decodes to zeros
             v = fields(fmt, data) if n > 0 else [0] * len(fmt.replace("x", ""))
-        rows.append((s, g, t, n, r, len(values), len(v)))
+        rows.append((s, g, t, n, r, len(values), len(v), decided))
         values.extend(v)
-        tick = decided // BYTES_PER_TICK + 1  # tick that feeds the byte deciding it
+        tick = decided  # the tick that delivers it
         if r == ROUTE_TYPED and (g, t) == (0x00, 0x80):
             events.setdefault(tick, []).append(("cmd", v))
         if r == ROUTE_TYPED and (g, t) == (0x48, 0x00) and n > 0:
@@ -243,6 +283,10 @@ def main():
     w("")
     w("#define STREAM_BYTES_PER_TICK %du" % BYTES_PER_TICK)
     w("#define STREAM_RUN_MS %du" % RUN_MS)
+    w("/* the line is quiet for STREAM_PAUSE_MS ticks before this byte */")
+    w("#define STREAM_PAUSE_AT %du" % pause_at)
+    w("#define STREAM_PAUSE_MS %du" % PAUSE_MS)
+    w("#define STREAM_LINE_BYTES_PER_S %du" % LINE_BYTES_PER_S)
     w("")
     w("static const uint8_t stream_bytes[%d] = {" % len(stream))
     for i in range(0, len(stream), 16):
@@ -258,12 +302,13 @@ def main():
     w("    uint32_t offset;")
     w("    uint8_t group, type, len, route;")
     w("    uint8_t first, nfields; /* decoded fields: expect_values[first..] */")
+    w("    uint16_t tick;          /* the main loop tick that delivers it */")
     w("} expect_frame_t;")
     w("")
     w("/* Every clean frame, in delivery order. */")
     w("static const expect_frame_t expect_frames[%d] = {" % len(rows))
-    for s, g, t, n, r, first, nf in rows:
-        w("    {%u, 0x%02X, 0x%02X, %u, %u, %u, %u}," % (s, g, t, n, r, first, nf))
+    for s, g, t, n, r, first, nf, tick in rows:
+        w("    {%u, 0x%02X, 0x%02X, %u, %u, %u, %u, %u}," % (s, g, t, n, r, first, nf, tick))
     w("};")
     w("")
     w("/* Decoded field values of the typed frames, in the spec's field order. */")

@@ -49,13 +49,13 @@
  * Headers of one release used with the library of another (a stale copy
  * in /usr/local/include, an old libtase-dev) would describe instances of
  * another size than the library fills: 0.1.0's tase_rx_t is 328 bytes on
- * x86-64, 0.2.0's 296. So every function that initialises an instance the
+ * x86-64, 0.2.0's 296, 0.3.0's 312. So every function that initialises an instance the
  * application allocates and the library fills links under a name that
  * carries the headers' ABI level (TASE_ABI_LEVEL, tase/version.h): the
- * call tase_rx_init(&rx) links to tase_rx_init_abi2, and a library of
+ * call tase_rx_init(&rx) links to tase_rx_init_abi3, and a library of
  * another level does not define that name. A mismatch is a link error
  * naming the level the application's headers expected, e.g.
- *     undefined reference to `tase_rx_init_abi2'
+ *     undefined reference to `tase_rx_init_abi3'
  * (0.1.0's headers give `tase_rx_init': that release had no tag). Fix:
  * build against the headers installed with the library you link. In
  * source code the functions keep their plain names (macros below);

@@ -15,7 +15,7 @@
 /* Keep each of these three lines exactly "#define NAME <number>":
  * CMakeLists.txt parses them. */
 #define TASE_VERSION_MAJOR 0
-#define TASE_VERSION_MINOR 2
+#define TASE_VERSION_MINOR 3
 #define TASE_VERSION_PATCH 0
 
 /* MAJOR * 10000 + MINOR * 100 + PATCH (minor and patch stay below 100). */
@@ -36,16 +36,18 @@
  * of a public function, and only then, so two releases with the same
  * level can be mixed. The initialisers of the instances an application
  * allocates and the library fills link under names that carry it
- * (tase_rx_init -> tase_rx_init_abi2; the list is in tase/config.h), so
+ * (tase_rx_init -> tase_rx_init_abi3; the list is in tase/config.h), so
  * headers of one level used with the library of another, such as a stale
  * copy in /usr/local/include, fail to link instead of overrunning memory:
- *     undefined reference to `tase_rx_init_abi2'
+ *     undefined reference to `tase_rx_init_abi3'
  * Levels:
  *   1  0.1.0, the first release (its initialisers link under their plain
  *      names, tase_rx_init; sizeof(tase_rx_t) 328 on x86-64).
  *   2  0.2.0: the greedy receiver (sizeof(tase_rx_t) 296 on x86-64)
  *      and the other changes CHANGELOG.md lists under 0.2.0.
+ *   3  0.3.0: the receiver's time bound (sizeof(tase_rx_t) 312),
+ *      tase_port_t's bytes_per_s and the other changes under 0.3.0.
  * Keep it a plain decimal number: it is pasted into link names. */
-#define TASE_ABI_LEVEL 2
+#define TASE_ABI_LEVEL 3
 
 #endif /* TASE_VERSION_H */

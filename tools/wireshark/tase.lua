@@ -72,6 +72,12 @@
 
 local tase = Proto("tase", "TASE gimbal protocol")
 local tase_serial = Proto("tase_serial", "TASE serial capture")
+-- A serial capture's line rate: `tase decode --baud`'s (the time bound of
+-- reassembly below). tshark: -o tase.baud:9600.
+tase.prefs.baud = Pref.uint("Serial line baud rate", 57600,
+    "The rate of the captured serial line (as tase decode --baud): a pending candidate frame "
+        .. "is judged false after a gap longer than its remaining bytes' time at this rate, "
+        .. "at least 20 ms")
 
 -- BEGIN GENERATED (tools/wireshark/schema_lua.c; do not edit by hand)
 -- {group, type, name, data length, flags, {{field, offset, width, signed}...}}
@@ -188,6 +194,8 @@ local SCHEMA = {
 -- END GENERATED
 
 local SYNC = "\0\255\90" -- 00 FF 5A
+-- the byte rate of the CAN encapsulation at 1 Mbit/s (tase/socketcan.h)
+local CAN_BYTES_PER_S = 50000
 local DIR_NAMES = {[0] = "out", [1] = "in"} -- serial pseudo-header values
 local CAN_DIRS = {[0x10000000] = "out", [0x11000000] = "in"}
 local ID_3AX_MOVE, ID_3AX_STATUS = 0x12010000, 0x12020000
@@ -322,17 +330,60 @@ local function scan(st, final, out)
     end
 end
 
--- First pass: append packet `num`'s bytes to stream `key` and record the
--- frames they decide, in stream order.
-local function feed(key, chunk, num)
+-- The live receiver's time bound (tase/frame.h, TIME BOUND), applied to
+-- the packets' times as `tase decode` applies it: what a stream holds (a
+-- pending candidate, or a partial sync at its end) is judged false, as at
+-- the end of the capture, when the next packet of the stream comes more
+-- than its quiet limit after the previous one: the time its remaining
+-- bytes need at the line's rate, at least QUIET_MS.
+local QUIET_MS = 20
+local FRAME_MAX = 261
+
+-- A packet time (seconds, a double) in whole milliseconds, as `tase
+-- decode` truncates a record's time (the half-microsecond guards the
+-- double's rounding at 1.7e9 s).
+local function ms_of(ts)
+    return math.floor(ts * 1000 + 0.0005)
+end
+
+-- The quiet limit of what stream `st` holds, or nil when it holds nothing.
+local function quiet_limit(st, rate)
+    local i = st.pos - st.base + 1
+    local held, left = #st.buf - i + 1, nil
+    if held >= 4 then -- a pending candidate (the scan stopped on it)
+        left = st.buf:byte(i + 3) + 6 - held
+    else -- the longest end of the buffer that begins a sync
+        for k = math.min(held, 3), 1, -1 do
+            if st.buf:sub(-k) == SYNC:sub(1, k) then
+                left = FRAME_MAX - k
+                break
+            end
+        end
+        if left == nil then return nil end
+    end
+    return math.max(math.floor((left * 1000 + rate - 1) / rate), QUIET_MS)
+end
+
+-- First pass: append packet `num`'s bytes (arrived at `ts` on a line of
+-- `rate` bytes/s) to stream `key` and record the frames they decide, in
+-- stream order.
+local function feed(key, chunk, num, ts, rate)
     local st = streams[key]
     if st == nil then
         st = {buf = "", base = 0, pos = 0, hist = {}, tail_nums = {}}
         streams[key] = st
     end
+    local out, now = {}, ms_of(ts)
+    if st.last_ms ~= nil then
+        local limit = quiet_limit(st, rate)
+        if limit ~= nil and now - st.last_ms > limit then
+            scan(st, true, out) -- the line went quiet on it
+            st.pos = st.base + #st.buf
+        end
+    end
+    st.last_ms = now
     st.buf = st.buf .. chunk
     st.hist[#st.hist + 1] = {stop = st.base + #st.buf, num = num}
-    local out = {}
     scan(st, false, out)
     st.buf = st.buf:sub(st.pos - st.base + 1)
     st.base = st.pos
@@ -421,7 +472,8 @@ local function dissect_chunk(tvb, pinfo, tree, kind, dir)
     local frames = {}
     if not pinfo.visited then
         if decided[num] == nil and tvb:len() > 0 then
-            feed(kind .. ":" .. ifid .. ":" .. dir, tvb:raw(), num)
+            local rate = kind == "can" and CAN_BYTES_PER_S or math.floor(tase.prefs.baud / 10)
+            feed(kind .. ":" .. ifid .. ":" .. dir, tvb:raw(), num, pinfo.abs_ts, rate)
             ifaces[num] = ifid
         end
         frames = decided[num] or {}
