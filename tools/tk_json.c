@@ -257,6 +257,19 @@ static const unit_t *unit_of(const tase_packet_desc_t *p, const char *field)
     return NULL;
 }
 
+bool tk_unit(const tase_packet_desc_t *p, const char *field, tk_unit_info_t *out)
+{
+    const unit_t *u = unit_of(p, field);
+    if (u == NULL) {
+        return false;
+    }
+    out->suffix = unit_kinds[u->kind].suffix;
+    out->label = unit_kinds[u->kind].label;
+    out->decimals = u->decimals;
+    out->scale = u->scale;
+    return true;
+}
+
 /* ---- a bounded line builder ---- */
 
 typedef struct {
