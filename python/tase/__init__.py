@@ -42,8 +42,8 @@ __all__ = [
     "packet_type",
 ]
 
-from . import sim  # noqa: E402
+from . import capture, plot, sim  # noqa: E402
 from .capture import read_capture  # noqa: E402
 from .link import Link, connect, parse_url  # noqa: E402
 
-__all__ += ["sim", "Link", "connect", "parse_url", "read_capture"]
+__all__ += ["capture", "plot", "sim", "Link", "connect", "parse_url", "read_capture"]

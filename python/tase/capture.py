@@ -19,6 +19,15 @@ _HIST = 264  # chunks remembered for frame times (tools/toolkit.h TK_HIST)
 _CAN_EFF = 0x80000000
 _CAN_RTR = 0x40000000
 _CAN_ERR = 0x20000000
+# First bytes of the files read_capture() takes (pcap us/ns, both byte
+# orders; pcapng).
+MAGICS = (
+    b"\xd4\xc3\xb2\xa1",
+    b"\x4d\x3c\xb2\xa1",
+    b"\xa1\xb2\xc3\xd4",
+    b"\xa1\xb2\x3c\x4d",
+    b"\x0a\x0d\x0d\x0a",
+)
 
 
 class CaptureError(Error, ValueError):
@@ -27,9 +36,9 @@ class CaptureError(Error, ValueError):
 
 def _pcap(f, head):
     magic = head[:4]
-    if magic in (b"\xd4\xc3\xb2\xa1", b"\x4d\x3c\xb2\xa1"):
+    if magic in MAGICS[0:2]:
         e = "<"
-    elif magic in (b"\xa1\xb2\xc3\xd4", b"\xa1\xb2\x3c\x4d"):
+    elif magic in MAGICS[2:4]:
         e = ">"
     else:
         raise CaptureError("not a pcap file")

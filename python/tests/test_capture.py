@@ -2,6 +2,7 @@
 the same packets and times as `tase decode`; capture: links."""
 
 import subprocess
+import sys
 
 import pytest
 
@@ -51,3 +52,24 @@ def test_not_a_capture(tmp_path):
     p.write_bytes(b"hello world, not pcap")
     with pytest.raises(ValueError, match="not a pcap"):
         list(tase.read_capture(str(p)))
+
+
+def test_plot_commanded_vs_reported(recorded, tmp_path):
+    pytest.importorskip("matplotlib")
+    cap, _ = recorded
+    out = tmp_path / "run.png"
+    r = subprocess.run([sys.executable, "-m", "tase", "plot", cap, "-o", str(out)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    s = tase.plot.series(cap)
+    assert s["pan_cmd"][1] == [10.0] and s["tilt_cmd"][1] == [20.0]
+    assert len(s["pan"][0]) > 5 and len(s["pan_rate"][0]) > 5
+
+
+def test_module_decode_equals_tase_decode(recorded):
+    cap, lines = recorded
+    r = subprocess.run([sys.executable, "-m", "tase", "decode", cap],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines() == lines
