@@ -7,11 +7,13 @@ packet's time that of the record carrying its last byte.
 """
 
 import collections
+import os
 import struct
+import time
 
 from ._core import Decoder, Error, _with_meta, ffi, lib
 
-__all__ = ["read_capture", "records", "CaptureLink"]
+__all__ = ["read_capture", "records", "CaptureLink", "CaptureWriter"]
 
 LINKTYPE_SERIAL = 147  # LINKTYPE_USER0: direction byte + bytes
 LINKTYPE_CAN = 227  # LINKTYPE_CAN_SOCKETCAN
@@ -128,6 +130,47 @@ def records(path):
             yield from _pcapng(f, head + f.read(4))
         else:
             yield from _pcap(f, head)
+
+
+class CaptureWriter:
+    """Write a serial capture as `tase record` does: nanosecond pcap, link
+    type 147, one record per read or write (a direction byte, 0 from the
+    gimbal, 1 to it, then the bytes). An existing file is appended to when
+    it is such a capture (as `--record`), else refused; a new one is
+    created. Every record is flushed."""
+
+    _HEADER = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, LINKTYPE_SERIAL)
+
+    def __init__(self, path):
+        self.path = path
+        self.records = 0
+        if os.path.exists(path) and os.path.getsize(path) > 0:
+            with open(path, "rb") as f:
+                head = f.read(24)
+            if head != self._HEADER:
+                raise CaptureError(
+                    "%s: not a nanosecond serial capture of tase record: not appending" % path
+                )
+            self.f = open(path, "ab")
+        else:
+            self.f = open(path, "wb")
+            self.f.write(self._HEADER)
+            self.f.flush()
+
+    def put(self, dir, data, t_ns=None):
+        """One record: dir 0 (bytes from the gimbal) or 1 (to it)."""
+        t = time.time_ns() if t_ns is None else t_ns
+        for i in range(0, len(data), 4096):
+            chunk = bytes((dir,)) + bytes(data[i : i + 4096])
+            self.f.write(
+                struct.pack("<IIII", t // 1000000000, t % 1000000000, len(chunk), len(chunk))
+                + chunk
+            )
+            self.records += 1
+        self.f.flush()
+
+    def close(self):
+        self.f.close()
 
 
 class _Stream:

@@ -61,12 +61,19 @@ def parse_url(url):
     )
 
 
-def connect(url, *, timeout=0.5, retries=2):
+def connect(url, *, timeout=0.5, retries=2, record=None):
     """Open the link `url` (see the module's doc) as a host. `timeout` (s,
     per attempt) and `retries` (more attempts) are the defaults of
-    query() and the verbs that wait for an answer. Use as a context
-    manager: the link is closed on exit."""
+    query() and the verbs that wait for an answer. `record`: a capture
+    file the session is appended to (serial links; as `tase --record`:
+    what is written as sent to the gimbal, what is read as sent by it).
+    Use as a context manager: the link is closed on exit."""
     scheme, target, baud = parse_url(url)
+    if record is not None and scheme != "serial":
+        raise FieldError(
+            "record: only a serial link's session can be recorded here (on CAN run "
+            "`tase record --can IFACE` beside it)"
+        )
     if scheme == "capture":
         from .capture import CaptureLink
 
@@ -75,7 +82,42 @@ def connect(url, *, timeout=0.5, retries=2):
         transport = _SerialTransport(target, baud)
     else:
         transport = _CanTransport(scheme, target)
+    if record is not None:
+        from .capture import CaptureWriter
+
+        try:
+            transport = _Recorder(transport, CaptureWriter(record))
+        except BaseException:
+            transport.close()
+            raise
     return Link(transport, url, timeout, retries)
+
+
+class _Recorder:
+    """A transport that records what passes through it."""
+
+    def __init__(self, inner, writer):
+        self.inner = inner
+        self.w = writer
+        self.name = inner.name
+        self.bytes_per_s = inner.bytes_per_s
+
+    def write(self, data):
+        n = self.inner.write(data)
+        self.w.put(1, data[:n])
+        return n
+
+    def read(self, cap, timeout_s):
+        data = self.inner.read(cap, timeout_s)
+        if data:
+            self.w.put(0, data)
+        return data
+
+    def close(self):
+        try:
+            self.inner.close()
+        finally:
+            self.w.close()
 
 
 # ---- transports: bytes in and out -------------------------------------------

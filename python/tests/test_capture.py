@@ -1,6 +1,7 @@
 """tase.read_capture(): a capture recorded by `tase record` reads back with
 the same packets and times as `tase decode`; capture: links."""
 
+import json
 import subprocess
 import sys
 
@@ -73,3 +74,26 @@ def test_module_decode_equals_tase_decode(recorded):
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
     assert r.stdout.splitlines() == lines
+
+
+def test_link_records_a_capture_tase_decode_reads(sim, tase_cli, tmp_path):
+    cap = str(tmp_path / "py.pcap")
+    with tase.connect(sim.url, record=cap) as link:
+        link.query("SYSTEM_VERSION")
+        link.point(5, 5)
+        n = len(list(link.packets(timeout=0.5)))
+    r = subprocess.run([tase_cli, "decode", cap], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert [p.json() for _, p in tase.read_capture(cap)] == lines
+    names = [json.loads(x)["name"] for x in lines]
+    assert names[:2] == ["SYSTEM_VERSION", "SYSTEM_VERSION"] and "GIMBAL_CMD" in names
+    assert len(lines) >= n + 3
+    # appended to by a second session, refused for a file that is not one
+    with tase.connect(sim.url, record=cap) as link:
+        link.query("PACKET_RATE")
+    assert len(list(tase.read_capture(cap))) > len(lines)
+    bad = tmp_path / "bad.pcap"
+    bad.write_bytes(b"not a capture at all, no")
+    with pytest.raises(ValueError, match="not appending"):
+        tase.connect(sim.url, record=str(bad))

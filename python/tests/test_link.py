@@ -196,3 +196,15 @@ def test_virtual_can_bus():
         g.stop = True
         g.join()
         g.bus.shutdown()
+
+
+def test_tase_sim_on_a_virtual_can_bus(tase_sim):
+    pytest.importorskip("can")
+    with tase.sim.start(virtual="tase-sim-test") as sim:
+        assert sim.url == "virtual:tase-sim-test"
+        with tase.connect(sim.url) as link:
+            assert link.query("SYSTEM_VERSION").raw["board_sn"] == 100123
+            link.rate(10, 0)
+            names = {p.name for p in link.packets(timeout=0.5)}
+            assert {"GIMBAL_ANGLE", "GIMBAL_RATE"} <= names
+    assert "GIMBAL_CMD: rate" in sim.log()
