@@ -13,16 +13,28 @@ _KIND_POSITION = 0x20
 
 def series(path, baud=57600):
     """The curves of a capture: dict of name -> (times, values), times in
-    seconds from the first packet. Commanded: GIMBAL_CMD position (deg)
-    and rate (deg/s) commands sent to the gimbal; reported: GIMBAL_ANGLE
-    (deg) and GIMBAL_RATE pan_rate/tilt_rate (deg/s)."""
+    seconds from the first packet. Reported: GIMBAL_ANGLE pan/tilt (deg)
+    and GIMBAL_RATE pan_rate/tilt_rate (deg/s). Commanded (GIMBAL_CMD sent
+    to the gimbal): pan_cmd/tilt_cmd (deg) while position commands are in
+    force and pan_rate_cmd/tilt_rate_cmd (deg/s) while rate commands are,
+    each value held until the next command (NaN between: no line drawn)."""
     out = {}
     t0 = None
+    last = None
+    mode = None  # the kind of command in force: "" (position) or "_rate"
 
     def add(name, t, v):
         ts, vs = out.setdefault(name, ([], []))
         ts.append(t)
         vs.append(v)
+
+    def hold(t, end=False):
+        if mode is not None:
+            for axis in ("pan", "tilt"):
+                name = axis + mode + "_cmd"
+                add(name, t, out[name][1][-1])
+                if end:
+                    add(name, t, float("nan"))
 
     for t, p in read_capture(path, baud):
         if t is None:
@@ -30,6 +42,7 @@ def series(path, baud=57600):
         if t0 is None:
             t0 = t
         t -= t0
+        last = t
         if p.error is not None or p.size == 0:
             continue
         if p.name == "GIMBAL_ANGLE":
@@ -42,13 +55,14 @@ def series(path, baud=57600):
             add("tilt_rate", t, f["tilt_rate"])
         elif p.name == "GIMBAL_CMD" and p.dir == "in":
             r = p.raw
-            kind = r["flags"] & 0x30
-            if kind == _KIND_POSITION:
-                add("pan_cmd", t, r["pan"] / 100.0)
-                add("tilt_cmd", t, r["tilt"] / 100.0)
-            elif kind == _KIND_RATE:
-                add("pan_rate_cmd", t, r["pan"] / 100.0)
-                add("tilt_rate_cmd", t, r["tilt"] / 100.0)
+            kind = {_KIND_POSITION: "", _KIND_RATE: "_rate"}.get(r["flags"] & 0x30)
+            hold(t, end=kind != mode)
+            mode = kind
+            if kind is not None:
+                add("pan" + kind + "_cmd", t, r["pan"] / 100.0)
+                add("tilt" + kind + "_cmd", t, r["tilt"] / 100.0)
+    if last is not None:
+        hold(last)
     return out
 
 
@@ -72,8 +86,8 @@ def plot_capture(path, out, baud=57600, title=None):
             if name in s:
                 ax.plot(*s[name], color=colour, label="%s reported" % name)
             if name + "_cmd" in s:
-                ax.step(*s[name + "_cmd"], where="post", color=colour, linestyle="--",
-                        marker="o", label="%s commanded" % name)
+                ax.plot(*s[name + "_cmd"], color=colour, linestyle="--",
+                        label="%s commanded" % name)
         ax.set_ylabel(unit)
         ax.grid(True, alpha=0.3)
         if ax.lines:

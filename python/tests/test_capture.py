@@ -2,6 +2,7 @@
 the same packets and times as `tase decode`; capture: links."""
 
 import json
+import os
 import subprocess
 import sys
 
@@ -64,7 +65,8 @@ def test_plot_commanded_vs_reported(recorded, tmp_path):
     assert r.returncode == 0, r.stderr
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     s = tase.plot.series(cap)
-    assert s["pan_cmd"][1] == [10.0] and s["tilt_cmd"][1] == [20.0]
+    assert s["pan_cmd"][1][0] == 10.0 and s["tilt_cmd"][1][0] == 20.0
+    assert s["pan_cmd"][0][-1] > 1.0  # held to the end of the capture
     assert len(s["pan"][0]) > 5 and len(s["pan_rate"][0]) > 5
 
 
@@ -97,3 +99,18 @@ def test_link_records_a_capture_tase_decode_reads(sim, tase_cli, tmp_path):
     bad.write_bytes(b"not a capture at all, no")
     with pytest.raises(ValueError, match="not appending"):
         tase.connect(sim.url, record=str(bad))
+
+
+def test_bench_script_of_the_docs_runs_against_tase_sim(tase_sim, tmp_path):
+    from conftest import ROOT
+
+    script = open(os.path.join(ROOT, "python", "examples", "bench_session.py")).read()
+    doc = open(os.path.join(ROOT, "docs", "PYTHON.md")).read()
+    assert script in doc  # the docs show the script that is tested
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "python", "examples",
+                                                     "bench_session.py"), "-o", str(tmp_path)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "on target at pan" in r.stdout
+    assert (tmp_path / "session.png").stat().st_size > 1000
+    assert len(list(tase.read_capture(str(tmp_path / "session.pcap")))) > 20

@@ -2,18 +2,16 @@
 # builds it into the build tree (never into the source tree: a clean clone
 # stays clean) with the cffi of the interpreter below; python_pytest runs
 # its pytest suite against that build, tase and tase-sim of this build.
-# The interpreter is TASE_PYTHON, by default Debian's /usr/bin/python3 when
-# present (its python3-cffi, python3-pytest, ... of scripts/packages.d/
-# python.txt), else python3 on the PATH.
+# The interpreter is TASE_PYTHON (python/CMakeLists.txt): by default
+# Debian's /usr/bin/python3 when present (with the python3-cffi,
+# python3-pytest, ... of scripts/packages.d/python.txt), else python3 on
+# the PATH. Without cffi the build test fails saying so.
 if(NOT TARGET tase_cli OR NOT TARGET tase_sim)
   return()
 endif()
-if(EXISTS /usr/bin/python3)
-  set(TASE_PYTHON_DEFAULT /usr/bin/python3)
-else()
-  find_program(TASE_PYTHON_DEFAULT python3)
+if(NOT TASE_PYTHON)
+  find_program(TASE_PYTHON python3)
 endif()
-set(TASE_PYTHON ${TASE_PYTHON_DEFAULT} CACHE FILEPATH "Python 3 for the tase package's tests")
 set(TASE_PYTHON_OUT ${CMAKE_BINARY_DIR}/python)
 add_test(NAME python_build
          COMMAND ${CMAKE_COMMAND} -E env TASE_SOURCE_DIR=${PROJECT_SOURCE_DIR} PYTHONDONTWRITEBYTECODE=1
