@@ -25,3 +25,8 @@ set_tests_properties(python_build PROPERTIES LABELS "check;python" TIMEOUT 300
                      FIXTURES_SETUP tase_python)
 set_tests_properties(python_pytest PROPERTIES LABELS "check;e2e;python" TIMEOUT 300
                      FIXTURES_REQUIRED tase_python)
+# The README's Python section: its install commands in a fresh venv
+# (offline), its example against tase-sim (python/check-readme.sh).
+add_test(NAME python_readme
+         COMMAND ${PROJECT_SOURCE_DIR}/python/check-readme.sh $<TARGET_FILE:tase_sim> ${TASE_PYTHON})
+set_tests_properties(python_readme PROPERTIES LABELS "check;python" TIMEOUT 300)
