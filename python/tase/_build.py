@@ -161,6 +161,8 @@ int py_encode(size_t pkt, const int64_t *vals, size_t nvals, const uint8_t *tail
 typedef struct {
     uint64_t *offset; /* stream offset of each frame's first sync byte */
     uint64_t *key;    /* id << 40 | data length << 32 | position in `data` */
+    uint64_t *time;   /* NULL, or each frame's `now` when delivered */
+    uint64_t now;     /* the caller's time (links: when the last read returned) */
     size_t n;
     size_t cap;
     uint8_t *data;
@@ -361,6 +363,9 @@ static void py_sink_put(py_sink_t *s, const tase_rx_t *rx, const tase_frame_t *f
     if (s->n == s->cap || s->dcap - s->dlen < f->len || s->dlen + f->len > UINT32_MAX) {
         s->dropped++;
         return;
+    }
+    if (s->time != NULL) {
+        s->time[s->n] = s->now;
     }
     s->offset[s->n] = s->base64 + (uint64_t)(int64_t)(int32_t)(f->offset - s->base32);
     s->key[s->n] = (uint64_t)TASE_ID(f->group, f->type) << 40 | (uint64_t)f->len << 32 |

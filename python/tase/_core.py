@@ -681,7 +681,7 @@ _alloc = ffi.new_allocator(should_clear_after_alloc=False)
 class _Sink:
     """Columns the C helper fills with the frames a call delivers."""
 
-    def __init__(self, nbytes, cap=None):
+    def __init__(self, nbytes, cap=None, timed=False):
         self.cap = cap if cap is not None else (nbytes + lib.TASE_FRAME_MAX) // 8 + 2
         self.dcap = nbytes + lib.TASE_FRAME_MAX + 1
         self.s = ffi.new("py_sink_t *")
@@ -691,9 +691,13 @@ class _Sink:
         s = self.s
         s.offset, s.key, s.data = self.offset, self.key, self.data
         s.cap, s.dcap = self.cap, self.dcap
+        self.time = None
+        if timed:  # a time per frame: s.now when the receiver delivered it
+            self.time = s.time = _alloc("uint64_t[]", self.cap)
 
     def take(self, time_us=None, dir=None):
-        """The packets collected since the last take(), then empty."""
+        """The packets collected since the last take(), then empty; each
+        with time_us (or, for a timed sink, the time of its delivery)."""
         s = self.s
         n = s.n
         if n == 0:
@@ -702,7 +706,10 @@ class _Sink:
         keys = memoryview(ffi.buffer(self.key, 8 * n)).cast("Q")
         offs = memoryview(ffi.buffer(self.offset, 8 * n)).cast("Q")
         rep = itertools.repeat
-        if time_us is None and dir is None:
+        if self.time is not None:
+            times = memoryview(ffi.buffer(self.time, 8 * n)).cast("Q")
+            cols = zip(keys, offs, rep(buf), times, rep(dir))
+        elif time_us is None and dir is None:
             cols = zip(keys, offs, rep(buf))
         else:
             cols = zip(keys, offs, rep(buf), rep(time_us), rep(dir))

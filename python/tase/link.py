@@ -268,7 +268,8 @@ def py_port_read(ctx, buf, cap, timeout_ms):
         return lib.TASE_EIO
     if data:
         ffi.memmove(buf, data, len(data))
-        link._arrived = time.time()
+        # the frames these bytes complete arrived now (tase monitor --time)
+        link._sink.s.now = _now_us()
     return len(data)
 
 
@@ -300,10 +301,9 @@ class Link:
         self.timeout = timeout
         self.retries = retries
         self._exc = None
-        self._arrived = None
         self._handle = ffi.new_handle(self)
         self._host = ffi.new("tase_host_t *")
-        self._sink = _Sink(1 << 18, cap=1 << 15)
+        self._sink = _Sink(1 << 18, cap=1 << 15, timed=True)
         self._ctx = ffi.new("py_ctx_t *")
         self._ctx.s = self._sink.s
         self._base = 0
@@ -343,7 +343,7 @@ class Link:
             r = fn(*args)
         finally:
             self._base += (self._host.rx.stats.bytes_in - before) & 0xFFFFFFFF
-            got = self._sink.take(_now_us(), "out")
+            got = self._sink.take(None, "out")
             if got:
                 self._queue.extend(got)
         if self._exc is not None:
