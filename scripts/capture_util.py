@@ -465,6 +465,18 @@ def quiet(out, gap):
                             bytes([DIRS["out"]]) + rest))
 
 
+def times(out):
+    """Issue 25 item 6: a serial capture of three GIMBAL_ANGLEs stamped
+    2147483647.75 (the last second a signed 32-bit field holds), 2147483648.25
+    (past 2038-01-19 03:14:07: the unsigned field) and 1700000000 s plus
+    1,500,000,000 ns (a fraction not normalised: 1700000001.5)."""
+    with open(out, "wb") as f:
+        f.write(pcap_header(LINKTYPE_SERIAL))
+        for i, (sec, ns) in enumerate([(2147483647, 750000000), (2147483648, 250000000),
+                                       (1700000000, 1500000000)]):
+            f.write(pcap_record(sec, ns, bytes([DIRS["out"]]) + gimbal_angle(i, 0)[1]))
+
+
 def cut_records(streams, sizes):
     """Round-robin records of the given sizes (cycled) from each stream:
     [(dir, stream offset of the end, bytes)]."""
@@ -640,6 +652,8 @@ def main(argv):
         expect_serial(args[0], args[1:])
     elif cmd == "can-pcap":
         can_pcap(args[0], args[1])
+    elif cmd == "times":
+        times(args[0])
     elif cmd == "quiet":
         quiet(args[0], args[1])
     elif cmd == "bad-pcap":

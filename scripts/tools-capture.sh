@@ -50,6 +50,12 @@ $U expect-serial "$dir/noisy.pcap" "$DATA/decode_noisy.jsonl:out" "$DATA/decode_
 rc=$?
 check "decode of a serial pcap (both directions, 1..64-byte records): every packet with dir and time, exit 0" \
     eval '[ $rc -eq 0 ] && same_per_dir "$dir/noisy.expect" "$dir/noisy.json"'
+# issue 25 item 6: record times past 2038-01-19 03:14:07 (the unsigned
+# 32-bit seconds of classic pcap) and a fraction of 10^9 ns or more
+$U times "$dir/times.pcap"
+t=$("$TASE" decode "$dir/times.pcap" | sed -n 's/.*"time":\([0-9.-]*\),.*/\1/p' | tr '\n' ' ')
+check "decode: times past 2038 and unnormalised fractions ($t)" \
+    test "$t" = "2147483647.750000 2147483648.250000 1700000001.500000 "
 "$TASE" decode - <"$dir/noisy.pcap" | cmp -s - "$dir/noisy.json"
 check "decode of the serial pcap from standard input (a file)" [ $? -eq 0 ]
 cat "$dir/noisy.pcap" | "$TASE" decode | cmp -s - "$dir/noisy.json"

@@ -372,8 +372,22 @@ int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap)
     }
     memset(rec, 0, sizeof(*rec));
     rec->index = ++r->index;
-    rec->t.sec = (int64_t)h->ts.tv_sec;
-    rec->t.usec = (uint32_t)h->ts.tv_usec / 1000u; /* opened in nanoseconds */
+    /* A classic pcap record's seconds are an unsigned 32-bit field (good
+     * to 2106); libpcap hands them over as a signed 32-bit number, so a
+     * time past 2038-01-19 03:14:07 would come out negative. No capture
+     * holds times before 1970: a negative value is the unsigned field. A
+     * fraction of a second beyond 10^9 ns (a writer that did not
+     * normalise) carries into the seconds. */
+    {
+        int64_t sec = (int64_t)h->ts.tv_sec;
+        uint64_t ns = (uint64_t)(uint32_t)h->ts.tv_usec; /* opened in nanoseconds */
+        if (sec < 0 && sec >= -(int64_t)0x80000000) {
+            sec += (int64_t)0x100000000;
+        }
+        sec += (int64_t)(ns / 1000000000u);
+        rec->t.sec = sec;
+        rec->t.usec = (uint32_t)(ns % 1000000000u / 1000u);
+    }
     if (h->caplen < h->len) {
         snprintf(why, cap, "cut to %u of its %u bytes by the capture's snapshot length",
                  (unsigned)h->caplen, (unsigned)h->len);
