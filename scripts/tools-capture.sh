@@ -108,8 +108,14 @@ expect_error "record --tap-in without --serial" 2 "needs --serial" \
     "$TASE" record --can vcan0 --tap-in /dev/null -o "$dir/x.pcap"
 expect_error "--record on a CAN link" 2 "on CAN run 'tase record --can can0" \
     "$TASE" query SYSTEM_VERSION --can can0 --record "$dir/x.pcap"
-expect_error "record to an unwritable file" 1 "cannot write capture" \
-    "$TASE" record --serial /dev/null -o "$dir/no/such/dir.pcap"
+# issue 25 item 1: a record that cannot start never touches an existing
+# capture (it was cut to 24 bytes before the device open failed)
+head -c 262184 /dev/urandom >"$dir/precious.pcap"
+cp "$dir/precious.pcap" "$dir/precious.copy"
+expect_error "record from a missing device: refused" 1 "cannot open serial device" \
+    "$TASE" record --serial "$dir/no-such-tty" -o "$dir/precious.pcap"
+check "... and the existing capture is untouched, no partial file left" \
+    eval 'cmp -s "$dir/precious.pcap" "$dir/precious.copy" && ! ls "$dir"/precious.pcap.partial-* >/dev/null 2>&1'
 
 # ---- a live session with tase-sim, recorded with --record ----
 "$SIM" --quiet --link "$dir/gimbal" --seconds 120 >"$dir/sim.log" 2>&1 &
@@ -157,6 +163,8 @@ $U can-pcap "$dir/other.pcap" "$DATA/decode_candump.log"
 expect_error "--record appending to a capture of another link type" 1 "cannot write capture" \
     "$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/other.pcap"
 
+expect_error "record to an unwritable file (the device opens first)" 1 "cannot write capture" \
+    "$TASE" record --serial "$dir/gimbal" -o "$dir/no/such/dir.pcap" --seconds 0.5
 expect_error "record onto a full disk (/dev/full)" 1 "cannot write capture /dev/full: No space left on device" \
     "$TASE" record --serial "$dir/gimbal" -o /dev/full --seconds 0.5
 
@@ -174,6 +182,18 @@ nr=$($U records "$dir/tele.pcap" | grep -c .)
 check "record --serial, stopped by SIGINT: exit $rc, '$(tail -1 "$dir/rec.out")', $nr records, $na GIMBAL_ANGLE (20/s set above)" \
     eval '[ $rc -eq 0 ] && grep -q "^recorded $nr records" "$dir/rec.out" && [ "$na" -ge 15 ] &&
           ! grep -q "\"dir\":\"in\"" "$dir/tele.json"'
+# a recording killed outright (SIGKILL) leaves the previous capture as it
+# was and its own records in the partial file beside it
+cp "$dir/tele.pcap" "$dir/tele.copy"
+"$TASE" record --serial "$dir/gimbal" -o "$dir/tele.pcap" >"$dir/rec2.out" 2>&1 &
+rp=$!
+wait_for "$dir/rec2.out" recording
+sleep 0.5
+kill -KILL $rp
+wait $rp 2>/dev/null
+check "record killed with SIGKILL: the previous capture is unchanged, the partial one kept beside it" \
+    eval 'cmp -s "$dir/tele.pcap" "$dir/tele.copy" && ls "$dir"/tele.pcap.partial-* >/dev/null 2>&1'
+rm -f "$dir"/tele.pcap.partial-*
 
 # ---- the recorded device goes away: record stops (it spun at 75% CPU) ----
 "$TASE" record --serial "$dir/gimbal" -o "$dir/gone.pcap" >"$dir/gone.out" 2>"$dir/gone.err" &

@@ -1999,11 +1999,9 @@ static int cmd_record(args_t *a)
     /* a signal is the normal end of a recording: the loops stop on it and
      * close the capture, and the command succeeds */
     if (lo.serial != NULL) {
-        tk_cap_create(&w, out, TK_CAP_LINKTYPE_SERIAL, false);
-        tk_cap_record_serial(&w, lo.serial, tap_in, lo.baud, seconds);
+        tk_cap_record_serial(&w, out, lo.serial, tap_in, lo.baud, seconds);
     } else {
-        tk_cap_create(&w, out, TK_CAP_LINKTYPE_CAN, false);
-        tk_cap_record_can(&w, lo.can, seconds);
+        tk_cap_record_can(&w, out, lo.can, seconds);
     }
     return TK_EXIT_OK;
 }

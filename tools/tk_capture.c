@@ -11,6 +11,7 @@
 #include <poll.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/uio.h>
 #include <time.h>
 #include <unistd.h>
@@ -32,10 +33,22 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
     int snaplen = linktype == TK_CAP_LINKTYPE_CAN ? (int)TK_CAP_CAN_MAX : SERIAL_SNAPLEN;
     pcap_t *p = pcap_open_dead_with_tstamp_precision(linktype, snaplen, PCAP_TSTAMP_PRECISION_NANO);
     pcap_dumper_t *d;
+    struct stat st;
     if (p == NULL) {
         tk_die("cannot start a capture: out of memory");
     }
-    d = append ? pcap_dump_open_append(p, path) : pcap_dump_open(p, path);
+    w->tmp[0] = '\0';
+    /* a temporary file and a rename only for a regular file (or a new
+     * one): a device, a FIFO or /dev/stdout is written in place, never
+     * replaced by a rename */
+    if (!append && (stat(path, &st) != 0 ? errno == ENOENT : S_ISREG(st.st_mode))) {
+        int k = snprintf(w->tmp, sizeof(w->tmp), "%s.partial-%ld", path, (long)getpid());
+        if (k < 0 || (size_t)k >= sizeof(w->tmp)) {
+            tk_die("cannot write capture %s: the path is too long", path);
+        }
+    }
+    d = append ? pcap_dump_open_append(p, path)
+               : pcap_dump_open(p, w->tmp[0] != '\0' ? w->tmp : path);
     if (d == NULL) {
         /* libpcap's message names the file and the reason */
         tk_die("cannot write capture: %s", pcap_geterr(p));
@@ -110,6 +123,16 @@ int tk_cap_finish(tk_cap_writer_t *w)
     pcap_close(w->pcap);
     w->dumper = NULL;
     w->pcap = NULL;
+    if (w->tmp[0] != '\0') {
+        if (e == 0 && rename(w->tmp, w->path) != 0) {
+            e = errno;
+        }
+        if (e != 0) {
+            fflush(stdout);
+            fprintf(stderr, "%s: the capture so far is kept in %s; %s is unchanged\n", tk_prog,
+                    w->tmp, w->path);
+        }
+    }
     return e;
 }
 
@@ -427,8 +450,8 @@ static int ms_left(double t_end)
     return left <= 0.0 ? 0 : (left > 0.2 ? 200 : (int)(left * 1000.0) + 1);
 }
 
-void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_in, long baud,
-                          double seconds)
+void tk_cap_record_serial(tk_cap_writer_t *w, const char *path, const char *dev, const char *tap_in,
+                          long baud, double seconds)
 {
     tk_link_t links[2];
     tase_port_t ports[2];
@@ -442,6 +465,8 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_i
     if (tap_in != NULL) {
         tk_link_serial(&links[1], tap_in, baud);
     }
+    /* the sources are open: only now is the capture created */
+    tk_cap_create(w, path, TK_CAP_LINKTYPE_SERIAL, false);
     print_recording(w, dev, tap_in, seconds);
     for (i = 0; i < n; i++) {
         ports[i] = tk_link_port(&links[i]);
@@ -520,11 +545,12 @@ static int open_can_recorder(const char *iface)
     return fd;
 }
 
-void tk_cap_record_can(tk_cap_writer_t *w, const char *iface, double seconds)
+void tk_cap_record_can(tk_cap_writer_t *w, const char *path, const char *iface, double seconds)
 {
     int fd = open_can_recorder(iface);
     double t_end = seconds > 0.0 ? tk_now_s() + seconds : 0.0;
     unsigned long frames = 0;
+    tk_cap_create(w, path, TK_CAP_LINKTYPE_CAN, false); /* the source is open */
     print_recording(w, iface, NULL, seconds);
     while (tk_signal == 0) {
         struct pollfd pfd = {fd, POLLIN, 0};
