@@ -163,6 +163,21 @@ $U can-pcap "$dir/other.pcap" "$DATA/decode_candump.log"
 expect_error "--record appending to a capture of another link type" 1 "cannot write capture" \
     "$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/other.pcap"
 
+# issue 25 item 2: --record onto a full disk (here: a file size limit,
+# SIGXFSZ ignored, so writes fail with EFBIG as on a full disk). The
+# GIMBAL_CMD reaches the gimbal: exit 5, one message saying it was sent.
+cp "$dir/session.pcap" "$dir/full.pcap"
+kb=$(($(stat -c %s "$dir/full.pcap") / 1024)) # below its size: no write fits
+(
+    trap '' XFSZ
+    ulimit -f "$kb"
+    exec "$TASE" point 12 -3 --serial "$dir/gimbal" --record "$dir/full.pcap"
+) >"$dir/full.out" 2>"$dir/full.err"
+rc=$?
+check "--record on a full disk: the command was carried out, exit $rc (5), '$(cat "$dir/full.err")'" \
+    eval '[ $rc -eq 5 ] && [ "$(wc -l <"$dir/full.err")" -eq 1 ] &&
+          grep -q "cannot write capture .*(GIMBAL_CMD was sent)" "$dir/full.err" &&
+          grep -q "^sent GIMBAL_CMD pan=1200 tilt=-300" "$dir/full.out"'
 expect_error "record to an unwritable file (the device opens first)" 1 "cannot write capture" \
     "$TASE" record --serial "$dir/gimbal" -o "$dir/no/such/dir.pcap" --seconds 0.5
 expect_error "record onto a full disk (/dev/full)" 1 "cannot write capture /dev/full: No space left on device" \

@@ -38,6 +38,7 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
         tk_die("cannot start a capture: out of memory");
     }
     w->tmp[0] = '\0';
+    w->err = 0;
     /* a temporary file and a rename only for a regular file (or a new
      * one): a device, a FIFO or /dev/stdout is written in place, never
      * replaced by a rename */
@@ -144,15 +145,31 @@ void tk_cap_close(tk_cap_writer_t *w)
     }
 }
 
+/* Record what the tapped link moved. A capture that cannot be written
+ * (a full disk) stops recording but not the command: the packet it sends
+ * still goes out and is reported, and the failure is reported at exit
+ * (close_session_capture()) with the status that says whether a packet
+ * was sent. */
+static void tap_record(tk_cap_tap_t *tap, unsigned dir, const uint8_t *data, size_t n)
+{
+    struct timespec t;
+    if (tap->w->err != 0) {
+        return;
+    }
+    clock_gettime(CLOCK_REALTIME, &t);
+    errno = 0;
+    tk_cap_put_serial(tap->w, &t, dir, data, n);
+    if (pcap_dump_flush(tap->w->dumper) != 0) {
+        tap->w->err = errno != 0 ? errno : EIO;
+    }
+}
+
 static int tap_write(void *ctx, const uint8_t *data, size_t n)
 {
     tk_cap_tap_t *tap = ctx;
     int rc = tap->inner.ops->write(tap->inner.ctx, data, n);
     if (rc > 0) {
-        struct timespec t;
-        clock_gettime(CLOCK_REALTIME, &t);
-        tk_cap_put_serial(tap->w, &t, TK_CAP_TO_GIMBAL, data, (size_t)rc);
-        tk_cap_flush(tap->w);
+        tap_record(tap, TK_CAP_TO_GIMBAL, data, (size_t)rc);
     }
     return rc;
 }
@@ -162,10 +179,7 @@ static int tap_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
     tk_cap_tap_t *tap = ctx;
     int rc = tap->inner.ops->read(tap->inner.ctx, buf, cap, timeout_ms);
     if (rc > 0) {
-        struct timespec t;
-        clock_gettime(CLOCK_REALTIME, &t);
-        tk_cap_put_serial(tap->w, &t, TK_CAP_FROM_GIMBAL, buf, (size_t)rc);
-        tk_cap_flush(tap->w);
+        tap_record(tap, TK_CAP_FROM_GIMBAL, buf, (size_t)rc);
     }
     return rc;
 }
@@ -201,8 +215,18 @@ static void close_session_capture(void)
         return;
     }
     e = tk_cap_finish(&session_capture);
+    if (session_capture.err != 0) {
+        e = session_capture.err; /* the first failure, not the close's */
+    }
     if (e != 0) {
+        const char *sent = tk_sent();
         fflush(stdout);
+        if (sent != NULL) {
+            /* the packet went out: a retrying script must not send it again */
+            fprintf(stderr, "%s: cannot write capture %s: %s (%s was sent)\n", tk_prog,
+                    session_capture.path, strerror(e), sent);
+            _exit(TK_EXIT_SENT);
+        }
         fprintf(stderr, "%s: cannot write capture %s: %s\n", tk_prog, session_capture.path,
                 strerror(e));
         _exit(TK_EXIT_FAIL);

@@ -71,6 +71,11 @@ void tk_mark_sent(const char *what)
     sent_what = what;
 }
 
+const char *tk_sent(void)
+{
+    return sent_what;
+}
+
 static void vexit(int status, const char *fmt, va_list ap)
 {
     char msg[448];
