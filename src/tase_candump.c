@@ -248,33 +248,32 @@ static size_t put_char(char *out, char ch)
     return 1u;
 }
 
-/* Powers of ten up to 10^19, the largest a uint64_t holds. */
-static const uint64_t pow10_u64[20] = {1u,
-                                       10u,
-                                       100u,
-                                       1000u,
-                                       10000u,
-                                       100000u,
-                                       1000000u,
-                                       10000000u,
-                                       100000000u,
-                                       1000000000u,
-                                       10000000000u,
-                                       100000000000u,
-                                       1000000000000u,
-                                       10000000000000u,
-                                       100000000000000u,
-                                       1000000000000000u,
-                                       10000000000000000u,
-                                       100000000000000000u,
-                                       1000000000000000000u,
-                                       10000000000000000000u};
-
 /* v in decimal, at least min_digits (<= 20) with leading zeros. Digits
  * from the top by subtraction (at most 9 per digit): no 64-bit division,
  * which is a library call on 32-bit targets. */
 static size_t put_dec(char *out, uint64_t v, unsigned min_digits)
 {
+    /* powers of ten up to 10^19, the largest a uint64_t holds */
+    static const uint64_t pow10_u64[20] = {1u,
+                                           10u,
+                                           100u,
+                                           1000u,
+                                           10000u,
+                                           100000u,
+                                           1000000u,
+                                           10000000u,
+                                           100000000u,
+                                           1000000000u,
+                                           10000000000u,
+                                           100000000000u,
+                                           1000000000000u,
+                                           10000000000000u,
+                                           100000000000000u,
+                                           1000000000000000u,
+                                           10000000000000000u,
+                                           100000000000000000u,
+                                           1000000000000000000u,
+                                           10000000000000000000u};
     uint64_t rest = v;
     size_t top = (min_digits > 0u) ? (size_t)min_digits - 1u : 0u;
     size_t n = 0;

@@ -111,7 +111,8 @@ static int send_pieces(const tase_port_t *port, uint8_t group, uint8_t type, con
     uint8_t st[STAGE];
     wr_t w;
     const uint8_t *src = a;
-    size_t left = na; /* bytes of src still to stage */
+    size_t len = na; /* bytes of src */
+    size_t off = 0;  /* of them staged */
     bool second = false;
     size_t n = TASE_FRAME_HEADER;
     uint16_t sum;
@@ -126,21 +127,24 @@ static int send_pieces(const tase_port_t *port, uint8_t group, uint8_t type, con
     sum = tase_checksum(0u, st, TASE_FRAME_HEADER);
     wr_init(&w, port);
     for (;;) {
-        size_t k = left < STAGE - n ? left : STAGE - n;
+        size_t k = len - off;
+        if (k > STAGE - n) {
+            k = STAGE - n;
+        }
         if (k > 0u) {
-            (void)memcpy(&st[n], src, k);
+            (void)memcpy(&st[n], &src[off], k);
             sum = tase_checksum(sum, &st[n], k);
             n += k;
-            src += k;
-            left -= k;
+            off += k;
         }
-        if (left == 0u && !second) {
+        if (off == len && !second) {
             second = true; /* the second span (maybe empty) */
             src = b;
-            left = nb;
+            len = nb;
+            off = 0;
             continue;
         }
-        if (left == 0u && n + 2u <= STAGE) {
+        if (off == len && n + 2u <= STAGE) {
             st[n] = (uint8_t)(sum >> 8);
             st[n + 1u] = (uint8_t)sum;
             r = wr_put(&w, st, n + 2u);
