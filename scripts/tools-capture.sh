@@ -275,6 +275,21 @@ replay_to zero replay_fast
 ms=$(cat "$dir/zero.ms")
 check "replay --speed 0 sends without waiting (${ms} ms for a 1.5 s capture)" [ "$ms" -lt "$fast_ms" ]
 
+# issue 25 item 7: the whole capture is checked before anything is sent
+# (what arrives is recorded on B as cutrx.pcap etc.)
+$U replay-checks "$dir/cut-in.pcap" "$dir/bad-in.pcap" "$dir/back-in.pcap"
+replay_to cutrx "$TASE" replay "$dir/cut-in.pcap" --serial "$dir/A" --dir out
+check "replay of a capture cut in its last record: refused before sending ('$(tail -1 "$dir/cutrx.out")'), nothing arrived" \
+    eval '! grep -q "^replayed" "$dir/cutrx.out" && [ "$($U records "$dir/cutrx.pcap" | grep -c .)" = 0 ]'
+replay_to badrx "$TASE" replay "$dir/bad-in.pcap" --serial "$dir/A" --dir out
+check "replay of a capture with a bad record: nothing sent ('$(tail -1 "$dir/badrx.out")')" \
+    eval 'grep -q "1 bad record: nothing was sent" "$dir/badrx.out" && [ "$($U records "$dir/badrx.pcap" | grep -c .)" = 0 ]'
+replay_to backrx "$TASE" replay "$dir/back-in.pcap" --serial "$dir/A" --dir out
+t_back=$(sed -n 's/^replayed 4 of 4 records (56 bytes) to .* in \([0-9.]*\) s$/\1/p' "$dir/backrx.out")
+check "replay across a clock stepped back: warned, the later gaps kept (${t_back:-?} s; 1.0 s of gaps, was 0.7)" \
+    eval 'grep -q "record 3 is 0.300000 s earlier than record 2" "$dir/backrx.out" &&
+          awk -v t="${t_back:-0}" "BEGIN { exit !(t >= 0.95 && t < 1.0 + $tol) }"'
+
 # A two-line tap: the gimbal's line into A (recorded on B), the host's line
 # into C (recorded on D with --tap-in), both replayed at once.
 replay_both() {

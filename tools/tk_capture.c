@@ -739,13 +739,57 @@ static void replay_send(replay_t *rp, const tk_cap_reader_t *r, const tk_cap_rec
     }
 }
 
+/* The seconds from record time a to b. */
+static double time_diff(const tk_time_t *a, const tk_time_t *b)
+{
+    return (double)(b->sec - a->sec) + ((double)b->usec - (double)a->usec) * 1e-6;
+}
+
+unsigned long tk_cap_check(tk_cap_reader_t *r, const tk_replay_opts_t *o, unsigned long *backward)
+{
+    replay_t rp;
+    tk_cap_rec_t rec;
+    tk_time_t last = {0, 0};
+    bool any = false;
+    unsigned long bad = 0, last_index = 0;
+    char why[160];
+    int rc;
+    memset(&rp, 0, sizeof(rp));
+    rp.o = o;
+    *backward = 0;
+    /* tk_cap_next() dies on a file cut inside a record header, naming it */
+    while ((rc = tk_cap_next(r, &rec, why, sizeof(why))) != TK_CAP_END) {
+        if (rc == TK_CAP_BAD) {
+            tk_warn("%s: record %lu is bad: %s", r->path, rec.index, why);
+            bad++;
+            continue;
+        }
+        if (!replay_selects(&rp, r, &rec)) {
+            continue;
+        }
+        if (any && time_diff(&last, &rec.t) < 0.0) {
+            if (++*backward <= 3u) {
+                tk_warn("%s: record %lu is %.6f s earlier than record %lu (a clock step?): "
+                        "replayed right after it",
+                        r->path, rec.index, -time_diff(&last, &rec.t), last_index);
+            }
+        }
+        last = rec.t;
+        last_index = rec.index;
+        any = true;
+        tk_exit_if_signalled();
+    }
+    return bad;
+}
+
 unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
 {
     replay_t rp;
     tk_cap_rec_t rec;
-    tk_time_t t0 = {0, 0};
+    tk_time_t prev = {0, 0};
     bool started = false;
     double start = 0.0;
+    double due = 0.0; /* seconds after the first record, at speed 1 */
     char why[160];
     int rc;
     memset(&rp, 0, sizeof(rp));
@@ -769,16 +813,20 @@ unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
             continue;
         }
         if (!started) { /* the timing starts at the first record sent */
-            t0 = rec.t;
+            prev = rec.t;
             start = tk_now_s();
             started = true;
         }
-        if (o->speed > 0.0) {
-            double dt =
-                (double)(rec.t.sec - t0.sec) + ((double)rec.t.usec - (double)t0.usec) * 1e-6;
-            if (!wait_until(start + (dt > 0.0 ? dt : 0.0) / o->speed)) {
-                break;
-            }
+        /* the recorded gap to the record before; a step back in the
+         * recorded clock is no gap (tk_cap_check() warned), and the gaps
+         * after it keep their lengths */
+        {
+            double gap = time_diff(&prev, &rec.t);
+            due += gap > 0.0 ? gap : 0.0;
+            prev = rec.t;
+        }
+        if (o->speed > 0.0 && !wait_until(start + due / o->speed)) {
+            break;
         }
         replay_send(&rp, r, &rec);
     }
