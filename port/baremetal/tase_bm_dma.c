@@ -1,13 +1,13 @@
 /* Circular-DMA receive: spans of a DMA ring into a receiver (tase/bm_dma.h). */
 #include "tase/bm_dma.h"
 
-int tase_bm_dma_init(tase_bm_dma_t *d, const uint8_t *buf, size_t size)
+int tase_bm_dma_init(tase_bm_dma_t *d, const uint8_t *buf, uint32_t size)
 {
     if (d == NULL || buf == NULL || size == 0u || size > 0x80000000u) {
         return TASE_EARG;
     }
     d->buf = buf;
-    d->size = (uint32_t)size;
+    d->size = size;
     d->pos = 0;
     d->read = 0;
     d->stats.bytes_fed = 0;
@@ -20,7 +20,7 @@ int tase_bm_dma_init(tase_bm_dma_t *d, const uint8_t *buf, size_t size)
 static int feed_span(tase_bm_dma_t *d, uint32_t n, tase_rx_t *rx, tase_rx_handler_t on_frame,
                      void *user)
 {
-    int r = tase_rx_feed(rx, &d->buf[d->pos], n, on_frame, user);
+    int r = tase_rx_feed(rx, &d->buf[d->pos], (size_t)n, on_frame, user);
     if (r >= 0) {
         d->stats.bytes_fed += n;
         d->read += n;

@@ -84,7 +84,7 @@ typedef struct {
 
 /* Start reading buf[0..size) from index 0, with the DMA's count at 0.
  * Returns TASE_OK or TASE_EARG (d or buf NULL, size 0 or > 2^31). */
-int tase_bm_dma_init(tase_bm_dma_t *d, const uint8_t *buf, size_t size);
+int tase_bm_dma_init(tase_bm_dma_t *d, const uint8_t *buf, uint32_t size);
 
 /* Feed the bytes the DMA wrote since the last call (see the top of this
  * file for `written`) to rx, then tick rx at now_ms. Returns the number
