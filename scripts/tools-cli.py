@@ -388,6 +388,31 @@ def after_noise(args):
     return took, out.decode(errors="replace")
 
 
+# issue 25 item 4: a signal whose default ends the process (not the
+# INT/TERM/HUP the tools end on) gives the line its settings back first
+def killed_by(sig):
+    master, slave = os.openpty()
+    path = os.ttyname(slave)
+    before = termios.tcgetattr(slave)
+    p = subprocess.Popen([TASE, "monitor", "--serial", path], stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL)
+    deadline = time.time() + 2.0
+    while time.time() < deadline and termios.tcgetattr(slave)[3] & termios.ICANON:
+        time.sleep(0.01)
+    raw = not termios.tcgetattr(slave)[3] & termios.ICANON
+    p.send_signal(sig)
+    p.wait(timeout=10)
+    after = termios.tcgetattr(slave)
+    os.close(master)
+    os.close(slave)
+    return raw, p.returncode, before == after
+
+
+for sig in (signal.SIGQUIT, signal.SIGUSR1, signal.SIGALRM):
+    raw, rc, same = killed_by(sig)
+    ok("%s: tase monitor dies of it (status %d) with the line's settings given back"
+       % (signal.Signals(sig).name, rc), raw and rc == -sig and same, "raw %s same %s" % (raw, same))
+
 # 57600 baud: the 257 bytes the false sync claims, less the frame's 14,
 # take 43 ms; 200 ms leaves room for a loaded machine.
 for what, args in (("monitor", ["monitor", "--json", "--serial"]), ("decode", ["decode"])):

@@ -258,6 +258,29 @@ static void on_signal(int sig)
     tk_signal = sig;
 }
 
+/* A signal whose default action ends the process and that the tools do
+ * not treat as the normal end of a run (SIGQUIT, SIGUSR1, SIGALRM, ...):
+ * give every open serial line its settings back (tcsetattr() and ioctl()
+ * are async-signal-safe), then die of the signal as before. Without this
+ * the line stayed raw with VMIN 0 for the next program (issue 25 item 4). */
+static void on_fatal_signal(int sig)
+{
+    size_t i;
+    for (i = 0; i < MAX_OPEN_LINKS; i++) {
+        tk_link_t *l = open_links[i];
+        if (l != NULL && !l->is_can && l->uart.fd >= 0 && l->uart.restore) {
+            (void)tcsetattr(l->uart.fd, TCSANOW, &l->uart.saved);
+#ifdef TIOCNXCL
+            if (l->uart.excl) {
+                (void)ioctl(l->uart.fd, TIOCNXCL);
+            }
+#endif
+        }
+    }
+    (void)signal(sig, SIG_DFL);
+    (void)raise(sig);
+}
+
 void tk_catch_signals(void)
 {
     struct sigaction sa;
@@ -269,6 +292,20 @@ void tk_catch_signals(void)
     (void)sigaction(SIGTERM, &sa, NULL);
     (void)sigaction(SIGHUP, &sa, NULL);
     (void)signal(SIGPIPE, SIG_IGN);
+    {
+        static const int fatal[] = {SIGQUIT, SIGUSR1,   SIGUSR2, SIGALRM,
+                                    SIGPROF, SIGVTALRM, SIGXCPU, SIGPOLL};
+        size_t i;
+        sa.sa_handler = on_fatal_signal;
+        sa.sa_flags = 0; /* the handler resets the action itself */
+        for (i = 0; i < sizeof(fatal) / sizeof(fatal[0]); i++) {
+            struct sigaction old;
+            /* one the caller's shell ignores stays ignored */
+            if (sigaction(fatal[i], NULL, &old) == 0 && old.sa_handler != SIG_IGN) {
+                (void)sigaction(fatal[i], &sa, NULL);
+            }
+        }
+    }
 }
 
 void tk_exit_if_signalled(void)
