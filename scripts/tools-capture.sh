@@ -178,6 +178,17 @@ check "--record on a full disk: the command was carried out, exit $rc (5), '$(ca
     eval '[ $rc -eq 5 ] && [ "$(wc -l <"$dir/full.err")" -eq 1 ] &&
           grep -q "cannot write capture .*(GIMBAL_CMD was sent)" "$dir/full.err" &&
           grep -q "^sent GIMBAL_CMD pan=1200 tilt=-300" "$dir/full.out"'
+check "... and the capture still ends at a whole record (tshark reads it cleanly)" \
+    eval 'tshark -r "$dir/full.pcap" >/dev/null 2>"$dir/full.tshark" && ! grep -v "Running as user" "$dir/full.tshark" | grep -q .'
+# issue 25 item 3: appending to a capture a crash cut inside a record
+cp "$dir/session.pcap" "$dir/crashed.pcap"
+truncate -s -5 "$dir/crashed.pcap"
+"$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/crashed.pcap" >/dev/null 2>"$dir/crashed.err"
+rc=$?
+check "--record appending to a capture cut inside a record: repaired first, said so, readable ($(cat "$dir/crashed.err"))" \
+    eval '[ $rc -eq 0 ] && grep -q "ended inside a record .* bytes of it removed before appending" "$dir/crashed.err" &&
+          tshark -r "$dir/crashed.pcap" >/dev/null 2>"$dir/crashed.tshark" && ! grep -v "Running as user" "$dir/crashed.tshark" | grep -q . &&
+          [ "$("$TASE" decode "$dir/crashed.pcap" | grep -c SYSTEM_VERSION)" -ge 2 ]'
 expect_error "record to an unwritable file (the device opens first)" 1 "cannot write capture" \
     "$TASE" record --serial "$dir/gimbal" -o "$dir/no/such/dir.pcap" --seconds 0.5
 expect_error "record onto a full disk (/dev/full)" 1 "cannot write capture /dev/full: No space left on device" \

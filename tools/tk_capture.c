@@ -28,6 +28,69 @@
 
 /* ---- writing ---- */
 
+/* The length of the whole records of an existing classic pcap file:
+ * the 24-byte file header and every record whose 16-byte header and data
+ * are complete. Returns -1 when it is not a classic pcap (pcapng, or not a
+ * capture: libpcap's append refuses those with its own message). */
+static long whole_records_len(FILE *f, long size)
+{
+    uint8_t h[24];
+    bool big;
+    long at = 24;
+    if (fread(h, 1, sizeof(h), f) != sizeof(h)) {
+        return -1;
+    }
+    /* magic a1b2c3d4 (microseconds) or a1b23c4d (nanoseconds), either order */
+    if (((h[0] == 0xD4u && h[1] == 0xC3u) || (h[0] == 0x4Du && h[1] == 0x3Cu)) && h[2] == 0xB2u &&
+        h[3] == 0xA1u) {
+        big = false;
+    } else if (h[0] == 0xA1u && h[1] == 0xB2u &&
+               ((h[2] == 0xC3u && h[3] == 0xD4u) || (h[2] == 0x3Cu && h[3] == 0x4Du))) {
+        big = true;
+    } else {
+        return -1;
+    }
+    while (at + 16 <= size) {
+        uint8_t r[16];
+        uint32_t caplen;
+        if (fseek(f, at, SEEK_SET) != 0 || fread(r, 1, sizeof(r), f) != sizeof(r)) {
+            break;
+        }
+        caplen = big ? ((uint32_t)r[8] << 24 | (uint32_t)r[9] << 16 | (uint32_t)r[10] << 8 | r[11])
+                     : ((uint32_t)r[11] << 24 | (uint32_t)r[10] << 16 | (uint32_t)r[9] << 8 | r[8]);
+        if ((long)caplen > size - at - 16) {
+            break; /* its data runs past the end */
+        }
+        at += 16 + (long)caplen;
+    }
+    return at;
+}
+
+/* Appending to a capture that a full disk or a crash cut inside a record
+ * would put every new record behind the partial one, unreadable: cut the
+ * file back to its last whole record first, and say so. */
+static void trim_partial_record(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    struct stat st;
+    long keep;
+    if (f == NULL) {
+        return; /* a new file, or libpcap reports why it cannot open it */
+    }
+    keep = (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode))
+               ? whole_records_len(f, (long)st.st_size)
+               : -1;
+    (void)fclose(f);
+    if (keep >= 24 && keep < (long)st.st_size) {
+        if (truncate(path, (off_t)keep) != 0) {
+            tk_die("cannot repair capture %s: %s", path, strerror(errno));
+        }
+        tk_warn("%s ended inside a record (a full disk or a crash?): %ld bytes of it removed "
+                "before appending",
+                path, (long)st.st_size - keep);
+    }
+}
+
 void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool append)
 {
     int snaplen = linktype == TK_CAP_LINKTYPE_CAN ? (int)TK_CAP_CAN_MAX : SERIAL_SNAPLEN;
@@ -39,6 +102,10 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
     }
     w->tmp[0] = '\0';
     w->err = 0;
+    w->good = -1;
+    if (append) {
+        trim_partial_record(path);
+    }
     /* a temporary file and a rename only for a regular file (or a new
      * one): a device, a FIFO or /dev/stdout is written in place, never
      * replaced by a rename */
@@ -56,6 +123,7 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
     }
     w->pcap = p;
     w->dumper = d;
+    w->good = ftell(pcap_dump_file(d)); /* the end of the last whole record */
     w->path = path;
     w->linktype = linktype;
     w->records = 0;
@@ -161,6 +229,8 @@ static void tap_record(tk_cap_tap_t *tap, unsigned dir, const uint8_t *data, siz
     tk_cap_put_serial(tap->w, &t, dir, data, n);
     if (pcap_dump_flush(tap->w->dumper) != 0) {
         tap->w->err = errno != 0 ? errno : EIO;
+    } else {
+        tap->w->good = ftell(pcap_dump_file(tap->w->dumper)); /* a record boundary */
     }
 }
 
@@ -217,6 +287,10 @@ static void close_session_capture(void)
     e = tk_cap_finish(&session_capture);
     if (session_capture.err != 0) {
         e = session_capture.err; /* the first failure, not the close's */
+        if (session_capture.good > 0) {
+            /* end the file at its last whole record */
+            (void)truncate(session_capture.path, (off_t)session_capture.good);
+        }
     }
     if (e != 0) {
         const char *sent = tk_sent();

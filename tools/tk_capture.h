@@ -66,7 +66,8 @@ typedef struct {
      * path when it is complete: an existing file at path is never touched
      * by a recording that fails or is killed (the partial file stays) */
     char tmp[4096];
-    int err; /* --record: the errno that stopped recording, 0 none */
+    int err;   /* --record: the errno that stopped recording, 0 none */
+    long good; /* --record: file length after the last whole record, -1 unknown */
 } tk_cap_writer_t;
 
 /* Start a new capture for `path`: a new or regular file is written to
