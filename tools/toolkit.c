@@ -263,6 +263,8 @@ static void on_signal(int sig)
  * give every open serial line its settings back (tcsetattr() and ioctl()
  * are async-signal-safe), then die of the signal as before. Without this
  * the line stayed raw with VMIN 0 for the next program (issue 25 item 4). */
+static sigset_t fatal_set; /* the signals on_fatal_signal() handles */
+
 static void on_fatal_signal(int sig)
 {
     size_t i;
@@ -298,11 +300,13 @@ void tk_catch_signals(void)
         size_t i;
         sa.sa_handler = on_fatal_signal;
         sa.sa_flags = 0; /* the handler resets the action itself */
+        sigemptyset(&fatal_set);
         for (i = 0; i < sizeof(fatal) / sizeof(fatal[0]); i++) {
             struct sigaction old;
             /* one the caller's shell ignores stays ignored */
             if (sigaction(fatal[i], NULL, &old) == 0 && old.sa_handler != SIG_IGN) {
                 (void)sigaction(fatal[i], &sa, NULL);
+                (void)sigaddset(&fatal_set, fatal[i]);
             }
         }
     }
@@ -350,10 +354,18 @@ int tk_link_serial_try(tk_link_t *l, const char *path, long baud)
     if (baud <= 0 || !tase_posix_uart_baud_supported((uint32_t)baud)) {
         tk_usage_error("unsupported baud rate %ld", baud);
     }
-    rc = tase_posix_uart_open(&l->uart, path, (uint32_t)baud);
-    if (rc == TASE_OK) {
-        l->open = true;
-        track_link(l, true);
+    {
+        /* a fatal signal between the open (the line is raw from here) and
+         * the tracking (from which its handler restores the line) waits
+         * until both are done */
+        sigset_t old;
+        (void)sigprocmask(SIG_BLOCK, &fatal_set, &old);
+        rc = tase_posix_uart_open(&l->uart, path, (uint32_t)baud);
+        if (rc == TASE_OK) {
+            l->open = true;
+            track_link(l, true);
+        }
+        (void)sigprocmask(SIG_SETMASK, &old, NULL);
     }
     return rc;
 }
