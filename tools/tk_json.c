@@ -299,6 +299,27 @@ static void sb_c(sb_t *b, char c)
     }
 }
 
+/* s as the inside of a JSON string: '"' and '\\' escaped, control
+ * characters as \u00XX (an interface name may hold any byte but '/',
+ * ':' and white space). */
+static void sb_json_str(sb_t *b, const char *s)
+{
+    static const char hex[] = "0123456789abcdef";
+    for (; *s != '\0'; s++) {
+        unsigned char ch = (unsigned char)*s;
+        if (ch == '"' || ch == '\\') {
+            sb_c(b, '\\');
+            sb_c(b, (char)ch);
+        } else if (ch < 0x20u) {
+            sb_str(b, "\\u00");
+            sb_c(b, hex[ch >> 4]);
+            sb_c(b, hex[ch & 15u]);
+        } else {
+            sb_c(b, (char)ch);
+        }
+    }
+}
+
 static const char digit_pairs[] = "00010203040506070809101112131415161718192021222324252627282930"
                                   "31323334353637383940414243444546474849505152535455565758596061"
                                   "6263646566676869707172737475767778798081828384858687888990919293"
@@ -516,7 +537,7 @@ static void json_frame(sb_t *b, const tk_fmt_t *fmt, const tk_meta_t *m, const t
     }
     if (m->iface != NULL) {
         sb_str(b, ",\"interface\":\"");
-        sb_str(b, m->iface); /* names are printable without spaces or quotes */
+        sb_json_str(b, m->iface); /* a name may hold '"' or '\\' */
         sb_c(b, '"');
     }
     if (p == NULL) {

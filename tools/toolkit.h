@@ -64,6 +64,8 @@ void tk_warn(const char *fmt, ...);
  * standard output (a full disk, a closed pipe) exits TK_EXIT_SENT with
  * "what was sent; cannot write to standard output: <reason>". */
 void tk_mark_sent(const char *what);
+/* What tk_mark_sent() noted, or NULL. */
+const char *tk_sent(void);
 
 /* ---- numbers ----
  * Integers: an optional sign ('+' or '-'), then decimal digits (leading
