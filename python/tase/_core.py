@@ -306,7 +306,6 @@ def packet_type(name):
 _KEY, _OFF, _BUF, _TIME, _DIR = range(5)
 _new_tuple = tuple.__new__
 _M32 = 0xFFFFFFFF
-_vals = ffi.new("int64_t[64]")
 
 
 class Packet(tuple):
@@ -439,10 +438,11 @@ class Packet(tuple):
         if t is None:
             return {"data": list(self.payload)}
         data = self.payload
-        n = lib.py_decode(t.index, data, len(data), _vals, 64)
+        vals = ffi.new("int64_t[]", len(t.fields) or 1)  # per call: threads
+        n = lib.py_decode(t.index, data, len(data), vals, len(t.fields))
         if n < 0:
             return {}
-        return {f.name: _vals[i] for i, f in zip(range(n), t.fields)}
+        return dict(zip((f.name for f in t.fields[:n]), ffi.unpack(vals, n)))
 
     @property
     def fields(self):
@@ -485,14 +485,14 @@ class Packet(tuple):
             raise UnknownPacketError("an unknown packet has no fields", lib.TASE_EUNKNOWN)
         raw = self.raw
         extra = fields.pop("raw", None) or {}
+        data = fields.pop("data", self.data)
         for k, v in fields.items():
             f = t.by_name.get(k)
             if f is None:
                 raise FieldError("%s has no field %r" % (t.name, k))
             raw[k] = f.to_raw(v, t.name)
         raw.update(extra)
-        data = fields.pop("data", self.data)
-        return _make(t, raw, self.size if self.size != t.len else None, data)
+        return _make(t, raw, self.size if self.size != t.len and not t.tail else None, data)
 
     def encode(self):
         """The complete frame (sync, size, group, type, data, checksum)."""
@@ -574,12 +574,13 @@ def _make(t, raw, length, data):
             raise FieldError("%s: a zero-length form carries no fields" % t.name)
     elif n is not None:
         # a shorter form: the fields that fit are sent (CAMERA_CMD: camera)
+        tmp = ffi.new("py_field_t *")
         sent = {
             f.name
             for f in t.fields
-            if lib.py_field(t.index, f.index, n, _field_tmp) == 0
-            and 0 <= _field_tmp.offset
-            and _field_tmp.offset + f.width <= n
+            if lib.py_field(t.index, f.index, n, tmp) == 0
+            and 0 <= tmp.offset
+            and tmp.offset + f.width <= n
         }
     for f in t.fields:
         if f.name in raw:
@@ -600,15 +601,12 @@ def _make(t, raw, length, data):
         raise FieldError("%s carries no data bytes" % t.name)
     if t.tail:
         data = bytes(data)
-    if len(vals) > 64:
-        raise FieldError("%s: too many fields" % t.name)
-    for i, v in enumerate(vals):
-        _enc_vals[i] = v
+    enc = ffi.new("int64_t[]", vals or [0])
     out = ffi.new("uint8_t[]", lib.TASE_FRAME_MAX)
     bad = ffi.new("int *")
     r = lib.py_encode(
         t.index,
-        _enc_vals,
+        enc,
         len(vals),
         data if data else ffi.NULL,
         len(data) if data else 0,
@@ -626,10 +624,6 @@ def _make(t, raw, length, data):
         raise error(r, what)
     frame = ffi.buffer(out, r)[:]
     return _from_data(t.id, frame[6:-2])
-
-
-_field_tmp = ffi.new("py_field_t *")
-_enc_vals = ffi.new("int64_t[64]")
 
 
 def encode(packet):

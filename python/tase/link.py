@@ -16,7 +16,6 @@ import re
 import select
 import time
 
-from . import _core
 from ._core import (
     Error,
     FieldError,
@@ -30,7 +29,6 @@ from ._core import (
     error,
     ffi,
     lib,
-    packet_type,
 )
 
 __all__ = ["connect", "Link", "parse_url"]
@@ -400,7 +398,16 @@ class Link:
         `retries` more times). TimeoutError when none comes."""
         self._live()
         if isinstance(what, Packet):
-            self._checked(what)
+            t = self._checked(what)
+            echoed = t.group == 0x48 or (
+                t.name == "SPOI_CMD" and what.size > 0 and what.raw["flags"] & lib.TASE_SPOI_ECHO
+            )
+            if not echoed:
+                # a retry would send it again: only packets the gimbal echoes
+                raise FieldError(
+                    "%s is not echoed by the gimbal (setup packets are, SPOI_CMD with its "
+                    "echo flag): use send(), nothing sent" % t.name
+                )
             req = what
         else:
             req = Packet.query(what)
@@ -625,4 +632,3 @@ def _now_us():
     return int(time.time() * 1e6)
 
 
-_core.LinkError = LinkError

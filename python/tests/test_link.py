@@ -88,6 +88,10 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
         (lambda l: l.camera("D"), tase.FieldError, "A, B or C"),
         (lambda l: l.camera(hfov=0), tase.FieldError, "0.01..327.67"),
         (lambda l: l.spoi(91, 0, 0), tase.FieldError, "out of range"),
+        (lambda l: l.query(tase.Packet("GIMBAL_CMD", pan=0, tilt=0, roll=0, flags=0xA0,
+                                       impulse_time=0)), tase.FieldError, "not echoed"),
+        (lambda l: l.query(tase.Packet("SPOI_CMD", lat=0, lon=0, height=0, vnorth=0, veast=0,
+                                       vdown=0, flags=0)), tase.FieldError, "not echoed"),
     ],
 )
 def test_refused_input_sends_nothing(silent_pty, call, exc, text):

@@ -71,6 +71,20 @@ def test_engineering_values_and_repr():
     assert g.fields["lat"] == 45.0
 
 
+def test_replace_and_pickle():
+    import pickle
+
+    p = tase.Packet("CAMERA_PASS", camera=1, baud=8, data=b"ab")
+    q = p.replace(camera=2)
+    assert q.raw == {"camera": 2, "baud": 8} and q.data == b"ab" and p.raw["camera"] == 1
+    assert p.replace(data=b"xyz").data == b"xyz"
+    with pytest.raises(tase.FieldError, match="no field"):
+        p.replace(zoom=1)
+    d = tase.decode(b"\0" + tase.encode(p))[0]
+    e = pickle.loads(pickle.dumps(d))
+    assert e == p and e.offset == 1
+
+
 def test_defaults_are_do_not_change_values():
     c = tase.Packet("CAMERA_CMD", camera=1)
     assert c.raw["hfov"] == -1 and c.raw["focus"] == 0xFFFF and c.raw["flags"] == 0x80
