@@ -212,3 +212,23 @@ def test_tase_sim_on_a_virtual_can_bus(tase_sim):
             names = {p.name for p in link.packets(timeout=0.5)}
             assert {"GIMBAL_ANGLE", "GIMBAL_RATE"} <= names
     assert "GIMBAL_CMD: rate" in sim.log()
+
+
+def test_units_json_equals_tase_monitor(sim, tase_cli):
+    """`tase monitor --json --units` and Packet.json(units=True) print the
+    same text for the same packets (everything after offset/time/dir)."""
+    import json
+    import subprocess
+
+    r = subprocess.run([tase_cli, "monitor", "--serial", sim.link, "--json", "--units",
+                        "--seconds", "1.2"], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    names = set()
+    for line in lines:
+        obj = json.loads(line)
+        p = tase.Packet(obj["name"], raw=obj["fields"])
+        mine = p.json(units=True)
+        assert mine[mine.index(',"group"'):] == line[line.index(',"group"'):]
+        names.add(obj["name"])
+    assert {"GIMBAL_ANGLE", "GIMBAL_RATE", "GEOREFERENCE_DATA"} <= names
