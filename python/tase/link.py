@@ -11,6 +11,7 @@ C code frames what is sent, scans what is received and matches answers
 and echoes to requests, with retries; Python only moves the bytes.
 """
 
+import collections
 import os
 import re
 import select
@@ -305,7 +306,7 @@ class Link:
         self._ctx = ffi.new("py_ctx_t *")
         self._ctx.s = self._sink.s
         self._base = 0
-        self._queue = []
+        self._queue = collections.deque()
         self._closed = False
         _check(
             lib.py_host_init(self._host, self._handle, transport.bytes_per_s, self._ctx), url
@@ -346,8 +347,8 @@ class Link:
                 self._queue.extend(got)
         if self._exc is not None:
             e, self._exc = self._exc, None
-            if isinstance(e, Error):
-                raise e
+            if isinstance(e, Error) or not isinstance(e, Exception):
+                raise e  # ours, or KeyboardInterrupt / SystemExit as they are
             raise LinkError("%s: %s" % (self.url, e), lib.TASE_EIO) from e
         return r
 
@@ -444,15 +445,16 @@ class Link:
 
     def packets(self, timeout=None, count=None):
         """Iterate over the packets received (telemetry, echoes, answers
-        not taken by query()) until `timeout` s have passed without... in
-        all (None: forever) or `count` packets were given."""
+        not taken by query()), each when it arrives, until `timeout`
+        seconds have passed in all (None: no limit) or `count` packets
+        were given."""
         self._live()
         deadline = None if timeout is None else time.monotonic() + timeout
         given = 0
         while count is None or given < count:
             if self._queue:
                 given += 1
-                yield self._queue.pop(0)
+                yield self._queue.popleft()
                 continue
             wait = 0.2 if deadline is None else deadline - time.monotonic()
             if wait <= 0:
@@ -470,7 +472,8 @@ class Link:
 
     @property
     def stats(self):
-        """Counters of the host role and its receiver."""
+        """Counters of the host role and its receiver (32-bit, as the
+        library keeps them)."""
         h = self._host.stats
         rx = self._host.rx.stats
         return {
@@ -485,6 +488,8 @@ class Link:
             "checksum_errors": rx.checksum_errors,
             "bad_size": rx.bad_size,
             "bytes_discarded": rx.bytes_discarded,
+            # frames beyond the link's buffer during one blocking call (32768)
+            "frames_dropped": self._sink.s.dropped,
         }
 
     # -- the CLI's safe verbs (tase point/rate/spoi/retract/deploy/camera)
@@ -545,14 +550,19 @@ class Link:
         self.send(p)
         if wait is None:
             return p
-        for q in self.packets(timeout=wait):
-            if q.name == "RETRACT_DEPLOY_CMD" and q.size > 0:
-                if bool(q.raw["deploy"]) != deploy:
-                    raise Error(
-                        "%s: the gimbal reports %s" % (self.url, "deployed" if q.raw["deploy"] else "retracted")
-                    )
-                return q
-            self._queue.append(q)  # left for packets()
+        others = []  # left for packets(), in order, after the wait
+        try:
+            for q in self.packets(timeout=wait):
+                if q.name == "RETRACT_DEPLOY_CMD" and q.size > 0:
+                    if bool(q.raw["deploy"]) != deploy:
+                        raise Error(
+                            "%s: the gimbal reports %s"
+                            % (self.url, "deployed" if q.raw["deploy"] else "retracted")
+                        )
+                    return q
+                others.append(q)
+        finally:
+            self._queue.extendleft(reversed(others))
         raise TimeoutError_(
             "%s: no RETRACT_DEPLOY_CMD echo within %s s" % (self.url, wait), lib.TASE_ETIMEOUT
         )

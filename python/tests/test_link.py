@@ -32,10 +32,14 @@ def test_live_exchange_with_tase_sim(sim):
         echo = link.query(tase.Packet("AXIS_SETTING", pan_max_rate=60))
         assert echo.name == "AXIS_SETTING" and echo.fields["pan_max_rate"] == 60
         assert link.spoi(45.0, -122.5, 100.0).fields["lat"] == 45.0
+        # deploy while deployed: the echo comes at once; telemetry waits
+        echo = link.deploy(wait=3.0)
+        assert echo.name == "RETRACT_DEPLOY_CMD" and echo.raw["deploy"] == 1
+        assert link.recv(timeout=1.0).name in ("GIMBAL_ANGLE", "GIMBAL_RATE", "GEOREFERENCE_DATA")
         st = link.stats
         assert st["replies"] == 3 and st["timeouts"] == 0 and st["frames_rx"] > 3
     assert "position pan 30.00 tilt -10.00" in sim.log()
-    assert "AXIS_SETTING" in sim.log()
+    assert "AXIS_SETTING" in sim.log() and "RETRACT_DEPLOY_CMD" in sim.log()
 
 
 @pytest.fixture
