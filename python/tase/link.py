@@ -12,6 +12,7 @@ and echoes to requests, with retries; Python only moves the bytes.
 """
 
 import collections
+import errno
 import os
 import re
 import select
@@ -191,7 +192,13 @@ class _CanTransport:
         try:
             self.bus = can.Bus(interface=scheme, channel=channel)
         except (OSError, can.CanError, ValueError) as e:
-            raise LinkError("cannot open %s:%s: %s" % (scheme, channel, e), lib.TASE_ENODEV) from e
+            why = {
+                errno.EAFNOSUPPORT: "this kernel has no SocketCAN support (load the can and "
+                "can-raw modules, or see docs/CAN.md for the VM)",
+                errno.ENODEV: "no such device",
+                errno.ENETDOWN: "interface is down (ip link set %s up)" % channel,
+            }.get(getattr(e, "errno", None), str(e))
+            raise LinkError("cannot open %s:%s: %s" % (scheme, channel, why), lib.TASE_ENODEV) from e
         self.bytes_per_s = lib.TASE_SOCKETCAN_BYTES_PER_S
         self.pending = b""
         self.frames = ffi.new("tase_can_frame_t[]", 40)

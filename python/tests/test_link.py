@@ -236,3 +236,9 @@ def test_units_json_equals_tase_monitor(sim, tase_cli):
         assert mine[mine.index(',"group"'):] == line[line.index(',"group"'):]
         names.add(obj["name"])
     assert {"GIMBAL_ANGLE", "GIMBAL_RATE", "GEOREFERENCE_DATA"} <= names
+
+
+def test_missing_can_interface():
+    pytest.importorskip("can")
+    with pytest.raises(tase.LinkError, match="no SocketCAN support|no such device"):
+        tase.connect("socketcan:tasenosuch0")
