@@ -42,7 +42,7 @@ def _raw_strategy(t):
 
 
 @pytest.mark.parametrize("t", tase.PACKET_TYPES, ids=lambda t: t.name)
-@settings(max_examples=25, derandomize=True, deadline=None)
+@settings(max_examples=25, derandomize=True, deadline=None, database=None)
 @given(data=st.data())
 def test_round_trip_every_packet_type(t, data):
     raw = data.draw(_raw_strategy(t))
@@ -157,3 +157,11 @@ def test_json_matches_contract():
     assert obj["data"] == [129, 1]
     u = json.loads(tase.Packet("GIMBAL_ANGLE", pan=1.5, tilt=0, roll=0).json(units=True))
     assert u["units"] == {"pan_deg": 1.5, "tilt_deg": 0.0, "roll_deg": 0.0}
+
+
+def test_examples_of_docs_python_md():
+    import doctest
+
+    r = doctest.testfile(os.path.join(ROOT, "docs", "PYTHON.md"), module_relative=False,
+                         optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert r.attempted >= 5 and r.failed == 0
