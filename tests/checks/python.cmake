@@ -30,3 +30,6 @@ set_tests_properties(python_pytest PROPERTIES LABELS "check;e2e;python" TIMEOUT 
 add_test(NAME python_readme
          COMMAND ${PROJECT_SOURCE_DIR}/python/check-readme.sh $<TARGET_FILE:tase_sim> ${TASE_PYTHON})
 set_tests_properties(python_readme PROPERTIES LABELS "check;python" TIMEOUT 300)
+# python_pytest talks to tase-sim on the real clock (query timeouts, the
+# time bound): alone, as tools_e2e, so the fuzzers cannot starve it.
+set_tests_properties(python_pytest PROPERTIES RUN_SERIAL TRUE)
