@@ -62,7 +62,7 @@ cat "$dir/image.log"
 grep -q '^PASS: 0 of [0-9]* checks failed' "$dir/image.log" || fail "the image did not report PASS"
 
 # The simulator saw the setup exchange and the SPOI command the image sent.
-grep -q 'PACKET_RATE: port 1 angle 20/s, rate 10/s, georef 10/s' "$dir/sim.log" ||
+grep -q 'PACKET_RATE: port 2 (this link) angle 20/s, rate 10/s, georef 10/s' "$dir/sim.log" ||
     fail "tase-sim's log lacks the PACKET_RATE setting"
 spoi=$(sed -n 's/^SPOI_CMD at \([-0-9.]*, [-0-9.]*, [-0-9.]* m\), echo confirmed.*/\1/p' \
        "$dir/image.log")

@@ -56,7 +56,7 @@ show "$TASE" query SYSTEM_VERSION "${link[@]}"
 echo "(camera_a=68 is a Sony FCB-EX1010, camera_b=97 a FLIR Photon 320; HFOVs in 1/100 deg)"
 
 step "Host: slow the telemetry down to 5 angle, 2 rate, 1 georef packets per second"
-show "$TASE" send PACKET_RATE angle_1=5 rate_1=2 geo_ref_1=1 "${link[@]}"
+show "$TASE" send PACKET_RATE angle_2=5 rate_2=2 geo_ref_2=1 "${link[@]}"
 echo "(the gimbal echoes a setup packet; unspecified fields kept their current values)"
 
 step "Host: point the camera at pan 45 deg, tilt -20 deg, stabilised (GIMBAL_CMD position)"

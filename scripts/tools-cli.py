@@ -141,6 +141,27 @@ expect("--no-wait setup packet needs every field",
 expect("point: out-of-range angle states the range", ["point", "200", "0"] + L, 2,
        r"out of range -180\.\.180 deg")
 expect("point: not a number", ["point", "ten", "0"] + L, 2, "not a number")
+# issue 23 item 3: tilt is -270..90 (spec 4.3.3), pan -180..180
+expect("point: tilt 150 is outside the spec's -270..90", ["point", "0", "150"] + L, 2,
+       r"bad tilt '150': out of range -270\.\.90 deg")
+expect("point: tilt -200 is inside it (then the missing device)", ["point", "0", "-200"] + L, 1,
+       "cannot open serial device")
+expect("point: pan stays -180..180", ["point", "-190", "-200"] + L, 2,
+       r"bad pan '-190': out of range -180\.\.180 deg")
+# issue 23 item 10: reserved flag bits are refused, nothing sent, unless --raw
+for pkt, flags, bits in (("HOST_ATTITUDE", "0xFF", r"0xFC"), ("SPOI_CMD", "0x7F", r"0x7F"),
+                         ("CAMERA_CMD", "0x78", r"0x78"), ("HOST_SENSOR", "0x01", r"0x1F")):
+    expect("send %s flags=%s: reserved bits refused" % (pkt, flags),
+           ["send", pkt, "flags=" + flags, "--zero"] + L, 2,
+           r"%s flags=%s sets reserved bits .*\(%s\).*nothing sent \(--raw sends it anyway\)$"
+           % (pkt, flags, bits))
+    expect("send %s flags=%s --raw: sent as given (then the missing device)" % (pkt, flags),
+           ["send", pkt, "flags=" + flags, "--zero", "--raw"] + L, 1, "cannot open serial device")
+expect("send: flags without reserved bits pass", ["send", "HOST_ATTITUDE", "flags=3", "--zero"] + L,
+       1, "cannot open serial device")
+out, _ = expect("send --help documents --raw", ["send", "--help"], 0, "", lines=0)
+ok("send --help: --raw in the usage and explained", "[--raw]" in out and "--raw sends them" in out,
+   out)
 expect("rate: range", ["rate", "400", "0"] + L, 2, r"-327\.68\.\.327\.67 deg/s")
 expect("point: negative numbers are arguments", ["point", "-10", "-5.5"] + L, 1,
        "cannot open serial device")

@@ -361,9 +361,13 @@ static void handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f,
     uint8_t tmp[SETUP_APPLY_MAX];
     size_t echo_len = setup_len[type];
 
+    if (!tase_schema_length_ok(p, f->len)) {
+        g->stats.bad_length++; /* SYSTEM_VERSION too (R3): 0 or 42 bytes */
+        return;
+    }
     if (f->len == 0 || type == SETUP_SYSTEM_VERSION) {
         g->stats.setup_queries++;
-    } else if (!tase_schema_length_ok(p, f->len) || p->len > sizeof tmp) {
+    } else if (p->len > sizeof tmp) {
         g->stats.bad_length++;
         return;
     } else {

@@ -141,6 +141,8 @@ static void simulator_words_decode_through_flags_h(void **state)
     b = sim_spoi_flags(&m);
     assert_int_equal(TASE_SPOI_MODE(b), TASE_MODE_SPOI);
     assert_true(b & TASE_SPOI_STAB);
+    /* issue 23 item 1: the SPOI flags carry stabilisation and mode only */
+    assert_int_equal(b, 0x80 | TASE_MODE_SPOI);
     /* retracted, unstabilised, position feedback; moving: neither 3AX bit */
     m.mode = SIM_MODE_POSITION;
     m.stabilised = false;
@@ -148,7 +150,7 @@ static void simulator_words_decode_through_flags_h(void **state)
     b = sim_spoi_flags(&m);
     assert_int_equal(TASE_SPOI_MODE(b), TASE_MODE_POSITION);
     assert_false(b & TASE_SPOI_STAB);
-    assert_true(b & TASE_SPOI_3AX_RETRACTED);
+    assert_false(b & (TASE_SPOI_3AX_DEPLOYED | TASE_SPOI_3AX_RETRACTED));
     m.tax = SIM_3AX_MOVING;
     m.mode = SIM_MODE_IMPULSE;
     b = sim_mode_byte(&m);
@@ -170,7 +172,10 @@ static void gps_status_and_nav_health_fields_decode(void **state)
     assert_int_equal(TASE_GPS_ANTENNA(0xFFF9), TASE_GPS_ANTENNA_GOOD);
     assert_int_equal(TASE_NAV_POSITION, 0x8000);
     assert_int_equal(TASE_NAV_MAG_BIAS, 0x0020);
-    assert_int_equal(TASE_NAV_FILTER_MODE(0xFFF3), TASE_NAV_FILTER_NORMAL);
+    /* filter modes as the vendor's later header numbers them (P8) */
+    assert_int_equal(TASE_NAV_FILTER_MODE(0xFFF4), TASE_NAV_FILTER_NORMAL);
+    assert_int_equal(TASE_NAV_FILTER_MODE(0x0002), TASE_NAV_FILTER_AHRS);
+    assert_int_equal(TASE_NAV_FILTER_MODE(0x0005), TASE_NAV_FILTER_ALIGN);
 }
 
 int main(void)

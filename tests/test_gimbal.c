@@ -392,6 +392,11 @@ static void system_version_is_query_only_and_answers_the_application_bytes(void 
     assert_int_equal(only_frame(&x->port[0], &g, &t, d), 42);
     assert_memory_equal(d, ver, 42);
     assert_int_equal(x->applies, 0);
+    /* Issue 23 item 12: a wrong length (5 bytes) is dropped like any other
+     * setup packet's (R1/R3), not answered. */
+    feed(x, 0, 0x48, 0x03, junk, 5, 30);
+    assert_int_equal(fake_frames_out(&x->port[0]), 0);
+    assert_int_equal(x->g.stats.bad_length, 1);
     free(x);
 }
 

@@ -31,16 +31,22 @@ static inline uint8_t sim_mode_byte(const sim_model_t *m)
 }
 
 /* Flags byte of a SPOI_CMD sent by the gimbal (4.3.2): "this bit will be
- * set if stabilization is on", "the mode will be recorded here": the Mode
- * byte itself (docs/PROTOCOL-NOTES.md P4), whatever the host's flags were. */
+ * set if stabilization is on", "the mode will be recorded here": bit 0
+ * stabilisation and the mode in bits 3-7, bits 1-2 clear, whatever the
+ * host's flags were. 4.3.2 defines only those two things, so the 3AX bits
+ * of the Mode byte are left out: read as the Mode byte or as a bare mode
+ * number in bits 1-7, the byte then gives the same mode
+ * (docs/PROTOCOL-NOTES.md P4). */
 static inline uint8_t sim_spoi_flags(const sim_model_t *m)
 {
-    return sim_mode_byte(m);
+    return (uint8_t)(sim_mode_byte(m) &
+                     ~(unsigned)(TASE_SPOI_3AX_DEPLOYED | TASE_SPOI_3AX_RETRACTED));
 }
 
 /* NavHealth of GEOREFERENCE_DATA (4.3.3): every health bit set (the
  * simulated filter is always within bounds), reserved bits 2-5 and 11
- * clear, filter mode "normal". */
+ * clear, filter mode "normal" (TASE_NAV_FILTER_NORMAL, 4: PROTOCOL-NOTES
+ * P8). */
 static inline uint16_t sim_nav_health(void)
 {
     return (uint16_t)(TASE_NAV_POSITION | TASE_NAV_VELOCITY | TASE_NAV_HEADING | TASE_NAV_ATTITUDE |

@@ -51,8 +51,9 @@ static const char usage_req[] =
 static const char usage_point[] =
     "usage: tase point PAN TILT [--stab on|off] LINK [--json]\n"
     "Position command (GIMBAL_CMD flags 0xA0, or 0x20 with --stab off): turn to pan\n"
-    "PAN and tilt TILT degrees (-180..180; sent in 1/100 deg). Stabilisation is on\n"
-    "unless --stab off. Prints what it sent. Negative numbers need no '--'.\n";
+    "PAN degrees (-180..180) and tilt TILT degrees (-270..90, the spec's range;\n"
+    "both sent in 1/100 deg). Stabilisation is on unless --stab off. Prints what\n"
+    "it sent. Negative numbers need no '--'.\n";
 
 static const char usage_rate[] =
     "usage: tase rate PAN_RATE TILT_RATE [--stab on|off] LINK [--json]\n"
@@ -102,8 +103,8 @@ static const char usage_monitor[] =
     "On CAN, --time is the kernel's receive time of the frame.\n";
 
 static const char usage_send[] =
-    "usage: tase send NAME [field=value ...] LINK [--len N] [--zero] [--no-wait]\n"
-    "                 [--json] [--timeout MS] [--retries N]\n"
+    "usage: tase send NAME [field=value ...] LINK [--len N] [--zero] [--raw]\n"
+    "                 [--no-wait] [--json] [--timeout MS] [--retries N]\n"
     "Sends packet NAME (an In or Both packet; see 'tase list') with raw wire integer\n"
     "field values: decimal (leading zeros are decimal), 0x hex, an optional sign; a\n"
     "signed field also takes its hex bit pattern (hfov=0xFFFF is -1). CAMERA_PASS\n"
@@ -126,7 +127,10 @@ static const char usage_send[] =
     "or changed) exits 3 naming it. --no-wait sends without waiting for anything\n"
     "(a setup packet then needs every field, or --zero). --len N sends a shorter\n"
     "accepted form (CAMERA_CMD --len 1: change camera only; AXIS_SETTING --len 22:\n"
-    "the 22-byte layout).\n";
+    "the 22-byte layout). A flags field with a bit the spec reserves (\"set to\n"
+    "zero\") set is refused, nothing sent: CAMERA_CMD 0x78, HOST_SENSOR 0x1F,\n"
+    "HOST_ATTITUDE 0xFC, SPOI_CMD 0x7F (to the gimbal only bit 0, the echo\n"
+    "request); --raw sends them as given, to test how a gimbal takes them.\n";
 
 static const char usage_query[] =
     "usage: tase query NAME LINK [--json] [--timeout MS] [--retries N]\n"
@@ -768,9 +772,42 @@ static void refuse_gimbal_cmd(const char *why)
 typedef struct {
     bool zero;     /* fields left out are 0 */
     bool no_wait;  /* wait for nothing */
+    bool raw;      /* reserved flag bits allowed */
     long long len; /* forced data length, -1 none */
     req_opts_t r;
 } send_opts_t;
+
+/* Flags fields of In packets with bits the spec reserves ("set to zero"),
+ * spec bit numbers (0 = MSB). */
+static const struct {
+    uint16_t id;
+    uint8_t reserved; /* mask */
+    const char *bits; /* in messages */
+} reserved_flags[] = {
+    {TASE_ID_CAMERA_CMD, TASE_MASK8(1, 4), "bits 1-4 (0x78), 4.1.3"},
+    {TASE_ID_HOST_SENSOR, TASE_MASK8(3, 7), "bits 3-7 (0x1F), 4.2.3"},
+    {TASE_ID_HOST_ATTITUDE, TASE_MASK8(0, 5), "bits 0-5 (0xFC), 4.2.4"},
+    {TASE_ID_SPOI_CMD, TASE_MASK8(1, 7), "bits 1-7 (0x7F): to the gimbal only bit 0, 4.3.2"},
+};
+
+/* Refuse (usage error, nothing sent) a flags value with a reserved bit. */
+static void check_reserved_flags(const fields_t *fs, unsigned nf)
+{
+    const tase_packet_desc_t *p = fs->p;
+    int fi = tase_schema_field_index(p, "flags");
+    size_t i;
+    if (fi < 0 || (unsigned)fi >= nf || !fs->given[fi]) {
+        return;
+    }
+    for (i = 0; i < sizeof(reserved_flags) / sizeof(reserved_flags[0]); i++) {
+        long long v = fields_value(fs, (unsigned)fi);
+        if (reserved_flags[i].id == p->id && (v & reserved_flags[i].reserved) != 0) {
+            tk_usage_error("%s flags=0x%02llX sets reserved %s; nothing sent (--raw sends it "
+                           "anyway)",
+                           tase_schema_packet_name(p), v, reserved_flags[i].bits);
+        }
+    }
+}
 
 /* Compare the gimbal's echo with what was sent; exit 3 naming every field
  * that differs. Fields sent as "do not change" are not compared (the echo
@@ -832,7 +869,7 @@ static void send_fields(session_t *s, const fields_t *fs, size_t len, const send
 static int cmd_send(args_t *a)
 {
     link_opts_t lo = {NULL, NULL, DEFAULT_BAUD, NULL};
-    send_opts_t o = {false, false, -1, {DEFAULT_TIMEOUT_MS, DEFAULT_RETRIES, false}};
+    send_opts_t o = {false, false, false, -1, {DEFAULT_TIMEOUT_MS, DEFAULT_RETRIES, false}};
     const char *name = NULL, *v;
     const char *assign[64];
     size_t nassign = 0, i, len;
@@ -850,6 +887,8 @@ static int cmd_send(args_t *a)
             o.zero = true;
         } else if (opt(a, "--no-wait", false, &v)) {
             o.no_wait = true;
+        } else if (opt(a, "--raw", false, &v)) {
+            o.raw = true;
         } else if (opt(a, "--len", true, &v)) {
             o.len = int_opt_value("--len", v, 0, TASE_DATA_MAX);
         } else if (is_arg(a, false) && name == NULL) {
@@ -900,6 +939,9 @@ static int cmd_send(args_t *a)
         if (gimbal_mode(fields_value(&fs, (unsigned)fi)) == NULL) {
             refuse_gimbal_cmd("flags is not a mode of the spec's table 5");
         }
+    }
+    if (!o.raw) {
+        check_reserved_flags(&fs, nf);
     }
     fields_keep(&fs, nf);
     if (!o.zero) {
@@ -1076,6 +1118,7 @@ static send_opts_t verb_opts(const verb_args_t *v)
     send_opts_t o;
     o.zero = false;
     o.no_wait = true;
+    o.raw = false;
     o.len = -1;
     o.r = v->r;
     return o;
@@ -1094,15 +1137,19 @@ typedef struct {
     uint8_t kind; /* TASE_GIMBAL_KIND_* */
     const char *args;
     const char *what; /* "pan" / "pan rate" in messages */
-    double lo, hi;
+    double pan_lo, pan_hi, tilt_lo, tilt_hi;
     const char *unit;
 } gimbal_verb_t;
 
+/* positions: the spec's axis ranges (tase/units.h) */
 static const gimbal_verb_t verb_point = {
-    TASE_GIMBAL_KIND_POSITION, "PAN TILT in degrees", "", -180.0, 180.0, "deg"};
+    TASE_GIMBAL_KIND_POSITION, "PAN TILT in degrees", "",   TASE_PAN_MIN_DEG, TASE_PAN_MAX_DEG,
+    TASE_TILT_MIN_DEG,         TASE_TILT_MAX_DEG,     "deg"};
 static const gimbal_verb_t verb_rate = {TASE_GIMBAL_KIND_RATE,
                                         "PAN_RATE TILT_RATE in degrees per second",
                                         " rate",
+                                        -327.68,
+                                        327.67,
                                         -327.68,
                                         327.67,
                                         "deg/s"};
@@ -1120,9 +1167,9 @@ static int gimbal_verb(args_t *a, const gimbal_verb_t *gv)
     verb_parse(a, &v, 2, "stab");
     need_args(&v, 2, gv->args);
     snprintf(what, sizeof(what), "pan%s", gv->what);
-    pan = tase_units_deg_to_cdeg(real_arg(what, v.pos[0], gv->lo, gv->hi, gv->unit));
+    pan = tase_units_deg_to_cdeg(real_arg(what, v.pos[0], gv->pan_lo, gv->pan_hi, gv->unit));
     snprintf(what, sizeof(what), "tilt%s", gv->what);
-    tilt = tase_units_deg_to_cdeg(real_arg(what, v.pos[1], gv->lo, gv->hi, gv->unit));
+    tilt = tase_units_deg_to_cdeg(real_arg(what, v.pos[1], gv->tilt_lo, gv->tilt_hi, gv->unit));
     flags = TASE_GIMBAL_FLAGS(gv->kind, v.stab == NULL || strcmp(v.stab, "on") == 0);
     fields_init(&fs, p, p->len);
     fields_set(&fs, "pan", pan);

@@ -24,7 +24,6 @@
 
 #define STEP_MS 5u         /* model step and service period */
 #define KLV_PERIOD_MS 900u /* spec section 6: about every 900 ms */
-#define NCAM 3u
 
 static const char usage[] =
     "usage: tase-sim [--link PATH [--baud N] | --can IFACE] [--klv-link PATH]\n"
@@ -35,7 +34,9 @@ static const char usage[] =
     "--klv-link PATH adds the KLV metadata output (an 87-byte packet about every\n"
     "900 ms) on a second pseudo-terminal, symlinked at PATH. It answers every In\n"
     "packet of the spec and streams GIMBAL_ANGLE, GIMBAL_RATE and GEOREFERENCE_DATA\n"
-    "at the PACKET_RATE rates, never more than the link carries: on the serial\n"
+    "at the PACKET_RATE rates of its link's port (the serial link is port 2, Com3;\n"
+    "port 1, Com2, with --baud 9600; CAN is port 3), never more than the link\n"
+    "carries (GEOREFERENCE_DATA's sample_rate says what it achieves): on the serial\n"
     "link (--baud, default 57600) telemetry uses at most 75% of baud/10 bytes per\n"
     "second (the gimbal role's capacity rule), whatever PACKET_RATE asks. Runs until SIGINT, "
     "SIGTERM or SIGHUP, or for S\n"
@@ -43,22 +44,17 @@ static const char usage[] =
     "refused. Exit status: 0 success, 1 failure, 2 bad command line.\n";
 
 typedef struct {
-    uint8_t type;      /* table 28, 0xFF none */
-    uint16_t max_hfov; /* 1/100 deg */
-    uint16_t min_hfov;
-    double hfov; /* current, deg */
-} camera_t;
-
-typedef struct {
     tase_gimbal_t g;
-    tase_rx_t rx[1]; /* the receiver of the gimbal's one port */
+    tase_rx_t rx[TASE_GIMBAL_PORTS]; /* receivers; only the link's port is present */
+    unsigned link;                   /* port index of the link (sim_link_port()) */
     sim_model_t m;
-    camera_t cam[NCAM];
-    uint8_t active_cam;
-    uint32_t t0;     /* start, ms */
+    sim_rate_meter_t georef_rate[TASE_GIMBAL_PORTS]; /* GEOREFERENCE_DATA sent */
+    uint32_t t0;                                     /* start, ms */
     int16_t p, q, r; /* host body rates from HOST_SENSOR, 1/100 deg/s */
     bool quiet;
     bool spoi_valid;
+    bool version_due;       /* the cameras changed: store SYSTEM_VERSION again */
+    int gps_said, att_said; /* what the log last said of HOST_GPS_DATA/_ATTITUDE */
 } sim_t;
 
 static void logf_(const sim_t *s, uint32_t now, const char *fmt, ...)
@@ -95,11 +91,12 @@ static void apply_axis(sim_t *s, const tase_axis_setting_t *a)
 }
 
 /* What a real gimbal does with a setup packet's `temporary` byte (the
- * simulator keeps every setting for its run only). */
+ * simulator keeps every setting for its run only). The packets without
+ * one are always stored (4.4; PROTOCOL-NOTES S11). */
+#define STORED "a gimbal would store it in non-volatile memory"
 static const char *storage(uint8_t temporary)
 {
-    return temporary == TASE_SETUP_TEMPORARY ? "temporary"
-                                             : "a gimbal would store it in non-volatile memory";
+    return temporary == TASE_SETUP_TEMPORARY ? "temporary" : STORED;
 }
 
 /* Setup packets arrive resolved by the role ("do not change" fields
@@ -124,14 +121,39 @@ static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
               storage(a->temporary));
     } else if (id == TASE_ID_PACKET_RATE) {
         const tase_packet_rate_t *r = msg;
-        logf_(s, now, "PACKET_RATE: port 1 angle %u/s, rate %u/s, georef %u/s (%s)", r->angle_1,
-              r->rate_1, r->geo_ref_1, storage(r->temporary));
+        const uint8_t a[] = {r->angle_1, r->angle_2, r->angle_3};
+        const uint8_t t[] = {r->rate_1, r->rate_2, r->rate_3};
+        const uint8_t g[] = {r->geo_ref_1, r->geo_ref_2, r->geo_ref_3};
+        unsigned i;
+        for (i = 0; i < TASE_GIMBAL_PORTS; i++) {
+            sim_rate_reset(&s->georef_rate[i], now);
+        }
+        logf_(s, now, "PACKET_RATE: port %u (this link) angle %u/s, rate %u/s, georef %u/s (%s)",
+              s->link + 1u, a[s->link], t[s->link], g[s->link], storage(r->temporary));
+    } else if (id == TASE_ID_CAMERA_TYPE) {
+        const tase_camera_type_t *c = msg;
+        const uint8_t types[SIM_CAMERAS] = {c->camera_a, c->camera_b, c->camera_c};
+        sim_model_camera_types(&s->m, types);
+        s->version_due = true; /* SYSTEM_VERSION reports the same cameras */
+        logf_(s, now, "CAMERA_TYPE: cameras %u/%u/%u, SYSTEM_VERSION follows (" STORED ")",
+              c->camera_a, c->camera_b, c->camera_c);
+    } else if (id == TASE_ID_NAV_SOURCE) {
+        const tase_nav_source_t *n = msg;
+        sim_model_nav_source(&s->m, n->external_attitude != 0, n->external_gps != 0);
+        logf_(s, now, "NAV_SOURCE: attitude from %s, position from %s (" STORED ")",
+              n->external_attitude ? "HOST_ATTITUDE" : "the gimbal's own GPS/INS",
+              n->external_gps ? "HOST_GPS_DATA" : "the gimbal's own GPS/INS");
+        s->gps_said = s->att_said = -1;
+    } else {
+        logf_(s, now, "%s: stored, not modelled (" STORED ")",
+              tase_schema_packet_name(tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id))));
     }
     return 0;
 }
 
 static void set_version(sim_t *s, uint32_t now)
 {
+    const sim_camera_t *cam = s->m.cam;
     tase_system_version_t v;
     tase_camera_type_t c;
     memset(&v, 0, sizeof(v));
@@ -148,20 +170,22 @@ static void set_version(sim_t *s, uint32_t now)
     v.board_year = 2023;
     v.board_month = 11;
     v.board_day = 2;
-    v.camera_a = s->cam[0].type;
-    v.max_hfov_a = s->cam[0].max_hfov;
-    v.min_hfov_a = s->cam[0].min_hfov;
-    v.camera_b = s->cam[1].type;
-    v.max_hfov_b = s->cam[1].max_hfov;
-    v.min_hfov_b = s->cam[1].min_hfov;
-    v.camera_c = s->cam[2].type;
+    v.camera_a = cam[0].type;
+    v.max_hfov_a = tase_units_deg_to_cdeg_u16(cam[0].max_hfov);
+    v.min_hfov_a = tase_units_deg_to_cdeg_u16(cam[0].min_hfov);
+    v.camera_b = cam[1].type;
+    v.max_hfov_b = tase_units_deg_to_cdeg_u16(cam[1].max_hfov);
+    v.min_hfov_b = tase_units_deg_to_cdeg_u16(cam[1].min_hfov);
+    v.camera_c = cam[2].type;
+    v.max_hfov_c = tase_units_deg_to_cdeg_u16(cam[2].max_hfov);
+    v.min_hfov_c = tase_units_deg_to_cdeg_u16(cam[2].min_hfov);
     if (tase_gimbal_setup_set_msg(&s->g, TASE_ID_SYSTEM_VERSION, &v, now) != TASE_OK) {
         tk_die("internal error: cannot store SYSTEM_VERSION");
     }
     /* CAMERA_TYPE reports the same cameras (the role starts at "none") */
-    c.camera_a = s->cam[0].type;
-    c.camera_b = s->cam[1].type;
-    c.camera_c = s->cam[2].type;
+    c.camera_a = cam[0].type;
+    c.camera_b = cam[1].type;
+    c.camera_c = cam[2].type;
     if (tase_gimbal_setup_set_msg(&s->g, TASE_ID_CAMERA_TYPE, &c, now) != TASE_OK) {
         tk_die("internal error: cannot store CAMERA_TYPE");
     }
@@ -213,8 +237,7 @@ static int fill_telemetry(void *user, unsigned port, uint16_t id, void *msg, uin
     }
     if (id == TASE_ID_GEOREFERENCE_DATA) {
         tase_georeference_t *r = msg;
-        tase_packet_rate_t rates;
-        double cr, cp, cy, hfov = s->cam[s->active_cam].hfov;
+        double cr, cp, cy, hfov = m->cam[m->active_cam].hfov;
         r->time = now - s->t0;
         r->lat = tase_units_deg_to_mas(m->host.lat);
         r->lon = tase_units_deg_to_mas(m->host.lon);
@@ -234,17 +257,17 @@ static int fill_telemetry(void *user, unsigned port, uint16_t id, void *msg, uin
         r->vfov = tase_units_deg_to_cdeg_u16(vfov_of(hfov));
         r->focal = tase_units_sat_u16(100.0 * 2.4 / tan(hfov * M_PI / 360.0)); /* 4.8 mm sensor */
         r->mode = sim_mode_byte(&s->m);
-        if (tase_gimbal_setup_get_msg(&s->g, TASE_ID_PACKET_RATE, &rates) >= 0) {
-            r->sample_rate =
-                port == 0u ? rates.geo_ref_1 : (port == 1u ? rates.geo_ref_2 : rates.geo_ref_3);
-        }
+        /* "the rate at which this packet is being sent": the rate achieved
+         * (the link's capacity may allow fewer than PACKET_RATE asks) */
+        sim_rate_note(&s->georef_rate[port], now);
+        r->sample_rate = (uint8_t)sim_rate_hz(&s->georef_rate[port], now);
         r->nav_health = sim_nav_health();
         r->mount_roll = tase_units_deg_to_cdeg(m->att.roll);
         r->mount_pitch = tase_units_deg_to_cdeg(m->att.pitch);
         r->mount_yaw = tase_units_deg_to_cdeg(m->att.yaw);
         r->pan = tase_units_deg_to_cdeg(m->pan);
         r->tilt = tase_units_deg_to_cdeg(m->tilt);
-        r->camera = s->active_cam;
+        r->camera = (uint8_t)m->active_cam;
         return 0;
     }
     return -1;
@@ -276,23 +299,72 @@ static const char *mode_name(const sim_model_t *m)
     return names[m->mode];
 }
 
+static const char *camera_refusal(int rc)
+{
+    return rc == SIM_CAM_PASS_THROUGH ? "camera control is disabled since a CAMERA_PASS (4.1.5) "
+                                        "until tase-sim restarts"
+                                      : "no such camera";
+}
+
 static void camera_cmd(sim_t *s, const tase_camera_cmd_t *c, int len, uint32_t now)
 {
-    camera_t *cam;
-    if (c->camera != 0xFF) {
-        if (c->camera >= NCAM || s->cam[c->camera].type == TASE_CAMTYPE_NONE) {
-            logf_(s, now, "CAMERA_CMD: no camera %u", (unsigned)c->camera);
-            return;
-        }
-        s->active_cam = c->camera;
+    bool set_hfov = len > 1 && c->hfov != TASE_HFOV_NO_CHANGE;
+    int rc = sim_model_camera_cmd(&s->m, c->camera, set_hfov, c->hfov / 100.0);
+    if (rc != SIM_CAM_OK) {
+        logf_(s, now, "CAMERA_CMD (camera %u) ignored: %s", (unsigned)c->camera,
+              camera_refusal(rc));
+        return;
     }
-    cam = &s->cam[s->active_cam];
-    if (len > 1 && c->hfov != -1) {
-        double h = c->hfov > 0 ? c->hfov / 100.0 : cam->max_hfov / 100.0 / (-c->hfov / 100.0);
-        double lo = cam->min_hfov / 100.0, hi = cam->max_hfov / 100.0;
-        cam->hfov = h < lo ? lo : (h > hi ? hi : h);
+    logf_(s, now, "CAMERA_CMD: camera %c, HFOV %.2f deg", 'A' + (int)s->m.active_cam,
+          s->m.cam[s->m.active_cam].hfov);
+}
+
+static void camera_pass(sim_t *s, unsigned port, const tase_camera_pass_t *c, uint32_t now)
+{
+    tase_camera_pass_t a = *c;
+    int baud = sim_model_camera_pass(&s->m, c->camera, c->baud);
+    if (baud < 0) {
+        logf_(s, now, "CAMERA_PASS to camera %u ignored: no such camera", (unsigned)c->camera);
+        return;
     }
-    logf_(s, now, "CAMERA_CMD: camera %c, HFOV %.2f deg", 'A' + s->active_cam, cam->hfov);
+    /* the simulated camera answers by echoing what it was sent; packets
+     * from the gimbal carry the interface's current baud */
+    a.baud = (uint8_t)baud;
+    send_packet(s, port, TASE_ID_CAMERA_PASS, &a);
+    logf_(s, now,
+          "CAMERA_PASS: %u bytes echoed by camera %u at %u baud; camera control disabled until "
+          "tase-sim restarts",
+          c->len, c->camera, 1200u * (unsigned)baud);
+}
+
+static const char *const not_deployed =
+    "the gimbal is not deployed; it holds still until a deploy completes";
+
+/* Log what happened to host navigation data when it changes (these
+ * packets come at 10-50 per second). */
+static void nav_said(sim_t *s, uint32_t now, int *said, int rc, const char *what)
+{
+    static const char *const how[] = {
+        "used", "ignored: NAV_SOURCE selects the gimbal's own GPS/INS", "ignored: Valid is 0",
+        "overwrote the gimbal's own attitude solution", "aided the gimbal's own heading"};
+    if (rc != *said) {
+        logf_(s, now, "%s: %s", what, how[rc]);
+        *said = rc;
+    }
+}
+
+/* A position and velocity in wire units (mas, cm, cm/s) in the model's. */
+static sim_pos_t wire_pos(int32_t lat, int32_t lon, int32_t height, int16_t vn, int16_t ve,
+                          int16_t vd)
+{
+    sim_pos_t p;
+    p.lat = tase_units_mas_to_deg(lat);
+    p.lon = tase_units_mas_to_deg(lon);
+    p.height = tase_units_cm_to_m(height);
+    p.vn = tase_units_cmps_to_mps(vn);
+    p.ve = tase_units_cmps_to_mps(ve);
+    p.vd = tase_units_cmps_to_mps(vd);
+    return p;
 }
 
 static void on_frame(void *user, unsigned port, const tase_frame_t *f)
@@ -310,17 +382,30 @@ static void on_frame(void *user, unsigned port, const tase_frame_t *f)
     switch (id) {
     case TASE_ID_GIMBAL_CMD: {
         const tase_gimbal_cmd_t *c = &msg.gimbal_cmd;
+        bool spoi = s->m.mode == SIM_MODE_SPOI;
         int rc = sim_model_command(&s->m, c->pan / 100.0, c->tilt / 100.0, c->flags,
                                    c->impulse_time / 100.0);
-        if (rc < 0) {
+        if (rc == SIM_CMD_UNKNOWN) {
             logf_(s, now, "GIMBAL_CMD: unknown flags 0x%02X ignored", c->flags);
-        } else if (rc > 0) {
+        } else if (rc == SIM_CMD_NOT_DEPLOYED) {
+            logf_(s, now, "GIMBAL_CMD (flags 0x%02X, pan %.2f tilt %.2f) ignored: %s", c->flags,
+                  c->pan / 100.0, c->tilt / 100.0, not_deployed);
+        } else if (rc == SIM_CMD_NOT_SPOI) {
             logf_(s, now,
-                  "GIMBAL_CMD: SPOI error%s (flags 0x%02X, pan %.2f tilt %.2f) ignored: not "
-                  "modelled; still in %s mode%s",
+                  "GIMBAL_CMD: SPOI error%s (flags 0x%02X, pan %.2f tilt %.2f) ignored: not in "
+                  "SPOI mode; still in %s mode%s",
                   c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR_RATE ? " rate" : "", c->flags,
                   c->pan / 100.0, c->tilt / 100.0, mode_name(&s->m),
                   s->m.stabilised ? ", stabilised" : "");
+        } else if (spoi && TASE_GIMBAL_KIND(c->flags) >= TASE_GIMBAL_KIND_IMPULSE) {
+            logf_(s, now,
+                  "GIMBAL_CMD: SPOI error %s pan %.2f tilt %.2f%s; SPOI error now %.2f/%.2f",
+                  c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR
+                      ? "set to"
+                      : (c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR_RATE ? "rate" : "impulse"),
+                  c->pan / 100.0, c->tilt / 100.0,
+                  TASE_GIMBAL_KIND(c->flags) == TASE_GIMBAL_KIND_IMPULSE ? " deg/s" : "",
+                  s->m.err_pan, s->m.err_tilt);
         } else {
             logf_(s, now, "GIMBAL_CMD: %s pan %.2f tilt %.2f%s", mode_name(&s->m), c->pan / 100.0,
                   c->tilt / 100.0, s->m.stabilised ? ", stabilised" : "");
@@ -330,56 +415,62 @@ static void on_frame(void *user, unsigned port, const tase_frame_t *f)
     case TASE_ID_GYRO_ZERO_CMD: logf_(s, now, "GYRO_ZERO_CMD: gyros zeroed"); break;
     case TASE_ID_CAMERA_CMD: camera_cmd(s, &msg.camera_cmd, len, now); break;
     case TASE_ID_LEGACY_CAMERA_CMD: {
-        camera_t *cam = &s->cam[0];
-        double z =
-            (msg.legacy_camera_cmd.zoom > 0x4000 ? 0x4000 : msg.legacy_camera_cmd.zoom) / 16384.0;
-        cam->hfov = cam->max_hfov / 100.0 * pow(cam->min_hfov / (double)cam->max_hfov, z);
-        logf_(s, now, "LEGACY_CAMERA_CMD: camera A HFOV %.2f deg", cam->hfov);
+        int rc = sim_model_camera_legacy_zoom(&s->m, msg.legacy_camera_cmd.zoom);
+        if (rc != SIM_CAM_OK) {
+            logf_(s, now, "LEGACY_CAMERA_CMD ignored: %s", camera_refusal(rc));
+        } else {
+            logf_(s, now, "LEGACY_CAMERA_CMD: camera A HFOV %.2f deg", s->m.cam[0].hfov);
+        }
         break;
     }
-    case TASE_ID_CAMERA_PASS:
-        /* the simulated camera answers by echoing what it was sent */
-        send_packet(s, port, id, &msg.camera_pass);
-        logf_(s, now, "CAMERA_PASS: %u bytes echoed by camera %u", msg.camera_pass.len,
-              msg.camera_pass.camera);
-        break;
+    case TASE_ID_CAMERA_PASS: camera_pass(s, port, &msg.camera_pass, now); break;
     case TASE_ID_RETRACT_DEPLOY_CMD:
         sim_model_retract_deploy(&s->m, msg.retract_deploy_cmd.deploy != 0);
         logf_(s, now, "RETRACT_DEPLOY_CMD: %s",
-              msg.retract_deploy_cmd.deploy ? "deploying" : "retracting");
+              msg.retract_deploy_cmd.deploy
+                  ? "deploying; the axes move again once deployed"
+                  : "retracting; the axes hold still (position hold) until deployed again");
         break;
     case TASE_ID_HOST_SENSOR:
         s->p = msg.host_sensor.roll;
         s->q = msg.host_sensor.pitch;
         s->r = msg.host_sensor.yaw;
         break;
-    case TASE_ID_HOST_ATTITUDE:
-        s->m.att.roll = tase_units_cdeg_to_deg(msg.host_attitude.roll);
-        s->m.att.pitch = tase_units_cdeg_to_deg(msg.host_attitude.pitch);
-        s->m.att.yaw = tase_units_cdeg_to_deg(msg.host_attitude.yaw);
+    case TASE_ID_HOST_ATTITUDE: {
+        sim_att_t a;
+        uint8_t fl = msg.host_attitude.flags;
+        a.roll = tase_units_cdeg_to_deg(msg.host_attitude.roll);
+        a.pitch = tase_units_cdeg_to_deg(msg.host_attitude.pitch);
+        a.yaw = tase_units_cdeg_to_deg(msg.host_attitude.yaw);
+        nav_said(s, now, &s->att_said,
+                 sim_model_host_attitude(&s->m, &a, (fl & TASE_HOST_ATT_OVERWRITE) != 0,
+                                         (fl & TASE_HOST_ATT_AID_YAW) != 0),
+                 "HOST_ATTITUDE");
         break;
-    case TASE_ID_HOST_GPS_DATA:
-        s->m.host.lat = tase_units_mas_to_deg(msg.host_gps.lat);
-        s->m.host.lon = tase_units_mas_to_deg(msg.host_gps.lon);
-        s->m.host.height = tase_units_cm_to_m(msg.host_gps.height);
-        s->m.host.vn = msg.host_gps.vnorth / 100.0;
-        s->m.host.ve = msg.host_gps.veast / 100.0;
-        s->m.host.vd = msg.host_gps.vdown / 100.0;
+    }
+    case TASE_ID_HOST_GPS_DATA: {
+        const tase_host_gps_t *g = &msg.host_gps;
+        sim_pos_t p = wire_pos(g->lat, g->lon, g->height, g->vnorth, g->veast, g->vdown);
+        nav_said(s, now, &s->gps_said, sim_model_host_gps(&s->m, &p, g->valid == 1u),
+                 "HOST_GPS_DATA");
         break;
+    }
     case TASE_ID_SPOI_CMD:
         if (len == 0) {
             send_spoi(s, port);
         } else {
-            sim_pos_t t;
-            t.lat = tase_units_mas_to_deg(msg.spoi_cmd.lat);
-            t.lon = tase_units_mas_to_deg(msg.spoi_cmd.lon);
-            t.height = tase_units_cm_to_m(msg.spoi_cmd.height);
-            t.vn = msg.spoi_cmd.vnorth / 100.0;
-            t.ve = msg.spoi_cmd.veast / 100.0;
-            t.vd = msg.spoi_cmd.vdown / 100.0;
-            sim_model_spoi(&s->m, &t);
-            s->spoi_valid = true;
-            logf_(s, now, "SPOI_CMD: pointing at %.6f, %.6f, %.1f m", t.lat, t.lon, t.height);
+            const tase_spoi_cmd_t *c = &msg.spoi_cmd;
+            sim_pos_t t = wire_pos(c->lat, c->lon, c->height, c->vnorth, c->veast, c->vdown);
+            if (sim_model_spoi(&s->m, &t) != SIM_CMD_OK) {
+                logf_(s, now, "SPOI_CMD (%.6f, %.6f, %.1f m) ignored: %s", t.lat, t.lon, t.height,
+                      not_deployed);
+            } else {
+                s->spoi_valid = true;
+                logf_(s, now, "SPOI_CMD: pointing at %.6f, %.6f, %.1f m%s", t.lat, t.lon, t.height,
+                      s->m.host.lat == s->m.own_pos.lat && !s->m.ext_gps
+                          ? " from the gimbal's own GPS/INS position (NAV_SOURCE)"
+                          : "");
+            }
             if (msg.spoi_cmd.flags & TASE_SPOI_ECHO) {
                 send_spoi(s, port); /* the gimbal's flags, not the request's */
             }
@@ -399,7 +490,7 @@ static void send_klv(sim_t *s, const tase_port_t *klv)
     tase_klv_t k;
     struct timespec ts;
     uint8_t buf[TASE_KLV_PACKET_LEN];
-    double hfov = s->cam[s->active_cam].hfov;
+    double hfov = s->m.cam[s->m.active_cam].hfov;
     clock_gettime(CLOCK_REALTIME, &ts);
     k.utc = (uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u;
     k.lat = tase_klv_lat_raw(s->m.host.lat);
@@ -431,13 +522,14 @@ int main(int argc, char **argv)
     bool baud_given = false;
     char path[256], klv_path[256];
     tk_link_t dl, kl;
-    tase_port_t port, klv_port;
+    tase_port_t port, klv_port, ports[TASE_GIMBAL_PORTS];
     tase_gimbal_app_t app;
     uint32_t now, last, next_klv;
     double t_end;
     int i, slave_fd = -1, klv_slave = -1;
     bool have_klv = false;
     tase_axis_setting_t axs;
+    tase_nav_source_t nav;
 
     tk_prog = "tase-sim";
     for (i = 1; i < argc; i++) {
@@ -502,15 +594,7 @@ int main(int argc, char **argv)
     }
 
     sim_model_init(&s.m);
-    s.cam[0].type = 68; /* SONY_FCB_EX1010, 36x optical zoom */
-    s.cam[0].max_hfov = 5780;
-    s.cam[0].min_hfov = 170;
-    s.cam[0].hfov = 57.80;
-    s.cam[1].type = 97; /* FLIR_320_PHOTON_23 */
-    s.cam[1].max_hfov = 2300;
-    s.cam[1].min_hfov = 2300;
-    s.cam[1].hfov = 23.0;
-    s.cam[2].type = TASE_CAMTYPE_NONE;
+    s.gps_said = s.att_said = -1;
 
     /* SIGINT, SIGTERM, SIGHUP stop the loop below; caught before the links
      * exist, so one that comes while they are made still removes them */
@@ -542,7 +626,15 @@ int main(int argc, char **argv)
     app.user = &s;
     now = tase_posix_now_ms();
     s.t0 = now;
-    if (tase_gimbal_init(&s.g, &port, s.rx, 1, &app, now) != TASE_OK) {
+    /* the link is one of PACKET_RATE's ports 1..3 (PROTOCOL-NOTES A2); the
+     * other two are absent */
+    memset(ports, 0, sizeof(ports));
+    s.link = sim_link_port(can != NULL, (uint32_t)baud);
+    ports[s.link] = port;
+    for (i = 0; i < (int)TASE_GIMBAL_PORTS; i++) {
+        sim_rate_reset(&s.georef_rate[i], now);
+    }
+    if (tase_gimbal_init(&s.g, ports, s.rx, TASE_GIMBAL_PORTS, &app, now) != TASE_OK) {
         tk_die("internal error: gimbal role init failed");
     }
     set_version(&s, now);
@@ -551,11 +643,16 @@ int main(int argc, char **argv)
         tk_die("internal error: no AXIS_SETTING");
     }
     apply_axis(&s, &axs);
+    if (tase_gimbal_setup_get_msg(&s.g, TASE_ID_NAV_SOURCE, &nav) < 0) {
+        tk_die("internal error: no NAV_SOURCE");
+    }
+    sim_model_nav_source(&s.m, nav.external_attitude != 0, nav.external_gps != 0);
 
     printf("tase-sim: simulated gimbal on %s%s", can ? "CAN interface " : "", path);
     if (can == NULL) {
         printf(", %lld baud", baud);
     }
+    printf(", PACKET_RATE port %u", s.link + 1u);
     printf(link ? " (link %s)\n" : "\n", link);
     if (have_klv) {
         printf("tase-sim: KLV output on %s (link %s)\n", klv_path, klv_link);
@@ -575,7 +672,7 @@ int main(int argc, char **argv)
         if (dt > 0 && sim_model_step(&s.m, (dt > 1000u ? 1000u : dt) / 1000.0)) {
             tase_retract_deploy_cmd_t rd;
             rd.deploy = s.m.tax == SIM_3AX_DEPLOYED ? 1u : 0u;
-            send_packet(&s, 0, TASE_ID_RETRACT_DEPLOY_CMD, &rd);
+            send_packet(&s, s.link, TASE_ID_RETRACT_DEPLOY_CMD, &rd);
             logf_(&s, now, "RETRACT_DEPLOY_CMD: %s, echoed", rd.deploy ? "deployed" : "retracted");
         }
         if (slave_fd >= 0 && tk_pty_unread(slave_fd) > 2048) {
@@ -583,6 +680,11 @@ int main(int argc, char **argv)
             (void)tk_pty_drop_unread(slave_fd);
         }
         (void)tase_gimbal_service(&s.g, now);
+        if (s.version_due) {
+            /* after the callbacks: they may not store setup packets */
+            set_version(&s, now);
+            s.version_due = false;
+        }
         if (have_klv && (int32_t)(now - next_klv) >= 0) {
             /* a packet still unread after 900 ms has no reader: drop it, as a
              * serial line would, so a reader that opens later gets fresh data */

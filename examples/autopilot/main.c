@@ -10,7 +10,8 @@
  * calls (tase_host_send_msg(), tase_host_request_msg_start()):
  *
  *  1. query SYSTEM_VERSION and report the gimbal's software and cameras;
- *  2. query PACKET_RATE, set port 1 to ANGLE_HZ/RATE_HZ/GEO_HZ and confirm
+ *  2. query PACKET_RATE, set port 2 (the gimbal's 57600-baud Com3 this
+ *     image is wired to, PROTOCOL-NOTES A2) to ANGLE_HZ/RATE_HZ/GEO_HZ and confirm
  *     the echo; set NAV_SOURCE to external attitude and GPS and confirm;
  *  3. stream HOST_ATTITUDE (ATT_HZ) and HOST_GPS_DATA (GPS_HZ) from the
  *     flight model (flight.c: a circle at constant height);
@@ -40,7 +41,7 @@
 #include "tase/flags.h"
 #include "tase/units.h"
 
-/* Telemetry asked of the gimbal (port 1), packets per second. */
+/* Telemetry asked of the gimbal (port 2, Com3), packets per second. */
 #define ANGLE_HZ 20u
 #define RATE_HZ 10u
 #define GEO_HZ 10u
@@ -365,12 +366,12 @@ static void run_step(mission_t *m)
         return;
     case STEP_RATE_GET:
         if (answered(m, TASE_ID_PACKET_RATE, NULL, 16, "PACKET_RATE query")) {
-            /* read-modify-write: only port 1 changes */
+            /* read-modify-write: only port 2 (this 57600-baud line) changes */
             m->rate_before = m->reply.packet_rate;
             m->rate_req = m->reply.packet_rate;
-            m->rate_req.angle_1 = (uint8_t)ANGLE_HZ;
-            m->rate_req.rate_1 = (uint8_t)RATE_HZ;
-            m->rate_req.geo_ref_1 = (uint8_t)GEO_HZ;
+            m->rate_req.angle_2 = (uint8_t)ANGLE_HZ;
+            m->rate_req.rate_2 = (uint8_t)RATE_HZ;
+            m->rate_req.geo_ref_2 = (uint8_t)GEO_HZ;
             m->rate_req.temporary = 1u; /* a mission setting, not for flash */
             next_step(m, STEP_RATE_SET);
         }
@@ -477,9 +478,9 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
               m->version.camera_a, 0);
     }
     if (m->step > STEP_RATE_SET) {
-        printf("PACKET_RATE port 1: %u/%u/%u per s (angle/rate/georef), set to %u/%u/%u, echo "
+        printf("PACKET_RATE port 2: %u/%u/%u per s (angle/rate/georef), set to %u/%u/%u, echo "
                "confirmed\n",
-               m->rate_before.angle_1, m->rate_before.rate_1, m->rate_before.geo_ref_1, ANGLE_HZ,
+               m->rate_before.angle_2, m->rate_before.rate_2, m->rate_before.geo_ref_2, ANGLE_HZ,
                RATE_HZ, GEO_HZ);
     }
     if (m->step > STEP_NAV_SET) {

@@ -9,9 +9,9 @@
  * are constant expressions usable in case labels.
  *
  * Enumerations the spec lists without values are numbered by this
- * library (docs/PROTOCOL-NOTES.md): the navigation filter mode in the
- * spec's order from 0 (P8), the gimbal mode as Cloud Cap's later public
- * header numbers the same modes (D2).
+ * library (docs/PROTOCOL-NOTES.md): the gimbal mode (D2) and the
+ * navigation filter mode (P8) both as Cloud Cap's later public gimbal
+ * header numbers the same modes.
  */
 #ifndef TASE_FLAGS_H
 #define TASE_FLAGS_H
@@ -183,12 +183,17 @@
 #define TASE_NAV_ACCEL_BIAS TASE_BIT16(9)
 #define TASE_NAV_MAG_BIAS TASE_BIT16(10)
 #define TASE_NAV_FILTER_MODE(health) TASE_BITS16_GET(health, 12, 15)
-/* Filter modes, in the spec's order (values are our decision). */
+/* Filter modes (bits 12-15). The spec lists "init, align, ready, normal,
+ * AHRS" without values; these are the values Cloud Cap's later public
+ * gimbal header gives the same modes (PROTOCOL-NOTES P8, the rule of D2):
+ * init 0, buffering 1, AHRS 2, bound velocity 3, normal 4, align 5.
+ * Buffering and bound velocity are not modes of this spec and have no
+ * name here; the spec's "ready" has no counterpart there and no constant
+ * (until 0.3.0: INIT 0, ALIGN 1, READY 2, NORMAL 3, AHRS 4, list order). */
 #define TASE_NAV_FILTER_INIT 0u
-#define TASE_NAV_FILTER_ALIGN 1u
-#define TASE_NAV_FILTER_READY 2u
-#define TASE_NAV_FILTER_NORMAL 3u
-#define TASE_NAV_FILTER_AHRS 4u
+#define TASE_NAV_FILTER_AHRS 2u
+#define TASE_NAV_FILTER_NORMAL 4u
+#define TASE_NAV_FILTER_ALIGN 5u
 
 /* ---- Setup packets (4.4) ---------------------------------------------- */
 #define TASE_SETUP_TEMPORARY 1u    /* `temporary` byte: do not store */

@@ -27,10 +27,11 @@
  *    the stored bytes are echoed unchanged, so the host always learns the
  *    settings in force. The stored bytes never hold a non-zero reserved
  *    byte nor a "do not change" value.
- *    SYSTEM_VERSION is query-only: any SYSTEM_VERSION packet is answered
- *    with the bytes the application set (tase_gimbal_setup_set()).
- *    A setup packet with a wrong data length is counted (stats.bad_length)
- *    and not answered.
+ *    SYSTEM_VERSION is query-only: a SYSTEM_VERSION packet of 0 or 42
+ *    data bytes is answered with the bytes the application set
+ *    (tase_gimbal_setup_set()).
+ *    A setup packet with a wrong data length (SYSTEM_VERSION's included)
+ *    is counted (stats.bad_length) and not answered.
  *
  *  - TELEMETRY: emits GIMBAL_ANGLE (0x08/0x10), GIMBAL_RATE (0x08/0x40)
  *    and GEOREFERENCE_DATA (0x10/0x41) on each port at the rates of the

@@ -2,7 +2,8 @@
 # types both AXIS_SETTING layouts (22 and 23 bytes); a running tase-sim
 # echoes a PACKET_RATE with its reserved bytes zero, answers a SPOI echo
 # request with its own flags and reports a NavHealth of filter mode
-# "normal". About 3 s.
+# "normal". Issue 23: one check per numbered line of the issue (tase-sim
+# behaving like a real TASE; see the script's header). About 35 s.
 if(TARGET tase_cli AND TARGET tase_sim)
   add_test(NAME spec_e2e
            COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-spec-e2e.sh $<TARGET_FILE:tase_cli>
