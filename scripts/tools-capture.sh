@@ -124,7 +124,7 @@ for _ in $(seq 100); do [ -L "$dir/gimbal" ] && break; sleep 0.05; done
 L=(--serial "$dir/gimbal" --record "$dir/session.pcap")
 t_start=$(date +%s.%N)
 v=$("$TASE" query SYSTEM_VERSION "${L[@]}" --json)
-e=$("$TASE" send PACKET_RATE angle_1=20 "${L[@]}" --json | tail -1) # the echo
+e=$("$TASE" send PACKET_RATE angle_2=20 "${L[@]}" --json | tail -1) # the echo (the link is port 2)
 "$TASE" monitor "${L[@]}" --json --seconds 1 >"$dir/mon.json"
 t_end=$(date +%s.%N)
 "$TASE" decode "$dir/session.pcap" >"$dir/session.json"
@@ -139,9 +139,9 @@ a=$(grep '"dir":"out"' "$dir/session.json" | grep -m1 '"name":"SYSTEM_VERSION"')
 check "--record: query (in, size 0) and answer (out) equal to what query printed" \
     eval '[[ "$q" == *"\"dir\":\"in\",\"group\":72,\"type\":3,\"name\":\"SYSTEM_VERSION\",\"size\":0,"* ]] &&
           [ "${a#*\"fields\"}" = "${v#*\"fields\"}" ]'
-check "--record: PACKET_RATE sent (in) and echoed (out) with angle_1 20" \
-    eval '[ "$(grep -c "\"name\":\"PACKET_RATE\",\"size\":16,\"fields\":{\"angle_1\":20," "$dir/session.json")" = 2 ] &&
-          [ "$(json_int "$e" angle_1)" = 20 ]'
+check "--record: PACKET_RATE sent (in) and echoed (out) with angle_2 20 (the link's port)" \
+    eval '[ "$(grep "\"name\":\"PACKET_RATE\",\"size\":16," "$dir/session.json" | grep -c "\"angle_2\":20,")" = 2 ] &&
+          [ "$(json_int "$e" angle_2)" = 20 ]'
 nmon=$(grep -c . "$dir/mon.json")
 ncap=$(grep '"dir":"out"' "$dir/session.json" | grep -c -e GIMBAL_ANGLE -e GIMBAL_RATE -e GEOREFERENCE_DATA)
 check "--record: the $nmon packets monitor printed are all in the capture ($ncap telemetry packets)" \

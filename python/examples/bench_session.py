@@ -26,7 +26,8 @@ def session(url, out):
         print("gimbal software %d.%d.%d, board %d" % (v["major"], v["minor"], v["sub"], v["board_sn"]))
 
         rates = link.query("PACKET_RATE")
-        print("telemetry rates:", rates.raw["angle_1"], rates.raw["rate_1"], "per second")
+        # port 2 is the gimbal's second serial port (Com3), tase-sim's link
+        print("telemetry rates on port 2:", rates.raw["angle_2"], rates.raw["rate_2"], "per second")
 
         # look 30 degrees right and 10 down, then wait until the gimbal is there
         link.point(30, -10)
