@@ -50,10 +50,14 @@
 
 /* Work units of the scan per byte taken in, and what a delivery costs
  * (frame.h COST; the unit is about one byte touched). */
-#define RX_BUDGET 160u
+#define RX_BUDGET 96u
 #define RX_COST_STEP 16u
 #define RX_COST_FRAME 16u
 #define RX_UNLIMITED UINT32_MAX
+
+/* `end` while a call runs or the scan lags: every fast path of
+ * tase_rx_push() fails on it (see the file comment). */
+#define RX_BLOCKED 0xFFFFu
 
 /* Work a window can hold for the scan, in units: every position a step
  * (RX_COST_STEP), every judged candidate (one per sync, so at most every
@@ -82,8 +86,10 @@ typedef char
  * another compiler may inline it, which costs speed, not correctness. */
 #if defined(__GNUC__)
 #define RX_NOINLINE __attribute__((noinline))
+#define RX_INLINE __inline__ __attribute__((always_inline))
 #else
 #define RX_NOINLINE
+#define RX_INLINE
 #endif
 
 /* C99 has no _Static_assert: a negative array size fails the build. */
@@ -262,6 +268,14 @@ static void compact(tase_rx_t *rx)
         /* cppcheck-suppress misra-c2012-21.15 */
         (void)memcpy(&b[i], &w, 4u);
     }
+#else
+    for (; n - i >= 4u; i += 4u) {
+        const uint8_t *q = &b[s + i];
+        b[i] = q[0];
+        b[i + 1u] = q[1];
+        b[i + 2u] = q[2];
+        b[i + 3u] = q[3];
+    }
 #endif
     for (; i < n; i++) {
         b[i] = b[s + i];
@@ -399,7 +413,7 @@ static bool put(tase_rx_t *rx, rx_call_t *c, uint8_t b)
  * at the front (len < 4, scan 0, lag 0): the sync and Size bytes of a
  * frame, or noise. Returns true when the byte was a Size >= 2 that makes
  * buf[0..4) a candidate. */
-static bool hunt(tase_rx_t *rx, uint8_t byte)
+RX_INLINE static bool hunt(tase_rx_t *rx, uint8_t byte)
 {
     uint16_t len = rx->len;
     rx->stats.bytes_in++;
@@ -435,17 +449,26 @@ static void begin(tase_rx_t *rx, rx_call_t *c, tase_rx_handler_t on_frame, void 
     c->user = user;
     c->count = 0u;
     rx->busy = 1u;
-    rx->end = 0u;
+    rx->end = RX_BLOCKED;
 }
 
 /* End it: unless a callback re-initialised the receiver (live false),
- * set `end` for tase_rx_push()'s fast path and clear `busy`. Returns the
- * frames delivered. */
+ * set `end` for tase_rx_push()'s fast paths (the held candidate's last
+ * byte, 0 while hunting, RX_BLOCKED while the scan lags) and clear
+ * `busy`. Returns the frames delivered. */
 static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
 {
     if (live) {
         size_t s = rx->scan;
-        rx->end = (rx->lag == 0u && rx->len >= s + 4u) ? (uint16_t)(s + rx->buf[s + 3u] + 5u) : 0u;
+        uint16_t end = 0u;
+        if (rx->lag != 0u) {
+            end = RX_BLOCKED;
+        } else if (rx->len >= s + 4u) {
+            end = (uint16_t)(s + rx->buf[s + 3u] + 5u);
+        } else {
+            /* hunting */
+        }
+        rx->end = end;
         rx->busy = 0u;
     }
     return (c->count > (uint32_t)INT_MAX) ? INT_MAX : (int)c->count;
@@ -524,7 +547,7 @@ static bool rx_sane(const tase_rx_t *rx)
         return false;
     }
     if (rx->lag != 0u) {
-        return end == 0u;
+        return end == RX_BLOCKED;
     }
     if (len - s < 4u) {
         return s == 0u && end == 0u;
@@ -556,7 +579,7 @@ RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
 
 /* tase_rx_push() for the last byte of the candidate held at buf[scan]
  * (len == end): a valid frame is delivered from the window, which is then
- * empty; a failed one takes the general path. */
+ * empty; after a failed one the scan goes on as in the general path. */
 RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
     size_t s = rx->scan;
@@ -564,8 +587,7 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     rx_call_t c;
     /* the checks of rx_sane() that make the frame lie inside buf; else
      * push_slow() gives the error */
-    if (s + 4u > len || rx->buf[s + 3u] < 2u || rx->end != s + rx->buf[s + 3u] + 5u ||
-        (rx->busy | rx->lag) != 0u) {
+    if (s + 4u > len || rx->buf[s + 3u] < 2u || rx->end != s + rx->buf[s + 3u] + 5u) {
         return push_slow(rx, b, on_frame, user);
     }
     if ((uint16_t)(rx->sum_len - rx->buf[len - 1u] - rx->sum_scan) ==
@@ -573,21 +595,19 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
         rx->stats.bytes_in++;
         rx->len = 0u;
         rx->scan = 0u;
-        rx->end = 0u;
         rx->sum_len = rx->sum_scan;
-        rx->busy = 1u;
-        c.on_frame = on_frame;
-        c.user = user;
-        c.count = 0u;
+        begin(rx, &c, on_frame, user);
         (void)deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), &c);
-        rx->busy = 0u; /* also right when the callback re-initialised rx */
+        /* hunting from here; also right when the callback re-initialised rx */
+        rx->end = 0u;
+        rx->busy = 0u;
         return 1;
     }
     /* Failed: the byte is stored, the scan moves past the candidate's
      * first byte (00) and goes on with what is left of the budget after
-     * this judgement, exactly as in run() (where advance() judges it:
-     * a step and 2 bytes summed), so that any split of the stream gives
-     * the same result. */
+     * this judgement, exactly as in run() (where advance() judges it: a
+     * step and 2 bytes summed), so that any split of the stream gives the
+     * same result. */
     begin(rx, &c, on_frame, user);
     rx->stats.checksum_errors++;
     rx->buf[len] = b;
@@ -597,6 +617,21 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     rx->stats.bytes_discarded++;
     rx->scan = (uint16_t)(s + 1u);
     return finish(rx, &c, advance(rx, &c, RX_BUDGET - RX_COST_STEP - 2u, false));
+}
+
+/* tase_rx_push() for every byte that is not inside a held candidate:
+ * the last byte of one, the sync and Size bytes of a frame while hunting,
+ * and everything else (the general path). Out of line, so that the fast
+ * path of tase_rx_push() needs no stack frame. */
+RX_NOINLINE static int push_event(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame,
+                                  void *user)
+{
+    uint16_t len = rx->len;
+    uint16_t end = rx->end;
+    if (len == end && end != 0u && end < RX_CAP) {
+        return push_last(rx, byte, on_frame, user);
+    }
+    return push_slow(rx, byte, on_frame, user);
 }
 
 int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user)
@@ -618,18 +653,16 @@ int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *
         rx->stats.bytes_in++;
         return 0;
     }
-    if (len == end && end != 0u && end < RX_CAP) {
-        return push_last(rx, byte, on_frame, user);
-    }
-    /* Hunting a sync, or its Size byte (nothing or a partial sync held at
-     * the front, the scan caught up, so end is 0). */
-    if (len < 4u && end == 0u && rx->busy == 0u && rx->lag == 0u && rx->scan == 0u) {
+    /* Hunting a sync, or its Size byte: end is 0 only when the scan has
+     * caught up and holds nothing or a partial sync at the front (never
+     * during a call). */
+    if (end == 0u && len < 4u) {
         if (hunt(rx, byte)) {
             rx->end = (uint16_t)(byte + 5u);
         }
         return 0;
     }
-    return push_slow(rx, byte, on_frame, user);
+    return push_event(rx, byte, on_frame, user);
 }
 
 int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
@@ -666,7 +699,8 @@ int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms)
 static uint32_t quiet_limit(const tase_rx_t *rx)
 {
     uint32_t rate = (rx->rate != 0u) ? rx->rate : TASE_RX_SLOWEST_RATE;
-    uint32_t last = (rx->end != 0u) ? (uint32_t)rx->end + 1u : (uint32_t)rx->scan + TASE_FRAME_MAX;
+    uint32_t last = (rx->end != 0u && rx->end != RX_BLOCKED) ? (uint32_t)rx->end + 1u
+                                                             : (uint32_t)rx->scan + TASE_FRAME_MAX;
     uint32_t left = (last > rx->len) ? last - rx->len : 0u;
     uint32_t ms = (left * 1000u + rate - 1u) / rate; /* at most 261,000 / 1 */
     return (ms > rx->margin_ms) ? ms : rx->margin_ms;

@@ -234,7 +234,7 @@ typedef struct {
 
 /* How many bytes after the byte that decides it a frame may be delivered
  * (LATENCY above): the scan's lag, bounded in src/tase_frame.c. */
-#define TASE_RX_LATE_MAX 136u
+#define TASE_RX_LATE_MAX 224u
 
 /* How many candidates a call judges (and so frames it delivers) at most
  * per byte it takes in, and per tick (COST above). */
