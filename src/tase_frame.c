@@ -294,22 +294,21 @@ static uint32_t spend(uint32_t budget, size_t units)
  * sync, or a candidate of flen bytes still incomplete. A partial sync
  * moves to the front (at most 3 bytes), a candidate only if the window
  * has no room for its last byte. */
-static uint32_t hold(tase_rx_t *rx, size_t s, size_t flen, uint32_t budget)
+static void hold(tase_rx_t *rx, size_t s, size_t flen)
 {
     rx->lag = 0u;
     if (s > 0u && s + flen > RX_CAP) {
-        budget = spend(budget, (size_t)rx->len - s);
         compact(rx);
     }
-    return budget;
 }
 
 /* The greedy scan from buf[scan] on, until it has caught up (lag 0) or
  * spent `budget` units (lag 1). `final`: end of input, so an incomplete
  * candidate or partial sync fails like a bad one. Returns false when a
  * callback re-initialised the receiver. */
-static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t budget, bool final)
+static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
 {
+    uint32_t budget = allowance;
     for (;;) {
         size_t s = rx->scan;
         size_t len = rx->len;
@@ -345,7 +344,7 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t budget, bool final)
             k++;
         }
         if (k == avail && !final) {
-            (void)hold(rx, s, RX_CAP, budget); /* a sync still arriving: to the front */
+            hold(rx, s, RX_CAP); /* a sync still arriving: to the front */
             return true;
         }
         if (k == 3u && avail > 3u) {
@@ -374,7 +373,7 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t budget, bool final)
                 rx->stats.checksum_errors++;
             } else if (!final) {
                 /* a candidate whose last byte is still to come */
-                (void)hold(rx, s, flen, budget);
+                hold(rx, s, flen);
                 return true;
             } else {
                 /* end of input: it can no longer complete */
@@ -474,7 +473,7 @@ static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
     return (c->count > (uint32_t)INT_MAX) ? INT_MAX : (int)c->count;
 }
 
-/* The general path: feed data[0..n) (n may be 0: only continue a
+/* The general path: feed data[0..n) (data not NULL; n may be 0: only continue a
  * lagging scan), then, if `final` (tase_rx_flush(), a settling tick),
  * settle everything. Bytes that cannot decide anything are taken in bulk:
  * noise while nothing is held, the sync and Size bytes of a frame, and
@@ -577,9 +576,29 @@ RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     return (r != TASE_OK) ? r : run(rx, &b, 1u, false, on_frame, user);
 }
 
+/* tase_rx_push() for the last byte of a held candidate that failed: the
+ * byte is stored, the scan moves past the candidate's first byte (00) and
+ * goes on with what is left of the budget after this judgement, exactly
+ * as in run() (where advance() judges it: a step and 2 bytes summed), so
+ * that any split of the stream gives the same result. */
+RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+{
+    rx_call_t c;
+    size_t len = rx->len;
+    begin(rx, &c, on_frame, user);
+    rx->stats.checksum_errors++;
+    rx->buf[len] = b;
+    rx->len = (uint16_t)(len + 1u);
+    rx->sum_len = (uint16_t)(rx->sum_len + b);
+    rx->stats.bytes_in++;
+    rx->stats.bytes_discarded++;
+    rx->scan = (uint16_t)(rx->scan + 1u);
+    return finish(rx, &c, advance(rx, &c, RX_BUDGET - RX_COST_STEP - 2u, false));
+}
+
 /* tase_rx_push() for the last byte of the candidate held at buf[scan]
  * (len == end): a valid frame is delivered from the window, which is then
- * empty; after a failed one the scan goes on as in the general path. */
+ * empty; after a failed one the scan goes on (push_failed()). */
 RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
     size_t s = rx->scan;
@@ -590,33 +609,20 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     if (s + 4u > len || rx->buf[s + 3u] < 2u || rx->end != s + rx->buf[s + 3u] + 5u) {
         return push_slow(rx, b, on_frame, user);
     }
-    if ((uint16_t)(rx->sum_len - rx->buf[len - 1u] - rx->sum_scan) ==
+    if ((uint16_t)(rx->sum_len - rx->buf[len - 1u] - rx->sum_scan) !=
         (uint16_t)(((uint16_t)rx->buf[len - 1u] << 8) | b)) {
-        rx->stats.bytes_in++;
-        rx->len = 0u;
-        rx->scan = 0u;
-        rx->sum_len = rx->sum_scan;
-        begin(rx, &c, on_frame, user);
-        (void)deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), &c);
-        /* hunting from here; also right when the callback re-initialised rx */
-        rx->end = 0u;
-        rx->busy = 0u;
-        return 1;
+        return push_failed(rx, b, on_frame, user);
     }
-    /* Failed: the byte is stored, the scan moves past the candidate's
-     * first byte (00) and goes on with what is left of the budget after
-     * this judgement, exactly as in run() (where advance() judges it: a
-     * step and 2 bytes summed), so that any split of the stream gives the
-     * same result. */
-    begin(rx, &c, on_frame, user);
-    rx->stats.checksum_errors++;
-    rx->buf[len] = b;
-    rx->len = (uint16_t)(len + 1u);
-    rx->sum_len = (uint16_t)(rx->sum_len + b);
     rx->stats.bytes_in++;
-    rx->stats.bytes_discarded++;
-    rx->scan = (uint16_t)(s + 1u);
-    return finish(rx, &c, advance(rx, &c, RX_BUDGET - RX_COST_STEP - 2u, false));
+    rx->len = 0u;
+    rx->scan = 0u;
+    rx->sum_len = rx->sum_scan;
+    begin(rx, &c, on_frame, user);
+    (void)deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), &c);
+    /* hunting from here; also right when the callback re-initialised rx */
+    rx->end = 0u;
+    rx->busy = 0u;
+    return 1;
 }
 
 /* tase_rx_push() for every byte that is not inside a held candidate:
@@ -672,13 +678,13 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
     if (r != TASE_OK) {
         return r;
     }
-    return run(rx, data, n, false, on_frame, user);
+    return run(rx, (data != NULL) ? data : rx->buf, n, false, on_frame, user); /* n 0 if NULL */
 }
 
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
 {
     int r = rx_check(rx);
-    return (r != TASE_OK) ? r : run(rx, NULL, 0u, true, on_frame, user);
+    return (r != TASE_OK) ? r : run(rx, rx->buf, 0u, true, on_frame, user);
 }
 
 int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms)
@@ -732,7 +738,7 @@ int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, voi
         return 0;
     }
     /* a lagging scan goes on; past the quiet limit, as at end of input */
-    return run(rx, NULL, 0u, settle, on_frame, user);
+    return run(rx, rx->buf, 0u, settle, on_frame, user);
 }
 
 uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms)

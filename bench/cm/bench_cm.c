@@ -9,11 +9,11 @@
  * counts down at 25 MHz of that clock: one tick is 40 instructions.
  *   - Long runs (a whole stream): ticks * 40, exact to 40 in millions. A
  *     calibration loop of known length checks the factor.
- *   - One call, exactly: the call is repeated REPS times from a copy of the
- *     receiver taken before it (restore, call), and the same loop is timed
- *     around a function that does nothing (`null_*`, 2 instructions: movs,
- *     bx). (A - B) / REPS + 2 is the call's count with an error below
- *     80 / REPS < 0.5: rounded, it is exact, and the same on every run.
+ *   - One call, exactly (measure.c): the call is repeated 200 times from
+ *     a copy of the receiver taken before it (restore, call), and the same
+ *     loop is timed around a function that does nothing (1 instruction,
+ *     bx lr). (A - B) / 200 + 1 is the call's count with an error below
+ *     80 / 200 < 0.5: rounded, it is exact, and the same on every run.
  *   - The longest call of a stream: pass 1 times every call once (a
  *     coarse count, +-39 instructions); pass 2 replays the stream and
  *     counts exactly every call whose coarse count is within 79 of the
@@ -32,18 +32,12 @@
 
 #include "../classic_rx.h"
 #include "../streams.h"
+#include "measure.h"
 #include "tase/frame.h"
-
-#define TIMER0_CTRL (*(volatile uint32_t *)0x40000000u)
-#define TIMER0_VALUE (*(volatile uint32_t *)0x40000004u)
-#define TIMER0_RELOAD (*(volatile uint32_t *)0x40000008u)
-#define INSN_PER_TICK 40u /* 1 ns per instruction, 25 MHz timer */
 
 #define STREAM_BYTES (256u * 1024u)
 #define MAXCALL_BYTES 8192u /* calls examined for the longest one */
-#define REPS 200u
 #define MAX_EXACT 64u
-#define NULL_INSNS 2u
 
 #define NOINLINE __attribute__((noinline, noipa))
 
@@ -60,18 +54,12 @@ static void on_frame(void *user, const tase_frame_t *f)
 
 static uint32_t ticks(void)
 {
-    return TIMER0_VALUE;
+    return measure_ticks();
 }
 
 static unsigned long since(uint32_t t0)
 {
-    return (unsigned long)(t0 - ticks()) * INSN_PER_TICK; /* counts down */
-}
-
-/* Exactly 2 * n instructions (subs + bne per turn). */
-static void known_loop(uint32_t n)
-{
-    __asm__ volatile(".syntax unified\n1: subs %0, %0, #1\n\tbne 1b" : "+l"(n) : : "cc");
+    return measure_since(t0);
 }
 
 /* ---- the calls measured: one signature, so one timing loop ----------- */
@@ -89,42 +77,44 @@ NOINLINE static int call_feed(const uint8_t *p, size_t n)
     return tase_rx_feed(&rx, p, n, on_frame, NULL);
 }
 
-NOINLINE static int call_flush(const uint8_t *p, size_t n)
-{
-    (void)p;
-    (void)n;
-    return tase_rx_flush(&rx, on_frame, NULL);
-}
-
-NOINLINE static int null_call(const uint8_t *p, size_t n)
+/* The caller's loop alone: the same call, to a function that returns. */
+NOINLINE static int empty_call(const uint8_t *p, size_t n)
 {
     (void)p;
     (void)n;
     return 0;
 }
 
-/* A count of call_push() is that of tase_rx_push() plus what any caller
- * spends on the call: setting up its four arguments and the branch. */
+/* One call of the stream, from the receiver state before it. */
+typedef struct {
+    call_fn f;
+    const tase_rx_t *snap;
+    const uint8_t *p;
+    size_t n;
+} one_call_t;
 
-/* REPS times: restore the receiver from `snap`, call. Instructions. */
-NOINLINE static unsigned long repeat(call_fn f, const tase_rx_t *snap, const uint8_t *p, size_t n)
+static void restore(void *ctx)
 {
-    uint32_t t0 = ticks();
-    unsigned r;
-    for (r = 0; r < REPS; r++) {
-        rx = *snap;
-        (void)f(p, n);
-    }
-    return since(t0);
+    rx = *((one_call_t *)ctx)->snap;
 }
 
-static unsigned long null_reps;
+static void call_one(void *ctx)
+{
+    one_call_t *o = ctx;
+    (void)o->f(o->p, o->n);
+}
 
-/* Exact instruction count of f(p, n) from the receiver state `snap`. */
+/* Exact instruction count of f(p, n) from the receiver state `snap`: that
+ * of tase_rx_push()/tase_rx_feed() plus the argument setup of a caller
+ * (the wrappers above and call_one()). */
 static unsigned long exact(call_fn f, const tase_rx_t *snap, const uint8_t *p, size_t n)
 {
-    unsigned long a = repeat(f, snap, p, n);
-    return (a - null_reps + REPS / 2u) / REPS + NULL_INSNS;
+    one_call_t o;
+    o.f = f;
+    o.snap = snap;
+    o.p = p;
+    o.n = n;
+    return measure_exact(restore, call_one, &o);
 }
 
 /* The longest single call of f over the first `bytes` of the stream, fed
@@ -184,7 +174,7 @@ static void loops(const char *sname, size_t n)
 
     t0 = ticks();
     for (i = 0; i < n; i++) {
-        (void)null_call(&stream[i], 1u);
+        (void)empty_call(&stream[i], 1u);
     }
     printf("loop empty %s %lu %lu 0\n", sname, (unsigned long)n, since(t0));
 
@@ -252,18 +242,12 @@ static const char *const streams[] = {"telemetry", "badsize", "sync4",   "syncra
 
 int main(void)
 {
-    static tase_rx_t snap;
     uint32_t t0;
     size_t s, n;
-    TIMER0_CTRL = 0u;
-    TIMER0_RELOAD = 0xFFFFFFFFu;
-    TIMER0_VALUE = 0xFFFFFFFFu;
-    TIMER0_CTRL = 1u; /* enable, no interrupt */
+    measure_start();
     t0 = ticks();
-    known_loop(1000000u);
+    measure_known_loop(1000000u);
     printf("calibration %lu\n", since(t0));
-    (void)tase_rx_init(&snap);
-    null_reps = repeat(null_call, &snap, stream, 1u);
     printf("sizeof tase_rx_t %lu\n", (unsigned long)sizeof(tase_rx_t));
     for (s = 0; s < sizeof(streams) / sizeof(streams[0]); s++) {
         n = bench_stream(streams[s], stream, sizeof(stream));
@@ -273,6 +257,5 @@ int main(void)
         max_call("tase_rx_feed/64", streams[s], call_feed, n, 64u);
         stack_push(streams[s], n < MAXCALL_BYTES ? n : MAXCALL_BYTES);
     }
-    (void)call_flush;
     return 0;
 }
