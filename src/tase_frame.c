@@ -234,18 +234,18 @@ typedef struct {
 /* Count and hand on the valid frame f[0..Size+6) at stream offset
  * `offset`. Returns false when the callback re-initialised the receiver:
  * the caller must then leave it alone. */
-static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, rx_call_t *c)
+static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, tase_rx_handler_t on_frame,
+                    void *user)
 {
     tase_frame_t fr;
     rx->stats.frames_ok++;
-    c->count++;
-    if (c->on_frame != NULL) {
+    if (on_frame != NULL) {
         fr.offset = offset;
         fr.group = f[4];
         fr.type = f[5];
         fr.len = (uint8_t)(f[3] - 2u);
         fr.data = &f[TASE_FRAME_HEADER];
-        c->on_frame(c->user, &fr);
+        on_frame(user, &fr);
     }
     return rx->busy != 0u;
 }
@@ -365,7 +365,9 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
                     rx->sum_scan = (uint16_t)(at_be + p[flen - 2u] + p[flen - 1u]);
                     rx->scan = (uint16_t)(s + flen);
                     budget = spend(budget, RX_COST_FRAME);
-                    if (!deliver(rx, p, rx->stats.bytes_in - (uint32_t)avail, c)) {
+                    c->count++;
+                    if (!deliver(rx, p, rx->stats.bytes_in - (uint32_t)avail, c->on_frame,
+                                 c->user)) {
                         return false;
                     }
                     continue;
@@ -569,11 +571,18 @@ static int rx_check(const tase_rx_t *rx)
     return rx_sane(rx) ? TASE_OK : TASE_EARG;
 }
 
-/* tase_rx_push() for every byte its fast paths do not take. */
+/* tase_rx_push() for every byte its fast paths do not take: a lagging
+ * scan (the byte is stored and the scan goes on with a budget, as run()
+ * does for each byte), a call from a callback, or a corrupted instance. */
 RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
+    rx_call_t c;
     int r = rx_check(rx);
-    return (r != TASE_OK) ? r : run(rx, &b, 1u, false, on_frame, user);
+    if (r != TASE_OK) {
+        return r;
+    }
+    begin(rx, &c, on_frame, user);
+    return finish(rx, &c, put(rx, &c, b) && advance(rx, &c, RX_BUDGET, false));
 }
 
 /* tase_rx_push() for the last byte of a held candidate that failed: the
@@ -603,7 +612,6 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
 {
     size_t s = rx->scan;
     size_t len = rx->len;
-    rx_call_t c;
     /* the checks of rx_sane() that make the frame lie inside buf; else
      * push_slow() gives the error */
     if (s + 4u > len || rx->buf[s + 3u] < 2u || rx->end != s + rx->buf[s + 3u] + 5u) {
@@ -617,8 +625,9 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     rx->len = 0u;
     rx->scan = 0u;
     rx->sum_len = rx->sum_scan;
-    begin(rx, &c, on_frame, user);
-    (void)deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), &c);
+    rx->busy = 1u;
+    rx->end = RX_BLOCKED;
+    (void)deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), on_frame, user);
     /* hunting from here; also right when the callback re-initialised rx */
     rx->end = 0u;
     rx->busy = 0u;

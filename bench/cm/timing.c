@@ -174,12 +174,12 @@ static void receiver(void)
     for (s = 0; s < sizeof(rx_streams) / sizeof(rx_streams[0]); s++) {
         stream_n = bench_stream(rx_streams[s], stream, sizeof(stream));
         (void)stream_n;
-        e = worst_over_prefixes(c_flush, 1024u, 0u, &at);
+        e = worst_over_prefixes(c_flush, 2048u, 0u, &at);
         if (e > worst_flush) {
             worst_flush = e, flush_in = rx_streams[s], flush_at = at;
         }
         /* a tick 100 s after the last byte: past every quiet limit */
-        e = worst_over_prefixes(c_tick, 1024u, 100000u, &at);
+        e = worst_over_prefixes(c_tick, 2048u, 100000u, &at);
         if (e > worst_tick) {
             worst_tick = e, tick_in = rx_streams[s], tick_at = at;
         }
