@@ -4,6 +4,7 @@
 #   libtase-dev  the install component "dev": static libraries, headers,
 #                CMake package, pkg-config files
 #   tase-tools   the component "tools": tase, tase-sim and their manual
+#   python3-tase the component "python": the Python package (python/)
 # scripts/check-packages.sh builds both, unpacks them and builds consumer
 # programs from the unpacked tree.
 set(CPACK_PACKAGE_NAME tase)
@@ -21,6 +22,9 @@ set(CPACK_GENERATOR DEB)
 set(CPACK_COMPONENTS_ALL dev)
 if(TARGET tase_cli)
   list(APPEND CPACK_COMPONENTS_ALL tools)
+endif()
+if(TARGET tase_python)
+  list(APPEND CPACK_COMPONENTS_ALL python)
 endif()
 set(CPACK_DEB_COMPONENT_INSTALL ON)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT) # <name>_<version>_<arch>.deb
@@ -46,5 +50,20 @@ set(CPACK_DEBIAN_TOOLS_DESCRIPTION
 tase talks to a Cloud Cap TASE gimbal over a serial port or SocketCAN:
 monitor telemetry, send commands, run queries, decode captures to JSON.
 tase-sim is a simulated gimbal on a pseudo-terminal or CAN interface.")
+
+# The Python package: its extension is built for the Python of the build
+# (TASE_PYTHON_VERSION, Debian 12: 3.11).
+set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-tase)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_SHLIBDEPS ON)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS
+    "python3 (>= ${TASE_PYTHON_VERSION}), python3 (<< ${TASE_PYTHON_NEXT}), python3-cffi-backend")
+set(CPACK_DEBIAN_PYTHON_PACKAGE_RECOMMENDS "python3-serial, python3-can, python3-matplotlib, tase-tools")
+set(CPACK_DEBIAN_PYTHON_DESCRIPTION
+"TASE gimbal protocol stack: Python 3 package
+The tase package drives a Cloud Cap TASE gimbal from Python over the same
+C code the firmware links: packets from the library's schema, encode and
+decode, serial, SocketCAN and virtual CAN links with queries and retries,
+the simulator, captures of tase record and plots (docs/PYTHON.md).")
 
 include(CPack)

@@ -465,6 +465,38 @@ def quiet(out, gap):
                             bytes([DIRS["out"]]) + rest))
 
 
+def times(out):
+    """Issue 25 item 6: a serial capture of three GIMBAL_ANGLEs stamped
+    2147483647.75 (the last second a signed 32-bit field holds), 2147483648.25
+    (past 2038-01-19 03:14:07: the unsigned field) and 1700000000 s plus
+    1,500,000,000 ns (a fraction not normalised: 1700000001.5)."""
+    with open(out, "wb") as f:
+        f.write(pcap_header(LINKTYPE_SERIAL))
+        for i, (sec, ns) in enumerate([(2147483647, 750000000), (2147483648, 250000000),
+                                       (1700000000, 1500000000)]):
+            f.write(pcap_record(sec, ns, bytes([DIRS["out"]]) + gimbal_angle(i, 0)[1]))
+
+
+def replay_checks(out_cut, out_bad, out_back):
+    """Issue 25 item 7: captures replay must check before sending anything.
+    out_cut: five GIMBAL_ANGLEs 0.1 s apart, the file cut inside the last
+    record's header; out_bad: the same with record 4 of direction 7;
+    out_back: four GIMBAL_ANGLEs stamped 0, 0.5, 0.2 (a clock stepped back)
+    and 0.7 s: replayed 0.5 s apart (the step is no gap; the gaps after it
+    keep their lengths), 1.0 s in all."""
+    recs = [pcap_record(T0, i * 100000000, b"\x00" + gimbal_angle(i, 0)[1]) for i in range(5)]
+    data = pcap_header(LINKTYPE_SERIAL) + b"".join(recs)
+    with open(out_cut, "wb") as f:
+        f.write(data[:-len(recs[-1]) + 9])
+    recs[3] = pcap_record(T0, 300000000, b"\x07" + gimbal_angle(3, 0)[1])
+    with open(out_bad, "wb") as f:
+        f.write(pcap_header(LINKTYPE_SERIAL) + b"".join(recs))
+    with open(out_back, "wb") as f:
+        f.write(pcap_header(LINKTYPE_SERIAL))
+        for i, ns in enumerate([0, 500000000, 200000000, 700000000]):
+            f.write(pcap_record(T0, ns, b"\x00" + gimbal_angle(i, 0)[1]))
+
+
 def cut_records(streams, sizes):
     """Round-robin records of the given sizes (cycled) from each stream:
     [(dir, stream offset of the end, bytes)]."""
@@ -640,6 +672,10 @@ def main(argv):
         expect_serial(args[0], args[1:])
     elif cmd == "can-pcap":
         can_pcap(args[0], args[1])
+    elif cmd == "replay-checks":
+        replay_checks(args[0], args[1], args[2])
+    elif cmd == "times":
+        times(args[0])
     elif cmd == "quiet":
         quiet(args[0], args[1])
     elif cmd == "bad-pcap":

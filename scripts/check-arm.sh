@@ -5,7 +5,8 @@
 #      directory and every src/*.c compiled by hand (no CMake, nothing
 #      generated);
 #   2. the CMake toolchain file cmake/arm-none-eabi.cmake (core library only).
-# Then check that no object references the heap.
+# Then check that no object references the heap, 64-bit division or
+# double arithmetic (scripts/check-no-softmath.sh; KLV excepted).
 # Usage: scripts/check-arm.sh cortex-m0plus|cortex-m3|cortex-m4|cortex-m7 [outdir]
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
@@ -24,6 +25,7 @@ for src in "$out"/copy/src/*.c; do
     objs+=("$obj")
 done
 "$TASE_ROOT/scripts/check-no-heap.sh" arm-none-eabi-nm "${objs[@]}"
+"$TASE_ROOT/scripts/check-no-softmath.sh" arm-none-eabi-nm "${objs[@]}"
 arm-none-eabi-size -t "${objs[@]}" | tail -1
 
 cmake -S "$TASE_ROOT" -B "$out/cmake" -DCMAKE_TOOLCHAIN_FILE="$TASE_ROOT/cmake/arm-none-eabi.cmake" \

@@ -105,4 +105,16 @@ for p in tase tase-sim; do
         echo "   $p: no --version option in tools/ yet (issue 15); --help runs"
     fi
 done
+tase_step "python3-tase (issue 22): fields, contents, import from the unpacked tree"
+py="$out/build/packages/python3-tase_${version}-1_${arch}.deb"
+[ -f "$py" ] || tase_fail "no $(basename "$py") (python3-cffi, python3-dev installed?)"
+field "$py" Package '^python3-tase$'
+field "$py" Version "^${version}-1$"
+field "$py" Depends 'python3 \(>= 3\.[0-9]+\), python3 \(<< 3\.[0-9]+\), python3-cffi-backend'
+dpkg-deb -x "$py" "$root"
+v=$(cd / && PYTHONPATH="$root/usr/lib/python3/dist-packages" /usr/bin/python3 -c \
+    'import tase; print(tase.__version__, tase.__file__)')
+[[ $v == "$version $root/usr/lib/python3/dist-packages/tase/__init__.py" ]] ||
+    tase_fail "python3-tase: import tase gave '$v'"
+echo "   python3-tase: import tase: $v"
 tase_step "packages: built, checked, unpacked and used"

@@ -7,7 +7,7 @@
 # Exits 0 when every step worked, non-zero (with the reason) otherwise.
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
-tase_need base
+tase_need base python
 
 build="$TASE_ROOT/build"
 work=$(mktemp -d)
@@ -112,6 +112,29 @@ nout=$(grep -c '"dir":"out"' "$work/session.json" || true)
 grep -q '"dir":"in".*"name":"GIMBAL_CMD","size":8,"fields":{"pan":4500,"tilt":-2000,' "$work/session.json" ||
     fail "the recorded session lacks the position command"
 echo "($nin packets to the gimbal and $nout from it, each with its capture time in seconds)"
+
+step "Python: the same gimbal and the same capture from a script (python/, docs/PYTHON.md)"
+cmake --build "$build" --target tase_python >/dev/null
+py=$(sed -n 's/^TASE_PYTHON:FILEPATH=//p' "$build/CMakeCache.txt")
+cat >"$work/bench.py" <<'PY'
+import sys
+import tase
+
+with tase.connect("serial:%s:57600" % sys.argv[1]) as link:
+    rates = link.query("PACKET_RATE")          # the host role: echo matching, retries
+    print("PACKET_RATE answered:", rates.raw["angle_1"], "angle packets/s")
+    link.point(-30, 10)                        # tase point -30 10
+    for p in link.packets(timeout=3.0):
+        if p.name == "GIMBAL_ANGLE" and abs(p.fields["pan"] + 30) < 0.5:
+            print("reached", p)
+            break
+    else:
+        sys.exit("the gimbal did not reach pan -30")
+packets = list(tase.read_capture(sys.argv[2]))  # the --record capture above
+print("capture: %d packets, first %s %s" % (len(packets), packets[0][1].dir, packets[0][1].name))
+PY
+echo "\$ PYTHONPATH=$build/python $py bench.py $work/gimbal $work/session.pcap"
+PYTHONPATH="$build/python" "$py" "$work/bench.py" "$work/gimbal" "$work/session.pcap"
 
 step "Stopping the simulator; its log of what it was asked to do:"
 kill "$sim_pid"

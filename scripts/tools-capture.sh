@@ -50,6 +50,12 @@ $U expect-serial "$dir/noisy.pcap" "$DATA/decode_noisy.jsonl:out" "$DATA/decode_
 rc=$?
 check "decode of a serial pcap (both directions, 1..64-byte records): every packet with dir and time, exit 0" \
     eval '[ $rc -eq 0 ] && same_per_dir "$dir/noisy.expect" "$dir/noisy.json"'
+# issue 25 item 6: record times past 2038-01-19 03:14:07 (the unsigned
+# 32-bit seconds of classic pcap) and a fraction of 10^9 ns or more
+$U times "$dir/times.pcap"
+t=$("$TASE" decode "$dir/times.pcap" | sed -n 's/.*"time":\([0-9.-]*\),.*/\1/p' | tr '\n' ' ')
+check "decode: times past 2038 and unnormalised fractions ($t)" \
+    test "$t" = "2147483647.750000 2147483648.250000 1700000001.500000 "
 "$TASE" decode - <"$dir/noisy.pcap" | cmp -s - "$dir/noisy.json"
 check "decode of the serial pcap from standard input (a file)" [ $? -eq 0 ]
 cat "$dir/noisy.pcap" | "$TASE" decode | cmp -s - "$dir/noisy.json"
@@ -102,8 +108,14 @@ expect_error "record --tap-in without --serial" 2 "needs --serial" \
     "$TASE" record --can vcan0 --tap-in /dev/null -o "$dir/x.pcap"
 expect_error "--record on a CAN link" 2 "on CAN run 'tase record --can can0" \
     "$TASE" query SYSTEM_VERSION --can can0 --record "$dir/x.pcap"
-expect_error "record to an unwritable file" 1 "cannot write capture" \
-    "$TASE" record --serial /dev/null -o "$dir/no/such/dir.pcap"
+# issue 25 item 1: a record that cannot start never touches an existing
+# capture (it was cut to 24 bytes before the device open failed)
+head -c 262184 /dev/urandom >"$dir/precious.pcap"
+cp "$dir/precious.pcap" "$dir/precious.copy"
+expect_error "record from a missing device: refused" 1 "cannot open serial device" \
+    "$TASE" record --serial "$dir/no-such-tty" -o "$dir/precious.pcap"
+check "... and the existing capture is untouched, no partial file left" \
+    eval 'cmp -s "$dir/precious.pcap" "$dir/precious.copy" && ! ls "$dir"/precious.pcap.partial-* >/dev/null 2>&1'
 
 # ---- a live session with tase-sim, recorded with --record ----
 "$SIM" --quiet --link "$dir/gimbal" --seconds 120 >"$dir/sim.log" 2>&1 &
@@ -151,6 +163,35 @@ $U can-pcap "$dir/other.pcap" "$DATA/decode_candump.log"
 expect_error "--record appending to a capture of another link type" 1 "cannot write capture" \
     "$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/other.pcap"
 
+# issue 25 item 2: --record onto a full disk (here: a file size limit,
+# SIGXFSZ ignored, so writes fail with EFBIG as on a full disk). The
+# GIMBAL_CMD reaches the gimbal: exit 5, one message saying it was sent.
+cp "$dir/session.pcap" "$dir/full.pcap"
+kb=$(($(stat -c %s "$dir/full.pcap") / 1024)) # below its size: no write fits
+(
+    trap '' XFSZ
+    ulimit -f "$kb"
+    exec "$TASE" point 12 -3 --serial "$dir/gimbal" --record "$dir/full.pcap"
+) >"$dir/full.out" 2>"$dir/full.err.all"
+rc=$?
+grep -v '^==[0-9]*== ' "$dir/full.err.all" >"$dir/full.err" # memcheck's notes are not ours
+check "--record on a full disk: the command was carried out, exit $rc (5), '$(cat "$dir/full.err")'" \
+    eval '[ $rc -eq 5 ] && [ "$(wc -l <"$dir/full.err")" -eq 1 ] &&
+          grep -q "cannot write capture .*(GIMBAL_CMD was sent)" "$dir/full.err" &&
+          grep -q "^sent GIMBAL_CMD pan=1200 tilt=-300" "$dir/full.out"'
+check "... and the capture still ends at a whole record (tshark reads it cleanly)" \
+    eval 'tshark -r "$dir/full.pcap" >/dev/null 2>"$dir/full.tshark" && ! grep -v "Running as user" "$dir/full.tshark" | grep -q .'
+# issue 25 item 3: appending to a capture a crash cut inside a record
+cp "$dir/session.pcap" "$dir/crashed.pcap"
+truncate -s -5 "$dir/crashed.pcap"
+"$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/crashed.pcap" >/dev/null 2>"$dir/crashed.err"
+rc=$?
+check "--record appending to a capture cut inside a record: repaired first, said so, readable ($(cat "$dir/crashed.err"))" \
+    eval '[ $rc -eq 0 ] && grep -q "ended inside a record .* bytes of it removed before appending" "$dir/crashed.err" &&
+          tshark -r "$dir/crashed.pcap" >/dev/null 2>"$dir/crashed.tshark" && ! grep -v "Running as user" "$dir/crashed.tshark" | grep -q . &&
+          [ "$("$TASE" decode "$dir/crashed.pcap" | grep -c SYSTEM_VERSION)" -ge 2 ]'
+expect_error "record to an unwritable file (the device opens first)" 1 "cannot write capture" \
+    "$TASE" record --serial "$dir/gimbal" -o "$dir/no/such/dir.pcap" --seconds 0.5
 expect_error "record onto a full disk (/dev/full)" 1 "cannot write capture /dev/full: No space left on device" \
     "$TASE" record --serial "$dir/gimbal" -o /dev/full --seconds 0.5
 
@@ -168,6 +209,18 @@ nr=$($U records "$dir/tele.pcap" | grep -c .)
 check "record --serial, stopped by SIGINT: exit $rc, '$(tail -1 "$dir/rec.out")', $nr records, $na GIMBAL_ANGLE (20/s set above)" \
     eval '[ $rc -eq 0 ] && grep -q "^recorded $nr records" "$dir/rec.out" && [ "$na" -ge 15 ] &&
           ! grep -q "\"dir\":\"in\"" "$dir/tele.json"'
+# a recording killed outright (SIGKILL) leaves the previous capture as it
+# was and its own records in the partial file beside it
+cp "$dir/tele.pcap" "$dir/tele.copy"
+"$TASE" record --serial "$dir/gimbal" -o "$dir/tele.pcap" >"$dir/rec2.out" 2>&1 &
+rp=$!
+wait_for "$dir/rec2.out" recording
+sleep 0.5
+kill -KILL $rp
+wait $rp 2>/dev/null
+check "record killed with SIGKILL: the previous capture is unchanged, the partial one kept beside it" \
+    eval 'cmp -s "$dir/tele.pcap" "$dir/tele.copy" && ls "$dir"/tele.pcap.partial-* >/dev/null 2>&1'
+rm -f "$dir"/tele.pcap.partial-*
 
 # ---- the recorded device goes away: record stops (it spun at 75% CPU) ----
 "$TASE" record --serial "$dir/gimbal" -o "$dir/gone.pcap" >"$dir/gone.out" 2>"$dir/gone.err" &
@@ -233,6 +286,21 @@ replay_fast() {
 replay_to zero replay_fast
 ms=$(cat "$dir/zero.ms")
 check "replay --speed 0 sends without waiting (${ms} ms for a 1.5 s capture)" [ "$ms" -lt "$fast_ms" ]
+
+# issue 25 item 7: the whole capture is checked before anything is sent
+# (what arrives is recorded on B as cutrx.pcap etc.)
+$U replay-checks "$dir/cut-in.pcap" "$dir/bad-in.pcap" "$dir/back-in.pcap"
+replay_to cutrx "$TASE" replay "$dir/cut-in.pcap" --serial "$dir/A" --dir out
+check "replay of a capture cut in its last record: refused before sending ('$(tail -1 "$dir/cutrx.out")'), nothing arrived" \
+    eval '! grep -q "^replayed" "$dir/cutrx.out" && [ "$($U records "$dir/cutrx.pcap" | grep -c .)" = 0 ]'
+replay_to badrx "$TASE" replay "$dir/bad-in.pcap" --serial "$dir/A" --dir out
+check "replay of a capture with a bad record: nothing sent ('$(tail -1 "$dir/badrx.out")')" \
+    eval 'grep -q "1 bad record: nothing was sent" "$dir/badrx.out" && [ "$($U records "$dir/badrx.pcap" | grep -c .)" = 0 ]'
+replay_to backrx "$TASE" replay "$dir/back-in.pcap" --serial "$dir/A" --dir out
+t_back=$(sed -n 's/^replayed 4 of 4 records (56 bytes) to .* in \([0-9.]*\) s$/\1/p' "$dir/backrx.out")
+check "replay across a clock stepped back: warned, the later gaps kept (${t_back:-?} s; 1.0 s of gaps, was 0.7)" \
+    eval 'grep -q "record 3 is 0.300000 s earlier than record 2" "$dir/backrx.out" &&
+          awk -v t="${t_back:-0}" "BEGIN { exit !(t >= 0.95 && t < 1.0 + $tol) }"'
 
 # A two-line tap: the gimbal's line into A (recorded on B), the host's line
 # into C (recorded on D with --tap-in), both replayed at once.

@@ -205,6 +205,16 @@ objs = jsonl(out)
 ok("candump: traffic mirrored on can0 and vcan0 gives one object per interface",
    rc == 0 and len(objs) == 2 and {o["interface"] for o in objs} == {"can0", "vcan0"} and
    all(o["fields"] == {"pan": 100, "tilt": -200, "roll": 0} for o in objs), out + err)
+# issue 25 item 5: an interface name with '"' and '\\' (Linux allows both)
+q = candump_lines('ca"n\\0', "10000000", a0, 1700000003.0)
+log = write("quote.log", "\n".join(l for _, l in q) + "\n")
+rc, out, err = run(["decode", "--candump", log])
+try:
+    names = [json.loads(l)["interface"] for l in out.splitlines()]
+except ValueError as e:
+    names = ["invalid JSON: %s" % e]
+ok("candump: an interface name with '\"' and '\\\\' is escaped: valid JSON, the name kept",
+   rc == 0 and names == ['ca"n\\0'], out + err)
 # both directions on one interface, interleaved
 cmd = frame(0x00, 0x80, (1000).to_bytes(2, "big") + (0).to_bytes(2, "big") + b"\0\0\x20\0")
 li = candump_lines("can0", "11000000", cmd, 1700000002.0)
@@ -377,6 +387,31 @@ def after_noise(args):
     os.close(slave)
     return took, out.decode(errors="replace")
 
+
+# issue 25 item 4: a signal whose default ends the process (not the
+# INT/TERM/HUP the tools end on) gives the line its settings back first
+def killed_by(sig):
+    master, slave = os.openpty()
+    path = os.ttyname(slave)
+    before = termios.tcgetattr(slave)
+    p = subprocess.Popen([TASE, "monitor", "--serial", path], stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL)
+    deadline = time.time() + 2.0
+    while time.time() < deadline and termios.tcgetattr(slave)[3] & termios.ICANON:
+        time.sleep(0.01)
+    raw = not termios.tcgetattr(slave)[3] & termios.ICANON
+    p.send_signal(sig)
+    p.wait(timeout=10)
+    after = termios.tcgetattr(slave)
+    os.close(master)
+    os.close(slave)
+    return raw, p.returncode, before == after
+
+
+for sig in (signal.SIGQUIT, signal.SIGUSR1, signal.SIGALRM):
+    raw, rc, same = killed_by(sig)
+    ok("%s: tase monitor dies of it (status %d) with the line's settings given back"
+       % (signal.Signals(sig).name, rc), raw and rc == -sig and same, "raw %s same %s" % (raw, same))
 
 # 57600 baud: the 257 bytes the false sync claims, less the frame's 14,
 # take 43 ms; 200 ms leaves room for a loaded machine.

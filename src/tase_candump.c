@@ -54,7 +54,9 @@ static bool read_dec(cursor_t *c, size_t max_digits, uint64_t *v, size_t *ndigit
         if (n == max_digits) {
             return false;
         }
-        if (acc > (UINT64_MAX - (uint64_t)(peek(c) - '0')) / 10u) {
+        /* acc * 10 + digit must fit: UINT64_MAX is 1844674407370955161 * 10
+         * + 5 (compared, not divided: no 64-bit division on 32-bit MCUs) */
+        if (acc > 1844674407370955161u || (acc == 1844674407370955161u && peek(c) > '5')) {
             return false;
         }
         acc = acc * 10u + (uint64_t)(peek(c) - '0');
@@ -246,19 +248,47 @@ static size_t put_char(char *out, char ch)
     return 1u;
 }
 
+/* v in decimal, at least min_digits (<= 20) with leading zeros. Digits
+ * from the top by subtraction (at most 9 per digit): no 64-bit division,
+ * which is a library call on 32-bit targets. */
 static size_t put_dec(char *out, uint64_t v, unsigned min_digits)
 {
-    char tmp[20];
+    /* powers of ten up to 10^19, the largest a uint64_t holds */
+    static const uint64_t pow10_u64[20] = {1u,
+                                           10u,
+                                           100u,
+                                           1000u,
+                                           10000u,
+                                           100000u,
+                                           1000000u,
+                                           10000000u,
+                                           100000000u,
+                                           1000000000u,
+                                           10000000000u,
+                                           100000000000u,
+                                           1000000000000u,
+                                           10000000000000u,
+                                           100000000000000u,
+                                           1000000000000000u,
+                                           10000000000000000u,
+                                           100000000000000000u,
+                                           1000000000000000000u,
+                                           10000000000000000000u};
     uint64_t rest = v;
+    size_t top = (min_digits > 0u) ? (size_t)min_digits - 1u : 0u;
     size_t n = 0;
     size_t k;
-    do {
-        tmp[n] = (char)('0' + (int)(rest % 10u));
+    while (top < 19u && pow10_u64[top + 1u] <= v) {
+        top++;
+    }
+    for (k = top + 1u; k > 0u; k--) {
+        char d = '0';
+        while (rest >= pow10_u64[k - 1u]) {
+            rest -= pow10_u64[k - 1u];
+            d++;
+        }
+        out[n] = d;
         n++;
-        rest /= 10u;
-    } while (rest != 0u || n < min_digits);
-    for (k = 0; k < n; k++) {
-        out[k] = tmp[n - 1u - k];
     }
     return n;
 }

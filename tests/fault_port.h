@@ -14,10 +14,14 @@
  *   stall    the call blocks for its whole bound and achieves nothing:
  *            write() spends write_bound_ms and returns TASE_EAGAIN, read()
  *            spends its timeout and returns 0
+ *   slow     write() passes only 1..n-1 bytes on (all of a 1-byte write)
+ *            and spends slow_ms doing it: a partial AND slow write (a
+ *            serial driver that trickles a frame out)
  *   jump     now_ms() jumps forward by 1..jump_max_ms (time that did not
- *            pass: a clock step)
+ *            pass: a clock step; jump_max_ms 0: no jumps)
  *   stale    now_ms() returns a sample 1..stale_max_ms older than the last
- *            one it returned (a value read earlier and handed in late)
+ *            one it returned (a value read earlier and handed in late;
+ *            stale_max_ms 0: no stale samples)
  * and a hang-up after `hangup_after` calls (0: never): from then on read()
  * and write() return TASE_EIO.
  *
@@ -36,8 +40,9 @@ typedef struct {
     tase_port_t inner;
     uint32_t rng; /* xorshift32 state, from the seed */
     /* probabilities in 1/256 per call (0: never) */
-    unsigned p_short, p_eagain, p_eintr, p_stall, p_jump, p_stale;
+    unsigned p_short, p_eagain, p_eintr, p_stall, p_jump, p_stale, p_slow;
     uint32_t write_bound_ms; /* what a stalled write spends (the port's W) */
+    uint32_t slow_ms;        /* what a slow partial write spends */
     uint32_t jump_max_ms, stale_max_ms;
     uint32_t hangup_after; /* calls before a permanent hang-up; 0 never */
     /* state */
@@ -46,7 +51,7 @@ typedef struct {
     uint32_t spent_ms; /* time stalls spent */
     uint32_t calls;    /* read() + write() calls */
     /* what was injected */
-    unsigned shorts, eagains, eintrs, stalls, jumps, stales, hangups;
+    unsigned shorts, eagains, eintrs, stalls, jumps, stales, hangups, slows;
 } fault_port_t;
 
 static inline uint32_t fault_rand(fault_port_t *f)
@@ -71,6 +76,7 @@ static inline void fault_init(fault_port_t *f, const tase_port_t *inner, uint32_
     f->write_bound_ms = 100u;
     f->jump_max_ms = 1000u;
     f->stale_max_ms = 1000u;
+    f->slow_ms = 10u;
     if (inner->ops->now_ms != NULL) {
         f->last = inner->ops->now_ms(inner->ctx);
     }
@@ -112,7 +118,14 @@ static inline int fault_write(void *ctx, const uint8_t *data, size_t n)
         f->spent_ms += f->write_bound_ms;
         return TASE_EAGAIN;
     }
-    if (n > 1u && fault_hit(f, f->p_short)) {
+    if (fault_hit(f, f->p_slow)) {
+        f->slows++;
+        f->offset += f->slow_ms;
+        f->spent_ms += f->slow_ms;
+        if (n > 1u) {
+            n = 1u + fault_rand(f) % (uint32_t)(n - 1u);
+        }
+    } else if (n > 1u && fault_hit(f, f->p_short)) {
         f->shorts++;
         n = 1u + fault_rand(f) % (uint32_t)(n - 1u);
     }
@@ -139,12 +152,12 @@ static inline uint32_t fault_now(void *ctx)
 {
     fault_port_t *f = ctx;
     uint32_t now;
-    if (fault_hit(f, f->p_jump)) {
+    if (f->jump_max_ms > 0u && fault_hit(f, f->p_jump)) {
         f->jumps++;
         f->offset += 1u + fault_rand(f) % f->jump_max_ms;
     }
     now = f->inner.ops->now_ms(f->inner.ctx) + f->offset;
-    if (fault_hit(f, f->p_stale)) {
+    if (f->stale_max_ms > 0u && fault_hit(f, f->p_stale)) {
         f->stales++;
         return f->last - (1u + fault_rand(f) % f->stale_max_ms);
     }

@@ -3,6 +3,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -173,6 +174,47 @@ static void longest_line_fits_the_documented_maximum_and_round_trips(void **stat
     assert_memory_equal(back.frame.data, r.frame.data, 8);
 }
 
+/* Seconds at the edges of uint64_t parse and print exactly (the decimal
+ * conversions use no 64-bit division, issue 26: checked digit by digit
+ * here against values whose digits differ in every position). */
+static void seconds_at_the_uint64_edges_round_trip(void **state)
+{
+    static const struct {
+        const char *text;
+        uint64_t sec;
+    } ok[] = {
+        {"0000000000", 0u},
+        {"0000000001", 1u},
+        {"1234567890", 1234567890u},
+        {"9999999999", 9999999999u},
+        {"10000000000", 10000000000u},
+        {"18446744073709551610", 18446744073709551610u},
+        {"18446744073709551615", UINT64_MAX},
+        {"9876543210123456789", 9876543210123456789u},
+    };
+    static const char *const too_big[] = {"18446744073709551616", "18446744073709551619",
+                                          "18446744073709551620", "99999999999999999999"};
+    tase_candump_rec_t r;
+    char line[TASE_CANDUMP_LINE_MAX];
+    char want[TASE_CANDUMP_LINE_MAX];
+    size_t i;
+    int n;
+    (void)state;
+    for (i = 0; i < sizeof ok / sizeof ok[0]; i++) {
+        snprintf(line, sizeof line, "(%s.000001) can0 123#", ok[i].text);
+        assert_int_equal(tase_candump_parse(line, strlen(line), &r), TASE_OK);
+        assert_true(r.sec == ok[i].sec);
+        n = tase_candump_format(&r, line, sizeof line);
+        assert_true(n > 0);
+        snprintf(want, sizeof want, "(%s.000001) can0 123#\n", ok[i].text);
+        assert_string_equal(line, want);
+    }
+    for (i = 0; i < sizeof too_big / sizeof too_big[0]; i++) {
+        snprintf(line, sizeof line, "(%s.000001) can0 123#", too_big[i]);
+        assert_int_equal(tase_candump_parse(line, strlen(line), &r), TASE_EFORMAT);
+    }
+}
+
 /* Bad arguments of candump.h give their documented codes and leave the
  * record and the output unchanged. */
 static void candump_api_rejects_bad_arguments(void **state)
@@ -223,6 +265,7 @@ int main(void)
         cmocka_unit_test(format_writes_candump_style_lines),
         cmocka_unit_test(format_needs_room_and_valid_records),
         cmocka_unit_test(longest_line_fits_the_documented_maximum_and_round_trips),
+        cmocka_unit_test(seconds_at_the_uint64_edges_round_trip),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -119,6 +119,7 @@ static fix_t *make(uint32_t now, unsigned nports, bool with_fill)
     tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL, NULL, NULL};
     unsigned i;
     assert_non_null(x);
+    memset(ports, 0, sizeof ports);
     app.user = x;
     if (!with_fill) {
         app.fill_telemetry = NULL;
@@ -764,6 +765,7 @@ static void service_reads_every_port_feeds_it_and_polls(void **state)
     assert_non_null(x);
     memset(d, 0, sizeof d); /* the GIMBAL_CMD pushed below carries d */
     app.user = x;
+    memset(ports, 0, sizeof ports); /* bytes_per_s 0: unknown */
     ports[0].ops = &fake_ops;
     ports[0].ctx = &x->port[0];
     ports[1].ops = &write_only;
@@ -876,6 +878,7 @@ static void gimbal_api_rejects_bad_arguments(void **state)
     (void)state;
 
     memset(&fp, 0, sizeof fp);
+    memset(ports, 0, sizeof ports); /* padding too: the role's copy is compared */
     for (i = 0; i < TASE_GIMBAL_PORTS + 1u; i++) {
         ports[i].ops = &fake_ops;
         ports[i].ctx = &fp;

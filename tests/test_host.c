@@ -488,10 +488,17 @@ static void host_api_rejects_bad_arguments(void **state)
     static tase_host_t copy;
     static const uint8_t req[4] = {1, 2, 3, 4};
     uint8_t reply[8];
-    tase_port_t port = {&fake_ops, &fp, 0};
-    tase_port_t no_write = {&liar_ops, &fp, 0};
+    tase_port_t port;
+    tase_port_t no_write;
     tase_port_ops_t ops_no_write = {NULL, fake_read, fake_now};
     (void)state;
+    /* padding too: the host's copy of the port is compared below */
+    memset(&port, 0, sizeof port);
+    memset(&no_write, 0, sizeof no_write);
+    port.ops = &fake_ops;
+    port.ctx = &fp;
+    no_write.ops = &liar_ops;
+    no_write.ctx = &fp;
 
     memset(&fp, 0, sizeof fp);
     memset(&h, 0, sizeof h); /* never initialised */

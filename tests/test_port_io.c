@@ -12,7 +12,9 @@
 #include "fake_port.h"
 #include "fault_port.h"
 #include "tase/codec.h"
+#include "tase/ids.h"
 #include "tase/port_io.h"
+#include "tase/schema.h"
 
 static fake_port_t *new_fake(void)
 {
@@ -294,6 +296,8 @@ static void write_all_keeps_its_contract_under_random_faults(void **state)
         fp.p_stall = fault_rand(&fp) & 0x3Fu;
         fp.p_jump = fault_rand(&fp) & 0x1Fu;
         fp.p_stale = fault_rand(&fp) & 0x1Fu;
+        fp.p_slow = fault_rand(&fp) & 0x1Fu;
+        fp.slow_ms = fault_rand(&fp) % 50u;
         fp.write_bound_ms = 1u + fault_rand(&fp) % 1000u;
         fp.hangup_after = seed % 5u == 0u ? fault_rand(&fp) % 20u + 1u : 0u;
         f->write_limit = (size_t)(fault_rand(&fp) % 40u);
@@ -313,8 +317,9 @@ static void write_all_keeps_its_contract_under_random_faults(void **state)
             assert_true(fp.hangups > 0u);
         }
         assert_memory_equal(f->out, data, f->nout);
-        assert_true(fp.spent_ms <= TASE_PORT_WRITE_TIMEOUT_MS +
-                                       fp.write_bound_ms * (1u + fp.stales - stales_before));
+        assert_true(fp.spent_ms <=
+                    TASE_PORT_WRITE_TIMEOUT_MS +
+                        (fp.write_bound_ms + fp.slow_ms) * (1u + fp.stales - stales_before));
     }
     free(f);
 }
@@ -352,6 +357,133 @@ static void send_msg_writes_the_codec_frame_and_checks_it_first(void **state)
     free(f);
 }
 
+/* Issue 26: a frame goes out in pieces of at most 24 bytes (no frame
+ * buffer on the stack), byte for byte the frame tase_frame_encode() and
+ * tase_packet_encode() build, every piece but the last a multiple of 8
+ * bytes (a CAN port packs it into whole CAN frames, as one write). Every
+ * data length, with a port taking all and a port taking 5 bytes a call. */
+static void frames_go_out_in_staged_pieces_byte_for_byte(void **state)
+{
+    static uint8_t data[TASE_DATA_MAX], camera[TASE_CAMERA_PASS_MAX];
+    uint8_t want[TASE_FRAME_MAX];
+    fake_port_t *f = new_fake();
+    tase_port_t p = {&fake_ops, f, 0};
+    tase_camera_pass_t cp;
+    size_t len;
+    unsigned limit;
+    int n;
+    (void)state;
+    for (len = 0; len < sizeof data; len++) {
+        data[len] = (uint8_t)(len * 37u + 11u);
+    }
+    for (len = 0; len < sizeof camera; len++) {
+        camera[len] = (uint8_t)(len * 13u + 1u);
+    }
+    for (limit = 0; limit <= 5; limit += 5) {
+        f->write_limit = limit;
+        for (len = 0; len <= TASE_DATA_MAX; len++) {
+            n = tase_frame_encode(want, sizeof want, 0x12, 0x34, data, len);
+            f->nout = 0;
+            f->writes = 0;
+            assert_int_equal(tase_port_send_frame(&p, 0x12, 0x34, data, len), n);
+            assert_int_equal(f->nout, n);
+            assert_memory_equal(f->out, want, (size_t)n);
+            if (limit == 0) {
+                assert_int_equal(f->writes, ((unsigned)n + 23u) / 24u);
+            }
+        }
+        /* CAMERA_PASS: the camera bytes from the caller's buffer */
+        for (len = 0; len <= TASE_CAMERA_PASS_MAX; len += 7) {
+            cp.camera = 1;
+            cp.baud = 8;
+            cp.len = (uint8_t)len;
+            cp.data = camera;
+            n = tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, want, sizeof want);
+            f->nout = 0;
+            assert_int_equal(tase_port_send_msg(&p, TASE_ID_CAMERA_PASS, &cp), n);
+            assert_int_equal(f->nout, n);
+            assert_memory_equal(f->out, want, (size_t)n);
+        }
+    }
+    /* every packet of the schema, at its table length, with data */
+    f->write_limit = 0;
+    for (len = 0; tase_schema_at(len) != NULL; len++) {
+        const tase_packet_desc_t *d = tase_schema_at(len);
+        tase_packet_msg_t m;
+        memset(&m, 0x5C, sizeof m);
+        if (d->id == TASE_ID_CAMERA_PASS) {
+            m.camera_pass.len = 9;
+            m.camera_pass.data = camera;
+        }
+        n = tase_packet_encode(d->id, &m, want, sizeof want);
+        assert_true(n >= 8);
+        f->nout = 0;
+        assert_int_equal(tase_port_send_msg(&p, d->id, &m), n);
+        assert_memory_equal(f->out, want, (size_t)n);
+    }
+    cp.len = TASE_CAMERA_PASS_MAX + 1u;
+    assert_int_equal(tase_port_send_msg(&p, TASE_ID_CAMERA_PASS, &cp), TASE_ETOOLONG);
+    cp.len = 3;
+    cp.data = NULL;
+    f->nout = 0;
+    assert_int_equal(tase_port_send_msg(&p, TASE_ID_CAMERA_PASS, &cp), TASE_EARG);
+    assert_int_equal(f->nout, 0);
+    free(f);
+}
+
+/* Issue 25 item 9: the fault port's clock faults with a zero range are
+ * off (they divided by zero), and a write that is partial AND slow (a
+ * driver trickling a frame out) still gets a whole frame out within one
+ * deadline, or a cut frame reported as TASE_ENOBUFS after it, with the
+ * time spent bounded by the deadline plus one slow call. */
+static void slow_partial_writes_and_zero_fault_ranges(void **state)
+{
+    fake_port_t *f = new_fake();
+    tase_port_t inner = {&fake_ops, f, 0};
+    uint8_t data[TASE_FRAME_MAX];
+    fault_port_t fp;
+    tase_port_t p;
+    uint32_t t0;
+    unsigned i;
+    int r;
+    (void)state;
+    for (i = 0; i < sizeof data; i++) {
+        data[i] = (uint8_t)(i * 7u + 3u);
+    }
+    /* jump_max_ms / stale_max_ms 0: now_ms() works and never moves */
+    fault_init(&fp, &inner, 7);
+    fp.p_jump = 255;
+    fp.p_stale = 255;
+    fp.jump_max_ms = 0;
+    fp.stale_max_ms = 0;
+    p = fault_port(&fp);
+    t0 = p.ops->now_ms(p.ctx);
+    for (i = 0; i < 100u; i++) {
+        assert_int_equal(p.ops->now_ms(p.ctx), t0);
+    }
+    assert_int_equal(fp.jumps + fp.stales, 0);
+
+    /* every write partial and 10 ms slow: 24 bytes make it in 100 ms */
+    fault_init(&fp, &inner, 11);
+    fp.p_slow = 256;
+    fp.slow_ms = 10;
+    p = fault_port(&fp);
+    f->nout = 0;
+    r = tase_port_write_all(&p, data, 2);
+    assert_int_equal(r, 2); /* at most 2 calls of 10 ms */
+    assert_true(fp.slows >= 1u && fp.spent_ms <= 20u);
+    f->nout = 0;
+    fp.spent_ms = 0;
+    f->write_limit = 4; /* the driver takes 4 bytes a call, 10 ms each */
+    r = tase_port_write_all(&p, data, sizeof data);
+    assert_int_equal(r, TASE_ENOBUFS); /* 261 bytes cannot trickle out in 100 ms */
+    assert_true(f->nout > 0u && f->nout < sizeof data);
+    assert_memory_equal(f->out, data, f->nout);
+    assert_true(fp.spent_ms >= TASE_PORT_WRITE_TIMEOUT_MS);
+    assert_true(fp.spent_ms <= TASE_PORT_WRITE_TIMEOUT_MS + fp.slow_ms);
+    free(f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -370,6 +502,8 @@ int main(void)
         cmocka_unit_test(write_all_keeps_its_contract_under_random_faults),
         cmocka_unit_test(elapsed_is_wrap_safe_and_a_stale_sample_is_no_time),
         cmocka_unit_test(send_msg_writes_the_codec_frame_and_checks_it_first),
+        cmocka_unit_test(frames_go_out_in_staged_pieces_byte_for_byte),
+        cmocka_unit_test(slow_partial_writes_and_zero_fault_ranges),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -302,6 +302,56 @@ static void write_retries_while_the_peer_drains(void **state)
     close_pair(&p);
 }
 
+/* Issue 25 item 8: a timeout of 2^31 ms or more (UINT32_MAX as "wait as
+ * long as possible") waits, clamped to TASE_SOCKETCAN_TIMEOUT_MAX: a read
+ * gets the frame the peer sends 100 ms later (it returned 0 at once), a
+ * write with a full queue goes out once the peer drains. */
+static void huge_timeouts_wait_instead_of_returning_at_once(void **state)
+{
+    pair_t p;
+    uint8_t wire[TASE_FRAME_MAX];
+    uint8_t buf[16];
+    uint8_t d[4] = {0x00, 0xFF, 0x5A, 0x02};
+    struct timespec t0, t1;
+    long ms;
+    int n, rc;
+    pid_t pid;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        usleep(100000);
+        peer_send(&p, 0x10000000u | CAN_EFF_FLAG, d, 4);
+        _exit(0);
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    rc = tase_socketcan_read(&p.s, buf, sizeof buf, UINT32_MAX);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    ms = (t1.tv_sec - t0.tv_sec) * 1000L + (t1.tv_nsec - t0.tv_nsec) / 1000000L;
+    assert_int_equal(rc, 4);
+    assert_memory_equal(buf, d, 4);
+    assert_true(ms >= 50);
+    assert_int_equal(waitpid(pid, NULL, 0), pid);
+    close_pair(&p);
+
+    n = open_full_pair(&p, wire);
+    pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        struct can_frame cf;
+        usleep(100000);
+        while (recv(p.peer, &cf, sizeof(cf), MSG_DONTWAIT) == (ssize_t)sizeof(cf)) {
+        }
+        _exit(0);
+    }
+    p.s.tx_timeout_ms = UINT32_MAX;
+    rc = tase_socketcan_write(&p.s, wire, (size_t)n);
+    assert_int_equal(rc, n);
+    assert_int_equal(waitpid(pid, NULL, 0), pid);
+    close_pair(&p);
+}
+
 static void adopt_and_open_check_their_arguments(void **state)
 {
     tase_socketcan_t s;
@@ -664,6 +714,7 @@ int main(void)
         cmocka_unit_test(threeax_move_goes_out_and_status_comes_back),
         cmocka_unit_test(full_queue_is_reported_never_dropped),
         cmocka_unit_test(write_retries_while_the_peer_drains),
+        cmocka_unit_test(huge_timeouts_wait_instead_of_returning_at_once),
         cmocka_unit_test(adopt_and_open_check_their_arguments),
         cmocka_unit_test(set_filter_on_a_non_can_socket_fails_cleanly),
         cmocka_unit_test(port_table_moves_bytes_both_ways),

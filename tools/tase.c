@@ -1999,11 +1999,9 @@ static int cmd_record(args_t *a)
     /* a signal is the normal end of a recording: the loops stop on it and
      * close the capture, and the command succeeds */
     if (lo.serial != NULL) {
-        tk_cap_create(&w, out, TK_CAP_LINKTYPE_SERIAL, false);
-        tk_cap_record_serial(&w, lo.serial, tap_in, lo.baud, seconds);
+        tk_cap_record_serial(&w, out, lo.serial, tap_in, lo.baud, seconds);
     } else {
-        tk_cap_create(&w, out, TK_CAP_LINKTYPE_CAN, false);
-        tk_cap_record_can(&w, lo.can, seconds);
+        tk_cap_record_can(&w, out, lo.can, seconds);
     }
     return TK_EXIT_OK;
 }
@@ -2014,7 +2012,7 @@ static int cmd_replay(args_t *a)
     tk_replay_opts_t ro;
     const char *path = NULL, *v;
     static uint8_t head[READ_CHUNK];
-    unsigned long bad;
+    unsigned long bad, backward;
     tk_cap_reader_t r;
     input_t in;
     size_t n;
@@ -2068,10 +2066,27 @@ static int cmd_replay(args_t *a)
                "replays them)",
                in.name);
     }
-    tk_cap_reader_open(&r, in.fd, head, n, in.name);
     ro.serial = lo.serial;
     ro.baud = lo.baud;
     ro.can = lo.can;
+    /* The whole capture is checked before anything is sent: read it once
+     * (so it must be a file, not a pipe), then again to send. */
+    if (lseek(in.fd, 0, SEEK_SET) != 0) {
+        tk_die("%s: replay reads its capture twice (checked before anything is sent): give a "
+               "file, not a pipe",
+               in.name);
+    }
+    tk_cap_reader_open(&r, in.fd, NULL, 0, in.name);
+    bad = tk_cap_check(&r, &ro, &backward);
+    tk_cap_reader_close(&r);
+    if (bad > 0) {
+        tk_exit(TK_EXIT_INPUT, "%s: %lu bad record%s: nothing was sent", in.name, bad,
+                bad == 1 ? "" : "s");
+    }
+    if (lseek(in.fd, 0, SEEK_SET) != 0) {
+        tk_die("cannot read %s again: %s", in.name, strerror(errno));
+    }
+    tk_cap_reader_open(&r, in.fd, NULL, 0, in.name);
     bad = tk_cap_replay(&r, &ro);
     tk_cap_reader_close(&r);
     input_close(&in);

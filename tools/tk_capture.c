@@ -11,6 +11,7 @@
 #include <poll.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/uio.h>
 #include <time.h>
 #include <unistd.h>
@@ -27,21 +28,102 @@
 
 /* ---- writing ---- */
 
+/* The length of the whole records of an existing classic pcap file:
+ * the 24-byte file header and every record whose 16-byte header and data
+ * are complete. Returns -1 when it is not a classic pcap (pcapng, or not a
+ * capture: libpcap's append refuses those with its own message). */
+static long whole_records_len(FILE *f, long size)
+{
+    uint8_t h[24];
+    bool big;
+    long at = 24;
+    if (fread(h, 1, sizeof(h), f) != sizeof(h)) {
+        return -1;
+    }
+    /* magic a1b2c3d4 (microseconds) or a1b23c4d (nanoseconds), either order */
+    if (((h[0] == 0xD4u && h[1] == 0xC3u) || (h[0] == 0x4Du && h[1] == 0x3Cu)) && h[2] == 0xB2u &&
+        h[3] == 0xA1u) {
+        big = false;
+    } else if (h[0] == 0xA1u && h[1] == 0xB2u &&
+               ((h[2] == 0xC3u && h[3] == 0xD4u) || (h[2] == 0x3Cu && h[3] == 0x4Du))) {
+        big = true;
+    } else {
+        return -1;
+    }
+    while (at + 16 <= size) {
+        uint8_t r[16];
+        uint32_t caplen;
+        if (fseek(f, at, SEEK_SET) != 0 || fread(r, 1, sizeof(r), f) != sizeof(r)) {
+            break;
+        }
+        caplen = big ? ((uint32_t)r[8] << 24 | (uint32_t)r[9] << 16 | (uint32_t)r[10] << 8 | r[11])
+                     : ((uint32_t)r[11] << 24 | (uint32_t)r[10] << 16 | (uint32_t)r[9] << 8 | r[8]);
+        if ((long)caplen > size - at - 16) {
+            break; /* its data runs past the end */
+        }
+        at += 16 + (long)caplen;
+    }
+    return at;
+}
+
+/* Appending to a capture that a full disk or a crash cut inside a record
+ * would put every new record behind the partial one, unreadable: cut the
+ * file back to its last whole record first, and say so. */
+static void trim_partial_record(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    struct stat st;
+    long keep;
+    if (f == NULL) {
+        return; /* a new file, or libpcap reports why it cannot open it */
+    }
+    keep = (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode))
+               ? whole_records_len(f, (long)st.st_size)
+               : -1;
+    (void)fclose(f);
+    if (keep >= 24 && keep < (long)st.st_size) {
+        if (truncate(path, (off_t)keep) != 0) {
+            tk_die("cannot repair capture %s: %s", path, strerror(errno));
+        }
+        tk_warn("%s ended inside a record (a full disk or a crash?): %ld bytes of it removed "
+                "before appending",
+                path, (long)st.st_size - keep);
+    }
+}
+
 void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool append)
 {
     int snaplen = linktype == TK_CAP_LINKTYPE_CAN ? (int)TK_CAP_CAN_MAX : SERIAL_SNAPLEN;
     pcap_t *p = pcap_open_dead_with_tstamp_precision(linktype, snaplen, PCAP_TSTAMP_PRECISION_NANO);
     pcap_dumper_t *d;
+    struct stat st;
     if (p == NULL) {
         tk_die("cannot start a capture: out of memory");
     }
-    d = append ? pcap_dump_open_append(p, path) : pcap_dump_open(p, path);
+    w->tmp[0] = '\0';
+    w->err = 0;
+    w->good = -1;
+    if (append) {
+        trim_partial_record(path);
+    }
+    /* a temporary file and a rename only for a regular file (or a new
+     * one): a device, a FIFO or /dev/stdout is written in place, never
+     * replaced by a rename */
+    if (!append && (stat(path, &st) != 0 ? errno == ENOENT : S_ISREG(st.st_mode))) {
+        int k = snprintf(w->tmp, sizeof(w->tmp), "%s.partial-%ld", path, (long)getpid());
+        if (k < 0 || (size_t)k >= sizeof(w->tmp)) {
+            tk_die("cannot write capture %s: the path is too long", path);
+        }
+    }
+    d = append ? pcap_dump_open_append(p, path)
+               : pcap_dump_open(p, w->tmp[0] != '\0' ? w->tmp : path);
     if (d == NULL) {
         /* libpcap's message names the file and the reason */
         tk_die("cannot write capture: %s", pcap_geterr(p));
     }
     w->pcap = p;
     w->dumper = d;
+    w->good = ftell(pcap_dump_file(d)); /* the end of the last whole record */
     w->path = path;
     w->linktype = linktype;
     w->records = 0;
@@ -110,6 +192,16 @@ int tk_cap_finish(tk_cap_writer_t *w)
     pcap_close(w->pcap);
     w->dumper = NULL;
     w->pcap = NULL;
+    if (w->tmp[0] != '\0') {
+        if (e == 0 && rename(w->tmp, w->path) != 0) {
+            e = errno;
+        }
+        if (e != 0) {
+            fflush(stdout);
+            fprintf(stderr, "%s: the capture so far is kept in %s; %s is unchanged\n", tk_prog,
+                    w->tmp, w->path);
+        }
+    }
     return e;
 }
 
@@ -121,15 +213,33 @@ void tk_cap_close(tk_cap_writer_t *w)
     }
 }
 
+/* Record what the tapped link moved. A capture that cannot be written
+ * (a full disk) stops recording but not the command: the packet it sends
+ * still goes out and is reported, and the failure is reported at exit
+ * (close_session_capture()) with the status that says whether a packet
+ * was sent. */
+static void tap_record(tk_cap_tap_t *tap, unsigned dir, const uint8_t *data, size_t n)
+{
+    struct timespec t;
+    if (tap->w->err != 0) {
+        return;
+    }
+    clock_gettime(CLOCK_REALTIME, &t);
+    errno = 0;
+    tk_cap_put_serial(tap->w, &t, dir, data, n);
+    if (pcap_dump_flush(tap->w->dumper) != 0) {
+        tap->w->err = errno != 0 ? errno : EIO;
+    } else {
+        tap->w->good = ftell(pcap_dump_file(tap->w->dumper)); /* a record boundary */
+    }
+}
+
 static int tap_write(void *ctx, const uint8_t *data, size_t n)
 {
     tk_cap_tap_t *tap = ctx;
     int rc = tap->inner.ops->write(tap->inner.ctx, data, n);
     if (rc > 0) {
-        struct timespec t;
-        clock_gettime(CLOCK_REALTIME, &t);
-        tk_cap_put_serial(tap->w, &t, TK_CAP_TO_GIMBAL, data, (size_t)rc);
-        tk_cap_flush(tap->w);
+        tap_record(tap, TK_CAP_TO_GIMBAL, data, (size_t)rc);
     }
     return rc;
 }
@@ -139,10 +249,7 @@ static int tap_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
     tk_cap_tap_t *tap = ctx;
     int rc = tap->inner.ops->read(tap->inner.ctx, buf, cap, timeout_ms);
     if (rc > 0) {
-        struct timespec t;
-        clock_gettime(CLOCK_REALTIME, &t);
-        tk_cap_put_serial(tap->w, &t, TK_CAP_FROM_GIMBAL, buf, (size_t)rc);
-        tk_cap_flush(tap->w);
+        tap_record(tap, TK_CAP_FROM_GIMBAL, buf, (size_t)rc);
     }
     return rc;
 }
@@ -178,8 +285,22 @@ static void close_session_capture(void)
         return;
     }
     e = tk_cap_finish(&session_capture);
+    if (session_capture.err != 0) {
+        e = session_capture.err; /* the first failure, not the close's */
+        if (session_capture.good > 0) {
+            /* end the file at its last whole record */
+            (void)truncate(session_capture.path, (off_t)session_capture.good);
+        }
+    }
     if (e != 0) {
+        const char *sent = tk_sent();
         fflush(stdout);
+        if (sent != NULL) {
+            /* the packet went out: a retrying script must not send it again */
+            fprintf(stderr, "%s: cannot write capture %s: %s (%s was sent)\n", tk_prog,
+                    session_capture.path, strerror(e), sent);
+            _exit(TK_EXIT_SENT);
+        }
         fprintf(stderr, "%s: cannot write capture %s: %s\n", tk_prog, session_capture.path,
                 strerror(e));
         _exit(TK_EXIT_FAIL);
@@ -372,8 +493,22 @@ int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap)
     }
     memset(rec, 0, sizeof(*rec));
     rec->index = ++r->index;
-    rec->t.sec = (int64_t)h->ts.tv_sec;
-    rec->t.usec = (uint32_t)h->ts.tv_usec / 1000u; /* opened in nanoseconds */
+    /* A classic pcap record's seconds are an unsigned 32-bit field (good
+     * to 2106); libpcap hands them over as a signed 32-bit number, so a
+     * time past 2038-01-19 03:14:07 would come out negative. No capture
+     * holds times before 1970: a negative value is the unsigned field. A
+     * fraction of a second beyond 10^9 ns (a writer that did not
+     * normalise) carries into the seconds. */
+    {
+        int64_t sec = (int64_t)h->ts.tv_sec;
+        uint64_t ns = (uint64_t)(uint32_t)h->ts.tv_usec; /* opened in nanoseconds */
+        if (sec < 0 && sec >= -(int64_t)0x80000000) {
+            sec += (int64_t)0x100000000;
+        }
+        sec += (int64_t)(ns / 1000000000u);
+        rec->t.sec = sec;
+        rec->t.usec = (uint32_t)(ns % 1000000000u / 1000u);
+    }
     if (h->caplen < h->len) {
         snprintf(why, cap, "cut to %u of its %u bytes by the capture's snapshot length",
                  (unsigned)h->caplen, (unsigned)h->len);
@@ -413,8 +548,8 @@ static int ms_left(double t_end)
     return left <= 0.0 ? 0 : (left > 0.2 ? 200 : (int)(left * 1000.0) + 1);
 }
 
-void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_in, long baud,
-                          double seconds)
+void tk_cap_record_serial(tk_cap_writer_t *w, const char *path, const char *dev, const char *tap_in,
+                          long baud, double seconds)
 {
     tk_link_t links[2];
     tase_port_t ports[2];
@@ -428,6 +563,8 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_i
     if (tap_in != NULL) {
         tk_link_serial(&links[1], tap_in, baud);
     }
+    /* the sources are open: only now is the capture created */
+    tk_cap_create(w, path, TK_CAP_LINKTYPE_SERIAL, false);
     print_recording(w, dev, tap_in, seconds);
     for (i = 0; i < n; i++) {
         ports[i] = tk_link_port(&links[i]);
@@ -506,11 +643,12 @@ static int open_can_recorder(const char *iface)
     return fd;
 }
 
-void tk_cap_record_can(tk_cap_writer_t *w, const char *iface, double seconds)
+void tk_cap_record_can(tk_cap_writer_t *w, const char *path, const char *iface, double seconds)
 {
     int fd = open_can_recorder(iface);
     double t_end = seconds > 0.0 ? tk_now_s() + seconds : 0.0;
     unsigned long frames = 0;
+    tk_cap_create(w, path, TK_CAP_LINKTYPE_CAN, false); /* the source is open */
     print_recording(w, iface, NULL, seconds);
     while (tk_signal == 0) {
         struct pollfd pfd = {fd, POLLIN, 0};
@@ -675,13 +813,57 @@ static void replay_send(replay_t *rp, const tk_cap_reader_t *r, const tk_cap_rec
     }
 }
 
+/* The seconds from record time a to b. */
+static double time_diff(const tk_time_t *a, const tk_time_t *b)
+{
+    return (double)(b->sec - a->sec) + ((double)b->usec - (double)a->usec) * 1e-6;
+}
+
+unsigned long tk_cap_check(tk_cap_reader_t *r, const tk_replay_opts_t *o, unsigned long *backward)
+{
+    replay_t rp;
+    tk_cap_rec_t rec;
+    tk_time_t last = {0, 0};
+    bool any = false;
+    unsigned long bad = 0, last_index = 0;
+    char why[160];
+    int rc;
+    memset(&rp, 0, sizeof(rp));
+    rp.o = o;
+    *backward = 0;
+    /* tk_cap_next() dies on a file cut inside a record header, naming it */
+    while ((rc = tk_cap_next(r, &rec, why, sizeof(why))) != TK_CAP_END) {
+        if (rc == TK_CAP_BAD) {
+            tk_warn("%s: record %lu is bad: %s", r->path, rec.index, why);
+            bad++;
+            continue;
+        }
+        if (!replay_selects(&rp, r, &rec)) {
+            continue;
+        }
+        if (any && time_diff(&last, &rec.t) < 0.0) {
+            if (++*backward <= 3u) {
+                tk_warn("%s: record %lu is %.6f s earlier than record %lu (a clock step?): "
+                        "replayed right after it",
+                        r->path, rec.index, -time_diff(&last, &rec.t), last_index);
+            }
+        }
+        last = rec.t;
+        last_index = rec.index;
+        any = true;
+        tk_exit_if_signalled();
+    }
+    return bad;
+}
+
 unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
 {
     replay_t rp;
     tk_cap_rec_t rec;
-    tk_time_t t0 = {0, 0};
+    tk_time_t prev = {0, 0};
     bool started = false;
     double start = 0.0;
+    double due = 0.0; /* seconds after the first record, at speed 1 */
     char why[160];
     int rc;
     memset(&rp, 0, sizeof(rp));
@@ -705,16 +887,20 @@ unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
             continue;
         }
         if (!started) { /* the timing starts at the first record sent */
-            t0 = rec.t;
+            prev = rec.t;
             start = tk_now_s();
             started = true;
         }
-        if (o->speed > 0.0) {
-            double dt =
-                (double)(rec.t.sec - t0.sec) + ((double)rec.t.usec - (double)t0.usec) * 1e-6;
-            if (!wait_until(start + (dt > 0.0 ? dt : 0.0) / o->speed)) {
-                break;
-            }
+        /* the recorded gap to the record before; a step back in the
+         * recorded clock is no gap (tk_cap_check() warned), and the gaps
+         * after it keep their lengths */
+        {
+            double gap = time_diff(&prev, &rec.t);
+            due += gap > 0.0 ? gap : 0.0;
+            prev = rec.t;
+        }
+        if (o->speed > 0.0 && !wait_until(start + due / o->speed)) {
+            break;
         }
         replay_send(&rp, r, &rec);
     }

@@ -62,11 +62,21 @@ typedef struct {
     const char *path;
     int linktype;
     unsigned long records;
+    /* a new capture is written to tmp ("PATH.partial-PID") and renamed to
+     * path when it is complete: an existing file at path is never touched
+     * by a recording that fails or is killed (the partial file stays) */
+    char tmp[4096];
+    int err;   /* --record: the errno that stopped recording, 0 none */
+    long good; /* --record: file length after the last whole record, -1 unknown */
 } tk_cap_writer_t;
 
-/* Create `path` (replacing it), or with `append` add to it (creating it if
- * it does not exist; an existing file must be a nanosecond pcap of the
- * same link type). Dies with the reason on failure. */
+/* Start a new capture for `path`: a new or regular file is written to
+ * w->tmp and renamed to path by tk_cap_close()/tk_cap_finish() when
+ * complete (until then an existing file at path is untouched; a failed
+ * finish keeps the partial file and says where), anything else (a device,
+ * a FIFO) is written in place; or with `append` add to path itself (creating it if it
+ * does not exist; an existing file must be a nanosecond pcap of the same
+ * link type). Dies with the reason on failure. */
 void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool append);
 /* One serial record: direction byte + n (>= 1) bytes, at wall-clock time t. */
 void tk_cap_put_serial(tk_cap_writer_t *w, const struct timespec *t, unsigned dir,
@@ -141,13 +151,15 @@ int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap);
 
 /* Record the serial device `dev` (bytes from the gimbal) and optionally a
  * second device `tap_in` (bytes to the gimbal, the other line of a tap)
- * into `w` until `seconds` pass or, with 0, until a signal the toolkit
- * catches (tk_signal: SIGINT, SIGTERM, SIGHUP, the normal end of a
- * recording). Closes `w` and prints a summary on stdout. */
-void tk_cap_record_serial(tk_cap_writer_t *w, const char *dev, const char *tap_in, long baud,
-                          double seconds);
+ * into a new capture `path` (through `w`, tk_cap_create()) until `seconds`
+ * pass or, with 0, until a signal the toolkit catches (tk_signal: SIGINT,
+ * SIGTERM, SIGHUP, the normal end of a recording). The devices are opened
+ * first: one that cannot be opened ends the command before anything is
+ * written. Closes `w` and prints a summary on stdout. */
+void tk_cap_record_serial(tk_cap_writer_t *w, const char *path, const char *dev, const char *tap_in,
+                          long baud, double seconds);
 /* Record every frame of CAN interface `iface` likewise. */
-void tk_cap_record_can(tk_cap_writer_t *w, const char *iface, double seconds);
+void tk_cap_record_can(tk_cap_writer_t *w, const char *path, const char *iface, double seconds);
 
 /* Send the records of `r` selected by `dirs` to a serial device (the
  * bytes) or, with `can` non-NULL, to a CAN interface (frames as recorded;
@@ -163,5 +175,12 @@ typedef struct {
     double speed;
 } tk_replay_opts_t;
 unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o);
+/* The check replay makes before sending anything: read every record of r
+ * (dies, naming the record, on a file cut inside a record header), warn
+ * about each bad record and return their count, and count in *backward
+ * the records (of those o selects) stamped earlier than the one before,
+ * warning about the first three (replay sends them right after it and
+ * keeps the gaps after them). */
+unsigned long tk_cap_check(tk_cap_reader_t *r, const tk_replay_opts_t *o, unsigned long *backward);
 
 #endif /* TASE_TOOLS_TK_CAPTURE_H */

@@ -257,6 +257,19 @@ static const unit_t *unit_of(const tase_packet_desc_t *p, const char *field)
     return NULL;
 }
 
+bool tk_unit(const tase_packet_desc_t *p, const char *field, tk_unit_info_t *out)
+{
+    const unit_t *u = unit_of(p, field);
+    if (u == NULL) {
+        return false;
+    }
+    out->suffix = unit_kinds[u->kind].suffix;
+    out->label = unit_kinds[u->kind].label;
+    out->decimals = u->decimals;
+    out->scale = u->scale;
+    return true;
+}
+
 /* ---- a bounded line builder ---- */
 
 typedef struct {
@@ -283,6 +296,27 @@ static void sb_c(sb_t *b, char c)
 {
     if (b->p < b->end) {
         *b->p++ = c;
+    }
+}
+
+/* s as the inside of a JSON string: '"' and '\\' escaped, control
+ * characters as \u00XX (an interface name may hold any byte but '/',
+ * ':' and white space). */
+static void sb_json_str(sb_t *b, const char *s)
+{
+    static const char hex[] = "0123456789abcdef";
+    for (; *s != '\0'; s++) {
+        unsigned char ch = (unsigned char)*s;
+        if (ch == '"' || ch == '\\') {
+            sb_c(b, '\\');
+            sb_c(b, (char)ch);
+        } else if (ch < 0x20u) {
+            sb_str(b, "\\u00");
+            sb_c(b, hex[ch >> 4]);
+            sb_c(b, hex[ch & 15u]);
+        } else {
+            sb_c(b, (char)ch);
+        }
     }
 }
 
@@ -503,7 +537,7 @@ static void json_frame(sb_t *b, const tk_fmt_t *fmt, const tk_meta_t *m, const t
     }
     if (m->iface != NULL) {
         sb_str(b, ",\"interface\":\"");
-        sb_str(b, m->iface); /* names are printable without spaces or quotes */
+        sb_json_str(b, m->iface); /* a name may hold '"' or '\\' */
         sb_c(b, '"');
     }
     if (p == NULL) {

@@ -71,6 +71,11 @@ void tk_mark_sent(const char *what)
     sent_what = what;
 }
 
+const char *tk_sent(void)
+{
+    return sent_what;
+}
+
 static void vexit(int status, const char *fmt, va_list ap)
 {
     char msg[448];
@@ -253,6 +258,31 @@ static void on_signal(int sig)
     tk_signal = sig;
 }
 
+/* A signal whose default action ends the process and that the tools do
+ * not treat as the normal end of a run (SIGQUIT, SIGUSR1, SIGALRM, ...):
+ * give every open serial line its settings back (tcsetattr() and ioctl()
+ * are async-signal-safe), then die of the signal as before. Without this
+ * the line stayed raw with VMIN 0 for the next program (issue 25 item 4). */
+static sigset_t fatal_set; /* the signals on_fatal_signal() handles */
+
+static void on_fatal_signal(int sig)
+{
+    size_t i;
+    for (i = 0; i < MAX_OPEN_LINKS; i++) {
+        tk_link_t *l = open_links[i];
+        if (l != NULL && !l->is_can && l->uart.fd >= 0 && l->uart.restore) {
+            (void)tcsetattr(l->uart.fd, TCSANOW, &l->uart.saved);
+#ifdef TIOCNXCL
+            if (l->uart.excl) {
+                (void)ioctl(l->uart.fd, TIOCNXCL);
+            }
+#endif
+        }
+    }
+    (void)signal(sig, SIG_DFL);
+    (void)raise(sig);
+}
+
 void tk_catch_signals(void)
 {
     struct sigaction sa;
@@ -264,6 +294,22 @@ void tk_catch_signals(void)
     (void)sigaction(SIGTERM, &sa, NULL);
     (void)sigaction(SIGHUP, &sa, NULL);
     (void)signal(SIGPIPE, SIG_IGN);
+    {
+        static const int fatal[] = {SIGQUIT, SIGUSR1,   SIGUSR2, SIGALRM,
+                                    SIGPROF, SIGVTALRM, SIGXCPU, SIGPOLL};
+        size_t i;
+        sa.sa_handler = on_fatal_signal;
+        sa.sa_flags = 0; /* the handler resets the action itself */
+        sigemptyset(&fatal_set);
+        for (i = 0; i < sizeof(fatal) / sizeof(fatal[0]); i++) {
+            struct sigaction old;
+            /* one the caller's shell ignores stays ignored */
+            if (sigaction(fatal[i], NULL, &old) == 0 && old.sa_handler != SIG_IGN) {
+                (void)sigaction(fatal[i], &sa, NULL);
+                (void)sigaddset(&fatal_set, fatal[i]);
+            }
+        }
+    }
 }
 
 void tk_exit_if_signalled(void)
@@ -308,10 +354,18 @@ int tk_link_serial_try(tk_link_t *l, const char *path, long baud)
     if (baud <= 0 || !tase_posix_uart_baud_supported((uint32_t)baud)) {
         tk_usage_error("unsupported baud rate %ld", baud);
     }
-    rc = tase_posix_uart_open(&l->uart, path, (uint32_t)baud);
-    if (rc == TASE_OK) {
-        l->open = true;
-        track_link(l, true);
+    {
+        /* a fatal signal between the open (the line is raw from here) and
+         * the tracking (from which its handler restores the line) waits
+         * until both are done */
+        sigset_t old;
+        (void)sigprocmask(SIG_BLOCK, &fatal_set, &old);
+        rc = tase_posix_uart_open(&l->uart, path, (uint32_t)baud);
+        if (rc == TASE_OK) {
+            l->open = true;
+            track_link(l, true);
+        }
+        (void)sigprocmask(SIG_SETMASK, &old, NULL);
     }
     return rc;
 }

@@ -64,6 +64,8 @@ void tk_warn(const char *fmt, ...);
  * standard output (a full disk, a closed pipe) exits TK_EXIT_SENT with
  * "what was sent; cannot write to standard output: <reason>". */
 void tk_mark_sent(const char *what);
+/* What tk_mark_sent() noted, or NULL. */
+const char *tk_sent(void);
 
 /* ---- numbers ----
  * Integers: an optional sign ('+' or '-'), then decimal digits (leading
@@ -225,6 +227,19 @@ typedef struct {
     const char *dir;       /* NULL, "in" (to the gimbal) or "out" */
     const char *iface;     /* CAN interface, or NULL */
 } tk_meta_t;
+
+/* The engineering unit of field `field` of packet p, as the output uses
+ * it (--units): `suffix` of the JSON key (field "_" suffix; "" none),
+ * `label` of the text output, the decimals printed and the unit per wire
+ * count. Returns false when the field has none (raw only: GIMBAL_CMD's
+ * pan, flags, ...). The Python package (python/) reads it too. */
+typedef struct {
+    const char *suffix;
+    const char *label;
+    unsigned decimals;
+    double scale;
+} tk_unit_info_t;
+bool tk_unit(const tase_packet_desc_t *p, const char *field, tk_unit_info_t *out);
 
 /* Longest line tk_format_frame() writes (with the newline and a NUL). */
 #define TK_LINE_MAX 8192u

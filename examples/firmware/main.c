@@ -3,19 +3,21 @@
  *
  * A recorded UART stream (stream.h: host requests mixed with line noise
  * and corruption) arrives byte by byte in a simulated receive interrupt
- * (SysTick stands in for the UART: 12 bytes per 1 ms tick, about 115200
- * baud), which hands each byte to the library's bare-metal UART port
- * (port/baremetal: tase_bm_uart_rx_isr() puts it into a tase_ring_t). Once
- * per tick the main loop polls the library's gimbal role (telemetry due at
- * the rates of PACKET_RATE), then drains the ring into tase_rx_feed() with
- * tase_dispatch_frame() as the frame callback (tase_bm_uart_poll()). The
+ * (SysTick stands in for the UART and its receive DMA: 12 bytes per 1 ms
+ * tick, about 115200 baud, written round a 64-byte circular buffer as a
+ * circular DMA channel does, with a count of the bytes written). Once per
+ * tick the main loop polls the library's gimbal role (telemetry due at the
+ * rates of PACKET_RATE), then feeds what the "DMA" wrote since the last
+ * tick, one span or two at the wrap, into tase_rx_feed() with
+ * tase_dispatch_frame() as the frame callback (port/baremetal's
+ * tase_bm_dma_poll(), which also ticks the receiver's time bound). The
  * application (gimbal.c) registers typed handlers in a ROM table; the
  * setup handler passes setup packets on to the gimbal role, which answers
  * queries and echoes settings through the same port, whose TX hook
  * appends to a buffer. Once the line goes quiet for 100 ms right after
  * noise that looks like a sync with Size 255 and a GIMBAL_CMD: the
  * receiver's time bound (tase/frame.h, TIME BOUND; ticked by
- * tase_bm_uart_poll()) delivers the command 22 ms after its last byte,
+ * tase_bm_dma_poll()) delivers the command 22 ms after its last byte,
  * not when 241 more bytes have come.
  *
  * After the simulated run the image checks everything against stream.h,
@@ -33,12 +35,14 @@
 #include "board.h"
 #include "gimbal.h"
 #include "stream.h"
+#include "tase/bm_dma.h"
 #include "tase/bm_uart.h"
 #include "tase/flags.h"
 
 #define CPU_HZ 25000000u /* mps2-an385 */
 #define TICK_HZ 1000u    /* one simulated millisecond per SysTick */
-#define RING_SIZE 64u    /* power of two; > bytes per tick */
+#define RING_SIZE 64u    /* power of two: the TX port's (unused) receive ring */
+#define DMA_SIZE 64u     /* the receive DMA's circular buffer; > bytes per tick */
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
 
 #define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
@@ -49,6 +53,8 @@
 
 static uint8_t ring_storage[RING_SIZE];
 static tase_bm_uart_t uart;
+static tase_bm_dma_t dma;
+static uint8_t dma_buf[DMA_SIZE];
 static volatile uint32_t ticks, uart_pos;
 
 /* What the UART's receive interrupt would do with each byte. */
@@ -65,8 +71,8 @@ void SysTick_Handler(void)
         if (uart_pos == STREAM_PAUSE_AT && paused < STREAM_PAUSE_MS) {
             break;
         }
-        tase_bm_uart_rx_isr(&uart, stream_bytes[uart_pos]);
-        uart_pos++;
+        dma_buf[uart_pos % DMA_SIZE] = stream_bytes[uart_pos]; /* what the DMA does */
+        uart_pos++; /* the DMA's count of bytes written */
     }
     ticks++;
 }
@@ -269,6 +275,7 @@ int main(void)
     check(tase_bm_uart_init(&uart, ring_storage, sizeof ring_storage, &uart_hooks, NULL) == TASE_OK,
           "tase_bm_uart_init", 0, 0);
     port = tase_bm_uart_port(&uart);
+    check(tase_bm_dma_init(&dma, dma_buf, sizeof dma_buf) == TASE_OK, "tase_bm_dma_init", 0, 0);
     /* The UART's byte rate: sizes the gimbal's telemetry capacity and the
      * receiver's time bound (tase/frame.h, TIME BOUND). */
     port.bytes_per_s = STREAM_LINE_BYTES_PER_S;
@@ -298,7 +305,7 @@ int main(void)
         app.now_ms = now;
         seen.now = now;
         (void)tase_gimbal_poll(&app.role, now);
-        (void)tase_bm_uart_poll(&uart, &rx, tase_dispatch_frame, &app.dispatch);
+        (void)tase_bm_dma_poll(&dma, uart_pos, now, &rx, tase_dispatch_frame, &app.dispatch);
         if (ticks != now) {
             late++; /* the next tick came before this one was handled */
         }
@@ -307,7 +314,7 @@ int main(void)
         }
     }
     SYST_CSR = 0u;
-    (void)tase_bm_uart_poll(&uart, &rx, tase_dispatch_frame, &app.dispatch);
+    (void)tase_bm_dma_poll(&dma, uart_pos, ticks, &rx, tase_dispatch_frame, &app.dispatch);
     (void)tase_rx_flush(&rx, tase_dispatch_frame, &app.dispatch);
     stack = board_stack_used(); /* before printf, which is not ours */
 
@@ -321,8 +328,9 @@ int main(void)
            (unsigned long)st->unknown);
     check(uart_pos == sizeof(stream_bytes), "bytes delivered by the ISR", (long)uart_pos,
           (long)sizeof(stream_bytes));
-    check(tase_ring_overflows(&uart.rx) == 0u, "ring overflows",
-          (long)tase_ring_overflows(&uart.rx), 0);
+    check(dma.stats.overruns == 0u, "DMA overruns", (long)dma.stats.overruns, 0);
+    check(dma.stats.bytes_fed == sizeof(stream_bytes), "bytes fed from the DMA buffer",
+          (long)dma.stats.bytes_fed, (long)sizeof(stream_bytes));
     check(late == 0u, "ticks the main loop fell behind", (long)late, 0);
     check(st->bytes_in == sizeof(stream_bytes), "bytes_in", (long)st->bytes_in,
           (long)sizeof(stream_bytes));

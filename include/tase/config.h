@@ -126,10 +126,11 @@
 #define tase_klv_rx_init TASE_CONFIG_LINK_NAME(tase_klv_rx_init_)
 #define tase_host_init TASE_CONFIG_LINK_NAME(tase_host_init_)
 #define tase_gimbal_init TASE_CONFIG_LINK_NAME(tase_gimbal_init_)
-/* ports: tase/ring.h and bm_uart.h (libtase_baremetal), posix_uart.h
+/* ports: tase/ring.h, bm_uart.h and bm_dma.h (libtase_baremetal), posix_uart.h
  * (libtase_posix_uart), socketcan.h (libtase_socketcan) */
 #define tase_ring_init TASE_CONFIG_LINK_NAME(tase_ring_init_)
 #define tase_bm_uart_init TASE_CONFIG_LINK_NAME(tase_bm_uart_init_)
+#define tase_bm_dma_init TASE_CONFIG_LINK_NAME(tase_bm_dma_init_)
 #define tase_posix_uart_open TASE_CONFIG_LINK_NAME(tase_posix_uart_open_)
 #define tase_posix_uart_open_flags TASE_CONFIG_LINK_NAME(tase_posix_uart_open_flags_)
 #define tase_posix_uart_attach TASE_CONFIG_LINK_NAME(tase_posix_uart_attach_)

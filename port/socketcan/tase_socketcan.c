@@ -102,6 +102,16 @@ uint32_t tase_socketcan_now_ms(void *ctx)
     return (uint32_t)((uint64_t)ts.tv_sec * 1000u + (uint64_t)ts.tv_nsec / 1000000u);
 }
 
+/* The deadline timeout_ms from now. Longer waits are clamped to
+ * TASE_SOCKETCAN_TIMEOUT_MAX (about 24.8 days): a deadline 2^31 ms or
+ * more ahead would read as passed (the clock's wrap rule), so UINT32_MAX
+ * as "wait for ever" returned at once. */
+static uint32_t deadline_in(uint32_t timeout_ms)
+{
+    uint32_t t = timeout_ms > TASE_SOCKETCAN_TIMEOUT_MAX ? TASE_SOCKETCAN_TIMEOUT_MAX : timeout_ms;
+    return tase_socketcan_now_ms(NULL) + t;
+}
+
 /* Milliseconds left until `deadline` (0 once it has passed). */
 static uint32_t remaining(uint32_t deadline)
 {
@@ -330,7 +340,7 @@ int tase_socketcan_send_frame(tase_socketcan_t *s, const tase_can_frame_t *f)
     if (!usable(s) || tase_can_frame_check(f) != TASE_OK) {
         return TASE_EARG;
     }
-    return send_until(s, f, tase_socketcan_now_ms(NULL) + s->tx_timeout_ms);
+    return send_until(s, f, deadline_in(s->tx_timeout_ms));
 }
 
 int tase_socketcan_write(tase_socketcan_t *s, const uint8_t *data, size_t n)
@@ -342,7 +352,7 @@ int tase_socketcan_write(tase_socketcan_t *s, const uint8_t *data, size_t n)
         tase_can_split_init(&sp, s->role, data, n) != TASE_OK) {
         return TASE_EARG;
     }
-    deadline = tase_socketcan_now_ms(NULL) + s->tx_timeout_ms;
+    deadline = deadline_in(s->tx_timeout_ms);
     for (;;) {
         size_t before = sp.pos;
         int rc;
@@ -489,7 +499,7 @@ static int take_record(tase_socketcan_t *s, ssize_t n, const can_record_t *cf, t
 static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint32_t timeout_ms)
 {
     can_record_t cf;
-    uint32_t deadline = tase_socketcan_now_ms(NULL) + timeout_ms;
+    uint32_t deadline = deadline_in(timeout_ms);
     for (;;) {
         ssize_t n = recv_record(s->fd, &cf, ns);
         if (n >= 0) {
@@ -519,7 +529,7 @@ static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint
 /* Next frame the role's filter passes (software copy of the kernel's). */
 static int recv_wanted(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint32_t timeout_ms)
 {
-    uint32_t deadline = tase_socketcan_now_ms(NULL) + timeout_ms;
+    uint32_t deadline = deadline_in(timeout_ms);
     for (;;) {
         int rc = raw_recv(s, f, ns, remaining(deadline));
         if (rc <= 0 || role_wants(s->role, f)) {
@@ -567,7 +577,7 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
     if (!usable(s) || buf == NULL || cap > (size_t)0x7FFFFFFF) {
         return TASE_EARG;
     }
-    deadline = tase_socketcan_now_ms(NULL) + timeout_ms;
+    deadline = deadline_in(timeout_ms);
     got = take_pending(s, buf, cap);
     /* Once some bytes are in hand, only drain what is already queued. */
     while (got < cap) {

@@ -163,6 +163,11 @@ int tase_socketcan_adopt(tase_socketcan_t *s, int fd, tase_can_role_t role, unsi
 /* Close the descriptor if owned. Safe to call twice; s NULL is ignored. */
 void tase_socketcan_close(tase_socketcan_t *s);
 
+/* The longest wait of any call: timeouts (read(), recv_frame()'s
+ * timeout_ms, tx_timeout_ms) above it are clamped to it, so UINT32_MAX
+ * serves as "wait as long as possible": 2^31 - 1 ms, about 24.8 days. */
+#define TASE_SOCKETCAN_TIMEOUT_MAX 0x7FFFFFFFu
+
 /* The byte rate the port states (tase_port_t.bytes_per_s): CAN at
  * 1 Mbit/s (spec 5) carries 8 datalink bytes per extended frame of at most
  * 160 bits with stuffing, about 50,000 bytes per second. */

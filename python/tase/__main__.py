@@ -1,0 +1,48 @@
+"""python3 -m tase: small commands over the package.
+
+    python3 -m tase plot CAPTURE -o FILE.png [--baud N]
+    python3 -m tase decode FILE        (JSON lines, as `tase decode`)
+    python3 -m tase version
+"""
+
+import argparse
+import sys
+
+import tase
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python3 -m tase")
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    p = sub.add_parser("plot", help="commanded vs reported pan/tilt of a capture")
+    p.add_argument("capture")
+    p.add_argument("-o", "--output", required=True, help="image file (.png, .svg, .pdf)")
+    p.add_argument("--baud", type=int, default=57600, help="serial line rate (default 57600)")
+    d = sub.add_parser("decode", help="a raw serial capture or a tase record capture as JSON")
+    d.add_argument("file")
+    sub.add_parser("version")
+    a = ap.parse_args(argv)
+    try:
+        if a.cmd == "version":
+            print(tase.__version__)
+        elif a.cmd == "plot":
+            s = tase.plot.plot_capture(a.capture, a.output, a.baud)
+            print("%s: %s" % (a.output, ", ".join("%s (%d)" % (k, len(v[0])) for k, v in s.items())))
+        elif a.cmd == "decode":
+            with open(a.file, "rb") as f:
+                head = f.read(4)
+            if head[:4] in tase.capture.MAGICS:
+                for _, pkt in tase.read_capture(a.file):
+                    print(pkt.json())
+            else:
+                with open(a.file, "rb") as f:
+                    for pkt in tase.decode(f.read()):
+                        print(pkt.json())
+    except (tase.Error, OSError, ValueError) as e:
+        print("tase: %s" % e, file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

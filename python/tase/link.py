@@ -1,0 +1,651 @@
+"""Links to a gimbal: tase.connect(url) -> Link, the host side.
+
+URLs, in pymavlink's style:
+    serial:/dev/ttyUSB0[:BAUD]   a serial device or pty (pyserial), 57600 baud by default
+    socketcan:can0               a SocketCAN interface (python-can)
+    virtual:NAME                 python-can's in-process virtual bus NAME
+    capture:FILE                 a capture of `tase record` (read only)
+
+A link runs the library's host role (tase/host.h) over the transport: the
+C code frames what is sent, scans what is received and matches answers
+and echoes to requests, with retries; Python only moves the bytes.
+"""
+
+import collections
+import errno
+import os
+import re
+import select
+import time
+
+from ._core import (
+    Error,
+    FieldError,
+    LinkError,
+    Packet,
+    TimeoutError_,
+    _check,
+    _from_data,
+    _Sink,
+    _with_meta,
+    error,
+    ffi,
+    lib,
+)
+
+__all__ = ["connect", "Link", "parse_url"]
+
+DEFAULT_BAUD = 57600
+_SERIAL_URL = re.compile(r"^serial:(?P<dev>[^:]+)(?::(?P<baud>[0-9]+))?$")
+_BAUDS = (9600, 19200, 38400, 57600, 115200, 230400, 460800, 921600)
+
+
+def parse_url(url):
+    """(scheme, target, baud) of a link URL; FieldError when it is not one."""
+    if not isinstance(url, str):
+        raise FieldError("a link URL is a string, not %s" % type(url).__name__)
+    m = _SERIAL_URL.match(url)
+    if m:
+        baud = int(m.group("baud")) if m.group("baud") else DEFAULT_BAUD
+        if baud not in _BAUDS:
+            raise FieldError(
+                "%s: baud %d is not one of %s" % (url, baud, ", ".join(map(str, _BAUDS)))
+            )
+        return "serial", m.group("dev"), baud
+    for scheme in ("socketcan", "virtual", "capture"):
+        if url.startswith(scheme + ":") and len(url) > len(scheme) + 1:
+            return scheme, url[len(scheme) + 1 :], None
+    raise FieldError(
+        "not a link URL: %r (serial:/dev/ttyUSB0[:BAUD], socketcan:IFACE, virtual:NAME, "
+        "capture:FILE)" % url
+    )
+
+
+def connect(url, *, timeout=0.5, retries=2, record=None):
+    """Open the link `url` (see the module's doc) as a host. `timeout` (s,
+    per attempt) and `retries` (more attempts) are the defaults of
+    query() and the verbs that wait for an answer. `record`: a capture
+    file the session is appended to (serial links; as `tase --record`:
+    what is written as sent to the gimbal, what is read as sent by it).
+    Use as a context manager: the link is closed on exit."""
+    scheme, target, baud = parse_url(url)
+    if record is not None and scheme != "serial":
+        raise FieldError(
+            "record: only a serial link's session can be recorded here (on CAN run "
+            "`tase record --can IFACE` beside it)"
+        )
+    if scheme == "capture":
+        from .capture import CaptureLink
+
+        return CaptureLink(target)
+    if scheme == "serial":
+        transport = _SerialTransport(target, baud)
+    else:
+        transport = _CanTransport(scheme, target)
+    if record is not None:
+        from .capture import CaptureWriter
+
+        try:
+            transport = _Recorder(transport, CaptureWriter(record))
+        except BaseException:
+            transport.close()
+            raise
+    return Link(transport, url, timeout, retries)
+
+
+class _Recorder:
+    """A transport that records what passes through it."""
+
+    def __init__(self, inner, writer):
+        self.inner = inner
+        self.w = writer
+        self.name = inner.name
+        self.bytes_per_s = inner.bytes_per_s
+
+    def write(self, data):
+        n = self.inner.write(data)
+        self.w.put(1, data[:n])
+        return n
+
+    def read(self, cap, timeout_s):
+        data = self.inner.read(cap, timeout_s)
+        if data:
+            self.w.put(0, data)
+        return data
+
+    def close(self):
+        try:
+            self.inner.close()
+        finally:
+            self.w.close()
+
+
+# ---- transports: bytes in and out -------------------------------------------
+
+
+class _SerialTransport:
+    def __init__(self, dev, baud):
+        try:
+            import serial
+        except ImportError as e:  # pragma: no cover - packaging
+            raise Error("serial links need pyserial (Debian: python3-serial)") from e
+        if not os.path.exists(dev):
+            raise LinkError("%s: No such file or directory" % dev, lib.TASE_ENODEV)
+        try:
+            self.ser = serial.Serial(dev, baud, timeout=0, exclusive=True)
+        except (serial.SerialException, OSError, ValueError) as e:
+            raise LinkError("cannot open %s: %s" % (dev, e), lib.TASE_EIO) from e
+        self.fd = self.ser.fileno()
+        self.name = dev
+        self.bytes_per_s = baud // 10
+
+    def write(self, data):
+        n = 0
+        while n < len(data):
+            try:
+                k = os.write(self.fd, data[n:])
+            except BlockingIOError:
+                select.select([], [self.fd], [], 1.0)
+                continue
+            except OSError as e:
+                raise LinkError(
+                    "cannot write to %s: the device went away or hung up (%s)" % (self.name, e),
+                    lib.TASE_EIO,
+                ) from e
+            n += k
+        return n
+
+    def read(self, cap, timeout_s):
+        try:
+            r, _, _ = select.select([self.fd], [], [], timeout_s)
+            if not r:
+                return b""
+            data = os.read(self.fd, cap)
+        except BlockingIOError:
+            return b""
+        except OSError as e:
+            raise LinkError(
+                "cannot read %s: the device went away or hung up (%s)" % (self.name, e),
+                lib.TASE_EIO,
+            ) from e
+        if not data:
+            raise LinkError(
+                "cannot read %s: the device went away or hung up" % self.name, lib.TASE_EIO
+            )
+        return data
+
+    def close(self):
+        self.ser.close()
+
+
+class _CanTransport:
+    """The datalink over CAN as the host (sends 0x11000000, listens to
+    0x10000000): the library splits and accepts, python-can moves frames."""
+
+    def __init__(self, scheme, channel):
+        try:
+            import can
+        except ImportError as e:  # pragma: no cover - packaging
+            raise Error("CAN links need python-can (Debian: python3-can)") from e
+        self.can = can
+        self.name = channel
+        try:
+            self.bus = can.Bus(interface=scheme, channel=channel)
+        except (OSError, can.CanError, ValueError) as e:
+            why = {
+                errno.EAFNOSUPPORT: "this kernel has no SocketCAN support (load the can and "
+                "can-raw modules, or see docs/CAN.md for the VM)",
+                errno.ENODEV: "no such device",
+                errno.ENETDOWN: "interface is down (ip link set %s up)" % channel,
+            }.get(getattr(e, "errno", None), str(e))
+            raise LinkError("cannot open %s:%s: %s" % (scheme, channel, why), lib.TASE_ENODEV) from e
+        self.bytes_per_s = lib.TASE_SOCKETCAN_BYTES_PER_S
+        self.pending = b""
+        self.frames = ffi.new("tase_can_frame_t[]", 40)
+        self.one = ffi.new("tase_can_frame_t *")
+
+    def write(self, data):
+        n = lib.tase_can_split(lib.TASE_CAN_ROLE_HOST, data, len(data), self.frames, 40)
+        if n < 0:
+            raise error(n, "CAN split")
+        for i in range(n):
+            f = self.frames[i]
+            msg = self.can.Message(
+                arbitration_id=f.id, is_extended_id=True, data=bytes(f.data[0 : f.dlc])
+            )
+            try:
+                self.bus.send(msg, timeout=1.0)
+            except (OSError, self.can.CanError) as e:
+                raise LinkError("cannot send on %s: %s" % (self.name, e), lib.TASE_EIO) from e
+        return len(data)
+
+    def read(self, cap, timeout_s):
+        if self.pending:
+            out, self.pending = self.pending[:cap], self.pending[cap:]
+            return out
+        deadline = time.monotonic() + timeout_s
+        while True:
+            left = max(0.0, deadline - time.monotonic())
+            try:
+                msg = self.bus.recv(left)
+            except (OSError, self.can.CanError) as e:
+                raise LinkError("cannot read %s: %s" % (self.name, e), lib.TASE_EIO) from e
+            if msg is None:
+                return b""
+            if msg.is_error_frame or msg.is_remote_frame or getattr(msg, "is_fd", False):
+                continue
+            f = self.one
+            f.id = msg.arbitration_id
+            f.extended = msg.is_extended_id
+            f.dlc = min(len(msg.data), 8)
+            ffi.memmove(f.data, bytes(msg.data[:8]), f.dlc)
+            n = lib.tase_can_accept(lib.TASE_CAN_ROLE_HOST, f)
+            if n > 0:
+                data = bytes(msg.data[:n])
+                out, self.pending = data[:cap], data[cap:]
+                return out
+            if time.monotonic() >= deadline:
+                return b""
+
+    def close(self):
+        self.bus.shutdown()
+
+
+# ---- the port callbacks of the C host role -----------------------------------
+
+
+@ffi.def_extern()
+def py_port_write(ctx, data, n):
+    link = ffi.from_handle(ctx)
+    try:
+        return link._t.write(ffi.buffer(data, n)[:])
+    except BaseException as e:  # noqa: B902 - handed back to the caller
+        link._exc = e
+        return lib.TASE_EIO
+
+
+@ffi.def_extern()
+def py_port_read(ctx, buf, cap, timeout_ms):
+    link = ffi.from_handle(ctx)
+    try:
+        data = link._t.read(cap, timeout_ms / 1000.0)
+    except BaseException as e:  # noqa: B902
+        link._exc = e
+        return lib.TASE_EIO
+    if data:
+        ffi.memmove(buf, data, len(data))
+        # the frames these bytes complete arrived now (tase monitor --time)
+        link._sink.s.now = _now_us()
+    return len(data)
+
+
+@ffi.def_extern()
+def py_port_now(ctx):
+    return int(time.monotonic() * 1000) & 0xFFFFFFFF
+
+
+_GIMBAL_CMD_FLAGS = {
+    lib.TASE_GIMBAL_FLAGS_RATE: "rate",
+    lib.TASE_GIMBAL_FLAGS_RATE_STAB: "rate, stabilised",
+    lib.TASE_GIMBAL_FLAGS_POSITION: "position",
+    lib.TASE_GIMBAL_FLAGS_POSITION_STAB: "position, stabilised",
+    lib.TASE_GIMBAL_FLAGS_IMPULSE: "impulse",
+    lib.TASE_GIMBAL_FLAGS_IMPULSE_STAB: "impulse, stabilised",
+    lib.TASE_GIMBAL_FLAGS_SPOI_ERROR: "SPOI error",
+    lib.TASE_GIMBAL_FLAGS_SPOI_ERROR_RATE: "SPOI error rate",
+}
+for _f in range(lib.TASE_GIMBAL_FLAGS_LEGACY_RATE, lib.TASE_GIMBAL_FLAGS_LEGACY_POSITION_STAB + 1):
+    _GIMBAL_CMD_FLAGS[_f] = "legacy"
+
+
+class Link:
+    """A link to a gimbal, as the host. Made by tase.connect()."""
+
+    def __init__(self, transport, url, timeout=0.5, retries=2):
+        self._t = transport
+        self.url = url
+        self.timeout = timeout
+        self.retries = retries
+        self._exc = None
+        self._handle = ffi.new_handle(self)
+        self._host = ffi.new("tase_host_t *")
+        self._sink = _Sink(1 << 18, cap=1 << 15, timed=True)
+        self._ctx = ffi.new("py_ctx_t *")
+        self._ctx.s = self._sink.s
+        self._base = 0
+        self._queue = collections.deque()
+        self._closed = False
+        _check(
+            lib.py_host_init(self._host, self._handle, transport.bytes_per_s, self._ctx), url
+        )
+        self._reply = ffi.new("uint8_t[]", lib.TASE_DATA_MAX)
+
+    # -- plumbing
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def close(self):
+        if not self._closed:
+            self._closed = True
+            self._t.close()
+
+    def _live(self):
+        if self._closed:
+            raise Error("%s: the link is closed" % self.url)
+
+    def _call(self, fn, *args):
+        """Run a host call that may receive; collect the frames it passed
+        on (telemetry, other answers) into the queue; raise what the
+        transport raised."""
+        self._exc = None
+        lib.py_host_begin(self._host, self._sink.s, self._base)
+        before = self._host.rx.stats.bytes_in
+        try:
+            r = fn(*args)
+        finally:
+            self._base += (self._host.rx.stats.bytes_in - before) & 0xFFFFFFFF
+            got = self._sink.take(None, "out")
+            if got:
+                self._queue.extend(got)
+        if self._exc is not None:
+            e, self._exc = self._exc, None
+            if isinstance(e, Error) or not isinstance(e, Exception):
+                raise e  # ours, or KeyboardInterrupt / SystemExit as they are
+            raise LinkError("%s: %s" % (self.url, e), lib.TASE_EIO) from e
+        return r
+
+    # -- sending
+
+    def _checked(self, packet):
+        if not isinstance(packet, Packet):
+            raise TypeError("send() takes a tase.Packet, not %s" % type(packet).__name__)
+        t = packet.packet_type
+        if t is None:
+            raise FieldError(
+                "group 0x%02X type 0x%02X is not a packet of the spec: not sent"
+                % (packet.group, packet.type)
+            )
+        if not t.to_gimbal:
+            raise FieldError("%s is sent by the gimbal, not to it: not sent" % t.name)
+        if packet.error is not None:
+            raise FieldError("%s: %s: not sent" % (t.name, packet.error))
+        if t.name == "GIMBAL_CMD" and packet.size > 0:
+            flags = packet.raw["flags"]
+            if flags not in _GIMBAL_CMD_FLAGS:
+                raise FieldError(
+                    "GIMBAL_CMD flags 0x%02X is not a mode of the spec's table 5 (%s): not sent"
+                    % (flags, ", ".join("0x%02X" % f for f in sorted(_GIMBAL_CMD_FLAGS)))
+                )
+        return t
+
+    def send(self, packet):
+        """Send one packet to the gimbal now (no answer awaited). Packets
+        the gimbal sends, unknown ones, wrong lengths and GIMBAL_CMD flags
+        outside the spec's table 5 are refused (FieldError), nothing sent."""
+        self._live()
+        self._checked(packet)
+        data = packet.payload
+        r = self._call(lib.tase_host_send, self._host, packet.group, packet.type, data, len(data))
+        if r < 0:
+            raise error(r, "%s: send %s" % (self.url, packet.name))
+        return packet
+
+    def query(self, what, timeout=None, retries=None):
+        """Ask the gimbal and return its answer (a Packet, dir "out").
+
+        `what` is a packet name (its zero-length query: setup packets,
+        SPOI_CMD, SYSTEM_VERSION) or a Packet to set and confirm (a setup
+        packet, SPOI_CMD with the echo flag, RETRACT_DEPLOY_CMD): the answer
+        is the gimbal's frame of the same group and type (the library's
+        host role matches it and re-sends after each `timeout` s, up to
+        `retries` more times). TimeoutError when none comes."""
+        self._live()
+        if isinstance(what, Packet):
+            t = self._checked(what)
+            echoed = t.group == 0x48 or (
+                t.name == "SPOI_CMD" and what.size > 0 and what.raw["flags"] & lib.TASE_SPOI_ECHO
+            )
+            if not echoed:
+                # a retry would send it again: only packets the gimbal echoes
+                raise FieldError(
+                    "%s is not echoed by the gimbal (setup packets are, SPOI_CMD with its "
+                    "echo flag): use send(), nothing sent" % t.name
+                )
+            req = what
+        else:
+            req = Packet.query(what)
+        t = req.packet_type
+        timeout = self.timeout if timeout is None else timeout
+        retries = self.retries if retries is None else retries
+        if not 0 < timeout <= 2**31 / 1000 or not 0 <= retries <= 255:
+            raise FieldError("timeout must be > 0 s and retries 0..255")
+        ms = max(1, int(round(timeout * 1000)))
+        data = req.payload
+        r = self._call(
+            lib.tase_host_transact,
+            self._host,
+            req.group,
+            req.type,
+            data,
+            len(data),
+            self._reply,
+            lib.TASE_DATA_MAX,
+            ms,
+            retries,
+        )
+        if r == lib.TASE_ETIMEOUT:
+            raise TimeoutError_(
+                "%s: timeout: no answer to %s after %d attempts of %d ms"
+                % (self.url, t.name, 1 + retries, ms),
+                r,
+            )
+        if r < 0:
+            raise error(r, "%s: %s" % (self.url, t.name))
+        return _with_meta(_from_data(req.id, ffi.buffer(self._reply, r)[:]), _now_us(), "out")
+
+    # -- receiving
+
+    def packets(self, timeout=None, count=None):
+        """Iterate over the packets received (telemetry, echoes, answers
+        not taken by query()), each when it arrives, until `timeout`
+        seconds have passed in all (None: no limit) or `count` packets
+        were given."""
+        self._live()
+        deadline = None if timeout is None else time.monotonic() + timeout
+        given = 0
+        while count is None or given < count:
+            if self._queue:
+                given += 1
+                yield self._queue.popleft()
+                continue
+            wait = 0.2 if deadline is None else deadline - time.monotonic()
+            if wait <= 0:
+                return
+            ms = max(1, min(int(wait * 1000), 200))
+            r = self._call(lib.tase_host_service, self._host, ms)
+            if r < 0:
+                raise error(r, "%s: receive" % self.url)
+
+    def recv(self, timeout=None):
+        """The next packet received, or TimeoutError after `timeout` s."""
+        for p in self.packets(timeout=timeout, count=1):
+            return p
+        raise TimeoutError_("%s: no packet within %s s" % (self.url, timeout), lib.TASE_ETIMEOUT)
+
+    @property
+    def stats(self):
+        """Counters of the host role and its receiver (32-bit, as the
+        library keeps them)."""
+        h = self._host.stats
+        rx = self._host.rx.stats
+        return {
+            "frames_tx": h.frames_tx,
+            "tx_errors": h.tx_errors,
+            "frames_rx": h.frames_rx,
+            "requests": h.requests,
+            "retries": h.retries,
+            "replies": h.replies,
+            "timeouts": h.timeouts,
+            "bytes_in": rx.bytes_in,
+            "checksum_errors": rx.checksum_errors,
+            "bad_size": rx.bad_size,
+            "bytes_discarded": rx.bytes_discarded,
+            # frames beyond the link's buffer during one blocking call (32768)
+            "frames_dropped": self._sink.s.dropped,
+        }
+
+    # -- the CLI's safe verbs (tase point/rate/spoi/retract/deploy/camera)
+
+    def point(self, pan, tilt, stab=True):
+        """GIMBAL_CMD position (`tase point`): pan and tilt in degrees,
+        -180..180 each."""
+        for name, v in (("pan", pan), ("tilt", tilt)):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not -180 <= v <= 180:
+                raise FieldError("point: %s %r is not a number in -180..180 degrees" % (name, v))
+        flags = lib.TASE_GIMBAL_FLAGS_POSITION_STAB if stab else lib.TASE_GIMBAL_FLAGS_POSITION
+        return self.send(_gimbal_cmd(pan, tilt, flags))
+
+    def rate(self, pan_rate, tilt_rate, stab=True):
+        """GIMBAL_CMD rate (`tase rate`): deg/s, -327.68..327.67; rate(0, 0) stops."""
+        for name, v in (("pan_rate", pan_rate), ("tilt_rate", tilt_rate)):
+            if (
+                isinstance(v, bool)
+                or not isinstance(v, (int, float))
+                or not -327.68 <= v <= 327.67
+            ):
+                raise FieldError(
+                    "rate: %s %r is not a number in -327.68..327.67 deg/s" % (name, v)
+                )
+        flags = lib.TASE_GIMBAL_FLAGS_RATE_STAB if stab else lib.TASE_GIMBAL_FLAGS_RATE
+        return self.send(_gimbal_cmd(pan_rate, tilt_rate, flags))
+
+    def spoi(self, lat, lon, height, wait=True, timeout=None, retries=None):
+        """SPOI_CMD (`tase spoi`): degrees WGS-84, metres; no velocity. With
+        wait the echo is requested and returned, and its position compared
+        (Error if it differs); else the packet sent is returned."""
+        if not -90 <= lat <= 90 or not -180 <= lon <= 180:
+            raise FieldError("spoi: latitude %r / longitude %r out of range" % (lat, lon))
+        p = Packet(
+            "SPOI_CMD",
+            lat=lat,
+            lon=lon,
+            height=height,
+            vnorth=0,
+            veast=0,
+            vdown=0,
+            raw={"flags": lib.TASE_SPOI_ECHO if wait else 0},
+        )
+        if not wait:
+            return self.send(p)
+        echo = self.query(p, timeout, retries)
+        sent, got = p.raw, echo.raw
+        for k in ("lat", "lon", "height"):
+            if got.get(k) != sent[k]:
+                raise Error(
+                    "%s: SPOI_CMD not applied as sent: %s sent %d, gimbal has %s"
+                    % (self.url, k, sent[k], got.get(k))
+                )
+        return echo
+
+    def _retract_deploy(self, deploy, wait):
+        p = Packet("RETRACT_DEPLOY_CMD", deploy=lib.TASE_DEPLOY if deploy else lib.TASE_RETRACT)
+        self.send(p)
+        if wait is None:
+            return p
+        others = []  # left for packets(), in order, after the wait
+        try:
+            for q in self.packets(timeout=wait):
+                if q.name == "RETRACT_DEPLOY_CMD" and q.size > 0:
+                    if bool(q.raw["deploy"]) != deploy:
+                        raise Error(
+                            "%s: the gimbal reports %s"
+                            % (self.url, "deployed" if q.raw["deploy"] else "retracted")
+                        )
+                    return q
+                others.append(q)
+        finally:
+            self._queue.extendleft(reversed(others))
+        raise TimeoutError_(
+            "%s: no RETRACT_DEPLOY_CMD echo within %s s" % (self.url, wait), lib.TASE_ETIMEOUT
+        )
+
+    def retract(self, wait=None):
+        """RETRACT_DEPLOY_CMD deploy=0; wait: seconds to wait for the echo
+        the gimbal sends when the move is complete (returned)."""
+        return self._retract_deploy(False, wait)
+
+    def deploy(self, wait=None):
+        """RETRACT_DEPLOY_CMD deploy=1; wait as retract()."""
+        return self._retract_deploy(True, wait)
+
+    def camera(self, camera=None, hfov=None, zoom=None, timeout=None, retries=None):
+        """CAMERA_CMD (`tase camera`): camera "A"/"B"/"C" (checked first in
+        the gimbal's SYSTEM_VERSION: a camera it does not have is refused,
+        nothing sent), hfov in degrees (0.01..327.67) or zoom ratio
+        (1..327.68); every other field "do not change"."""
+        if hfov is not None and zoom is not None:
+            raise FieldError("camera: hfov or zoom, not both")
+        cam = None
+        if camera is not None:
+            if not isinstance(camera, str) or camera.upper() not in ("A", "B", "C"):
+                raise FieldError("camera: %r is not A, B or C" % (camera,))
+            cam = "ABC".index(camera.upper())
+        elif hfov is None and zoom is None:
+            raise FieldError("camera: name a camera, an hfov or a zoom")
+        if hfov is not None and (
+            isinstance(hfov, bool) or not isinstance(hfov, (int, float)) or not 0.01 <= hfov <= 327.67
+        ):
+            raise FieldError("camera: hfov %r is not in 0.01..327.67 degrees" % (hfov,))
+        if zoom is not None and (
+            isinstance(zoom, bool) or not isinstance(zoom, (int, float)) or not 1 <= zoom <= 327.68
+        ):
+            raise FieldError("camera: zoom %r is not in 1..327.68" % (zoom,))
+        if cam is not None:
+            version = self.query("SYSTEM_VERSION", timeout, retries)
+            kind = version.raw["camera_" + "abc"[cam]]
+            if kind == lib.TASE_CAMTYPE_NONE:
+                raise Error(
+                    "%s: the gimbal has no camera %s (SYSTEM_VERSION: type 0xFF, none); "
+                    "CAMERA_CMD was not sent" % (self.url, "ABC"[cam])
+                )
+        raw = {}
+        if cam is not None:
+            raw["camera"] = cam
+        if hfov is not None:
+            raw["hfov"] = _round(hfov * 100)
+        if zoom is not None:
+            raw["hfov"] = -_round(zoom * 100)
+        if hfov is None and zoom is None:
+            return self.send(Packet("CAMERA_CMD", raw=raw, length=1))
+        return self.send(Packet("CAMERA_CMD", raw=raw))
+
+
+def _round(x):
+    import math
+
+    r = math.floor(abs(x) + 0.5)
+    return -r if x < 0 else r
+
+
+def _gimbal_cmd(pan, tilt, flags):
+    return Packet(
+        "GIMBAL_CMD",
+        raw={
+            "pan": _round(pan * 100),
+            "tilt": _round(tilt * 100),
+            "roll": 0,
+            "flags": flags,
+            "impulse_time": 0,
+        },
+    )
+
+
+def _now_us():
+    return int(time.time() * 1e6)
+
+

@@ -1,0 +1,196 @@
+"""tase.sim.start(): the simulated gimbal `tase-sim` for tests and scripts.
+
+    with tase.sim.start() as sim, tase.connect(sim.url) as link:
+        link.point(45, -20)
+
+It runs `tase-sim` on a new pseudo-terminal (its --link symlink in a
+temporary directory), with can="IFACE" on a SocketCAN interface, or with
+virtual="NAME" on python-can's in-process virtual bus NAME (tase-sim on a
+pty, its bytes carried to and from the bus in CAN frames of the spec's
+encapsulation by a thread of this process: CAN without kernel support),
+and stops it on exit from the with block, also on an exception. The
+program is found as $TASE_SIM, else `tase-sim` on the PATH.
+"""
+
+import os
+import re
+import shutil
+import signal
+import subprocess
+import tempfile
+import threading
+import time
+
+from ._core import Error, error, ffi, lib
+
+__all__ = ["start", "Sim", "find_program"]
+
+_READY = re.compile(r"simulated gimbal on (\S+?),? ")
+
+
+def find_program():
+    path = os.environ.get("TASE_SIM") or shutil.which("tase-sim")
+    if not path:
+        raise Error(
+            "tase-sim not found: install tase-tools, put it on the PATH or set TASE_SIM "
+            "to its path"
+        )
+    return path
+
+
+class Sim:
+    """A running tase-sim. url: what tase.connect() takes; log(): what it
+    printed so far; pid; stop()."""
+
+    def __init__(
+        self, baud=57600, can=None, seconds=None, program=None, ready_timeout=10.0, virtual=None
+    ):
+        if can is not None and virtual is not None:
+            raise Error("tase.sim.start(): can or virtual, not both")
+        self._bridge = None
+        self._log_text = None
+        self.program = program or find_program()
+        self.dir = tempfile.mkdtemp(prefix="tase-sim-")
+        self.logfile = os.path.join(self.dir, "sim.log")
+        args = [self.program]
+        if can is not None:
+            args += ["--can", can]
+            self.url = "socketcan:" + can
+        else:
+            link = os.path.join(self.dir, "gimbal")
+            args += ["--link", link, "--baud", str(baud)]
+            self.url = "serial:%s:%d" % (link, baud)
+            self.link = link
+        if seconds is not None:
+            args += ["--seconds", str(seconds)]
+        with open(self.logfile, "wb") as log:
+            self.proc = subprocess.Popen(
+                args, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT
+            )
+        self.pid = self.proc.pid
+        deadline = time.monotonic() + ready_timeout
+        while True:
+            text = self.log()
+            if _READY.search(text) and (can is not None or os.path.exists(self.link)):
+                break
+            if self.proc.poll() is not None:
+                self._cleanup()
+                raise Error("tase-sim exited with status %d: %s" % (self.proc.returncode, text.strip()))
+            if time.monotonic() > deadline:
+                self.stop()
+                raise Error("tase-sim did not start within %s s: %s" % (ready_timeout, text.strip()))
+            time.sleep(0.02)
+        if virtual is not None:
+            try:
+                self._bridge = _Bridge(self.link, baud, virtual)
+            except BaseException:
+                self.stop()
+                raise
+            self.url = "virtual:" + virtual
+
+    def log(self):
+        """What tase-sim printed (its log of commands), also after stop()."""
+        if self._log_text is not None:
+            return self._log_text
+        try:
+            with open(self.logfile, "rb") as f:
+                return f.read().decode(errors="replace")
+        except OSError:
+            return ""
+
+    def stop(self):
+        """Stop the simulator (SIGTERM, then SIGKILL after 5 s). Returns
+        its exit status."""
+        if self._bridge is not None:
+            self._bridge.stop()
+            self._bridge = None
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGTERM)
+            try:
+                self.proc.wait(5)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        if self._log_text is None:
+            self._log_text = self.log()
+        self._cleanup()
+        return self.proc.returncode
+
+    def _cleanup(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.stop()
+        return False
+
+
+def start(baud=57600, can=None, seconds=None, program=None, virtual=None):
+    """Start tase-sim (see the module's doc); returns a Sim to use in a
+    with statement."""
+    return Sim(baud=baud, can=can, seconds=seconds, program=program, virtual=virtual)
+
+
+class _Bridge:
+    """tase-sim's pty <-> a python-can virtual bus, as the gimbal's CAN
+    node: the sim's bytes go out in frames of ID 0x10000000 (the library's
+    splitter), frames of ID 0x11000000 (the library's acceptance) go in."""
+
+    def __init__(self, dev, baud, channel):
+        import can
+
+        from .link import _SerialTransport
+
+        self.can = can
+        self.pty = _SerialTransport(dev, baud)
+        self.bus = can.Bus(interface="virtual", channel=channel)
+        self.done = False
+        self.frames = ffi.new("tase_can_frame_t[]", 64)
+        self.threads = [threading.Thread(target=f, daemon=True) for f in (self._out, self._in)]
+        for t in self.threads:
+            t.start()
+
+    def _out(self):
+        while not self.done:
+            try:
+                data = self.pty.read(256, 0.05)
+            except Error:
+                return
+            if not data:
+                continue
+            n = lib.tase_can_split(lib.TASE_CAN_ROLE_GIMBAL, data, len(data), self.frames, 64)
+            if n < 0:
+                raise error(n, "CAN split")
+            for i in range(n):
+                f = self.frames[i]
+                self.bus.send(
+                    self.can.Message(
+                        arbitration_id=f.id, is_extended_id=True, data=bytes(f.data[0 : f.dlc])
+                    )
+                )
+
+    def _in(self):
+        one = ffi.new("tase_can_frame_t *")
+        while not self.done:
+            m = self.bus.recv(0.05)
+            if m is None or m.is_error_frame or m.is_remote_frame or len(m.data) > 8:
+                continue
+            one.id = m.arbitration_id
+            one.extended = m.is_extended_id
+            one.dlc = len(m.data)
+            ffi.memmove(one.data, bytes(m.data), len(m.data))
+            n = lib.tase_can_accept(lib.TASE_CAN_ROLE_GIMBAL, one)
+            if n > 0:
+                try:
+                    self.pty.write(bytes(m.data[:n]))
+                except Error:
+                    return
+
+    def stop(self):
+        self.done = True
+        for t in self.threads:
+            t.join(2.0)
+        self.bus.shutdown()
+        self.pty.close()

@@ -1,0 +1,244 @@
+"""Links: a live exchange with tase-sim on a pty, query/echo through the C
+host role, timeouts, refused input (nothing sent), a vanished peer, and the
+virtual CAN bus."""
+
+import os
+import pty
+import select
+import threading
+import time
+import tty
+
+import pytest
+
+import tase
+
+
+def test_live_exchange_with_tase_sim(sim):
+    with tase.connect(sim.url) as link:
+        v = link.query("SYSTEM_VERSION")
+        assert v.name == "SYSTEM_VERSION" and v.dir == "out"
+        assert (v.raw["major"], v.raw["minor"], v.raw["sub"]) == (2, 5, 1)
+        assert v.fields["max_hfov_a"] == 57.8
+        link.point(30, -10)
+        last = None
+        for p in link.packets(timeout=3.0):
+            if p.name == "GIMBAL_ANGLE":
+                last = p
+                if abs(p.fields["pan"] - 30) < 0.5 and abs(p.fields["tilt"] + 10) < 0.5:
+                    break
+        assert last is not None and abs(last.fields["pan"] - 30) < 0.5, last
+        # set and confirm: the gimbal's echo through the host role
+        echo = link.query(tase.Packet("AXIS_SETTING", pan_max_rate=60))
+        assert echo.name == "AXIS_SETTING" and echo.fields["pan_max_rate"] == 60
+        assert link.spoi(45.0, -122.5, 100.0).fields["lat"] == 45.0
+        # deploy while deployed: the echo comes at once; telemetry waits
+        echo = link.deploy(wait=3.0)
+        assert echo.name == "RETRACT_DEPLOY_CMD" and echo.raw["deploy"] == 1
+        assert link.recv(timeout=1.0).name in ("GIMBAL_ANGLE", "GIMBAL_RATE", "GEOREFERENCE_DATA")
+        st = link.stats
+        assert st["replies"] == 3 and st["timeouts"] == 0 and st["frames_rx"] > 3
+    assert "position pan 30.00 tilt -10.00" in sim.log()
+    assert "AXIS_SETTING" in sim.log() and "RETRACT_DEPLOY_CMD" in sim.log()
+
+
+@pytest.fixture
+def silent_pty():
+    """A pty nobody answers on: (url, master fd)."""
+    master, slave = pty.openpty()
+    tty.setraw(master)
+    path = os.ttyname(slave)
+    yield "serial:%s:57600" % path, master
+    os.close(master)
+    os.close(slave)
+
+
+def _drain(fd, wait=0.2):
+    out = b""
+    while select.select([fd], [], [], wait)[0]:
+        out += os.read(fd, 4096)
+    return out
+
+
+def test_timeout_is_timeouterror_after_retries(silent_pty):
+    url, master = silent_pty
+    with tase.connect(url) as link:
+        t0 = time.monotonic()
+        with pytest.raises(TimeoutError, match="no answer to PACKET_RATE after 3 attempts"):
+            link.query("PACKET_RATE", timeout=0.1, retries=2)
+        assert 0.25 < time.monotonic() - t0 < 2.0
+        sent = _drain(master)
+        q = tase.encode(tase.Packet.query("PACKET_RATE"))
+        assert sent == q * 3  # the host role re-sent it twice
+        assert link.stats["timeouts"] == 1 and link.stats["retries"] == 2
+
+
+@pytest.mark.parametrize(
+    "call, exc, text",
+    [
+        (lambda l: l.point(200, 0), tase.FieldError, "-180..180"),
+        (lambda l: l.point(float("nan"), 0), tase.FieldError, "-180..180"),
+        (lambda l: l.rate(400, 0), tase.FieldError, "327.67"),
+        (lambda l: l.send(tase.Packet("GIMBAL_ANGLE", pan=0, tilt=0, roll=0)), tase.FieldError,
+         "sent by the gimbal"),
+        (lambda l: l.send(tase.Packet("GIMBAL_CMD", pan=0, tilt=0, roll=0, flags=0x55,
+                                      impulse_time=0)), tase.FieldError, "table 5"),
+        (lambda l: l.send(tase.Packet.from_data(0x28, 1, b"\x01")), tase.FieldError,
+         "not a packet of the spec"),
+        (lambda l: l.send(tase.Packet.from_data(0, 0x80, b"\x01")), tase.FieldError,
+         "wrong length"),
+        (lambda l: l.query("NO_SUCH"), tase.UnknownPacketError, "unknown packet name"),
+        (lambda l: l.query("GIMBAL_CMD"), tase.FieldError, "no zero-length form"),
+        (lambda l: l.camera("D"), tase.FieldError, "A, B or C"),
+        (lambda l: l.camera(hfov=0), tase.FieldError, "0.01..327.67"),
+        (lambda l: l.spoi(91, 0, 0), tase.FieldError, "out of range"),
+        (lambda l: l.query(tase.Packet("GIMBAL_CMD", pan=0, tilt=0, roll=0, flags=0xA0,
+                                       impulse_time=0)), tase.FieldError, "not echoed"),
+        (lambda l: l.query(tase.Packet("SPOI_CMD", lat=0, lon=0, height=0, vnorth=0, veast=0,
+                                       vdown=0, flags=0)), tase.FieldError, "not echoed"),
+    ],
+)
+def test_refused_input_sends_nothing(silent_pty, call, exc, text):
+    url, master = silent_pty
+    with tase.connect(url) as link:
+        with pytest.raises(exc, match=text):
+            call(link)
+        assert link.stats["frames_tx"] == 0
+    assert _drain(master, 0.05) == b""
+
+
+@pytest.mark.parametrize(
+    "url, text",
+    [
+        ("serial:/dev/ttyUSB0:12345", "baud 12345"),
+        ("udp:127.0.0.1:14550", "not a link URL"),
+        ("serial:", "not a link URL"),
+        ("/dev/ttyUSB0", "not a link URL"),
+    ],
+)
+def test_wrong_urls(url, text):
+    with pytest.raises(tase.FieldError, match=text):
+        tase.connect(url)
+
+
+def test_missing_device():
+    with pytest.raises(tase.LinkError, match="No such file"):
+        tase.connect("serial:/nonexistent/tty:57600")
+
+
+def test_vanished_peer_is_a_clear_error(tase_sim):
+    sim = tase.sim.start()
+    link = tase.connect(sim.url)
+    try:
+        assert link.query("PACKET_RATE").name == "PACKET_RATE"
+        sim.stop()
+        with pytest.raises(ConnectionError, match="went away or hung up"):
+            link.query("PACKET_RATE", timeout=0.2, retries=0)
+        with pytest.raises(ConnectionError):
+            for _ in link.packets(timeout=1.0):
+                pass
+    finally:
+        link.close()
+        sim.stop()
+
+
+def test_sim_stopped_on_exception(tase_sim):
+    with pytest.raises(RuntimeError):
+        with tase.sim.start() as s:
+            proc = s.proc
+            raise RuntimeError("boom")
+    assert proc.poll() is not None
+
+
+class _VirtualGimbal(threading.Thread):
+    """The gimbal's side of a python-can virtual bus, written in the test:
+    it reassembles what the host sends (ID 0x11000000) with tase.Decoder
+    and echoes setup packets in CAN frames of ID 0x10000000."""
+
+    def __init__(self, channel):
+        super().__init__(daemon=True)
+        import can
+
+        self.can = can
+        self.bus = can.Bus(interface="virtual", channel=channel)
+        self.dec = tase.Decoder(50000)
+        self.got = []
+        self.stop = False
+
+    def send(self, packet):
+        frame = tase.encode(packet)
+        for i in range(0, len(frame), 8):
+            self.bus.send(self.can.Message(arbitration_id=0x10000000, is_extended_id=True,
+                                           data=frame[i:i + 8]))
+
+    def run(self):
+        rate = tase.Packet("PACKET_RATE", raw={f.name: 7 for f in
+                           tase.packet_type("PACKET_RATE").fields})
+        while not self.stop:
+            m = self.bus.recv(0.05)
+            if m is None or m.arbitration_id != 0x11000000:
+                continue
+            for p in self.dec.feed(bytes(m.data)):
+                self.got.append(p)
+                if p.name == "PACKET_RATE":
+                    self.send(rate if p.is_query else p)
+                    self.send(tase.Packet("GIMBAL_ANGLE", pan=1, tilt=2, roll=0))
+
+
+def test_virtual_can_bus():
+    pytest.importorskip("can")
+    g = _VirtualGimbal("tase-test")
+    g.start()
+    try:
+        with tase.connect("virtual:tase-test") as link:
+            r = link.query("PACKET_RATE", timeout=0.5)
+            assert r.raw["angle_1"] == 7 and r.size == 16
+            link.point(10, -5)
+            angle = link.recv(timeout=2.0)
+            assert angle.name == "GIMBAL_ANGLE" and angle.fields["tilt"] == 2.0
+            time.sleep(0.2)
+        cmd = [p for p in g.got if p.name == "GIMBAL_CMD"]
+        assert cmd and cmd[0].raw["pan"] == 1000 and cmd[0].raw["flags"] == 0xA0
+        assert g.got[0] == tase.Packet.query("PACKET_RATE")
+    finally:
+        g.stop = True
+        g.join()
+        g.bus.shutdown()
+
+
+def test_tase_sim_on_a_virtual_can_bus(tase_sim):
+    pytest.importorskip("can")
+    with tase.sim.start(virtual="tase-sim-test") as sim:
+        assert sim.url == "virtual:tase-sim-test"
+        with tase.connect(sim.url) as link:
+            assert link.query("SYSTEM_VERSION").raw["board_sn"] == 100123
+            link.rate(10, 0)
+            names = {p.name for p in link.packets(timeout=0.5)}
+            assert {"GIMBAL_ANGLE", "GIMBAL_RATE"} <= names
+    assert "GIMBAL_CMD: rate" in sim.log()
+
+
+def test_units_json_equals_tase_monitor(sim, tase_cli):
+    """`tase monitor --json --units` and Packet.json(units=True) print the
+    same text for the same packets (everything after offset/time/dir)."""
+    import json
+    import subprocess
+
+    r = subprocess.run([tase_cli, "monitor", "--serial", sim.link, "--json", "--units",
+                        "--seconds", "1.2"], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    names = set()
+    for line in lines:
+        obj = json.loads(line)
+        p = tase.Packet(obj["name"], raw=obj["fields"])
+        mine = p.json(units=True)
+        assert mine[mine.index(',"group"'):] == line[line.index(',"group"'):]
+        names.add(obj["name"])
+    assert {"GIMBAL_ANGLE", "GIMBAL_RATE", "GEOREFERENCE_DATA"} <= names
+
+
+def test_missing_can_interface():
+    pytest.importorskip("can")
+    with pytest.raises(tase.LinkError, match="no SocketCAN support|no such device"):
+        tase.connect("socketcan:tasenosuch0")

@@ -1,0 +1,167 @@
+"""Packets from the ROM schema, encode/decode through the C codec and
+receiver, JSON equal to `tase --json`."""
+
+import json
+import os
+import re
+import subprocess
+
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import tase
+from conftest import ROOT
+
+
+def test_version_is_the_libraries():
+    text = open(os.path.join(ROOT, "include", "tase", "version.h")).read()
+    want = ".".join(
+        re.search(r"#define TASE_VERSION_%s (\d+)" % k, text).group(1)
+        for k in ("MAJOR", "MINOR", "PATCH")
+    )
+    assert tase.__version__ == want
+
+
+def test_schema_has_the_21_packets():
+    names = [t.name for t in tase.PACKET_TYPES]
+    assert len(names) == 21
+    assert names[0] == "GIMBAL_CMD" and "GEOREFERENCE_DATA" in names
+    gc = tase.packet_type("gimbal_cmd")
+    assert [f.name for f in gc.fields] == ["pan", "tilt", "roll", "flags", "impulse_time"]
+    cam = tase.packet_type("CAMERA_CMD").by_name
+    assert cam["hfov"].keep == -1 and cam["focus"].keep == 0xFFFF
+    ang = tase.packet_type("GIMBAL_ANGLE").by_name["pan"]
+    assert (ang.unit, ang.scale, ang.signed, ang.width) == ("deg", 0.01, True, 2)
+
+
+def _raw_strategy(t):
+    fields = {}
+    for f in t.fields:
+        fields[f.name] = st.integers(f.min, f.max)
+    return st.fixed_dictionaries(fields)
+
+
+@pytest.mark.parametrize("t", tase.PACKET_TYPES, ids=lambda t: t.name)
+@settings(max_examples=25, derandomize=True, deadline=None, database=None)
+@given(data=st.data())
+def test_round_trip_every_packet_type(t, data):
+    raw = data.draw(_raw_strategy(t))
+    tail = data.draw(st.binary(max_size=249)) if t.tail else b""
+    p = tase.Packet(t.name, raw=raw, data=tail)
+    assert p.raw == raw
+    assert p.data == tail
+    frame = tase.encode(p)
+    assert len(frame) == p.size + 8
+    got = tase.decode(frame)
+    assert got == [p]
+    assert got[0].raw == raw and got[0].name == t.name and got[0].offset == 0
+    # engineering values convert back to the same wire integers
+    assert tase.Packet(t.name, data=tail, **p.fields) == p
+
+
+def test_engineering_values_and_repr():
+    p = tase.Packet("GIMBAL_ANGLE", pan=12.345, tilt=-45, roll=0)
+    assert p.raw == {"pan": 1235, "tilt": -4500, "roll": 0}  # half away from zero
+    assert p.fields == {"pan": 12.35, "tilt": -45.0, "roll": 0.0}
+    assert eval(repr(p), {"Packet": tase.Packet}) == p
+    g = tase.Packet("HOST_GPS_DATA", raw={"lat": 162000000}, time=1.5, lon=-122.5, height=10.25,
+                    vnorth=1, veast=0, vdown=-0.5, year=2024, month=1, day=2, hour=3, minute=4,
+                    second=5, frac_second=6, valid=1, sample_rate=10)
+    assert g.raw["time"] == 1500 and g.raw["lon"] == -441000000 and g.raw["vdown"] == -50
+    assert g.fields["lat"] == 45.0
+
+
+def test_replace_and_pickle():
+    import pickle
+
+    p = tase.Packet("CAMERA_PASS", camera=1, baud=8, data=b"ab")
+    q = p.replace(camera=2)
+    assert q.raw == {"camera": 2, "baud": 8} and q.data == b"ab" and p.raw["camera"] == 1
+    assert p.replace(data=b"xyz").data == b"xyz"
+    with pytest.raises(tase.FieldError, match="no field"):
+        p.replace(zoom=1)
+    d = tase.decode(b"\0" + tase.encode(p))[0]
+    e = pickle.loads(pickle.dumps(d))
+    assert e == p and e.offset == 1
+
+
+def test_defaults_are_do_not_change_values():
+    c = tase.Packet("CAMERA_CMD", camera=1)
+    assert c.raw["hfov"] == -1 and c.raw["focus"] == 0xFFFF and c.raw["flags"] == 0x80
+    r = tase.Packet("AXIS_SETTING", pan_max_rate=100)
+    assert r.raw["pan_max_rate"] == 20 and r.raw["tilt_max_rate"] == 0xFF
+    assert r.raw["temporary"] == 1  # not stored by the gimbal unless asked
+    short = tase.Packet("AXIS_SETTING", length=22, pan_max_rate=100)
+    assert short.size == 22 and tase.decode(tase.encode(short))[0].raw == r.raw
+    one = tase.Packet("CAMERA_CMD", length=1, camera=2)
+    assert one.size == 1 and one.raw == {"camera": 2}
+    q = tase.Packet.query("PACKET_RATE")
+    assert q.size == 0 and q.raw == {} and q.is_query
+
+
+@pytest.mark.parametrize(
+    "call, text",
+    [
+        (lambda: tase.Packet("GIMBAL_ANGEL"), "unknown packet name"),
+        (lambda: tase.Packet("GIMBAL_ANGLE", pan=400, tilt=0, roll=0), "out of range"),
+        (lambda: tase.Packet("GIMBAL_ANGLE", pan=float("nan"), tilt=0, roll=0), "finite"),
+        (lambda: tase.Packet("GIMBAL_ANGLE", pan=1, tilt=0, rol=0), "has no field 'rol'"),
+        (lambda: tase.Packet("GIMBAL_ANGLE", pan=1), "missing tilt, roll"),
+        (lambda: tase.Packet("GIMBAL_CMD", raw={"pan": 1.5}), "not an integer"),
+        (lambda: tase.Packet("PACKET_RATE", raw={"angle_1": 256}), "out of range 0..255"),
+        (lambda: tase.Packet("CAMERA_CMD", length=5, camera=1), "not an accepted data length"),
+        (lambda: tase.Packet.query("GIMBAL_CMD"), "no zero-length form"),
+        (lambda: tase.Packet("CAMERA_PASS", camera=0, baud=0, data=bytes(250)), "at most 249"),
+    ],
+)
+def test_bad_packets_are_clear_errors(call, text):
+    with pytest.raises(tase.FieldError if "unknown" not in text else tase.UnknownPacketError,
+                       match=text):
+        call()
+
+
+NOISY = os.path.join(ROOT, "tests", "data", "decode_noisy.bin")
+
+
+def _cli_decode(cli, path):
+    r = subprocess.run([cli, "decode", path, "--stats"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    return r.stdout.splitlines(), r.stderr
+
+
+def test_decode_equals_tase_decode(tase_cli, tmp_path):
+    """Same frames, offsets, JSON and error counts as `tase decode` on the
+    same bytes: noise, queries, CAMERA_PASS, unknown, wrong length, a
+    frame hidden behind a corrupted Size byte."""
+    data = open(NOISY, "rb").read()
+    extra = tase.encode(tase.Packet("GIMBAL_RATE", raw={k: 0 for k in
+                        [f.name for f in tase.packet_type("GIMBAL_RATE").fields]}))
+    data += b"\x00\xff\x5a\xf0" + extra + b"\x01\x02" + extra[:-1]
+    path = tmp_path / "in.bin"
+    path.write_bytes(data)
+    lines, stderr = _cli_decode(tase_cli, str(path))
+    got = tase.decode(data)
+    assert [p.json() for p in got] == lines
+    s = got.stats
+    want = re.search(r"(\d+) frames \((\d+) unknown, (\d+) wrong length\), (\d+) checksum errors, "
+                     r"(\d+) bad sizes, (\d+) of (\d+) bytes discarded", stderr).groups()
+    assert [s["frames"], s["unknown"], s["bad_length"], s["checksum_errors"], s["bad_size"],
+            s["discarded"], s["bytes"]] == [int(x) for x in want]
+    assert any(p.name == "UNKNOWN" for p in got) and any(p.error for p in got)
+
+
+def test_json_matches_contract():
+    p = tase.Packet("CAMERA_PASS", camera=1, baud=8, data=b"\x81\x01")
+    obj = json.loads(p.json())
+    assert list(obj) == ["offset", "group", "type", "name", "size", "fields", "data"]
+    assert obj["data"] == [129, 1]
+    u = json.loads(tase.Packet("GIMBAL_ANGLE", pan=1.5, tilt=0, roll=0).json(units=True))
+    assert u["units"] == {"pan_deg": 1.5, "tilt_deg": 0.0, "roll_deg": 0.0}
+
+
+def test_examples_of_docs_python_md():
+    import doctest
+
+    r = doctest.testfile(os.path.join(ROOT, "docs", "PYTHON.md"), module_relative=False,
+                         optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert r.attempted >= 5 and r.failed == 0
