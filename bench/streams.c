@@ -86,9 +86,54 @@ static size_t gen_telemetry(uint8_t *buf, size_t cap, int corrupt_size)
     }
 }
 
+/* 00 FF 5A FF (a false sync claiming 253 data bytes), then 63 groups
+ * 00 FF 5A (255 - 4k), k = 1..63: every group is a complete false
+ * candidate ending where the first one ends, so all 64 are decided by the
+ * same byte (issue 21's longest call). Repeated. */
+static size_t gen_held255(uint8_t *buf, size_t cap)
+{
+    size_t n = 0, k;
+    while (n + 256u <= cap) {
+        for (k = 0; k < 64u; k++) {
+            buf[n++] = 0x00;
+            buf[n++] = 0xFF;
+            buf[n++] = 0x5A;
+            buf[n++] = (uint8_t)(255u - 4u * k);
+        }
+    }
+    return n;
+}
+
+/* 00 FF 5A FF, then 31 valid empty frames (8 bytes each) and 9 bytes of
+ * noise: the false candidate fails on its 261st byte and releases the 31
+ * frames it was hiding, all decided by that byte. Repeated. */
+static size_t gen_burst(uint8_t *buf, size_t cap)
+{
+    size_t n = 0, k;
+    while (n + 261u <= cap) {
+        buf[n++] = 0x00;
+        buf[n++] = 0xFF;
+        buf[n++] = 0x5A;
+        buf[n++] = 0xFF;
+        for (k = 0; k < 31u; k++) {
+            n += (size_t)tase_frame_encode(&buf[n], cap - n, 0x00, (uint8_t)k, NULL, 0u);
+        }
+        for (k = 0; k < 9u; k++) {
+            buf[n++] = (uint8_t)(0x11u + k);
+        }
+    }
+    return n;
+}
+
 size_t bench_stream(const char *name, uint8_t *buf, size_t cap)
 {
     size_t i;
+    if (strcmp(name, "held255") == 0) {
+        return gen_held255(buf, cap);
+    }
+    if (strcmp(name, "burst") == 0) {
+        return gen_burst(buf, cap);
+    }
     if (strcmp(name, "telemetry") == 0) {
         return gen_telemetry(buf, cap, 0);
     }

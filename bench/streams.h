@@ -9,6 +9,10 @@
  *   syncrand   00 FF 5A then a random Size, repeated
  *   noise      uniformly random bytes
  *   zeros      0x00 repeated (every byte may start a sync)
+ *   held255    00 FF 5A FF + 63 groups 00 FF 5A (255-4k), repeated: 64
+ *              complete false candidates decided by one byte (issue 21)
+ *   burst      00 FF 5A FF + 31 valid empty frames + 9 noise bytes,
+ *              repeated: one byte releases 31 frames
  */
 #ifndef BENCH_STREAMS_H
 #define BENCH_STREAMS_H

@@ -26,7 +26,7 @@ TARGET_FRAMING_FLASH = 1500
 # decoding links of the receiver.
 FRAMING_ROOTS = ["tase_rx_init", "tase_rx_push", "tase_rx_feed", "tase_rx_flush"]
 TARGET_CORE_FLASH = 4096
-TARGET_RX_RAM = 272
+TARGET_RX_RAM = 360  # issue 21: the window of a resumable scan
 TARGET_RX_STACK = 128
 
 
@@ -426,7 +426,7 @@ def main():
             ", ".join(m4["rest_names"]), " | ".join(str(res[c]["rest"][0]) for c in CPUS)))
     types = {t: s for _, t, s in m4["types"][0]}
     rxsz = types.get("tase_rx_t", 0)
-    p("| RAM per receiver: sizeof(tase_rx_t) | %s | 272 | %s |" % (
+    p("| RAM per receiver: sizeof(tase_rx_t) | %s | 360 | %s |" % (
         " | ".join(str({t: s for _, t, s in res[c]["types"][0]}.get("tase_rx_t", 0)) for c in CPUS),
         met(rxsz, TARGET_RX_RAM)))
     stacks = {}
@@ -434,23 +434,30 @@ def main():
         own, edges, names = res[c]["graph"]
         memo = {}
         stacks[c] = (own, edges, names, memo)
-    def rx_stack(c):
-        """Deepest of: the receiver's own chains, and the chain down to its
-        frame-callback call site plus the dispatcher's deepest chain."""
+    # Every receive entry point: a byte (push), a buffer (feed), end of
+    # input (flush) and the clock (tick).
+    rx_roots = ("tase_rx_push", "tase_rx_feed", "tase_rx_flush", "tase_rx_tick")
+
+    def rx_stack(c, with_dispatch=False):
+        """Deepest of the receiver's own chains (a trivial callback), or,
+        with_dispatch, the chain down to its frame-callback call site plus
+        the dispatcher's deepest chain."""
         own, edges, names, memo = stacks[c]
-        best = max((worst_stack(r, own, edges, names, memo) for r in
-                    ("tase_rx_feed", "tase_rx_flush") if r in own), key=lambda x: x[0])
-        if not res[c]["dispatch"]:
+        best = max((worst_stack(r, own, edges, names, memo) for r in rx_roots if r in own),
+                   key=lambda x: x[0])
+        if not with_dispatch or not res[c]["dispatch"]:
             return best
         disp = max((worst_stack(s, own, edges, names, memo)
                     for s in globals_of(res[c]["objs"]["dispatch"])), key=lambda x: x[0])
-        site = max((to_callback(r, own, edges, names, {}) for r in
-                    ("tase_rx_feed", "tase_rx_flush") if r in own), key=lambda x: x[0])
+        site = max((to_callback(r, own, edges, names, {}) for r in rx_roots if r in own),
+                   key=lambda x: x[0])
         via = (site[0] + disp[0], site[1] + ["(callback)"] + disp[1], disp[2])
         return via if via[0] > best[0] else best
-    p("| receive path stack (worst chain%s) | %s | 128 | %s |" % (
-        ", + the dispatcher as the frame callback" if dispatch else "",
+    p("| receive path stack (push/feed/flush/tick, worst chain, trivial callback) | %s | 128 | %s |" % (
         " | ".join(str(rx_stack(c)[0]) for c in CPUS), met(rx_stack("cortex-m4")[0], TARGET_RX_STACK)))
+    if dispatch:
+        p("| receive path stack, the dispatcher as the frame callback | %s | - | informational |" % (
+            " | ".join(str(rx_stack(c, True)[0]) for c in CPUS)))
     p("")
     p("For comparison (as issue 8 states it): MAVLink's `mavlink_parse_char` alone links to about "
       "1.8 KB of code plus a 2.8 KB CRC table on Cortex-M4 `-Os`.")
@@ -465,9 +472,9 @@ def main():
     p("")
     rx_gap = m4["rx"][0] - TARGET_RX_FLASH
     p("- **Receive path flash, %d B against 1024 (%s).** Framing alone (%s) links to %d B "
-      "(%s against its own target of %d B): the greedy receiver keeps one pending candidate "
-      "in a window, scans the caller's buffer in place (memchr over idle bytes, frames checked "
-      "where they lie) and has a byte path for tase_rx_push() (largest symbols: %s). "
+      "(%s against its own target of %d B): the greedy receiver's resumable scan over a "
+      "window (a budget per byte, running sums, compaction), the bulk paths of "
+      "tase_rx_feed() and the byte paths of tase_rx_push() (largest symbols: %s). "
       "Dispatch adds %d B: the generic decoder of the "
       "codec (largest symbols of tase_codec.c: %s) and the schema's ROM tables and lookup "
       "(tase_schema.c: %s), which describe every packet of the spec once." % (
@@ -483,26 +490,21 @@ def main():
           m4["core"][0], "met" if core_gap <= 0 else "+%d" % core_gap,
           ", ".join("%s %d" % (m, fl(m)) for m in sorted(CORE_MODULES, key=lambda x: -fl(x))
                     if m in mods4)))
-    p("- **RAM per receiver, %d B against 272 (%s).** 272 is impossible with 32-bit "
-      "counters in the instance (docs/DESIGN.md, \"RAM: why not 272 bytes\"): a maximal "
-      "frame is %d bytes, and even a receiver that keeps only Group, PktType and the data "
-      "holds 255, leaving nothing for 32-bit counters. Ours: the %d-byte window (one whole "
-      "frame, delivered as one contiguous view), %d bytes of counters (%d of them), and %d "
-      "bytes of state (held length, the held candidate's end, the busy flag) and padding. "
-      "include/tase/frame.h sets the budget at %d (TASE_RX_SIZE_BUDGET)." % (
+    p("- **RAM per receiver, %d B against 360 (%s).** A maximal frame is %d bytes; the "
+      "window holds one and the bytes that arrive while a lagging scan catches up "
+      "(TASE_RX_WINDOW, docs/DESIGN.md), beside %d bytes of counters (%d of them) and the "
+      "scan's state (%d bytes with padding, the time bound's included). "
+      "include/tase/frame.h sets the budget at 360 (TASE_RX_SIZE_BUDGET)." % (
           rxsz, "met" if rxsz <= TARGET_RX_RAM else "+%d" % (rxsz - TARGET_RX_RAM), frame_max,
-          frame_max, stats, stats // 4, rxsz - frame_max - stats, rxsz))
+          stats, stats // 4, rxsz - 300 - stats))
     st4 = rx_stack("cortex-m4")[0]
     own4 = stacks["cortex-m4"][0]
     frame_of = lambda fn: next((v for k, v in own4.items() if k.endswith(":" + fn) or k == fn), 0)
-    p("- **Receive path stack, %d B against 128 (%s)**, plus the application's handler. The "
-      "receiver's share is its entry point (%d B for tase_rx_feed, which at run time is gone: "
-      "it tail-calls the general path) and run() (%d B: the general path and the greedy scan "
-      "in one frame, with the tase_frame_t handed to the callback), which calls the frame "
-      "callback. The receiver before issue 12 called the callback from a 72-byte "
-      "tase_rx_feed(); the greedy receiver's general path keeps more state live (the "
-      "caller's buffer, the window and the scan position at once)." % (
-          st4, met(st4, TARGET_RX_STACK), frame_of("tase_rx_feed"), frame_of("run")))
+    p("- **Receive path stack, %d B against 128 (%s)**, plus the application's handler: the "
+      "deepest of tase_rx_push(), tase_rx_feed(), tase_rx_flush() and tase_rx_tick() down to "
+      "the frame callback (run() %d B, advance() %d B). bench/bench.sh also measures the "
+      "push path by painting (docs/PERFORMANCE.md)." % (
+          st4, met(st4, TARGET_RX_STACK), frame_of("run"), frame_of("advance")))
     p("")
     p("### Biggest contributors per module (Cortex-M4, `arm-none-eabi-nm --size-sort`)")
     p("")

@@ -1,43 +1,117 @@
 /*
  * Frame encoder and receiver. The contract (which frames, order, latency,
- * re-entrancy) is in include/tase/frame.h; comments here explain how.
+ * cost per call, re-entrancy) is in include/tase/frame.h; comments here
+ * explain how.
  *
- * The receiver runs the greedy scan of frame.h online. Its whole state is
- * the window buf[0..len), which holds one of:
- *   - nothing (len 0);
- *   - a partial sync: 00, 00 FF or 00 FF 5A (len 1..3, end 0);
- *   - the earliest pending candidate, from its first sync byte on: Size
- *     >= 2 known, last byte still to come (4 <= len <= end, end = Size + 5).
- * Bytes after a pending candidate are not examined: a frame in them could
- * only be delivered if the candidate fails, and then the rest of the window
- * is scanned as if it were new input (scan()). So the scan position never
- * moves back, each candidate is judged once, and nothing needs tracking
- * besides the one candidate.
+ * The receiver runs the greedy scan of frame.h online, over a window
+ * buf[0..len) of the bytes received and not yet decided. buf[scan] is the
+ * scan position: everything before it is decided (delivered or
+ * discarded), and buf[0..scan) is dead space, dropped by compact() when
+ * room is needed. From buf[scan] on the window holds
+ *   - nothing, a partial sync (00, 00 FF, 00 FF 5A: then scan is 0) or a
+ *     candidate whose last byte has not come (Size >= 2 known, `end` the
+ *     index of its last byte): the scan has caught up (lag 0); or
+ *   - bytes not yet examined (lag 1): a call stopped scanning because it
+ *     had spent its budget. Each later call, even one that brings no byte,
+ *     continues the scan before anything else, with a new budget.
+ * The scan position never moves back: each position is examined once and
+ * each candidate judged once.
  *
- * tase_rx_push() stores a byte inside a frame with one test (len < end).
- * Every other path runs with `busy` set and `end` zero, so that test fails
- * while a callback runs and a re-entrant call lands on the busy check.
+ * Judging a complete candidate needs the 16-bit sum of its bytes before
+ * the checksum. sum_len (the sum of buf[0..len) plus a constant) grows
+ * with every byte stored; sum_scan is the same up to buf[scan]. The
+ * candidate's sum is prefix(be) - sum_scan, where be is the index of its
+ * Check_0 byte and prefix(be) is summed forward from scan or backward from
+ * len, whichever is shorter: for the held candidate whose last byte
+ * just came, that is 2 bytes back. (compact() moves the constant, not the
+ * sums: the differences stay right.)
+ *
+ * BUDGET. A call spends at most RX_BUDGET work units on the scan per byte
+ * it takes in (a unit is about one byte examined, summed or moved; a
+ * delivery counts RX_COST_FRAME), and then stops with lag 1. Whatever
+ * work the window holds is bounded (RX_WORK_MAX below), so a frame comes
+ * out at most RX_WORK_MAX / RX_BUDGET + 1 bytes after the byte that
+ * decides it (frame.h, LATENCY). A byte that finds the window full first
+ * makes room: one step of the scan if the scan is at buf[0], then
+ * compact().
+ *
+ * tase_rx_push() stores a byte inside a held candidate with one test
+ * (len < end) and handles the sync and Size bytes of a frame beside it;
+ * every other byte takes the general path (run()). Every other path runs
+ * with `busy` set and `end` zero, so that test fails while a callback runs
+ * and a re-entrant call lands on the busy check.
  */
 #include "tase/frame.h"
 
 #include <limits.h>
 #include <string.h>
 
-#define RX_CAP ((uint16_t)TASE_FRAME_MAX)
+#define RX_CAP ((uint16_t)TASE_RX_WINDOW)
 
-/* Keeps the byte events of tase_rx_push() out of line, so that its fast
+/* Work units of the scan per byte taken in, and what a delivery costs
+ * (frame.h COST; the unit is about one byte touched). */
+#define RX_BUDGET 96u
+#define RX_COST_STEP 16u
+#define RX_COST_FRAME 16u
+#define RX_UNLIMITED UINT32_MAX
+
+/* `end` while a call runs or the scan lags: every fast path of
+ * tase_rx_push() fails on it (see the file comment). */
+#define RX_BLOCKED 0xFFFFu
+
+/* Work a window can hold for the scan, in units: every position a step
+ * (RX_COST_STEP), every judged candidate (one per sync, so at most every
+ * third position) a sum of at most half the window (the shorter of the
+ * two ways, which together span at most the window), every frame
+ * delivered (at least 8 bytes each) RX_COST_FRAME, noise bytes summed and
+ * one compaction (a unit per byte each). A frame the reference decides at
+ * byte t lies in the window at t with everything before it, and every
+ * byte from t on brings RX_BUDGET units (a byte never waits behind a
+ * full window: the byte that finds it full is stored after a step taken
+ * on top of the budget). So it is delivered by the call that takes byte
+ * t + RX_WORK_MAX / RX_BUDGET at the latest: TASE_RX_LATE_MAX. */
+#define RX_WORK_MAX                                                                                \
+    ((uint32_t)RX_CAP * RX_COST_STEP + ((uint32_t)RX_CAP / 3u + 1u) * ((uint32_t)RX_CAP / 2u) +    \
+     ((uint32_t)RX_CAP / 8u) * RX_COST_FRAME + 2u * (uint32_t)RX_CAP)
+/* A judgement costs a step and at least 2 bytes summed; the last step may
+ * overrun the budget, and a byte that finds the window full takes one
+ * more. */
+typedef char
+    tase_rx_judge_check[RX_BUDGET / (RX_COST_STEP + 2u) + 2u <= TASE_RX_JUDGE_MAX ? 1 : -1];
+typedef char
+    tase_rx_late_check[(RX_WORK_MAX + RX_BUDGET - 1u) / RX_BUDGET <= TASE_RX_LATE_MAX ? 1 : -1];
+
+/* Keeps the general path of tase_rx_push() out of line, so that its fast
  * path (a byte inside a frame) needs no stack frame. GCC and clang only;
  * another compiler may inline it, which costs speed, not correctness. */
 #if defined(__GNUC__)
 #define RX_NOINLINE __attribute__((noinline))
+#define RX_INLINE __inline__ __attribute__((always_inline))
 #else
 #define RX_NOINLINE
+#define RX_INLINE
 #endif
 
 /* C99 has no _Static_assert: a negative array size fails the build. */
 typedef char tase_rx_size_check[sizeof(tase_rx_t) <= TASE_RX_SIZE_BUDGET ? 1 : -1];
+typedef char tase_rx_window_check[(TASE_RX_WINDOW > TASE_FRAME_MAX + 8u && TASE_RX_WINDOW < 0xFFFFu)
+                                      ? 1
+                                      : -1];
 typedef char tase_rx_cand_check[(TASE_RX_CANDIDATES >= 1 && TASE_RX_CANDIDATES <= 16) ? 1 : -1];
 
+/* Word access at any alignment is native on x86, 64-bit ARM and the
+ * ARMv7-M/ARMv8-M mainline cores (Cortex-M3/M4/M7/M33: the compiler says
+ * so with __ARM_FEATURE_UNALIGNED); elsewhere (Cortex-M0/M0+, AVR, ...)
+ * memcpy of a word is a library call or four byte loads, and a byte loop
+ * is shorter and faster. */
+#if defined(__x86_64__) || defined(__i386__) || defined(__aarch64__) ||                            \
+    defined(__ARM_FEATURE_UNALIGNED)
+#define RX_WORDS 1
+#else
+#define RX_WORDS 0
+#endif
+
+#if RX_WORDS
 /* The checksum adds a machine word of bytes per step: the word is split
  * into 16-bit lanes (even and odd bytes) that are added and folded at the
  * end. Byte order does not matter to a sum. A lane gains at most 2 * 255
@@ -62,6 +136,7 @@ static uint32_t lane_total(uint32_t lanes)
     return (lanes & 0xFFFFu) + (lanes >> 16);
 }
 #endif
+#endif
 
 uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n)
 {
@@ -70,6 +145,7 @@ uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n)
     if (p == NULL) {
         return seed;
     }
+#if RX_WORDS
     while (n - i >= sizeof(sum_word_t)) {
         sum_word_t lanes = 0u;
         size_t stop = i + sizeof(sum_word_t) * 128u;
@@ -87,6 +163,7 @@ uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n)
         }
         sum += lane_total(lanes);
     }
+#endif
     for (; i < n; i++) {
         sum += p[i];
     }
@@ -155,9 +232,8 @@ typedef struct {
 } rx_call_t;
 
 /* Count and hand on the valid frame f[0..Size+6) at stream offset
- * `offset` (f is in the window or in the caller's buffer). Returns false
- * when the callback re-initialised the receiver: the caller must then
- * leave it alone. */
+ * `offset`. Returns false when the callback re-initialised the receiver:
+ * the caller must then leave it alone. */
 static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, tase_rx_handler_t on_frame,
                     void *user)
 {
@@ -174,189 +250,311 @@ static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, tase_rx_ha
     return rx->busy != 0u;
 }
 
-/* The greedy scan of src[0..m), with nothing pending before it. The first
- * `counted_before` bytes are already in stats.bytes_in (bytes of the
- * window); the others are counted as the scan passes them, so that a
- * callback sees bytes_in up to the byte that decided its frame (its last
- * byte, or the last byte of a longer candidate before it that failed). A
- * complete candidate is judged where it lies. The first incomplete one (a sync still arriving, or a
- * candidate whose last byte has not come) is moved with everything after
- * it to the window, unless `final` (end of input), where it fails like a
- * bad one: discard its first byte and scan on. Returns false when a
- * callback re-initialised the receiver. */
-static bool scan(tase_rx_t *rx, const uint8_t *src, size_t m, size_t counted_before, bool final,
-                 rx_call_t *c)
+/* Drop the decided bytes buf[0..scan): the rest moves to the front. The
+ * running sums stay as they are (they carry a constant, see above). */
+static void compact(tase_rx_t *rx)
 {
-    size_t p = 0;
-    size_t held = 0;
-    size_t counted = counted_before;
-    while (p < m) {
-        const uint8_t *s = &src[p];
-        size_t avail = m - p;
+    size_t s = rx->scan;
+    size_t n = (size_t)rx->len - s;
+    size_t i = 0;
+    uint8_t *b = rx->buf;
+    /* A forward copy down by s >= 1: every load is ahead of every store
+     * before it, so the overlap is safe word by word as well. */
+#if RX_WORDS
+    for (; n - i >= 4u; i += 4u) {
+        uint32_t w;
+        /* cppcheck-suppress misra-c2012-21.15 */
+        (void)memcpy(&w, &b[s + i], 4u);
+        /* cppcheck-suppress misra-c2012-21.15 */
+        (void)memcpy(&b[i], &w, 4u);
+    }
+#else
+    for (; n - i >= 4u; i += 4u) {
+        const uint8_t *q = &b[s + i];
+        b[i] = q[0];
+        b[i + 1u] = q[1];
+        b[i + 2u] = q[2];
+        b[i + 3u] = q[3];
+    }
+#endif
+    for (; i < n; i++) {
+        b[i] = b[s + i];
+    }
+    rx->len = (uint16_t)n;
+    rx->scan = 0u;
+}
+
+/* Take `units` from the budget, down to zero. */
+static uint32_t spend(uint32_t budget, size_t units)
+{
+    return (budget > units) ? budget - (uint32_t)units : 0u;
+}
+
+/* The scan has caught up with something to hold at buf[s]: a partial
+ * sync, or a candidate of flen bytes still incomplete. A partial sync
+ * moves to the front (at most 3 bytes), a candidate only if the window
+ * has no room for its last byte. */
+static void hold(tase_rx_t *rx, size_t s, size_t flen)
+{
+    rx->lag = 0u;
+    if (s > 0u && s + flen > RX_CAP) {
+        compact(rx);
+    }
+}
+
+/* The greedy scan from buf[scan] on, until it has caught up (lag 0) or
+ * spent `budget` units (lag 1). `final`: end of input, so an incomplete
+ * candidate or partial sync fails like a bad one. Returns false when a
+ * callback re-initialised the receiver. */
+static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
+{
+    uint32_t budget = allowance;
+    for (;;) {
+        size_t s = rx->scan;
+        size_t len = rx->len;
+        size_t avail = len - s;
+        const uint8_t *p = &rx->buf[s];
         size_t k = 1;
-        if (s[0] != TASE_SYNC1) {
-            /* noise up to the next 00 */
-            const uint8_t *z = memchr(s, TASE_SYNC1, avail);
-            size_t skip = (z != NULL) ? (size_t)(z - s) : avail;
-            rx->stats.bytes_discarded += (uint32_t)skip;
-            p += skip;
+        if (avail == 0u) {
+            /* all decided: start the window over */
+            rx->len = 0u;
+            rx->scan = 0u;
+            rx->lag = 0u;
+            return true;
+        }
+        if (budget == 0u) {
+            rx->lag = 1u;
+            return true;
+        }
+        budget = spend(budget, RX_COST_STEP);
+        if (p[0] != TASE_SYNC1) {
+            /* noise up to the next 00 (summed on the way) */
+            uint16_t sum = (uint16_t)(rx->sum_scan + p[0]);
+            while (k < avail && p[k] != TASE_SYNC1) {
+                sum = (uint16_t)(sum + p[k]);
+                k++;
+            }
+            rx->sum_scan = sum;
+            rx->stats.bytes_discarded += (uint32_t)k;
+            rx->scan = (uint16_t)(s + k);
+            budget = spend(budget, k);
             continue;
         }
-        while (k < 3u && k < avail && s[k] == sync[k]) {
+        while (k < 3u && k < avail && p[k] == sync[k]) {
             k++;
         }
+        if (k == avail && !final) {
+            hold(rx, s, RX_CAP); /* a sync still arriving: to the front */
+            return true;
+        }
         if (k == 3u && avail > 3u) {
-            size_t flen = (size_t)s[3] + 6u;
-            if (s[3] < 2u) {
+            size_t flen = (size_t)p[3] + 6u;
+            if (p[3] < 2u) {
                 rx->stats.bad_size++;
             } else if (flen <= avail) {
-                uint16_t want = (uint16_t)(((uint16_t)s[flen - 2u] << 8) | s[flen - 1u]);
-                if (tase_checksum(0u, s, flen - 2u) == want) {
-                    if (p + flen > counted) {
-                        rx->stats.bytes_in += (uint32_t)(p + flen - counted);
-                        counted = p + flen;
-                    }
+                /* complete: judge it (see the file comment for the sums) */
+                size_t be = s + flen - 2u;
+                size_t fwd = flen - 2u;
+                size_t bwd = len - be;
+                uint16_t at_be =
+                    (bwd < fwd) ? (uint16_t)(rx->sum_len - tase_checksum(0u, &rx->buf[be], bwd))
+                                : tase_checksum(rx->sum_scan, p, fwd);
+                uint16_t want = (uint16_t)(((uint16_t)p[flen - 2u] << 8) | p[flen - 1u]);
+                budget = spend(budget, (bwd < fwd) ? bwd : fwd);
+                if ((uint16_t)(at_be - rx->sum_scan) == want) {
+                    rx->sum_scan = (uint16_t)(at_be + p[flen - 2u] + p[flen - 1u]);
+                    rx->scan = (uint16_t)(s + flen);
+                    budget = spend(budget, RX_COST_FRAME);
                     c->count++;
-                    if (!deliver(rx, s, rx->stats.bytes_in - (uint32_t)(counted - p), c->on_frame,
+                    if (!deliver(rx, p, rx->stats.bytes_in - (uint32_t)avail, c->on_frame,
                                  c->user)) {
                         return false;
                     }
-                    p += flen;
                     continue;
                 }
-                /* Failed, after looking up to its last byte: a frame
-                 * found inside it is delivered as of that byte, the same
-                 * moment as when the stream comes one byte at a time. */
                 rx->stats.checksum_errors++;
-                if (p + flen > counted) {
-                    rx->stats.bytes_in += (uint32_t)(p + flen - counted);
-                    counted = p + flen;
-                }
             } else if (!final) {
-                held = avail; /* a candidate whose last byte is still to come */
-                break;
+                /* a candidate whose last byte is still to come */
+                hold(rx, s, flen);
+                return true;
             } else {
                 /* end of input: it can no longer complete */
             }
-        } else if (k == avail && !final) {
-            held = avail; /* a sync still arriving */
-            break;
-        } else {
-            /* not a sync */
         }
+        /* no frame here: the scan moves on one byte (a first sync byte is
+         * 00: the sum does not change) */
+        rx->sum_scan = (uint16_t)(rx->sum_scan + p[0]);
         rx->stats.bytes_discarded++;
-        p++;
+        rx->scan = (uint16_t)(s + 1u);
     }
-    if (m > counted) {
-        rx->stats.bytes_in += (uint32_t)(m - counted);
+}
+
+/* Store one byte, making room first if the window is full: one step of
+ * the scan if it is at buf[0] (a lagging scan: a caught-up one holds at
+ * most a frame there), then compact(). Returns false when a callback
+ * re-initialised the receiver. */
+static bool put(tase_rx_t *rx, rx_call_t *c, uint8_t b)
+{
+    if (rx->len == RX_CAP) {
+        if (rx->scan == 0u && !advance(rx, c, 1u, false)) {
+            return false;
+        }
+        if (rx->scan > 0u) {
+            compact(rx);
+        }
     }
-    if (held > 0u && &src[p] != rx->buf) {
-        (void)memmove(rx->buf, &src[p], held);
-    }
-    rx->len = (uint16_t)held;
+    rx->buf[rx->len] = b;
+    rx->len++;
+    rx->sum_len = (uint16_t)(rx->sum_len + b);
+    rx->stats.bytes_in++;
     return true;
 }
 
-/* The general path: feed data[0..n) (n may be 0), or settle everything at
- * end of input (data NULL: tase_rx_flush()). While the window holds
- * something, just enough bytes to decide it are copied in and the window is
- * scanned; once it is empty, the rest of the input is scanned in place.
- * (Five arguments, like the entry points: they can tail-call it.) */
-static int run(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame, void *user)
+/* A byte while the scan has caught up and holds nothing or a partial sync
+ * at the front (len < 4, scan 0, lag 0): the sync and Size bytes of a
+ * frame, or noise. Returns true when the byte was a Size >= 2 that makes
+ * buf[0..4) a candidate. */
+RX_INLINE static bool hunt(tase_rx_t *rx, uint8_t byte)
+{
+    uint16_t len = rx->len;
+    rx->stats.bytes_in++;
+    if ((len < 3u) ? (byte == sync[len]) : (byte >= 2u)) {
+        rx->buf[len] = byte;
+        rx->len = (uint16_t)(len + 1u);
+        rx->sum_len = (uint16_t)(rx->sum_len + byte);
+        return len == 3u;
+    }
+    /* Broken (a Size < 2 is a bad Size): the bytes held are noise; a 00
+     * may begin a sync, keep it (buf[0] is 00 already; it adds nothing to
+     * the sums). */
+    if (len == 3u) {
+        rx->stats.bad_size++;
+    }
+    len = (uint16_t)(len + 1u);
+    if (byte == TASE_SYNC1) {
+        len--;
+        rx->len = 1u;
+    } else {
+        rx->len = 0u;
+    }
+    rx->stats.bytes_discarded += len;
+    rx->sum_len = rx->sum_scan;
+    return false;
+}
+
+/* Start a call that may deliver frames: `busy` set and `end` zero for
+ * its whole length (see the file comment). */
+static void begin(tase_rx_t *rx, rx_call_t *c, tase_rx_handler_t on_frame, void *user)
+{
+    c->on_frame = on_frame;
+    c->user = user;
+    c->count = 0u;
+    rx->busy = 1u;
+    rx->end = RX_BLOCKED;
+}
+
+/* End it: unless a callback re-initialised the receiver (live false),
+ * set `end` for tase_rx_push()'s fast paths (the held candidate's last
+ * byte, 0 while hunting, RX_BLOCKED while the scan lags) and clear
+ * `busy`. Returns the frames delivered. */
+static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
+{
+    if (live) {
+        size_t s = rx->scan;
+        uint16_t end = 0u;
+        if (rx->lag != 0u) {
+            end = RX_BLOCKED;
+        } else if (rx->len >= s + 4u) {
+            end = (uint16_t)(s + rx->buf[s + 3u] + 5u);
+        } else {
+            /* hunting */
+        }
+        rx->end = end;
+        rx->busy = 0u;
+    }
+    return (c->count > (uint32_t)INT_MAX) ? INT_MAX : (int)c->count;
+}
+
+/* The general path: feed data[0..n) (data not NULL; n may be 0: only continue a
+ * lagging scan), then, if `final` (tase_rx_flush(), a settling tick),
+ * settle everything. Bytes that cannot decide anything are taken in bulk:
+ * noise while nothing is held, the sync and Size bytes of a frame, and
+ * the bytes of a held candidate before its last one. Every other byte is
+ * stored and the scan runs on with a budget of RX_BUDGET: the result is
+ * the same for any split of the stream into calls. */
+static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx_handler_t on_frame,
+               void *user)
 {
     rx_call_t c;
     size_t i = 0;
     bool live = true;
-    bool final = data == NULL;
-    c.on_frame = on_frame;
-    c.user = user;
-    c.count = 0u;
-    rx->busy = 1u;
-    rx->end = 0u;
-    while (live) {
-        size_t len = rx->len;
-        size_t need;
-        size_t k;
-        bool short_of;
-        const uint8_t *src = rx->buf;
-        size_t m;
-        size_t counted;
-        if (len == 0u) {
-            if (i == n) {
-                break;
-            }
-            /* the rest of the input, in place */
-            src = &data[i];
-            m = n - i;
-            counted = 0u;
-            i = n;
-        } else if (len < 4u) {
-            /* A partial sync: the input continues it into a header, or
-             * breaks it. Broken, its bytes are noise (00 FF 5A with a Size
-             * < 2 is a bad Size), and the byte that broke it is scanned in
-             * place like the rest of the input. */
-            while (len < 3u && i < n && data[i] == sync[len]) {
-                rx->buf[len] = data[i];
-                len++;
-                i++;
-                rx->stats.bytes_in++;
-            }
-            if (i == n && !final) {
-                rx->len = (uint16_t)len;
-                break;
-            }
-            if (len == 3u && i < n && data[i] >= 2u) {
-                rx->buf[3] = data[i];
-                len = 4u;
-                i++;
-                rx->stats.bytes_in++;
-            } else {
-                if (len == 3u && i < n) {
-                    rx->stats.bad_size++;
-                }
-                rx->stats.bytes_discarded += (uint32_t)len;
-                len = 0u;
-            }
-            rx->len = (uint16_t)len;
-            continue;
-        } else {
-            /* the rest of the held candidate (rx_sane: Size >= 2) */
-            need = (size_t)rx->buf[3] + 6u - len;
-            short_of = n - i < need;
-            k = short_of ? n - i : need;
-            if (k > 0u) {
-                (void)memcpy(&rx->buf[len], &data[i], k);
-                rx->len = (uint16_t)(len + k);
+    begin(rx, &c, on_frame, user);
+    if (n == 0u && rx->lag != 0u) {
+        live = advance(rx, &c, RX_BUDGET, false);
+    }
+    while (live && i < n) {
+        if (rx->lag == 0u) {
+            size_t k = 0;
+            size_t s = rx->scan;
+            size_t held = (size_t)rx->len - s;
+            if (held == 0u) {
+                /* nothing held: noise up to the next 00 is decided now */
+                const uint8_t *z = memchr(&data[i], TASE_SYNC1, n - i);
+                k = (z != NULL) ? (size_t)(z - &data[i]) : n - i;
+                rx->stats.bytes_discarded += (uint32_t)k;
                 rx->stats.bytes_in += (uint32_t)k;
-                i += k;
+            } else if (held >= 4u) {
+                /* the bytes of the held candidate before its last one */
+                k = s + rx->buf[s + 3u] + 5u - rx->len;
+                if (k > n - i) {
+                    k = n - i;
+                }
+                if (k > 0u) {
+                    (void)memcpy(&rx->buf[rx->len], &data[i], k);
+                    rx->sum_len = tase_checksum(rx->sum_len, &data[i], k);
+                    rx->len = (uint16_t)(rx->len + k);
+                    rx->stats.bytes_in += (uint32_t)k;
+                }
+            } else {
+                /* the sync and Size bytes */
+                (void)hunt(rx, data[i]);
+                k = 1u;
             }
-            if (short_of && !final) {
-                break; /* its last byte is still to come */
+            i += k;
+            if (k > 0u) {
+                continue;
             }
-            m = rx->len;
-            counted = m;
         }
-        /* one call site: scan() is inlined here, one stack frame for both */
-        live = scan(rx, src, m, counted, final, &c);
+        live = put(rx, &c, data[i]) && advance(rx, &c, RX_BUDGET, false);
+        i++;
     }
-    if (live) {
-        rx->end = (rx->len >= 4u) ? (uint16_t)(rx->buf[3] + 5u) : 0u;
-        rx->busy = 0u;
+    if (live && final) {
+        live = advance(rx, &c, RX_UNLIMITED, true);
     }
-    return (c.count > (uint32_t)INT_MAX) ? INT_MAX : (int)c.count;
+    return finish(rx, &c, live);
 }
 
 /* What every entry point checks of an instance, so that a corrupted or
  * never-initialised one gives TASE_EARG instead of indexing outside buf:
- * nothing held beyond a partial sync without a candidate, and a held
- * candidate's end agrees with its Size byte and lies ahead. */
+ * the indices in order inside the window; a caught-up receiver holds a
+ * partial sync at the front, or a candidate at buf[scan] whose end agrees
+ * with its Size byte and lies ahead inside the window. */
 static bool rx_sane(const tase_rx_t *rx)
 {
-    uint16_t len = rx->len;
-    if (len < 4u) {
-        return rx->end == 0u;
+    size_t len = rx->len;
+    size_t s = rx->scan;
+    size_t end = rx->end;
+    if (len > RX_CAP || s > len || rx->lag > 1u) {
+        return false;
     }
-    return rx->buf[3] >= 2u && rx->end == (uint16_t)(rx->buf[3] + 5u) && len <= rx->end;
+    if (rx->lag != 0u) {
+        return end == RX_BLOCKED;
+    }
+    if (len - s < 4u) {
+        return s == 0u && end == 0u;
+    }
+    return rx->buf[s] == TASE_SYNC1 && rx->buf[s + 3u] >= 2u && end == s + rx->buf[s + 3u] + 5u &&
+           len <= end && end < RX_CAP;
 }
 
 /* What every entry point checks: rx NULL, a call in progress, visibly
@@ -373,37 +571,82 @@ static int rx_check(const tase_rx_t *rx)
     return rx_sane(rx) ? TASE_OK : TASE_EARG;
 }
 
-/* tase_rx_push() for the last byte of a held candidate (and for a receiver
- * that is busy or visibly corrupted). A valid frame is delivered from the
- * window; a failed one leaves the byte in the window for the general path
- * to scan on. */
-RX_NOINLINE static int push_event(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+/* tase_rx_push() for every byte its fast paths do not take: a lagging
+ * scan (the byte is stored and the scan goes on with a budget, as run()
+ * does for each byte), a call from a callback, or a corrupted instance. */
+RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    uint16_t len = rx->len;
-    uint16_t want;
-    if (rx->busy != 0u) {
-        return rx->busy == 1u ? TASE_EBUSY : TASE_EARG;
+    rx_call_t c;
+    int r = rx_check(rx);
+    if (r != TASE_OK) {
+        return r;
     }
-    /* tase_rx_push() took every other byte of a sane receiver: held
-     * candidate (len >= 4) and len == end is what is left */
-    if (len < 4u || !rx_sane(rx)) {
-        return TASE_EARG;
-    }
-    rx->stats.bytes_in++;
-    want = (uint16_t)(((uint16_t)rx->buf[len - 1u] << 8) | b);
-    if (tase_checksum(0u, rx->buf, (size_t)len - 1u) == want) {
-        rx->len = 0u;
-        rx->end = 0u;
-        rx->busy = 1u;
-        (void)deliver(rx, rx->buf, rx->stats.bytes_in - (uint32_t)len - 1u, on_frame, user);
-        rx->busy = 0u; /* also right when the callback re-initialised rx */
-        return 1;
-    }
+    begin(rx, &c, on_frame, user);
+    return finish(rx, &c, put(rx, &c, b) && advance(rx, &c, RX_BUDGET, false));
+}
+
+/* tase_rx_push() for the last byte of a held candidate that failed: the
+ * byte is stored, the scan moves past the candidate's first byte (00) and
+ * goes on with what is left of the budget after this judgement, exactly
+ * as in run() (where advance() judges it: a step and 2 bytes summed), so
+ * that any split of the stream gives the same result. */
+RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+{
+    rx_call_t c;
+    size_t len = rx->len;
+    begin(rx, &c, on_frame, user);
     rx->stats.checksum_errors++;
     rx->buf[len] = b;
     rx->len = (uint16_t)(len + 1u);
-    rx->buf[0] = TASE_SYNC2;                     /* judged: its first byte is noise to the scan */
-    return run(rx, rx->buf, 0u, on_frame, user); /* no new byte, not the end */
+    rx->sum_len = (uint16_t)(rx->sum_len + b);
+    rx->stats.bytes_in++;
+    rx->stats.bytes_discarded++;
+    rx->scan = (uint16_t)(rx->scan + 1u);
+    return finish(rx, &c, advance(rx, &c, RX_BUDGET - RX_COST_STEP - 2u, false));
+}
+
+/* tase_rx_push() for the last byte of the candidate held at buf[scan]
+ * (len == end): a valid frame is delivered from the window, which is then
+ * empty; after a failed one the scan goes on (push_failed()). */
+RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+{
+    size_t s = rx->scan;
+    size_t len = rx->len;
+    /* the checks of rx_sane() that make the frame lie inside buf; else
+     * push_slow() gives the error */
+    if (s + 4u > len || rx->buf[s + 3u] < 2u || rx->end != s + rx->buf[s + 3u] + 5u) {
+        return push_slow(rx, b, on_frame, user);
+    }
+    if ((uint16_t)(rx->sum_len - rx->buf[len - 1u] - rx->sum_scan) !=
+        (uint16_t)(((uint16_t)rx->buf[len - 1u] << 8) | b)) {
+        return push_failed(rx, b, on_frame, user);
+    }
+    rx->stats.bytes_in++;
+    rx->len = 0u;
+    rx->scan = 0u;
+    rx->sum_len = rx->sum_scan;
+    rx->busy = 1u;
+    rx->end = RX_BLOCKED;
+    (void)deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), on_frame, user);
+    /* hunting from here; also right when the callback re-initialised rx */
+    rx->end = 0u;
+    rx->busy = 0u;
+    return 1;
+}
+
+/* tase_rx_push() for every byte that is not inside a held candidate:
+ * the last byte of one, the sync and Size bytes of a frame while hunting,
+ * and everything else (the general path). Out of line, so that the fast
+ * path of tase_rx_push() needs no stack frame. */
+RX_NOINLINE static int push_event(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame,
+                                  void *user)
+{
+    uint16_t len = rx->len;
+    uint16_t end = rx->end;
+    if (len == end && end != 0u && end < RX_CAP) {
+        return push_last(rx, byte, on_frame, user);
+    }
+    return push_slow(rx, byte, on_frame, user);
 }
 
 int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user)
@@ -421,31 +664,16 @@ int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *
     if (len < end && end < RX_CAP) {
         rx->buf[len] = byte;
         rx->len = (uint16_t)(len + 1u);
+        rx->sum_len = (uint16_t)(rx->sum_len + byte);
         rx->stats.bytes_in++;
         return 0;
     }
-    /* Hunting a sync, or its Size byte (nothing or a partial sync held, so
-     * end is 0). */
-    if (len < 4u && end == 0u && rx->busy == 0u) {
-        rx->stats.bytes_in++;
-        if ((len < 3u) ? (byte == sync[len]) : (byte >= 2u)) {
-            rx->buf[len] = byte;
-            rx->len = (uint16_t)(len + 1u);
-            if (len == 3u) {
-                rx->end = (uint16_t)(byte + 5u);
-            }
-        } else {
-            /* Broken (a Size < 2 is a bad Size): the bytes held are noise;
-             * a 00 may begin a sync, keep it (buf[0] is 00 already). */
-            uint16_t keep = 0u;
-            if (byte == TASE_SYNC1) {
-                keep = 1u;
-            }
-            if (len == 3u) {
-                rx->stats.bad_size++;
-            }
-            rx->stats.bytes_discarded += (uint32_t)(len + 1u - keep);
-            rx->len = keep;
+    /* Hunting a sync, or its Size byte: end is 0 only when the scan has
+     * caught up and holds nothing or a partial sync at the front (never
+     * during a call). */
+    if (end == 0u && len < 4u) {
+        if (hunt(rx, byte)) {
+            rx->end = (uint16_t)(byte + 5u);
         }
         return 0;
     }
@@ -459,13 +687,13 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
     if (r != TASE_OK) {
         return r;
     }
-    return run(rx, (data != NULL) ? data : rx->buf, n, on_frame, user); /* NULL: flush */
+    return run(rx, (data != NULL) ? data : rx->buf, n, false, on_frame, user); /* n 0 if NULL */
 }
 
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
 {
     int r = rx_check(rx);
-    return (r != TASE_OK) ? r : run(rx, NULL, 0u, on_frame, user);
+    return (r != TASE_OK) ? r : run(rx, rx->buf, 0u, true, on_frame, user);
 }
 
 int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms)
@@ -479,12 +707,16 @@ int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms)
 }
 
 /* The quiet limit of what the window holds (frame.h, TIME BOUND): the
- * time its remaining bytes need at the link's rate, or the margin. */
+ * time its remaining bytes need at the link's rate, or the margin. The
+ * remaining bytes run to the held candidate's last byte, or, for a partial
+ * sync or a scan not caught up, to the last byte of a maximal frame
+ * beginning at the scan position. */
 static uint32_t quiet_limit(const tase_rx_t *rx)
 {
     uint32_t rate = (rx->rate != 0u) ? rx->rate : TASE_RX_SLOWEST_RATE;
-    uint32_t left =
-        (rx->len >= 4u) ? (uint32_t)rx->end + 1u - rx->len : (uint32_t)TASE_FRAME_MAX - rx->len;
+    uint32_t last = (rx->end != 0u && rx->end != RX_BLOCKED) ? (uint32_t)rx->end + 1u
+                                                             : (uint32_t)rx->scan + TASE_FRAME_MAX;
+    uint32_t left = (last > rx->len) ? last - rx->len : 0u;
     uint32_t ms = (left * 1000u + rate - 1u) / rate; /* at most 261,000 / 1 */
     return (ms > rx->margin_ms) ? ms : rx->margin_ms;
 }
@@ -500,6 +732,7 @@ static uint32_t quiet_for(uint32_t now, uint32_t since)
 int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, void *user)
 {
     int r = rx_check(rx);
+    bool settle = false;
     if (r != TASE_OK) {
         return r;
     }
@@ -507,12 +740,14 @@ int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, voi
         rx->ticked = 1u;
         rx->tick_bytes = rx->stats.bytes_in;
         rx->quiet_since = now_ms;
+    } else {
+        settle = rx->len != 0u && quiet_for(now_ms, rx->quiet_since) > quiet_limit(rx);
+    }
+    if (!settle && rx->lag == 0u) {
         return 0;
     }
-    if (rx->len == 0u || quiet_for(now_ms, rx->quiet_since) <= quiet_limit(rx)) {
-        return 0;
-    }
-    return run(rx, NULL, 0u, on_frame, user); /* as at end of input */
+    /* a lagging scan goes on; past the quiet limit, as at end of input */
+    return run(rx, rx->buf, 0u, settle, on_frame, user);
 }
 
 uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms)
@@ -522,7 +757,7 @@ uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms)
     if (rx == NULL || rx->len == 0u) {
         return UINT32_MAX;
     }
-    if (rx->ticked == 0u || rx->stats.bytes_in != rx->tick_bytes) {
+    if (rx->ticked == 0u || rx->stats.bytes_in != rx->tick_bytes || rx->lag != 0u) {
         return 0u;
     }
     limit = quiet_limit(rx);

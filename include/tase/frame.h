@@ -38,42 +38,52 @@
  *     there;
  *   - frames are delivered in stream order, each exactly once.
  *
- * LATENCY. A frame that does not lie inside a still-pending earlier
- * candidate is delivered from the call that feeds its last byte (zero
- * added latency). One that does (a pending candidate is one whose last
- * byte has not arrived yet, e.g. after a Size byte corrupted upwards) is
- * held while it does: if such a candidate turns out valid, the frame was
- * its data and is dropped; once every candidate that covered it has
- * failed, it is delivered from the call that fed the last of their last
- * bytes, late by at most TASE_FRAME_MAX - 8 = 253 bytes (each began before
- * it and spans at most TASE_FRAME_MAX bytes). In the callback,
- * stats.bytes_in counts the bytes up to that deciding byte, whatever the
- * split of the stream into calls. tase_rx_flush() settles whatever is
- * pending at end of input: pending candidates can no longer complete, so
- * they fail and what they were hiding is scanned.
+ * LATENCY. A frame is delivered once the stream decides it: by its own
+ * last byte, or, when it lies inside an earlier candidate that is still
+ * pending (a candidate whose last byte has not arrived yet, e.g. after a
+ * Size byte corrupted upwards), by the last byte of the last such
+ * candidate to fail (if one turns out valid, the frame was its data and
+ * is dropped); that is at most TASE_FRAME_MAX - 8 = 253 bytes after its
+ * own last byte (each began before it and spans at most TASE_FRAME_MAX
+ * bytes). The scan behind it does a bounded amount of work per byte (COST
+ * below), so when one byte decides much at once (a failed candidate over
+ * a window full of candidates or frames) the scan lags, and the frame
+ * comes out at most TASE_RX_LATE_MAX bytes after the byte that decided
+ * it, from the call that feeds that later byte, or earlier from a
+ * tase_rx_tick() (each tick continues a lagging scan like a byte would).
+ * Frames, their order, offsets and the final counters are those of the
+ * greedy scan exactly; only that moment moves. In the callback,
+ * stats.bytes_in counts the bytes fed up to the delivering byte, and the
+ * other counters the candidates judged so far. The result is the same for
+ * any split of the stream into calls (seen_at included).
+ * tase_rx_flush() settles whatever is pending at end of input: the scan
+ * catches up, pending candidates can no longer complete, so they fail and
+ * what they were hiding is scanned.
  *
- * COST. The receiver keeps only the earliest pending candidate (the bytes
- * after it are not examined until it is decided), so the scan position
- * never moves back: each byte is examined once, each candidate's checksum
- * is computed once. tase_rx_push() stores a byte inside a frame with one
- * test; the sync bytes and the Size byte are handled next to it, and the
- * last byte sums the frame once. A buffer fed with tase_rx_feed() is
- * scanned in place: idle bytes are skipped with memchr, and a frame wholly
- * inside the buffer is checked and delivered straight from it. On a clean
- * telemetry stream (x86-64 gcc -O2, callgrind) that is about 6
- * instructions per byte fed in 4 KB buffers and about 23 fed one byte at a
- * time with tase_rx_push(), where the classic single-state parser of
- * bench/ costs 24; on Cortex-M4 (-O2, QEMU) about 6 and 33 Thumb-2
- * instructions per byte (classic: 32). A stream made only of false syncs
- * claiming 253 data bytes is the worst case, about 160 (190 byte at a
- * time): every candidate there fails and is summed. docs/PERFORMANCE.md
- * has the measured numbers.
+ * COST. The scan position never moves back: each byte is examined once,
+ * each candidate judged once, and a candidate's checksum is read off
+ * running sums plus the shorter of the two stretches between them and its
+ * checksum bytes (at most half the window, 2 bytes for a candidate whose
+ * last byte just came). Every call spends at most a fixed budget of work
+ * on the scan per byte it takes in (and a call with no byte, or a tick,
+ * one byte's worth), then stops; the scan goes on in the next call. So
+ * every call has a worst case that does not depend on the stream:
+ * docs/TIMING.md lists it per function, measured on Cortex-M4 and M0+ on
+ * the adversarial streams of bench/. tase_rx_push() stores a byte inside
+ * a frame with one test, a store and an add; the sync bytes, the Size
+ * byte and the last byte of a valid frame (its checksum is two bytes off
+ * the running sum) are handled beside it without the general path. A
+ * buffer fed with tase_rx_feed() takes noise and the bytes of a held
+ * candidate in bulk (memchr, memcpy, one checksum pass). On telemetry a
+ * byte costs about as much as in a classic single-state parser; the worst
+ * streams measured, false syncs every 4 bytes (each failing after its
+ * 261st byte), cost about 110 Thumb instructions per byte on a Cortex-M4
+ * (-O2) and 160 on an M0+ (-Os). docs/PERFORMANCE.md has the numbers.
  *
- * RAM. sizeof(tase_rx_t) is TASE_FRAME_MAX window bytes + counters + 5
- * bytes of state + 16 of the time bound (312 in all); checked against TASE_RX_SIZE_BUDGET at
- * compile time. Stack: see docs/FOOTPRINT.md. See
- * docs/DESIGN.md for why the 272-byte target of the original brief cannot
- * hold with 32-bit counters in the instance.
+ * RAM. sizeof(tase_rx_t) is 356: the TASE_RX_WINDOW (300) window bytes (a
+ * frame and the room a lagging scan needs), 28 of counters, 15 of the time
+ * bound and 13 of scan state; checked against TASE_RX_SIZE_BUDGET at
+ * compile time. Stack: see docs/FOOTPRINT.md.
  *
  * TIME BOUND. A held candidate waits for its last byte, and with it every
  * frame inside it. On a link that goes quiet (a command link: a few
@@ -189,6 +199,10 @@ typedef struct {
                                  of a group/type the schema does not know */
 } tase_rx_stats_t;
 
+/* Bytes the receiver's window holds: a whole frame (TASE_FRAME_MAX) and
+ * the slack the resumable scan needs (frame.h COST, docs/DESIGN.md). */
+#define TASE_RX_WINDOW 300u
+
 /* Receiver instance. Treat every field except `stats` as private. */
 typedef struct {
     tase_rx_stats_t stats;
@@ -201,19 +215,35 @@ typedef struct {
     uint32_t quiet_since;
     uint16_t margin_ms;
     uint8_t ticked;
-    /* buf[0..len) holds nothing, a partial sync, or the earliest pending
-     * candidate from its first byte; `end` is the index of that
-     * candidate's last byte (0 when none is held, and during a call);
-     * `busy` is set while a call (and so its callback) runs. */
+    /* `busy` is set while a call (and so its callback) runs; `lag` while
+     * the scan has not caught up with the bytes held. */
     uint8_t busy;
+    uint8_t lag;
+    uint8_t spare;
+    /* buf[0..len) holds the bytes not yet decided from buf[scan] on (see
+     * src/tase_frame.c); `end` is the index of the last byte of the
+     * candidate held at buf[scan] once the scan has caught up (0 when
+     * none, and during a call); sum_len and sum_scan are running sums of
+     * buf up to len and up to scan. */
     uint16_t len;
     uint16_t end;
-    uint8_t buf[TASE_FRAME_MAX];
+    uint16_t scan;
+    uint16_t sum_len;
+    uint16_t sum_scan;
+    uint8_t buf[TASE_RX_WINDOW];
 } tase_rx_t;
+
+/* How many bytes after the byte that decides it a frame may be delivered
+ * (LATENCY above): the scan's lag, bounded in src/tase_frame.c. */
+#define TASE_RX_LATE_MAX 224u
+
+/* How many candidates a call judges (and so frames it delivers) at most
+ * per byte it takes in, and per tick (COST above). */
+#define TASE_RX_JUDGE_MAX 12u
 
 /* Upper bound on sizeof(tase_rx_t) (the same on 32- and 64-bit targets:
  * the instance holds no pointers), enforced at compile time in tase_frame.c. */
-#define TASE_RX_SIZE_BUDGET 312u
+#define TASE_RX_SIZE_BUDGET 360u
 
 /* Called once per valid frame, in stream order. See RE-ENTRANCY above for
  * what it may call on the same receiver. */
@@ -249,24 +279,24 @@ int tase_rx_init(tase_rx_t *rx);
  *   TASE_EBUSY called from inside a callback of this receiver;
  * and then nothing is consumed and rx is unchanged.
  * Feeding a stream one byte at a time or in any split gives the same
- * frames, offsets and counters. Cost O(n) on a stream without
- * overlapping candidates; worst case O(n * TASE_FRAME_MAX) (each
- * candidate's checksum is summed once, and candidates worth summing are at
- * least 4 bytes apart). Longest single step: the call that feeds the last
- * byte of a failing candidate scans the rest of the window, which may hold
- * up to about 64 overlapping complete candidates to sum (bounded by
- * TASE_FRAME_MAX^2 / 8 byte additions), plus the callbacks. */
+ * frames, offsets, counters and moments of delivery. Feeding 0 bytes
+ * continues a lagging scan. Cost O(n): per byte taken in, at most a fixed
+ * budget of scan work (COST), plus the callbacks; worst case per call on
+ * Cortex-M in docs/TIMING.md. */
 int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
                  void *user);
 
 /* Feed one byte: the same as tase_rx_feed(rx, &byte, 1, on_frame, user),
  * for callers that get one byte at a time (a UART interrupt's ring). A
- * byte inside a frame is only stored, and a frame's Size and last byte are
- * handled here too, so a clean stream never takes the general path.
- * Returns the number of frames delivered (0 or 1 on a clean stream; more
- * when a failing candidate releases frames it was hiding), or TASE_EARG
- * (rx NULL or visibly corrupted) / TASE_EBUSY (inside a callback of this
- * receiver), receiver unchanged. Longest block: as tase_rx_feed(). */
+ * byte inside a frame is only stored, and a frame's sync, Size and last
+ * byte are handled here too, so a clean stream never takes the general
+ * path. Returns the number of frames delivered (0 or 1 on a clean stream;
+ * a few more while a lagging scan releases frames), or TASE_EARG (rx NULL
+ * or visibly corrupted) / TASE_EBUSY (inside a callback of this
+ * receiver), receiver unchanged. Longest block: one byte's budget of scan
+ * work plus one compaction of the window and the callbacks of the frames
+ * that work releases: bounded whatever the stream (docs/TIMING.md: the
+ * measured worst case on Cortex-M4 and M0+ and the stream that gives it). */
 int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user);
 
 /* End of input (end of a capture file, link closed): settle what is
@@ -275,7 +305,10 @@ int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *
  * bytes after its first sync byte are scanned: frames found there are
  * delivered. Afterwards the receiver is empty (counters kept) and ready for
  * a new stream. Returns frames delivered (>= 0), or TASE_EARG /
- * TASE_EBUSY as tase_rx_feed() (receiver unchanged). */
+ * TASE_EBUSY as tase_rx_feed() (receiver unchanged). Longest block: the
+ * whole window's scan work (at most one window of TASE_RX_WINDOW
+ * positions, its candidates and frames), with no budget: end of input is
+ * where everything is decided (docs/TIMING.md). */
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user);
 
 /* The byte rate taken when none is set: 9600 baud 8N1. */
@@ -300,8 +333,10 @@ int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms);
  * returns 0. The first tick after tase_rx_init() only notes the time. A
  * now_ms earlier than the noted time (a stale sample: a difference of
  * 2^31 or more) counts as no time passed. Returns TASE_EARG / TASE_EBUSY
- * as tase_rx_flush() (receiver unchanged). Longest block: as
- * tase_rx_flush() when it settles, O(1) otherwise. */
+ * as tase_rx_flush() (receiver unchanged). A tick also continues a
+ * lagging scan (one byte's budget, and its frames are counted in the
+ * return value). Longest block: as tase_rx_flush() when it settles, as
+ * tase_rx_push() otherwise. */
 int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, void *user);
 
 /* How long (ms from now_ms) the caller may wait for bytes before it must
@@ -309,8 +344,8 @@ int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, voi
  * (bytes fed since the last tick, or the limit has passed), UINT32_MAX
  * when nothing is held (no bound to keep), else what is left of the quiet
  * limit. A blocking reader waits at most this long (the roles' service
- * calls do). UINT32_MAX for rx NULL. O(1), reentrant; allowed from the
- * callback. */
+ * calls do); 0 also while the scan lags (ticks continue it). UINT32_MAX
+ * for rx NULL. O(1), reentrant; allowed from the callback. */
 uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms);
 
 /* Zero every counter, nothing else. Returns TASE_OK or TASE_EARG (rx

@@ -231,7 +231,7 @@ typedef struct {
  * is NULL leaves that port absent: nothing is sent there), app is copied
  * (NULL: no callbacks), setup packets take their defaults and every
  * stream is anchored at now_ms (first packets one period later).
- * rx is the caller's array of nports receivers (312 bytes each), one per
+ * rx is the caller's array of nports receivers (356 bytes each), one per
  * port, used by tase_gimbal_feed() and tase_gimbal_service(); init
  * initialises them, sets each one's time bound to its port's byte rate
  * (tase_rx_set_timing()) and keeps the pointer. Each port's telemetry

@@ -48,6 +48,7 @@ int tase_bm_dma_poll(tase_bm_dma_t *d, uint32_t written, uint32_t now_ms, tase_r
     if (r < 0) {
         return r;
     }
+    frames = r; /* the probe may finish a scan the last call left pending */
     fresh = written - d->read;
     if (fresh >= 0x80000000u) {
         fresh = 0; /* a stale sample: the DMA cannot run backwards */

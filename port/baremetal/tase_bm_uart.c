@@ -47,6 +47,7 @@ int tase_bm_uart_poll(tase_bm_uart_t *u, tase_rx_t *rx, tase_rx_handler_t on_fra
         if (r < 0) {
             return r;
         }
+        frames = r; /* the probe may finish a scan the last call left pending */
     }
     budget = tase_ring_capacity(&u->rx);
     while (budget > 0) {

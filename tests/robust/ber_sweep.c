@@ -261,7 +261,7 @@ static void run(const channel_t *ch, size_t npk, result_t *res)
         if (k < npk && p[k].out_start == d->offset && p[k].flips == 0u && !p[k].moved &&
             d->len == p[k].len) {
             p[k].outcome = OUT_CLEAN;
-            if (d->seen_at - (d->offset + d->len) > TASE_FRAME_MAX - 8u) {
+            if (d->seen_at - (d->offset + d->len) > TASE_FRAME_MAX - 8u + TASE_RX_LATE_MAX) {
                 FAIL(res, "%s: packet %zu delivered %u bytes late", ch->name, k,
                      (unsigned)(d->seen_at - (d->offset + d->len)));
             }

@@ -1,4 +1,4 @@
-/* Minimal Cortex-M4 startup for the benchmark image on QEMU's mps2-an386:
+/* Minimal Cortex-M startup for the benchmark image on QEMU's mps2-an386:
  * the vector table, a reset handler that sets up C and semihosting, and a
  * fault handler that ends the run with a failure status. */
 #include <stdint.h>

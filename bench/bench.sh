@@ -1,0 +1,416 @@
+#!/usr/bin/env bash
+# Receiver benchmark (issue 21): a program that reports numbers, never a
+# pass/fail test. Writes docs/PERFORMANCE.md with:
+#   0. issue 21's targets side by side: the longest single call and the
+#      sustained cost per byte on Cortex-M4 -O2/-Os and Cortex-M0+ -Os under
+#      QEMU (exact instruction counts, bench/cm/bench_cm.c), typical cost
+#      beside a classic parser, framing flash, push-path stack, sizeof;
+#   1. x86-64 gcc -O2, callgrind, one program run per stream: instructions
+#      per byte of tase_rx_push() and tase_rx_feed() beside a classic
+#      single-state parser and a store-and-sum loop (bench/classic_rx.c);
+#   2. x86-64, per stream and chunk size, framing and framing + dispatch
+#      (callgrind --toggle-collect, cross-checked by subtracting a run that
+#      feeds nothing), and MB/s (wall clock, informational);
+#   3. the Cortex-M runs of 0 in full, per stream.
+# Usage: bench/bench.sh [--out FILE] [--build DIR]
+set -euo pipefail
+. "$(dirname "$0")/../scripts/lib.sh"
+out="$TASE_ROOT/docs/PERFORMANCE.md"
+bdir="$TASE_ROOT/build-bench"
+while [ $# -gt 0 ]; do
+    case $1 in
+        --out) out=$2; shift 2 ;;
+        --build) bdir=$2; shift 2 ;;
+        *) echo "usage: $0 [--out FILE] [--build DIR]"; exit 2 ;;
+    esac
+done
+tase_need base firmware
+mkdir -p "$bdir"
+cd "$TASE_ROOT" # the build commands below are quoted relative to it
+warn=(-Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wshadow -Werror)
+cflags=(-std=c99 -O2 -g "${warn[@]}")
+variants=(framing)
+if [ -f "$TASE_ROOT/include/tase/dispatch.h" ]; then
+    cflags+=(-DBENCH_DISPATCH)
+    variants+=(dispatch)
+fi
+srcs=(src/*.c bench/classic_rx.c bench/streams.c bench/bench_rx.c)
+build_cmd="gcc ${cflags[*]} -Iinclude src/*.c ${srcs[*]:${#srcs[@]}-3} -o ${bdir#$TASE_ROOT/}/bench_rx"
+gcc "${cflags[@]}" -Iinclude "${srcs[@]}" -o "$bdir/bench_rx"
+bin="$bdir/bench_rx"
+streams=(telemetry badsize sync4 syncrand noise zeros held255 burst)
+
+# ir ARGS...: instructions counted by callgrind (all of them, or only inside
+# one function when the first argument is --toggle-collect=...).
+ir() {
+    local f="$bdir/callgrind.out"
+    valgrind --tool=callgrind --callgrind-out-file="$f" "$@" >/dev/null 2>&1
+    awk '/^totals:/ {print $2}' "$f"
+}
+per_byte() { awk -v a="$1" -v b="$2" 'BEGIN {printf "%.1f", a / b}'; }
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN {printf "%.2f", a / b}'; }
+le() { awk -v a="$1" -v b="$2" 'BEGIN {exit !(a <= b)}'; }
+met() { if le "$1" "$2"; then echo met; else echo "**missed**"; fi; }
+# inclusive FUNCTION: callgrind's inclusive cost of FUNCTION in the last run.
+inclusive() {
+    callgrind_annotate --inclusive=yes --threshold=100 "$bdir/callgrind.out" 2>/dev/null |
+        awk -v fn=":$1 " 'index($0, fn) && $0 !~ /=>/ {gsub(",", "", $1); print $1; exit}'
+}
+
+# 1. One run per stream: classic, store-and-sum, push, feed 4096.
+cmp_rows=()
+for stream in "${streams[@]}"; do
+    line=$("$bin" "$stream" 4096 compare)
+    bytes=$(sed -n 's/.*bytes=\([0-9]*\).*/\1/p' <<<"$line")
+    cframes=$(sed -n 's/.*classic_frames=\([0-9]*\).*/\1/p' <<<"$line")
+    pframes=$(sed -n 's/.*push_frames=\([0-9]*\).*/\1/p' <<<"$line")
+    ir "$bin" "$stream" 4096 compare >/dev/null
+    c=$(per_byte "$(inclusive classic_rx_push)" "$bytes")
+    s=$(per_byte "$(inclusive store_sum_push)" "$bytes")
+    p=$(per_byte "$(inclusive tase_rx_push)" "$bytes")
+    f=$(per_byte "$(inclusive tase_rx_feed)" "$bytes")
+    cmp_rows+=("| $stream | $bytes | $cframes | $pframes | $s | $c | $p | $(ratio "$p" "$c") | $f |")
+    echo "${cmp_rows[-1]}"
+    if [ "$stream" = telemetry ]; then
+        t_classic=$c t_store=$s t_push=$p t_feed=$f
+    fi
+done
+
+# 2. Per stream and chunk size, framing and dispatch.
+rows=()
+worst_name="" worst=0 worst4096=0 worst4096_name=""
+for stream in "${streams[@]}"; do
+    for variant in "${variants[@]}"; do
+        [ "$variant" = dispatch ] && [ "$stream" != telemetry ] && continue
+        extra=(); [ "$variant" = dispatch ] && extra=(dispatch)
+        line=$("$bin" "$stream" 4096 once "${extra[@]}")
+        bytes=$(sed -n 's/.*bytes=\([0-9]*\).*/\1/p' <<<"$line")
+        frames=$(sed -n 's/.*frames=\([0-9]*\).*/\1/p' <<<"$line")
+        cols=()
+        for chunk in 4096 64 1; do
+            tog=tase_rx_feed
+            [ "$chunk" = 1 ] && tog=tase_rx_push # chunk 1 goes through tase_rx_push()
+            n=$(ir --toggle-collect="$tog" "$bin" "$stream" "$chunk" once "${extra[@]}")
+            cols+=("$(per_byte "$n" "$bytes")")
+        done
+        full=$(ir "$bin" "$stream" 4096 once "${extra[@]}")
+        empty=$(ir "$bin" "$stream" 4096 empty "${extra[@]}")
+        cross=$(per_byte $((full - empty)) "$bytes")
+        mb4096=$("$bin" "$stream" 4096 time "${extra[@]}" | sed -n 's/mbps=\([0-9.]*\).*/\1/p')
+        mb1=$("$bin" "$stream" 1 time "${extra[@]}" | sed -n 's/mbps=\([0-9.]*\).*/\1/p')
+        rows+=("| $stream | $variant | $bytes | $frames | ${cols[0]} | ${cols[1]} | ${cols[2]} | $cross | $mb4096 | $mb1 |")
+        echo "${rows[-1]}"
+        if [ "$stream" != telemetry ] && ! le "${cols[2]}" "$worst"; then
+            worst=${cols[2]} worst_name=$stream
+        fi
+        if [ "$stream" != telemetry ] && ! le "${cols[0]}" "$worst4096"; then
+            worst4096=${cols[0]} worst4096_name=$stream
+        fi
+        if [ "$stream" = telemetry ] && [ "$variant" = dispatch ]; then
+            tele_dispatch=${cols[0]}
+        fi
+        if [ "$stream" = telemetry ] && [ "$variant" = framing ]; then
+            tele=${cols[0]} tele1=${cols[2]}
+            ir --toggle-collect='tase_rx_feed' "$bin" telemetry 4096 once >/dev/null
+            profile=$(callgrind_annotate --inclusive=no --auto=no "$bdir/callgrind.out" 2>/dev/null |
+                      grep -E '^ *[0-9,]+ +\(' | grep -v 'PROGRAM TOTALS' | head -8 |
+                      sed -E "s#$TASE_ROOT/##; s# \[[^]]*\]##; s#^ *#    #")
+        fi
+    done
+done
+
+# 3. Cortex-M in QEMU: M4 -O2, M4 -Os, M0+ -Os (ARMv6-M code on the M4 board).
+targets=("cortex-m4 O2" "cortex-m4 Os" "cortex-m0plus Os")
+cm_cmd() {
+    echo "arm-none-eabi-gcc -std=c99 -mcpu=$1 -mthumb -$2 -g ${cmwarn[*]}" \
+         "-ffunction-sections -fdata-sections -Iinclude src/tase_frame.c bench/classic_rx.c" \
+         "bench/streams.c bench/cm/bench_cm.c bench/cm/measure.c bench/cm/startup.c -T bench/cm/mps2.ld" \
+         "--specs=rdimon.specs -nostartfiles -Wl,--gc-sections -o ${bdir#$TASE_ROOT/}/cm_$1_$2.elf"
+}
+declare -A cm
+cmwarn=("${warn[@]/-Wpedantic/}") # startup.c needs GNU attributes and inline assembly
+cmwarn=(${cmwarn[@]})
+for t in "${targets[@]}"; do
+    set -- $t
+    key="$1-$2"
+    eval "$(cm_cmd "$1" "$2")"
+    timeout 900 qemu-system-arm -M mps2-an386 -nographic -monitor none -icount shift=0 \
+        -semihosting-config enable=on,target=native -kernel "$bdir/cm_$1_$2.elf" > "$bdir/cm_$key.txt"
+    while read -r kind a b c d e f; do
+        case $kind in
+            calibration) cm[$key,calibration]=$a ;;
+            loop) cm[$key,loop,$a,$b]=$d cm[$key,bytes,$b]=$c cm[$key,frames,$a,$b]=$e ;;
+            maxcall) cm[$key,max,$a,$b]=$c cm[$key,maxat,$a,$b]=$d cm[$key,maxn,$a,$b]="$e/$f" ;;
+            stack) cm[$key,stack,$a]=$b ;;
+            sizeof) cm[sizeof]=$b ;;
+        esac
+    done < "$bdir/cm_$key.txt"
+    [ "${cm[$key,calibration]:-}" = 2000000 ] ||
+        { echo "QEMU calibration loop ($key): ${cm[$key,calibration]:-none} instructions, want 2000000"; exit 1; }
+done
+# net FUNC STREAM KEY: instructions per byte of a byte loop, the caller's loop (an empty call) taken off
+net() { awk -v a="${cm[$3,loop,$1,$2]}" -v e="${cm[$3,loop,empty,$2]}" -v b="${cm[$3,bytes,$2]}" 'BEGIN {printf "%.1f", (a - e) / b}'; }
+# perb FUNC STREAM KEY: instructions per byte, loop included (feed: one call per chunk)
+perb() { awk -v a="${cm[$3,loop,$1,$2]}" -v b="${cm[$3,bytes,$2]}" 'BEGIN {printf "%.1f", a / b}'; }
+# maxof FUNC KEY: the longest call over all streams, and which stream
+maxof() {
+    local best=0 at="" s
+    for s in "${streams[@]}"; do
+        if [ "${cm[$2,max,$1,$s]}" -gt "$best" ]; then best=${cm[$2,max,$1,$s]} at=$s; fi
+    done
+    echo "$best $at"
+}
+# worstof FUNC KEY: the highest sustained cost per byte over the adversarial streams
+worstof() {
+    local best=0 at="" s v
+    for s in "${streams[@]}"; do
+        [ "$s" = telemetry ] && continue
+        if [ "$1" = tase_rx_push ]; then v=$(net "$1" "$s" "$2"); else v=$(perb "$1" "$s" "$2"); fi
+        if ! le "$v" "$best"; then best=$v at=$s; fi
+    done
+    echo "$best $at"
+}
+
+# 4. docs/TIMING.md: worst case per call of the public functions of src/
+# (bench/cm/timing.c), M4 -O2 and M0+ -Os, beside the receiver's longest
+# push/feed calls of part 3.
+timing_out="$(dirname "$out")/TIMING.md"
+declare -A tm
+timing_cmd() {
+    echo "arm-none-eabi-gcc -std=c99 -mcpu=$1 -mthumb -$2 -g ${cmwarn[*]}" \
+         "-ffunction-sections -fdata-sections -Iinclude src/*.c bench/streams.c bench/cm/timing.c" \
+         "bench/cm/measure.c bench/cm/startup.c -T bench/cm/mps2.ld --specs=rdimon.specs" \
+         "-nostartfiles -Wl,--gc-sections -o ${bdir#$TASE_ROOT/}/timing_$1_$2.elf"
+}
+timing_fns=()
+for t in "cortex-m4 O2" "cortex-m0plus Os"; do
+    set -- $t
+    key="$1-$2"
+    eval "$(timing_cmd "$1" "$2")" || { echo "bench/cm/timing.c no longer builds against src/: adapt it"; exit 1; }
+    timeout 900 qemu-system-arm -M mps2-an386 -nographic -monitor none -icount shift=0 \
+        -semihosting-config enable=on,target=native -kernel "$bdir/timing_$1_$2.elf" > "$bdir/timing_$key.txt"
+    grep -qx done "$bdir/timing_$key.txt" || { echo "timing run ($key) did not finish"; exit 1; }
+    while read -r kind fn insns input; do
+        [ "$kind" = timing ] || continue
+        [ "$key" = cortex-m4-O2 ] && timing_fns+=("$fn")
+        tm[$key,$fn]=$insns tm[input,$fn]=${input//_/ }
+    done < "$bdir/timing_$key.txt"
+done
+# every public function of src/ (the headers' declarations), to list what is not measured
+mapfile -t public_fns < <(grep -ho '^[a-z][a-z0-9_ *]* \**tase_[a-z0-9_]*(' include/tase/*.h |
+                          sed 's/($//; s/.*[ *]//' | sort -u)
+
+# 5. Framing flash: init/push/feed/flush linked alone, M4 -Os.
+fl="$bdir/flash"
+mkdir -p "$fl"
+flash_cc=(arm-none-eabi-gcc -std=c99 -mcpu=cortex-m4 -mthumb -Os -ffunction-sections -fdata-sections -Iinclude)
+"${flash_cc[@]}" -c src/tase_frame.c -o "$fl/tase_frame.o"
+"${flash_cc[@]}" -c bench/cm/framing.c -o "$fl/framing.o"
+arm-none-eabi-gcc -mcpu=cortex-m4 -mthumb --specs=nosys.specs -Wl,--gc-sections \
+    -Wl,-Map="$fl/framing.map" "$fl/framing.o" "$fl/tase_frame.o" -o "$fl/framing.elf"
+flash_rows=$(awk '/^Linker script and memory map/ {on=1} !on {next}
+    /^ \.(text|rodata)/ {sec=$1; if (NF>=4) {print sec, $3, $4; sec=""} next}
+    sec!="" && NF>=3 && $1 ~ /^0x/ {print sec, $2, $3; sec=""} {sec=""}' "$fl/framing.map" |
+    grep 'tase_frame\.o' | while read -r sec size _; do echo "$sec $((size))"; done)
+flash=$(awk '{s += $2} END {print s}' <<<"$flash_rows")
+flash_list=$(awk '{sub(/^\.(text|rodata)\./, ""); printf "%s%s %d", sep, $1, $2; sep=", "}' <<<"$flash_rows")
+
+# The issue's targets (issue 21, "Done when").
+K4=cortex-m4-O2 K4s=cortex-m4-Os K0=cortex-m0plus-Os
+read -r push4 push4_at <<<"$(maxof tase_rx_push $K4)"
+read -r push4s push4s_at <<<"$(maxof tase_rx_push $K4s)"
+read -r push0 push0_at <<<"$(maxof tase_rx_push $K0)"
+read -r f16 f16_at <<<"$(maxof tase_rx_feed/16 $K4)"
+read -r f64 f64_at <<<"$(maxof tase_rx_feed/64 $K4)"
+read -r f64_0 f64_0_at <<<"$(maxof tase_rx_feed/64 $K0)"
+read -r sus4 sus4_at <<<"$(worstof tase_rx_push $K4)"
+read -r sus0 sus0_at <<<"$(worstof tase_rx_push $K0)"
+read -r sus4f sus4f_at <<<"$(worstof tase_rx_feed/64 $K4)"
+read -r sus0f sus0f_at <<<"$(worstof tase_rx_feed/64 $K0)"
+typ4=$(net tase_rx_push telemetry $K4) cls4=$(net classic telemetry $K4)
+typ0=$(net tase_rx_push telemetry $K0) cls0=$(net classic telemetry $K0)
+stack=0 stack_at=""
+for s in "${streams[@]}"; do
+    v=${cm[$K4s,stack,tase_rx_push/$s]}
+    if [ "$v" -gt "$stack" ]; then stack=$v stack_at=$s; fi
+done
+# A hand-kept section at the end of the file (the Python package's numbers,
+# from python/bench/decode_bench.py) survives regeneration.
+kept=$(sed -n '/^<!-- Not generated by scripts\/bench.sh/,$p' "$out" 2>/dev/null || true)
+{
+    echo "# Receiver performance"
+    echo
+    echo "<!-- GENERATED by bench/bench.sh; do not edit by hand. -->"
+    echo "Generated by \`bench/bench.sh\` on $(uname -m), $(gcc --version | head -1),"
+    echo "$(valgrind --version), $(arm-none-eabi-gcc --version | head -1),"
+    echo "$(qemu-system-arm --version | head -1)."
+    echo
+    echo "Streams (256 KiB each, deterministic, \`bench/streams.c\`): **telemetry** = GIMBAL_ANGLE"
+    echo "(6 data bytes) and GIMBAL_RATE (18) at 10 Hz with GEOREFERENCE_DATA (63) at 4 Hz, back"
+    echo "to back; **badsize** = the same with every other frame's Size byte random; **sync4** ="
+    echo "\`00 FF 5A FF\` repeated (every 4-byte group is a false sync claiming 253 data bytes, so"
+    echo "a candidate fails every 4 bytes); **syncrand** = \`00 FF 5A\` + random Size, repeated;"
+    echo "**noise** = uniform random bytes; **zeros** = all 0x00; **held255** = \`00 FF 5A FF\`"
+    echo "then 63 groups \`00 FF 5A (255-4k)\`, k = 1..63, repeated (64 complete false"
+    echo "candidates decided by one byte: issue 21's longest call); **burst** = \`00 FF 5A FF\`,"
+    echo "31 valid empty frames and 9 noise bytes, repeated (one byte releases 31 frames)."
+    echo
+    echo "## Issue 21's targets side by side"
+    echo
+    echo "Cortex-M counts are exact Thumb instruction counts under QEMU (\`bench/cm/bench_cm.c\`,"
+    echo "method below); \"longest call\" is the longest single call over every stream above"
+    echo "(the stream named), including the caller's argument setup and branch."
+    echo
+    echo "| target | measured | goal | |"
+    echo "|---|---:|---:|---|"
+    echo "| longest \`tase_rx_push()\`, M4 -O2 | $push4 ($push4_at) | <= 1000 | $(met "$push4" 1000) |"
+    echo "| longest \`tase_rx_push()\`, M4 -Os | $push4s ($push4s_at) | | |"
+    echo "| longest \`tase_rx_push()\`, M0+ -Os | $push0 ($push0_at) | <= 2500 | $(met "$push0" 2500) |"
+    echo "| longest 16-byte \`tase_rx_feed()\`, M4 -O2 | $f16 ($f16_at) | <= 4000 | $(met "$f16" 4000) |"
+    echo "| longest 64-byte \`tase_rx_feed()\`, M4 -O2 | $f64 ($f64_at) | <= 4000 | $(met "$f64" 4000) |"
+    echo "| longest 64-byte \`tase_rx_feed()\`, M0+ -Os | $f64_0 ($f64_0_at) | | |"
+    echo "| worst sustained, push, instr/byte, M4 -O2 | $sus4 ($sus4_at) | <= 100 | $(met "$sus4" 100) |"
+    echo "| worst sustained, push, instr/byte, M0+ -Os | $sus0 ($sus0_at) | <= 250 | $(met "$sus0" 250) |"
+    echo "| worst sustained, 64-byte feed, instr/byte, M4 -O2 | $sus4f ($sus4f_at) | <= 100 | $(met "$sus4f" 100) |"
+    echo "| worst sustained, 64-byte feed, instr/byte, M0+ -Os | $sus0f ($sus0f_at) | <= 250 | $(met "$sus0f" 250) |"
+    echo "| telemetry, push net instr/byte vs classic parser, M4 -O2 | $typ4 vs $cls4 ($(ratio "$typ4" "$cls4")x) | <= 1.0x | $(met "$(ratio "$typ4" "$cls4")" 1.0) |"
+    echo "| telemetry, push net instr/byte vs classic parser, M0+ -Os | $typ0 vs $cls0 ($(ratio "$typ0" "$cls0")x) | <= 1.0x | $(met "$(ratio "$typ0" "$cls0")" 1.0) |"
+    echo "| framing flash (init/push/feed/flush), M4 -Os | $flash B | <= 1024 | $(met "$flash" 1024) |"
+    echo "| push-path stack, M4 -Os, trivial callback (painted) | $stack B ($stack_at) | <= 128 | $(met "$stack" 128) |"
+    echo "| \`sizeof(tase_rx_t)\` (Cortex-M) | ${cm[sizeof]} | <= 360 | $(met "${cm[sizeof]}" 360) |"
+    echo
+    echo "Framing flash is the sum of the input sections of src/tase_frame.c left in an M4 -Os"
+    echo "image that calls only those four functions (\`bench/cm/framing.c\`, linked with"
+    echo "\`--gc-sections\`): $flash_list."
+    echo
+    echo "## Cortex-M (QEMU), per stream"
+    echo
+    echo "\`bench/cm/bench_cm.c\` runs on QEMU's \`mps2-an386\` (a Cortex-M4) with \`-icount shift=0\`:"
+    echo "the virtual clock advances one nanosecond per executed instruction, and the board's"
+    echo "CMSDK APB timer 0 counts at 25 MHz of that clock, so one tick is 40 instructions (a"
+    echo "calibration loop of exactly 2,000,000 instructions reads ${cm[$K4,calibration]}). M0+ images are"
+    echo "ARMv6-M code (\`-mcpu=cortex-m0plus\`): the M4 executes it instruction for instruction, and"
+    echo "QEMU has no M0+ board. Built with \`$(cm_cmd cortex-m4 O2)\`"
+    echo "(and \`-mcpu=cortex-m4 -Os\`, \`-mcpu=cortex-m0plus -Os\`), run with \`qemu-system-arm -M"
+    echo "mps2-an386 -icount shift=0 -semihosting-config enable=on,target=native -kernel ...\`."
+    echo
+    echo "- **Per byte**: a whole 256 KiB stream, timer read before and after (exact to 40 in"
+    echo "  millions). Byte loops (store-and-sum, classic parser, \`tase_rx_push\`) are shown net of"
+    echo "  the caller's loop: the same loop around a call of an empty function is subtracted."
+    echo "  \`tase_rx_feed\` is called once per 4096, 64 or 16 bytes (loop included)."
+    echo "- **Longest call, exact**: every call of the first 8 KiB of the stream is timed once"
+    echo "  (+-39 instructions); then the stream is replayed and each call whose coarse count is within"
+    echo "  79 of the largest (no other can be longer) is repeated 200 times from a copy of the"
+    echo "  receiver taken before it, against the same loop around an empty function: the"
+    echo "  difference / 200 is exact after rounding (error < 0.4). At most 64 such calls per stream"
+    echo "  are counted exactly (the column says how many of how many candidates)."
+    echo
+    for t in "${targets[@]}"; do
+        set -- $t
+        key="$1-$2"
+        echo "### $1 -$2"
+        echo
+        echo "| stream | classic net/byte | push net/byte | feed 4096 /byte | feed 64 /byte | feed 16 /byte | longest push (call #, exact/candidates) | longest feed 16 | longest feed 64 | frames |"
+        echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        for s in "${streams[@]}"; do
+            echo "| $s | $(net classic "$s" "$key") | $(net tase_rx_push "$s" "$key") | $(perb tase_rx_feed/4096 "$s" "$key") | $(perb tase_rx_feed/64 "$s" "$key") | $(perb tase_rx_feed/16 "$s" "$key") | ${cm[$key,max,tase_rx_push,$s]} (#${cm[$key,maxat,tase_rx_push,$s]}, ${cm[$key,maxn,tase_rx_push,$s]}) | ${cm[$key,max,tase_rx_feed/16,$s]} | ${cm[$key,max,tase_rx_feed/64,$s]} | ${cm[$key,frames,tase_rx_push,$s]} |"
+        done
+        echo
+    done
+    echo "Push-path stack by painting (M4 -Os, bytes below the caller's stack pointer, trivial"
+    echo "callback):$(for s in "${streams[@]}"; do printf ' %s %s;' "$s" "${cm[$K4s,stack,tase_rx_push/$s]}"; done)"
+    echo
+    echo "## Byte at a time beside a classic parser (x86-64, one program run per stream)"
+    echo
+    echo "\`bench_rx STREAM 4096 compare\` (\`bench/bench_rx.c\`, built with"
+    echo "\`$build_cmd\`)"
+    echo "feeds each stream, in one run, to the classic single-state parser of"
+    echo "\`bench/classic_rx.c\` (a switch over sync1, sync2, sync3, Size, body and checksum, no"
+    echo "window: it loses the frames behind a false sync or a corrupted Size), to the"
+    echo "store-and-sum loop there (store the byte, add it to a sum: the floor of any byte-at-a-time"
+    echo "receiver), to \`tase_rx_push()\` one byte per call, and to \`tase_rx_feed()\` in 4096-byte"
+    echo "calls. Instructions per byte = callgrind's inclusive cost of each function (the frame"
+    echo "callback included) / stream bytes; the caller's loop is not counted."
+    echo
+    echo "| stream | bytes | frames (classic) | frames (tase) | store-and-sum | classic parser | tase_rx_push | push / classic | tase_rx_feed (4096) |"
+    echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+    printf '%s\n' "${cmp_rows[@]}"
+    echo
+    echo "## Per stream and chunk size (x86-64)"
+    echo
+    echo "**Instructions per byte** are counted by"
+    echo "\`valgrind --tool=callgrind --toggle-collect=tase_rx_feed bench_rx STREAM CHUNK once\`"
+    echo "(\`--toggle-collect=tase_rx_push\` for chunk 1, which feeds one byte per"
+    echo "\`tase_rx_push()\` call): only instructions executed inside that function (and what it"
+    echo "calls: libc's memchr/memcpy, the frame callback) count, divided by the stream length."
+    echo "They are repeatable on any machine with the same compiler and libc. The cross-check"
+    echo "column counts the whole program instead and subtracts a run that builds the stream but"
+    echo "feeds nothing (it also includes \`tase_rx_init\`/\`tase_rx_flush\`). **MB/s** is wall clock"
+    echo "on a shared machine: informational only. CHUNK is the number of bytes per call: 4096 is a"
+    echo "\`read()\` from a tty or socket, 64 a DMA half-buffer, 1 a firmware that feeds each byte"
+    echo "from its UART interrupt ring. Variant **framing** = a trivial callback; **dispatch** ="
+    echo "frames through \`tase_dispatch_frame\` (typed decode + one trivial handler per packet"
+    echo "type)$( [ ${#variants[@]} -eq 1 ] && echo ": not measured, include/tase/dispatch.h is not in this tree yet")."
+    echo
+    echo "| stream | variant | bytes | frames | instr/byte chunk 4096 | chunk 64 | chunk 1 | cross-check (4096) | MB/s chunk 4096 | MB/s chunk 1 |"
+    echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+    printf '%s\n' "${rows[@]}"
+    echo
+    echo "On x86-64 (gcc -O2, callgrind) the telemetry stream costs $t_push instructions per byte"
+    echo "through \`tase_rx_push\` against the classic parser's $t_classic (store-and-sum floor"
+    echo "$t_store), and $tele per byte through 4096-byte \`tase_rx_feed\` calls$( [ -n "${tele_dispatch:-}" ] && echo " ($tele_dispatch with typed decode and dispatch)")."
+    echo "Where the telemetry stream's instructions go (chunk 4096, exclusive cost per function;"
+    echo "static functions of src/tase_frame.c that gcc inlined are counted in their caller):"
+    echo
+    echo "$profile"
+} > "$out"
+if [ -n "$kept" ]; then
+    printf '\n%s\n' "$kept" >>"$out"
+fi
+echo "wrote $out"
+
+{
+    echo "# Worst case per call"
+    echo
+    echo "<!-- GENERATED by bench/bench.sh; do not edit by hand. -->"
+    echo "Generated by \`bench/bench.sh\` with $(arm-none-eabi-gcc --version | head -1) and"
+    echo "$(qemu-system-arm --version | head -1)."
+    echo
+    echo "Exact instruction counts of one call (Thumb instructions, QEMU \`mps2-an386\` with"
+    echo "\`-icount shift=0\`; M0+ is ARMv6-M code run on that board, see PERFORMANCE.md), each on"
+    echo "the input built to be its worst, named in the last column. A call is counted as a caller"
+    echo "makes it (its argument setup and branch included), from a state put back before every"
+    echo "repetition (\`bench/cm/measure.c\`: 200 repetitions against the same loop around an empty"
+    echo "function, exact after rounding). Callbacks are trivial (add a length to a counter)."
+    echo "Programs: \`bench/cm/timing.c\` (built with \`$(timing_cmd cortex-m4 O2)\`) and, for"
+    echo "\`tase_rx_push\`/\`tase_rx_feed\`, \`bench/cm/bench_cm.c\` (the longest call over every"
+    echo "call of the first 8 KiB of each stream of PERFORMANCE.md)."
+    echo
+    echo "| function | M4 -O2 | M0+ -Os | worst-case input |"
+    echo "|---|---:|---:|---|"
+    for f in tase_rx_push tase_rx_feed/16 tase_rx_feed/64; do
+        read -r a a_at <<<"$(maxof "$f" cortex-m4-O2)"
+        read -r b b_at <<<"$(maxof "$f" cortex-m0plus-Os)"
+        echo "| \`$f\` | $a | $b | one call of the $a_at stream (M4), $b_at (M0+); bench/streams.h |"
+    done
+    for f in "${timing_fns[@]}"; do
+        echo "| \`$f\` | ${tm[cortex-m4-O2,$f]} | ${tm[cortex-m0plus-Os,$f]:-?} | ${tm[input,$f]} |"
+    done
+    echo
+    echo "\`tase_rx_flush\` and a settling \`tase_rx_tick\` decide the whole window at once (end of"
+    echo "input); every other receiver call spends at most a fixed budget of scan work per byte it"
+    echo "takes in (include/tase/frame.h, COST), so a \`tase_rx_feed\` of n bytes costs at most n times"
+    echo "the longest \`tase_rx_push\` plus its copying."
+    echo
+    echo "Public functions of src/ not measured here yet (their headers state their bounds in"
+    echo "O() terms):"
+    echo
+    for f in "${public_fns[@]}"; do
+        case " ${timing_fns[*]} tase_rx_push tase_rx_feed " in
+            *" $f "* | *" $f/"*) ;;
+            *) printf '%s' "\`$f\` " ;;
+        esac
+    done
+    echo
+} > "$timing_out"
+echo "wrote $timing_out"

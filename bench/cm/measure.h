@@ -1,0 +1,33 @@
+/*
+ * bench/cm/measure.h - exact instruction counts under QEMU -icount
+ * shift=0 on mps2-an386 (bench_cm.c, timing.c): see bench_cm.c, THE CLOCK.
+ */
+#ifndef BENCH_CM_MEASURE_H
+#define BENCH_CM_MEASURE_H
+
+#include <stdint.h>
+
+#define MEASURE_REPS 200u
+
+/* Start the CMSDK timer (call once). */
+void measure_start(void);
+
+/* Timer value (counts down, 40 instructions per tick). */
+uint32_t measure_ticks(void);
+
+/* Instructions since measure_ticks() returned t0, to 40. */
+unsigned long measure_since(uint32_t t0);
+
+/* A step of a measurement, on a context. */
+typedef void (*measure_fn)(void *ctx);
+
+/* Exact instructions of call(ctx) right after setup(ctx) (which puts the
+ * state back), as a caller that passes ctx makes the call (the argument
+ * setup and branch included): both run MEASURE_REPS times, against the
+ * same loop around an empty function. */
+unsigned long measure_exact(measure_fn setup, measure_fn call, void *ctx);
+
+/* Exactly 2 * n instructions (n >= 1): the calibration loop. */
+void measure_known_loop(uint32_t n);
+
+#endif /* BENCH_CM_MEASURE_H */
