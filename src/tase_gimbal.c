@@ -529,7 +529,7 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
      * receiver's stack unwound. The first round takes no byte when n is 0. */
     do {
         size_t k = n - done < FEED_PIECE ? n - done : FEED_PIECE;
-        r = tase_rx_feed(&g->rx[port], k > 0u ? &bytes[done] : NULL, k, gimbal_rx, g);
+        r = tase_rx_feed(&g->rx[port], bytes != NULL ? &bytes[done] : NULL, k, gimbal_rx, g);
         if (r >= 0) {
             frames += r;
             done += k;

@@ -1508,6 +1508,7 @@ static void commands_reach_the_dispatcher_typed_with_their_port(void **state)
     memset(&a, 0, sizeof a);
     memset(&app, 0, sizeof app);
     memset(ports, 0, sizeof ports);
+    memset(data, 0, sizeof data);
     a.g = &x->g;
     a.port = -100;
     for (i = 0; i < 3; i++) {
