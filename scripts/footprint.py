@@ -41,7 +41,7 @@ def optional(module):
 # The "whole core" of issue 8: framing, dispatch, all codecs, CAN and KLV.
 # Other modules (host/gimbal roles, candump text logs, port helpers) are
 # reported on their own row, outside the 4 KB budget.
-CORE_MODULES = ("frame", "dispatch", "schema", "codec", "can", "klv")
+CORE_MODULES = ("frame", "frame_time", "dispatch", "schema", "codec", "can", "klv")
 
 # Engineering-unit conversions done in double precision (they pull the
 # soft-float library on most MCUs); firmware that forwards raw values does
@@ -542,7 +542,7 @@ def main():
           biggest("schema")))
     core_gap = m4["core"][0] - TARGET_CORE_FLASH
     p("- **Whole core flash, %d B against 4096 (%s).** By module (object file, everything "
-      "compiled in): %s. Framing is the receiver above plus the encoder; KLV (the MISB ST 0601 "
+      "compiled in): %s. Framing (frame, frame_time) is the receiver above plus its time bound and the encoder; KLV (the MISB ST 0601 "
       "metadata encoder, decoder and stream receiver) is the other large one; the schema is the ROM description of all 21 packets and their fields that the "
       "codec, dispatcher and tools share." % (
           m4["core"][0], "met" if core_gap <= 0 else "+%d" % core_gap,

@@ -1,7 +1,10 @@
 /*
- * Frame encoder and receiver. The contract (which frames, order, latency,
- * cost per call, re-entrancy) is in include/tase/frame.h; comments here
- * explain how.
+ * Frame encoder, checksum and receiver: everything of include/tase/frame.h
+ * that takes stream bytes. The contract (which frames, order, latency, cost
+ * per call, re-entrancy) is in frame.h; comments here explain how. The
+ * receiver's set-up and its time bound (tase_rx_init(),
+ * tase_rx_stats_reset(), tase_rx_set_timing(), tase_rx_tick(),
+ * tase_rx_quiet_ms()) are src/tase_frame_time.c.
  *
  * The receiver runs the greedy scan of frame.h online, over a window
  * buf[0..len) of the bytes received and not yet decided. buf[scan] is the
@@ -46,6 +49,8 @@
 #include <limits.h>
 #include <string.h>
 
+#include "tase_frame_private.h"
+
 #define RX_CAP ((uint16_t)TASE_RX_WINDOW)
 
 /* Work units of the scan per byte taken in, and what a delivery costs
@@ -54,10 +59,6 @@
 #define RX_COST_STEP 16u
 #define RX_COST_FRAME 16u
 #define RX_UNLIMITED UINT32_MAX
-
-/* `end` while a call runs or the scan lags: every fast path of
- * tase_rx_push() fails on it (see the file comment). */
-#define RX_BLOCKED 0xFFFFu
 
 /* Work a window can hold for the scan, in units: every position a step
  * (RX_COST_STEP), every judged candidate (one per sync, so at most every
@@ -198,28 +199,6 @@ int tase_frame_encode(uint8_t *out, size_t cap, uint8_t group, uint8_t type, con
     out[len + TASE_FRAME_HEADER] = (uint8_t)(sum >> 8);
     out[len + TASE_FRAME_HEADER + 1u] = (uint8_t)(sum & 0xFFu);
     return (int)total;
-}
-
-int tase_rx_init(tase_rx_t *rx)
-{
-    if (rx == NULL) {
-        return TASE_EARG;
-    }
-    /* Clears `busy` too: a call whose callback re-initialises the receiver
-     * sees that and returns without touching it again. */
-    (void)memset(rx, 0, sizeof(*rx));
-    rx->margin_ms = (uint16_t)TASE_RX_QUIET_MS;
-    return TASE_OK;
-}
-
-int tase_rx_stats_reset(tase_rx_t *rx)
-{
-    if (rx == NULL) {
-        return TASE_EARG;
-    }
-    (void)memset(&rx->stats, 0, sizeof(rx->stats));
-    rx->tick_bytes = 0u; /* bytes fed from here on still count as activity */
-    return TASE_OK;
 }
 
 static const uint8_t sync[3] = {TASE_SYNC1, TASE_SYNC2, TASE_SYNC3};
@@ -696,72 +675,15 @@ int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
     return (r != TASE_OK) ? r : run(rx, rx->buf, 0u, true, on_frame, user);
 }
 
-int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms)
+/* The time bound's two ways into the scan (tase_frame_private.h): thin
+ * wrappers, so that the static rx_check() and run() keep the callers gcc
+ * compiled them for. */
+int tase_rx_state_check(const tase_rx_t *rx)
 {
-    int r = rx_check(rx);
-    if (r == TASE_OK) {
-        rx->rate = bytes_per_s;
-        rx->margin_ms = (margin_ms != 0u) ? margin_ms : (uint16_t)TASE_RX_QUIET_MS;
-    }
-    return r;
+    return rx_check(rx);
 }
 
-/* The quiet limit of what the window holds (frame.h, TIME BOUND): the
- * time its remaining bytes need at the link's rate, or the margin. The
- * remaining bytes run to the held candidate's last byte, or, for a partial
- * sync or a scan not caught up, to the last byte of a maximal frame
- * beginning at the scan position. */
-static uint32_t quiet_limit(const tase_rx_t *rx)
+int tase_rx_continue(tase_rx_t *rx, bool settle, tase_rx_handler_t on_frame, void *user)
 {
-    uint32_t rate = (rx->rate != 0u) ? rx->rate : TASE_RX_SLOWEST_RATE;
-    uint32_t last = (rx->end != 0u && rx->end != RX_BLOCKED) ? (uint32_t)rx->end + 1u
-                                                             : (uint32_t)rx->scan + TASE_FRAME_MAX;
-    uint32_t left = (last > rx->len) ? last - rx->len : 0u;
-    uint32_t ms = (left * 1000u + rate - 1u) / rate; /* at most 261,000 / 1 */
-    return (ms > rx->margin_ms) ? ms : rx->margin_ms;
-}
-
-/* Milliseconds from `since` to `now`; 0 for a sample older than `since`
- * (a difference of 2^31 or more, the port contract's "not yet"). */
-static uint32_t quiet_for(uint32_t now, uint32_t since)
-{
-    uint32_t d = now - since;
-    return (d >= 0x80000000u) ? 0u : d;
-}
-
-int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, void *user)
-{
-    int r = rx_check(rx);
-    bool settle = false;
-    if (r != TASE_OK) {
-        return r;
-    }
-    if (rx->ticked == 0u || rx->stats.bytes_in != rx->tick_bytes) {
-        rx->ticked = 1u;
-        rx->tick_bytes = rx->stats.bytes_in;
-        rx->quiet_since = now_ms;
-    } else {
-        settle = rx->len != 0u && quiet_for(now_ms, rx->quiet_since) > quiet_limit(rx);
-    }
-    if (!settle && rx->lag == 0u) {
-        return 0;
-    }
-    /* a lagging scan goes on; past the quiet limit, as at end of input */
     return run(rx, rx->buf, 0u, settle, on_frame, user);
-}
-
-uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms)
-{
-    uint32_t limit;
-    uint32_t quiet;
-    if (rx == NULL || rx->len == 0u) {
-        return UINT32_MAX;
-    }
-    if (rx->ticked == 0u || rx->stats.bytes_in != rx->tick_bytes || rx->lag != 0u) {
-        return 0u;
-    }
-    limit = quiet_limit(rx);
-    quiet = quiet_for(now_ms, rx->quiet_since);
-    /* a tick settles once the quiet time is past the limit: one ms more */
-    return (quiet > limit) ? 0u : limit - quiet + 1u;
 }

@@ -1,7 +1,8 @@
 /* The framing entry points and nothing else, for the flash measurement of
  * bench/bench.sh: linked with --gc-sections, what is left of
- * src/tase_frame.c is what a firmware that calls tase_rx_init(),
- * tase_rx_push(), tase_rx_feed() and tase_rx_flush() carries. */
+ * src/tase_frame.c and src/tase_frame_time.c is what a firmware that calls
+ * tase_rx_init(), tase_rx_push(), tase_rx_feed() and tase_rx_flush()
+ * carries. */
 #include "tase/frame.h"
 
 static void on_frame(void *user, const tase_frame_t *f)

@@ -1,0 +1,104 @@
+/*
+ * The receiver's set-up and its time bound (include/tase/frame.h, TIME
+ * BOUND): tase_rx_init() and tase_rx_stats_reset(), which also set and
+ * reset the time bound's state, tase_rx_set_timing(), tase_rx_tick() and
+ * tase_rx_quiet_ms(). A settle is the end of input of the scan in
+ * src/tase_frame.c, reached through tase_rx_continue().
+ */
+#include "tase/frame.h"
+
+#include <string.h>
+
+#include "tase_frame_private.h"
+
+int tase_rx_init(tase_rx_t *rx)
+{
+    if (rx == NULL) {
+        return TASE_EARG;
+    }
+    /* Clears `busy` too: a call whose callback re-initialises the receiver
+     * sees that and returns without touching it again. */
+    (void)memset(rx, 0, sizeof(*rx));
+    rx->margin_ms = (uint16_t)TASE_RX_QUIET_MS;
+    return TASE_OK;
+}
+
+int tase_rx_stats_reset(tase_rx_t *rx)
+{
+    if (rx == NULL) {
+        return TASE_EARG;
+    }
+    (void)memset(&rx->stats, 0, sizeof(rx->stats));
+    rx->tick_bytes = 0u; /* bytes fed from here on still count as activity */
+    return TASE_OK;
+}
+
+int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms)
+{
+    int r = tase_rx_state_check(rx);
+    if (r == TASE_OK) {
+        rx->rate = bytes_per_s;
+        rx->margin_ms = (margin_ms != 0u) ? margin_ms : (uint16_t)TASE_RX_QUIET_MS;
+    }
+    return r;
+}
+
+/* The quiet limit of what the window holds (frame.h, TIME BOUND): the
+ * time its remaining bytes need at the link's rate, or the margin. The
+ * remaining bytes run to the held candidate's last byte, or, for a partial
+ * sync or a scan not caught up, to the last byte of a maximal frame
+ * beginning at the scan position. */
+static uint32_t quiet_limit(const tase_rx_t *rx)
+{
+    uint32_t rate = (rx->rate != 0u) ? rx->rate : TASE_RX_SLOWEST_RATE;
+    uint32_t last = (rx->end != 0u && rx->end != RX_BLOCKED) ? (uint32_t)rx->end + 1u
+                                                             : (uint32_t)rx->scan + TASE_FRAME_MAX;
+    uint32_t left = (last > rx->len) ? last - rx->len : 0u;
+    uint32_t ms = (left * 1000u + rate - 1u) / rate; /* at most 261,000 / 1 */
+    return (ms > rx->margin_ms) ? ms : rx->margin_ms;
+}
+
+/* Milliseconds from `since` to `now`; 0 for a sample older than `since`
+ * (a difference of 2^31 or more, the port contract's "not yet"). */
+static uint32_t quiet_for(uint32_t now, uint32_t since)
+{
+    uint32_t d = now - since;
+    return (d >= 0x80000000u) ? 0u : d;
+}
+
+int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, void *user)
+{
+    int r = tase_rx_state_check(rx);
+    bool settle = false;
+    if (r != TASE_OK) {
+        return r;
+    }
+    if (rx->ticked == 0u || rx->stats.bytes_in != rx->tick_bytes) {
+        rx->ticked = 1u;
+        rx->tick_bytes = rx->stats.bytes_in;
+        rx->quiet_since = now_ms;
+    } else {
+        settle = rx->len != 0u && quiet_for(now_ms, rx->quiet_since) > quiet_limit(rx);
+    }
+    if (!settle && rx->lag == 0u) {
+        return 0;
+    }
+    /* a lagging scan goes on; past the quiet limit, as at end of input */
+    return tase_rx_continue(rx, settle, on_frame, user);
+}
+
+uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms)
+{
+    uint32_t limit;
+    uint32_t quiet;
+    if (rx == NULL || rx->len == 0u) {
+        return UINT32_MAX;
+    }
+    if (rx->ticked == 0u || rx->stats.bytes_in != rx->tick_bytes || rx->lag != 0u) {
+        return 0u;
+    }
+    limit = quiet_limit(rx);
+    quiet = quiet_for(now_ms, rx->quiet_since);
+    /* a tick settles once the quiet time is past the limit: one ms more */
+    return (quiet > limit) ? 0u : limit - quiet + 1u;
+}
