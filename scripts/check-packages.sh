@@ -99,7 +99,7 @@ for p in tase tase-sim; do
     if v=$("$root/usr/bin/$p" --version 2>/dev/null); then
         [[ $v == *"$version"* ]] || tase_fail "$p --version says '$v', the library is $version"
         echo "   $p --version: $v"
-    elif grep -q -- '"--version"' "$TASE_ROOT/tools/"*.c; then
+    elif grep -rq --include='*.c' -- '"--version"' "$TASE_ROOT/tools/"; then
         tase_fail "$p --version failed"
     else
         echo "   $p: no --version option in tools/ yet (issue 15); --help runs"

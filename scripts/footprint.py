@@ -156,6 +156,63 @@ def stack_graph(bdir):
     return own, edges, names
 
 
+def rx_handler_sites(bdir):
+    """Functions of the receiver (tase_frame*.c, tase_rx*.c) that call
+    through a function pointer: the call of the frame handler."""
+    sites = set()
+    for ci in glob.glob(os.path.join(bdir, "CMakeFiles", "tase.dir", "src", "*.ci")):
+        base = os.path.basename(ci)
+        if not (base.startswith("tase_frame") or base.startswith("tase_rx")):
+            continue
+        for line in open(ci):
+            m = re.match(r'edge: \{ sourcename: "([^"]+)" targetname: "__indirect_call"', line)
+            if m:
+                sites.add(m.group(1))
+    return sites
+
+
+# Role entry points (issue 26): the frame handler a role gives its own
+# receiver is followed from the receiver's call site; the application's
+# callbacks and the port's functions are not (their stack is theirs).
+ROLE_ROOTS = [
+    ("tase_gimbal_feed", "gimbal_rx", 256),
+    ("tase_gimbal_poll", None, 256),
+    ("tase_gimbal_service", "gimbal_rx", None),
+    ("tase_gimbal_handle_frame", None, None),
+    ("tase_gimbal_send", None, None),
+    ("tase_gimbal_send_msg", None, None),
+    ("tase_host_feed", "host_rx", None),
+    ("tase_host_service", "host_rx", None),
+    ("tase_host_poll", None, None),
+    ("tase_host_send_msg", None, None),
+    ("tase_port_send_frame", None, None),
+    ("tase_port_send_msg", None, 128),
+]
+
+
+def role_stack(root, handler, own, edges, names, sites):
+    """worst_stack() of root with the receiver's handler call bound to the
+    role's own handler (a static function, matched by name)."""
+    if root not in own:
+        return None
+    if handler is None:
+        return worst_stack(root, own, edges, names, {})
+    h = [t for t in own if t.endswith(":" + handler) or t == handler]
+    if not h:
+        return None
+    own2 = dict(own)
+    own2["__rx_handler"] = 0
+    names2 = dict(names)
+    names2["__rx_handler"] = "(frame handler)"
+    edges2 = {k: set(v) for k, v in edges.items()}
+    for src in sites:
+        if src in edges2 and "__indirect_call" in edges2[src]:
+            edges2[src].discard("__indirect_call")
+            edges2[src].add("__rx_handler")
+    edges2["__rx_handler"] = {h[0]}
+    return worst_stack(root, own2, edges2, names2, {})
+
+
 def worst_stack(fn, own, edges, names, memo):
     """Deepest chain below fn (the core has no recursion, so a plain
     depth-first walk ends). Returns (bytes, chain, externals reached)."""
@@ -364,6 +421,7 @@ def main():
             "rest_names": sorted(m for m in objs if m not in CORE_MODULES and not optional(m)),
             "types": sizeof_types(cpu, args.build),
             "graph": stack_graph(bdir),
+            "sites": rx_handler_sites(bdir),
             "objs": objs,
             "dispatch": has_dispatch,
         }
@@ -588,6 +646,29 @@ def main():
     p("")
     d, chain, ext = rx_stack("cortex-m4")
     p("Receive path on Cortex-M4: %d bytes, %s." % (d, " > ".join(chain)))
+    p("")
+    p("### Role entry points")
+    p("")
+    p("The deepest stack of each entry point of the roles and the send calls, with the frame "
+      "handler a role gives its own receiver followed from the receiver's call site (so "
+      "`tase_gimbal_feed` includes handling a setup packet). Not counted: the application's "
+      "callbacks (on_frame, apply_setup, fill_telemetry, the dispatcher's handlers), the port's "
+      "functions, and libc.")
+    p("")
+    p("| entry point | " + " | ".join(CPUS) + " | target | status (Cortex-M4) | deepest chain (Cortex-M4) |")
+    p("|---|" + "---:|" * len(CPUS) + "---:|---|---|")
+    for root, handler, target in ROLE_ROOTS:
+        got = {}
+        for c in CPUS:
+            own, edges, names, _ = stacks[c]
+            got[c] = role_stack(root, handler, own, edges, names, res[c]["sites"])
+        if got["cortex-m4"] is None:
+            continue
+        p("| `%s` | %s | %s | %s | %s |" % (
+            root, " | ".join(str(got[c][0]) if got[c] else "-" for c in CPUS),
+            target if target else "-",
+            met(got["cortex-m4"][0], target) if target else "informational",
+            " > ".join(got["cortex-m4"][1])))
     p("")
     with open(args.out, "w") as f:
         f.write("\n".join(w))

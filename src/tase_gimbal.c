@@ -12,11 +12,26 @@
 #define SETUP_SYSTEM_VERSION 0x03u
 #define SETUP_PACKET_RATE 0x00u
 #define SETUP_CAMERA_TYPE 0x05u
+#define SETUP_AXIS_SETTING 0x02u
 #define SETUP_MAX 42u          /* longest setup packet: SYSTEM_VERSION */
 #define RATE_BYTES_PER_PORT 5u /* Angle, Rate, Geo-ref, Camera, Reserved */
 #define SETUP_APPLY_MAX 23u    /* longest writable setup packet: AXIS_SETTING */
 #define SERVICE_CHUNK 64u
 #define SERVICE_READS 64u
+#define FEED_PIECE 64u     /* tase_gimbal_feed()'s pieces: echoes in between */
+#define NO_FRAME 0xFFu     /* frame_port outside a callback */
+#define ECHO_SHORT_AXIS 8u /* echo[] index: AXIS_SETTING, 22-byte layout */
+/* g->tx_frame is telemetry's frame during tase_gimbal_poll() and the
+ * setup path's scratch otherwise: the setting offered to the application
+ * at TX_APPLY, the bytes being stored at TX_STORE, an echo's short layout
+ * at 0 (after both are done). */
+#define TX_APPLY 0u
+#define TX_STORE 24u
+typedef char
+    chk_tx_scratch[(TX_STORE >= SETUP_APPLY_MAX &&
+                    TX_STORE + SETUP_MAX <= TASE_GIMBAL_TELEMETRY_MAX + TASE_FRAME_OVERHEAD)
+                       ? 1
+                       : -1];
 
 /* Data length and offset into g->setup of each setup packet (spec 4.4). */
 static const uint8_t setup_len[TASE_GIMBAL_SETUP_TYPES] = {16u, 2u, 23u, 42u, 2u, 3u, 6u, 16u};
@@ -154,7 +169,8 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
         return TASE_EARG;
     }
     if (app != NULL && ((app->fill_telemetry != NULL && app->fill_telemetry_msg != NULL) ||
-                        (app->apply_setup != NULL && app->apply_setup_msg != NULL))) {
+                        (app->apply_setup != NULL && app->apply_setup_msg != NULL) ||
+                        (app->on_frame != NULL && app->dispatch != NULL))) {
         return TASE_EARG; /* which one would be meant? */
     }
     for (i = 0; i < nports; i++) {
@@ -163,6 +179,7 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
         }
     }
     (void)memset(g, 0, sizeof *g);
+    g->frame_port = NO_FRAME;
     for (i = 0; i < nports; i++) {
         g->port[i] = ports[i];
     }
@@ -248,13 +265,22 @@ static void setup_copy(const tase_packet_desc_t *p, const uint8_t *src, size_t s
     (void)memset(dst, 0, dst_len);
     for (i = 0; i < p->nfields; i++) {
         const tase_field_t *f = tase_schema_field(p, i);
+        unsigned w = TASE_FIELD_WIDTH(f);
         const uint8_t *from = &src[tase_layout_offset(f, src_short)];
-        int64_t v;
-        if (cur != NULL && tase_field_get(p, i, src, src_len, &v) == TASE_OK &&
-            tase_field_is_keep(p, i, v)) {
-            from = &cur[tase_layout_offset(f, false)]; /* stored: table layout */
+        uint32_t keep;
+        if (cur != NULL && tase_layout_keep_bits(f, &keep)) {
+            /* the wire bits against the "do not change" bits (fields
+             * with one are at most 4 bytes wide) */
+            uint32_t bits = 0;
+            unsigned k;
+            for (k = 0; k < w; k++) {
+                bits = (bits << 8) | from[k];
+            }
+            if (bits == keep) {
+                from = &cur[tase_layout_offset(f, false)]; /* stored: table layout */
+            }
         }
-        (void)memcpy(&dst[tase_layout_offset(f, dst_short)], from, TASE_FIELD_WIDTH(f));
+        (void)memcpy(&dst[tase_layout_offset(f, dst_short)], from, w);
     }
 }
 
@@ -267,7 +293,7 @@ static const tase_packet_desc_t *setup_desc(uint8_t type)
  * stored with reserved bytes zero and "do not change" fields unchanged. */
 static void setup_store(tase_gimbal_t *g, uint8_t type, const uint8_t *data, uint32_t now_ms)
 {
-    uint8_t tmp[SETUP_MAX];
+    uint8_t *tmp = &g->tx_frame[TX_STORE]; /* not on the stack; after TX_APPLY */
     const tase_packet_desc_t *p = setup_desc(type);
     setup_copy(p, data, p->len, tmp, p->len, &g->setup[setup_off[type]]);
     (void)memcpy(&g->setup[setup_off[type]], tmp, setup_len[type]);
@@ -336,7 +362,7 @@ int tase_gimbal_setup_get_msg(const tase_gimbal_t *g, uint16_t id, void *msg)
 static int apply_setup(tase_gimbal_t *g, unsigned port, uint8_t type, uint8_t *data, size_t len)
 {
     uint16_t id = TASE_ID(TASE_GROUP_SETUP, type);
-    tase_packet_msg_t m;
+    tase_packet_msg_t *m = &g->msg; /* not on the stack (STACK in gimbal.h) */
     int r;
     if (g->app.apply_setup != NULL) {
         return g->app.apply_setup(g->app.user, port, type, data, len);
@@ -345,49 +371,105 @@ static int apply_setup(tase_gimbal_t *g, unsigned port, uint8_t type, uint8_t *d
         return 0;
     }
     /* Cannot fail: a known setup packet of its full length. */
-    (void)tase_packet_decode_data(id, data, len, &m);
-    r = g->app.apply_setup_msg(g->app.user, port, id, &m);
+    (void)tase_packet_decode_data(id, data, len, m);
+    r = g->app.apply_setup_msg(g->app.user, port, id, m);
     if (r >= 0) {
-        (void)tase_packet_encode_data(id, &m, data, len);
+        (void)tase_packet_encode_data(id, m, data, len);
     }
     return r;
 }
 
-static void handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f, uint32_t now_ms)
+/* Write the echo of setup `type` on port: what is in force now, in the
+ * 22-byte layout of AXIS_SETTING when `short_axis`. */
+static void send_echo(tase_gimbal_t *g, unsigned port, uint8_t type, bool short_axis)
+{
+    const uint8_t *cur = &g->setup[setup_off[type]];
+    size_t len = setup_len[type];
+    if (short_axis) {
+        /* laid out in the frame buffer, free outside tase_gimbal_poll() */
+        len = (size_t)setup_len[type] - 1u;
+        setup_copy(setup_desc(type), cur, setup_len[type], g->tx_frame, len, NULL);
+        cur = g->tx_frame;
+    }
+    (void)gimbal_write(g, tase_port_send_frame(&g->port[port], TASE_GROUP_SETUP, type, cur, len));
+}
+
+/* Handle setup frame f: apply it. Returns the echo it owes (an echo[]
+ * index), or -1 for none; the caller writes it or notes it. */
+static int handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f, uint32_t now_ms)
 {
     uint8_t type = f->type;
     const tase_packet_desc_t *p = setup_desc(type);
-    const uint8_t *cur = &g->setup[setup_off[type]];
-    uint8_t tmp[SETUP_APPLY_MAX];
-    size_t echo_len = setup_len[type];
+    bool short_axis = false;
 
     if (!tase_schema_length_ok(p, f->len)) {
         g->stats.bad_length++; /* SYSTEM_VERSION too (R3): 0 or 42 bytes */
-        return;
+        return -1;
     }
     if (f->len == 0 || type == SETUP_SYSTEM_VERSION) {
         g->stats.setup_queries++;
-    } else if (p->len > sizeof tmp) {
+    } else if (p->len > SETUP_APPLY_MAX) {
         g->stats.bad_length++;
-        return;
+        return -1;
     } else {
         /* The application sees the settings asked for in the table's
          * layout: reserved bytes zero, "do not change" resolved. */
-        setup_copy(p, f->data, f->len, tmp, p->len, cur);
+        uint8_t *tmp = &g->tx_frame[TX_APPLY];
+        setup_copy(p, f->data, f->len, tmp, p->len, &g->setup[setup_off[type]]);
         if (apply_setup(g, port, type, tmp, p->len) >= 0) {
             setup_store(g, type, tmp, now_ms);
             g->stats.setup_applied++;
         } else {
             g->stats.setup_refused++;
         }
-        echo_len = f->len; /* answered in the layout it came in */
+        short_axis = f->len != setup_len[type]; /* answered in the layout it came in */
     }
-    /* The echo always carries what is in force now. */
-    if (echo_len != setup_len[type]) {
-        setup_copy(p, cur, p->len, tmp, echo_len, NULL);
-        cur = tmp;
+    /* The echo always carries what is in force when it is written. */
+    return short_axis ? (int)ECHO_SHORT_AXIS : (int)type;
+}
+
+/* Write echo e (an echo[] index) on port. */
+static void send_echo_of(tase_gimbal_t *g, unsigned port, unsigned e)
+{
+    if (e == ECHO_SHORT_AXIS) {
+        send_echo(g, port, SETUP_AXIS_SETTING, true);
+    } else {
+        send_echo(g, port, (uint8_t)e, false);
     }
-    (void)tase_gimbal_send(g, port, TASE_GROUP_SETUP, type, cur, echo_len);
+}
+
+/* Write the echoes the frames of the last piece owe, by setup type. */
+static void send_echoes(tase_gimbal_t *g, unsigned port)
+{
+    unsigned i;
+    for (i = 0; i <= ECHO_SHORT_AXIS; i++) {
+        while (g->echo[i] > 0u) {
+            g->echo[i]--;
+            send_echo_of(g, port, i);
+        }
+    }
+}
+
+/* Handle one frame; returns the echo it owes (handle_setup()) or -1. */
+static int handle(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame, uint32_t now_ms)
+{
+    uint8_t outer = g->frame_port; /* a handler may hand over another frame */
+    int echo = -1;
+    g->stats.frames_rx++;
+    g->frame_port = (uint8_t)port;
+    if (frame->group == TASE_GROUP_SETUP && frame->type < TASE_GIMBAL_SETUP_TYPES) {
+        if (port_present(g, port)) {
+            echo = handle_setup(g, port, frame, now_ms);
+        }
+    } else if (g->app.dispatch != NULL) {
+        tase_dispatch_frame(g->app.dispatch, frame);
+    } else if (g->app.on_frame != NULL) {
+        g->app.on_frame(g->app.user, port, frame);
+    } else {
+        /* nobody to tell */
+    }
+    g->frame_port = outer;
+    return echo;
 }
 
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
@@ -396,56 +478,71 @@ int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t
     if (g == NULL || frame == NULL || frame->data == NULL || port >= TASE_GIMBAL_PORTS) {
         return TASE_EARG;
     }
-    g->stats.frames_rx++;
-    if (frame->group == TASE_GROUP_SETUP && frame->type < TASE_GIMBAL_SETUP_TYPES) {
-        if (port_present(g, port)) {
-            handle_setup(g, port, frame, now_ms);
+    {
+        int e = handle(g, port, frame, now_ms);
+        if (e >= 0) {
+            send_echo_of(g, port, (unsigned)e);
         }
-    } else if (g->app.on_frame != NULL) {
-        g->app.on_frame(g->app.user, port, frame);
-    } else {
-        /* nobody to tell */
     }
     return TASE_OK;
 }
 
-typedef struct {
-    tase_gimbal_t *g;
-    unsigned port;
-    uint32_t now_ms;
-} feed_ctx_t;
+int tase_gimbal_frame_port(const tase_gimbal_t *g)
+{
+    if (g == NULL) {
+        return TASE_EARG;
+    }
+    return g->frame_port == NO_FRAME ? TASE_ESTATE : (int)g->frame_port;
+}
 
+/* The receiver's callback inside tase_gimbal_feed(): g->feed_port and
+ * g->feed_now say where and when. */
 static void gimbal_rx(void *user, const tase_frame_t *frame)
 {
-    feed_ctx_t *c = user;
-    (void)tase_gimbal_handle_frame(c->g, c->port, frame, c->now_ms);
+    tase_gimbal_t *g = user;
+    int e = handle(g, g->feed_port, frame, g->feed_now);
+    if (e >= 0) {
+        /* cannot saturate: a piece of input completes far fewer frames */
+        g->echo[e] = (uint8_t)(g->echo[e] < 0xFFu ? g->echo[e] + 1u : 0xFFu);
+    }
 }
 
 int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
                      uint32_t now_ms)
 {
-    feed_ctx_t c;
+    size_t done = 0;
+    int frames = 0;
     int r;
-    int t;
     if (g == NULL) {
         return TASE_EARG;
     }
     if (g->rx == NULL) {
         return TASE_ESTATE;
     }
-    if (port >= g->nrx) {
+    if (port >= g->nrx || (bytes == NULL && n > 0u)) {
         return TASE_EARG;
     }
-    c.g = g;
-    c.port = port;
-    c.now_ms = now_ms;
-    r = tase_rx_feed(&g->rx[port], bytes, n, gimbal_rx, &c);
-    if (r < 0) {
-        return r;
-    }
+    g->feed_port = (uint8_t)port;
+    g->feed_now = now_ms;
+    /* Pieces: the receiver hands over the frames of a piece (a setup is
+     * applied there), and the echoes they owe are written here, with the
+     * receiver's stack unwound. The first round takes no byte when n is 0. */
+    do {
+        size_t k = n - done < FEED_PIECE ? n - done : FEED_PIECE;
+        r = tase_rx_feed(&g->rx[port], bytes != NULL ? &bytes[done] : NULL, k, gimbal_rx, g);
+        if (r >= 0) {
+            frames += r;
+            done += k;
+        }
+        send_echoes(g, port);
+        if (r < 0) {
+            return r;
+        }
+    } while (done < n);
     /* the bytes' arrival, or (n == 0) a look that found the line quiet */
-    t = tase_rx_tick(&g->rx[port], now_ms, gimbal_rx, &c);
-    return t < 0 ? t : r + t;
+    r = tase_rx_tick(&g->rx[port], now_ms, gimbal_rx, g);
+    send_echoes(g, port);
+    return r < 0 ? r : frames + r;
 }
 
 /* Move a stream to the first slot strictly after now_ms (a late poll
@@ -468,25 +565,24 @@ static void sched_catch_up(tase_gimbal_t *g, tase_gimbal_sched_t *s, uint32_t no
 }
 
 /* Ask the application for telemetry packet id and frame it in
- * frame[0..TASE_FRAME_MAX): the frame length, or < 0 to skip the slot. */
-static int telemetry_frame(tase_gimbal_t *g, unsigned port, uint16_t id, uint8_t *frame,
-                           uint32_t now_ms)
+ * g->tx_frame: the frame length, or < 0 to skip the slot. */
+static int telemetry_frame(tase_gimbal_t *g, unsigned port, uint16_t id, uint32_t now_ms)
 {
+    uint8_t *frame = g->tx_frame;
     int n;
     if (g->app.fill_telemetry_msg != NULL) {
-        tase_packet_msg_t m;
-        (void)memset(&m, 0, sizeof m);
-        n = g->app.fill_telemetry_msg(g->app.user, port, id, &m, now_ms);
-        return n < 0 ? n : tase_packet_encode(id, &m, frame, TASE_FRAME_MAX);
+        (void)memset(&g->msg, 0, sizeof g->msg);
+        n = g->app.fill_telemetry_msg(g->app.user, port, id, &g->msg, now_ms);
+        return n < 0 ? n : tase_packet_encode(id, &g->msg, frame, sizeof g->tx_frame);
     }
     /* The application writes the data where the frame will carry it, and
      * the frame is encoded around it in place: one buffer, not two. */
-    n = g->app.fill_telemetry(g->app.user, port, id, frame + TASE_FRAME_HEADER, TASE_DATA_MAX,
-                              now_ms);
-    if (n < 0 || n > (int)TASE_DATA_MAX) {
+    n = g->app.fill_telemetry(g->app.user, port, id, frame + TASE_FRAME_HEADER,
+                              TASE_GIMBAL_TELEMETRY_MAX, now_ms);
+    if (n < 0 || n > (int)TASE_GIMBAL_TELEMETRY_MAX) {
         return TASE_ERANGE;
     }
-    return tase_frame_encode(frame, TASE_FRAME_MAX, TASE_ID_GROUP(id), TASE_ID_TYPE(id),
+    return tase_frame_encode(frame, sizeof g->tx_frame, TASE_ID_GROUP(id), TASE_ID_TYPE(id),
                              frame + TASE_FRAME_HEADER, (size_t)n);
 }
 
@@ -499,7 +595,6 @@ static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_
     static const uint16_t stream_id[TASE_GIMBAL_STREAMS] = {
         TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE, TASE_ID_GEOREFERENCE_DATA};
     tase_gimbal_sched_t *s = &g->sched[port][stream];
-    uint8_t frame[TASE_FRAME_MAX];
     uint16_t id = stream_id[stream];
     int n;
     int sent = 0;
@@ -512,10 +607,11 @@ static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_
     } else if (!within_budget(g, port, s)) {
         g->stats.slots_over_capacity++;
     } else {
-        n = telemetry_frame(g, port, id, frame, now_ms);
+        n = telemetry_frame(g, port, id, now_ms);
         if (n < 0) {
             g->stats.telemetry_skipped++;
-        } else if (gimbal_write(g, tase_port_write_all(&g->port[port], frame, (size_t)n)) >= 0) {
+        } else if (gimbal_write(g, tase_port_write_all(&g->port[port], g->tx_frame, (size_t)n)) >=
+                   0) {
             g->stats.telemetry_tx++;
             sent = 1;
         } else {

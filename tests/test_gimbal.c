@@ -13,6 +13,7 @@
 #include "fake_port.h"
 #include "fault_port.h"
 #include "tase/codec.h"
+#include "tase/dispatch.h"
 #include "tase/gimbal.h"
 #include "tase/ids.h"
 #include "tase/port_io.h"
@@ -78,7 +79,7 @@ static int app_fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_
     fix_t *x = user;
     unsigned s = stream_of(id);
     assert_true(port < 3);
-    assert_int_equal(cap, TASE_DATA_MAX);
+    assert_int_equal(cap, TASE_GIMBAL_TELEMETRY_MAX);
     if (x->count[port][s] == 0) {
         x->first[port][s] = now;
         x->min_gap[port][s] = 0xFFFFFFFFu;
@@ -116,7 +117,7 @@ static fix_t *make(uint32_t now, unsigned nports, bool with_fill)
 {
     fix_t *x = calloc(1, sizeof *x);
     tase_port_t ports[3];
-    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL, NULL, NULL};
+    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL, NULL, NULL, NULL};
     unsigned i;
     assert_non_null(x);
     memset(ports, 0, sizeof ports);
@@ -764,7 +765,7 @@ static void service_reads_every_port_feeds_it_and_polls(void **state)
     static const tase_port_ops_t broken = {fake_write, broken_read, fake_now};
     fix_t *x = calloc(1, sizeof *x);
     tase_port_t ports[3];
-    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL, NULL, NULL};
+    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL, NULL, NULL, NULL};
     uint8_t g, t, d[TASE_DATA_MAX], noise[5000];
     (void)state;
     assert_non_null(x);
@@ -1454,6 +1455,178 @@ static void the_gimbal_keeps_its_bounds_under_random_faults(void **state)
     free(f);
 }
 
+/* Typed commands through the application's dispatcher (issue 26 item 4). */
+typedef struct {
+    tase_gimbal_t *g;
+    unsigned cmds, queries, errors, defaults;
+    int port;
+    tase_gimbal_cmd_t cmd;
+} cmd_app_t;
+
+static void on_cmd(void *user, const tase_frame_t *f, const void *msg)
+{
+    cmd_app_t *a = user;
+    if (f->len == 0u) {
+        a->queries++;
+    } else {
+        a->cmds++;
+        memcpy(&a->cmd, msg, sizeof a->cmd);
+    }
+    a->port = tase_gimbal_frame_port(a->g);
+}
+
+static void on_cmd_error(void *user, const tase_frame_t *f, int err)
+{
+    cmd_app_t *a = user;
+    (void)f;
+    assert_int_equal(err, TASE_ELENGTH);
+    a->errors++;
+}
+
+static void on_cmd_default(void *user, const tase_frame_t *f)
+{
+    cmd_app_t *a = user;
+    (void)f;
+    a->defaults++;
+}
+
+static void commands_reach_the_dispatcher_typed_with_their_port(void **state)
+{
+    static const tase_packet_handler_t handlers[TASE_PKT_COUNT] = {
+        [TASE_PKT_GIMBAL_CMD] = on_cmd, [TASE_PKT_SPOI_CMD] = on_cmd};
+    fix_t *x = calloc(1, sizeof *x);
+    tase_dispatch_t d;
+    cmd_app_t a;
+    tase_port_t ports[3];
+    tase_gimbal_app_t app;
+    tase_gimbal_cmd_t cmd = {1500, -250, 0, 0x20, 0};
+    uint8_t fr[TASE_FRAME_MAX], g, t, data[TASE_DATA_MAX];
+    int n;
+    unsigned i;
+    (void)state;
+    assert_non_null(x);
+    memset(&a, 0, sizeof a);
+    memset(&app, 0, sizeof app);
+    memset(ports, 0, sizeof ports);
+    memset(data, 0, sizeof data);
+    a.g = &x->g;
+    a.port = -100;
+    for (i = 0; i < 3; i++) {
+        ports[i].ops = &fake_ops;
+        ports[i].ctx = &x->port[i];
+        ports[i].bytes_per_s = 100000u;
+    }
+    assert_int_equal(tase_dispatch_init(&d, handlers, on_cmd_default, on_cmd_error, &a, NULL),
+                     TASE_OK);
+    app.dispatch = &d;
+    app.on_frame = app_other;
+    assert_int_equal(tase_gimbal_init(&x->g, ports, x->rx, 3, &app, 0), TASE_EARG);
+    app.on_frame = NULL;
+    assert_int_equal(tase_gimbal_init(&x->g, ports, x->rx, 3, &app, 0), TASE_OK);
+    assert_int_equal(tase_gimbal_frame_port(&x->g), TASE_ESTATE); /* no frame now */
+    assert_int_equal(tase_gimbal_frame_port(NULL), TASE_EARG);
+
+    n = tase_packet_encode(TASE_ID_GIMBAL_CMD, &cmd, fr, sizeof fr);
+    assert_true(n > 0);
+    assert_int_equal(tase_gimbal_feed(&x->g, 2, fr, (size_t)n, 5), 1);
+    assert_int_equal(a.cmds, 1);
+    assert_int_equal(a.port, 2);
+    assert_int_equal(a.cmd.flags, 0x20);
+    assert_int_equal(a.cmd.pan, 1500);
+    assert_int_equal(a.cmd.tilt, -250);
+    assert_int_equal(tase_gimbal_frame_port(&x->g), TASE_ESTATE);
+    /* a SPOI_CMD query: a zeroed struct, frame->len 0 */
+    n = tase_frame_encode(fr, sizeof fr, TASE_ID_GROUP(TASE_ID_SPOI_CMD),
+                          TASE_ID_TYPE(TASE_ID_SPOI_CMD), NULL, 0);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, fr, (size_t)n, 6), 1);
+    assert_int_equal(a.queries, 1);
+    assert_int_equal(a.port, 0);
+    /* a GIMBAL_CMD of a wrong length: the error hook, no handler */
+    n = tase_frame_encode(fr, sizeof fr, TASE_ID_GROUP(TASE_ID_GIMBAL_CMD),
+                          TASE_ID_TYPE(TASE_ID_GIMBAL_CMD), data, 3);
+    assert_int_equal(tase_gimbal_feed(&x->g, 1, fr, (size_t)n, 7), 1);
+    assert_int_equal(a.errors, 1);
+    assert_int_equal(a.cmds, 1);
+    /* a packet without a handler: the default handler */
+    n = tase_frame_encode(fr, sizeof fr, 0x28, 0x01, data, 2);
+    assert_int_equal(tase_gimbal_feed(&x->g, 1, fr, (size_t)n, 8), 1);
+    assert_int_equal(a.defaults, 1);
+    /* setups stay the role's: answered, never dispatched */
+    n = tase_frame_encode(fr, sizeof fr, 0x48, 0x00, NULL, 0);
+    assert_int_equal(tase_gimbal_feed(&x->g, 1, fr, (size_t)n, 9), 1);
+    assert_int_equal(only_frame(&x->port[1], &g, &t, data), 16);
+    assert_int_equal(a.cmds + a.queries + a.errors + a.defaults, 4);
+    assert_int_equal(x->g.stats.frames_rx, 5);
+    free(x);
+}
+
+/* Echoes are written after the receiver returns: every setup frame of a
+ * long buffer gets its own, none is lost (the count per type would wrap
+ * at 256 in one piece; pieces of 64 bytes keep it far below). */
+static void every_setup_in_a_long_buffer_gets_its_echo(void **state)
+{
+    fix_t *x = make(0, 3, false);
+    static uint8_t buf[4000];
+    size_t n = 0;
+    unsigned q = 0, i;
+    uint8_t axis22[22];
+    (void)state;
+    memset(axis22, 0xFF, sizeof axis22); /* all "do not change" */
+    while (n + 30u + 8u < sizeof buf) {
+        int k;
+        if (q % 5u == 4u) { /* an AXIS_SETTING in its 22-byte layout */
+            k = tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x02, axis22, sizeof axis22);
+        } else {
+            k = tase_frame_encode(&buf[n], sizeof buf - n, 0x48, (uint8_t)(q % 2u), NULL, 0);
+        }
+        assert_true(k > 0);
+        n += (size_t)k;
+        q++;
+    }
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, buf, n, 10), (int)q);
+    assert_int_equal(fake_frames_out(&x->port[0]), q);
+    /* the echoes in the layout asked for: 22-byte AXIS_SETTINGs */
+    {
+        unsigned axis = 0;
+        size_t at = 0;
+        for (i = 0; i < q; i++) {
+            uint8_t len = (uint8_t)(x->port[0].out[at + 3u] - 2u);
+            if (x->port[0].out[at + 5u] == 0x02) {
+                assert_int_equal(len, 22);
+                axis++;
+            }
+            at += (size_t)len + 8u;
+        }
+        assert_int_equal(axis, q / 5u);
+    }
+    assert_int_equal(x->g.stats.setup_queries + x->g.stats.setup_applied, q);
+    free(x);
+}
+
+/* fill_telemetry gets room for the longest telemetry packet; a longer
+ * answer skips the slot (it would not fit the role's frame buffer). */
+static int fill_too_long(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
+                         uint32_t now)
+{
+    (void)user;
+    (void)port;
+    (void)id;
+    (void)now;
+    memset(data, 0x55, cap);
+    return (int)cap + 1;
+}
+
+static void telemetry_longer_than_its_room_is_skipped(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    (void)state;
+    x->g.app.fill_telemetry = fill_too_long;
+    assert_int_equal(tase_gimbal_poll(&x->g, 1000), 0);
+    assert_true(x->g.stats.telemetry_skipped >= 3u);
+    assert_int_equal(fake_frames_out(&x->port[0]), 0);
+    free(x);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1490,6 +1663,9 @@ int main(void)
         cmocka_unit_test(capacity_is_per_port_and_checks_its_arguments),
         cmocka_unit_test(a_stuck_port_costs_one_frame_bound_per_poll),
         cmocka_unit_test(the_gimbal_keeps_its_bounds_under_random_faults),
+        cmocka_unit_test(commands_reach_the_dispatcher_typed_with_their_port),
+        cmocka_unit_test(every_setup_in_a_long_buffer_gets_its_echo),
+        cmocka_unit_test(telemetry_longer_than_its_room_is_skipped),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

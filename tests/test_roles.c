@@ -110,7 +110,7 @@ static void host_and_gimbal_talk_over_a_real_pty(void **state)
     static host_side_t hs;
     tase_posix_uart_t hu;
     tase_port_t hport;
-    tase_gimbal_app_t app = {NULL, fill, gimbal_frame, &gs, NULL, NULL};
+    tase_gimbal_app_t app = {NULL, fill, gimbal_frame, &gs, NULL, NULL, NULL};
     tase_port_t gport;
     pthread_t th;
     uint8_t reply[TASE_DATA_MAX], version[42];

@@ -1,7 +1,8 @@
 /* tase-sim: a simulated TASE gimbal on a pseudo-terminal or a CAN
  * interface, built on the library's gimbal role (tase/gimbal.h). The
- * physics is in sim_model.c; this file is the protocol glue. Behaviour and
- * conventions: docs/TOOLS.md. */
+ * physics is in sim_model.c; this file is the protocol glue (setup
+ * packets, telemetry, KLV, the main loop), the commands it receives are
+ * in sim_commands.c. Behaviour and conventions: docs/TOOLS.md. */
 #define _XOPEN_SOURCE 700
 
 #include <limits.h>
@@ -20,6 +21,7 @@
 #include "tase/gimbal.h"
 #include "tase/klv.h"
 #include "tase/units.h"
+#include "tase_sim.h"
 #include "toolkit.h"
 
 #define STEP_MS 5u         /* model step and service period */
@@ -43,21 +45,7 @@ static const char usage[] =
     "seconds, then removes its links. A link another running tase-sim holds is\n"
     "refused. Exit status: 0 success, 1 failure, 2 bad command line.\n";
 
-typedef struct {
-    tase_gimbal_t g;
-    tase_rx_t rx[TASE_GIMBAL_PORTS]; /* receivers; only the link's port is present */
-    unsigned link;                   /* port index of the link (sim_link_port()) */
-    sim_model_t m;
-    sim_rate_meter_t georef_rate[TASE_GIMBAL_PORTS]; /* GEOREFERENCE_DATA sent */
-    uint32_t t0;                                     /* start, ms */
-    int16_t p, q, r; /* host body rates from HOST_SENSOR, 1/100 deg/s */
-    bool quiet;
-    bool spoi_valid;
-    bool version_due;       /* the cameras changed: store SYSTEM_VERSION again */
-    int gps_said, att_said; /* what the log last said of HOST_GPS_DATA/_ATTITUDE */
-} sim_t;
-
-static void logf_(const sim_t *s, uint32_t now, const char *fmt, ...)
+void sim_log(const sim_t *s, uint32_t now, const char *fmt, ...)
 {
     va_list ap;
     if (s->quiet) {
@@ -71,7 +59,7 @@ static void logf_(const sim_t *s, uint32_t now, const char *fmt, ...)
     fflush(stdout);
 }
 
-static void send_packet(sim_t *s, unsigned port, uint16_t id, const void *msg)
+void sim_send_packet(sim_t *s, unsigned port, uint16_t id, const void *msg)
 {
     (void)tase_gimbal_send_msg(&s->g, port, id, msg);
 }
@@ -109,16 +97,16 @@ static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
     if (id == TASE_ID_AXIS_SETTING) {
         const tase_axis_setting_t *a = msg;
         if (a->pan_max_rate == 0 || a->tilt_max_rate == 0) {
-            logf_(s, now, "AXIS_SETTING refused: a max rate of 0 would lock the axis");
+            sim_log(s, now, "AXIS_SETTING refused: a max rate of 0 would lock the axis");
             return -1;
         }
         apply_axis(s, a);
-        logf_(s, now,
-              "AXIS_SETTING: pan no-go %.2f+-%.2f, tilt no-go %.2f+-%.2f, max rates "
-              "%.0f/%.0f deg/s (%s)",
-              s->m.axis_pan.nogo_center, s->m.axis_pan.nogo_range / 2, s->m.axis_tilt.nogo_center,
-              s->m.axis_tilt.nogo_range / 2, s->m.axis_pan.max_rate, s->m.axis_tilt.max_rate,
-              storage(a->temporary));
+        sim_log(s, now,
+                "AXIS_SETTING: pan no-go %.2f+-%.2f, tilt no-go %.2f+-%.2f, max rates "
+                "%.0f/%.0f deg/s (%s)",
+                s->m.axis_pan.nogo_center, s->m.axis_pan.nogo_range / 2, s->m.axis_tilt.nogo_center,
+                s->m.axis_tilt.nogo_range / 2, s->m.axis_pan.max_rate, s->m.axis_tilt.max_rate,
+                storage(a->temporary));
     } else if (id == TASE_ID_PACKET_RATE) {
         const tase_packet_rate_t *r = msg;
         const uint8_t a[] = {r->angle_1, r->angle_2, r->angle_3};
@@ -128,25 +116,25 @@ static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
         for (i = 0; i < TASE_GIMBAL_PORTS; i++) {
             sim_rate_reset(&s->georef_rate[i], now);
         }
-        logf_(s, now, "PACKET_RATE: port %u (this link) angle %u/s, rate %u/s, georef %u/s (%s)",
-              s->link + 1u, a[s->link], t[s->link], g[s->link], storage(r->temporary));
+        sim_log(s, now, "PACKET_RATE: port %u (this link) angle %u/s, rate %u/s, georef %u/s (%s)",
+                s->link + 1u, a[s->link], t[s->link], g[s->link], storage(r->temporary));
     } else if (id == TASE_ID_CAMERA_TYPE) {
         const tase_camera_type_t *c = msg;
         const uint8_t types[SIM_CAMERAS] = {c->camera_a, c->camera_b, c->camera_c};
         sim_model_camera_types(&s->m, types);
         s->version_due = true; /* SYSTEM_VERSION reports the same cameras */
-        logf_(s, now, "CAMERA_TYPE: cameras %u/%u/%u, SYSTEM_VERSION follows (" STORED ")",
-              c->camera_a, c->camera_b, c->camera_c);
+        sim_log(s, now, "CAMERA_TYPE: cameras %u/%u/%u, SYSTEM_VERSION follows (" STORED ")",
+                c->camera_a, c->camera_b, c->camera_c);
     } else if (id == TASE_ID_NAV_SOURCE) {
         const tase_nav_source_t *n = msg;
         sim_model_nav_source(&s->m, n->external_attitude != 0, n->external_gps != 0);
-        logf_(s, now, "NAV_SOURCE: attitude from %s, position from %s (" STORED ")",
-              n->external_attitude ? "HOST_ATTITUDE" : "the gimbal's own GPS/INS",
-              n->external_gps ? "HOST_GPS_DATA" : "the gimbal's own GPS/INS");
+        sim_log(s, now, "NAV_SOURCE: attitude from %s, position from %s (" STORED ")",
+                n->external_attitude ? "HOST_ATTITUDE" : "the gimbal's own GPS/INS",
+                n->external_gps ? "HOST_GPS_DATA" : "the gimbal's own GPS/INS");
         s->gps_said = s->att_said = -1;
     } else {
-        logf_(s, now, "%s: stored, not modelled (" STORED ")",
-              tase_schema_packet_name(tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id))));
+        sim_log(s, now, "%s: stored, not modelled (" STORED ")",
+                tase_schema_packet_name(tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id))));
     }
     return 0;
 }
@@ -271,216 +259,6 @@ static int fill_telemetry(void *user, unsigned port, uint16_t id, void *msg, uin
         return 0;
     }
     return -1;
-}
-
-/* ---- commands and host data ---- */
-
-/* SPOI_CMD from the gimbal: the SPOI in force (zeros before the first)
- * and the gimbal's own flags (stabilisation and mode). */
-static void send_spoi(sim_t *s, unsigned port)
-{
-    tase_spoi_cmd_t a;
-    memset(&a, 0, sizeof(a));
-    if (s->spoi_valid) {
-        a.lat = tase_units_deg_to_mas(s->m.spoi.lat);
-        a.lon = tase_units_deg_to_mas(s->m.spoi.lon);
-        a.height = tase_units_m_to_cm(s->m.spoi.height);
-        a.vnorth = tase_units_sat_i16(s->m.spoi.vn * 100.0);
-        a.veast = tase_units_sat_i16(s->m.spoi.ve * 100.0);
-        a.vdown = tase_units_sat_i16(s->m.spoi.vd * 100.0);
-    }
-    a.flags = sim_spoi_flags(&s->m);
-    send_packet(s, port, TASE_ID_SPOI_CMD, &a);
-}
-
-static const char *mode_name(const sim_model_t *m)
-{
-    static const char *const names[] = {"rate", "position", "SPOI", "impulse"};
-    return names[m->mode];
-}
-
-static const char *camera_refusal(int rc)
-{
-    return rc == SIM_CAM_PASS_THROUGH ? "camera control is disabled since a CAMERA_PASS (4.1.5) "
-                                        "until tase-sim restarts"
-                                      : "no such camera";
-}
-
-static void camera_cmd(sim_t *s, const tase_camera_cmd_t *c, int len, uint32_t now)
-{
-    bool set_hfov = len > 1 && c->hfov != TASE_HFOV_NO_CHANGE;
-    int rc = sim_model_camera_cmd(&s->m, c->camera, set_hfov, c->hfov / 100.0);
-    if (rc != SIM_CAM_OK) {
-        logf_(s, now, "CAMERA_CMD (camera %u) ignored: %s", (unsigned)c->camera,
-              camera_refusal(rc));
-        return;
-    }
-    logf_(s, now, "CAMERA_CMD: camera %c, HFOV %.2f deg", 'A' + (int)s->m.active_cam,
-          s->m.cam[s->m.active_cam].hfov);
-}
-
-static void camera_pass(sim_t *s, unsigned port, const tase_camera_pass_t *c, uint32_t now)
-{
-    tase_camera_pass_t a = *c;
-    int baud = sim_model_camera_pass(&s->m, c->camera, c->baud);
-    if (baud < 0) {
-        logf_(s, now, "CAMERA_PASS to camera %u ignored: no such camera", (unsigned)c->camera);
-        return;
-    }
-    /* the simulated camera answers by echoing what it was sent; packets
-     * from the gimbal carry the interface's current baud */
-    a.baud = (uint8_t)baud;
-    send_packet(s, port, TASE_ID_CAMERA_PASS, &a);
-    logf_(s, now,
-          "CAMERA_PASS: %u bytes echoed by camera %u at %u baud; camera control disabled until "
-          "tase-sim restarts",
-          c->len, c->camera, 1200u * (unsigned)baud);
-}
-
-static const char *const not_deployed =
-    "the gimbal is not deployed; it holds still until a deploy completes";
-
-/* Log what happened to host navigation data when it changes (these
- * packets come at 10-50 per second). */
-static void nav_said(sim_t *s, uint32_t now, int *said, int rc, const char *what)
-{
-    static const char *const how[] = {
-        "used", "ignored: NAV_SOURCE selects the gimbal's own GPS/INS", "ignored: Valid is 0",
-        "overwrote the gimbal's own attitude solution", "aided the gimbal's own heading"};
-    if (rc != *said) {
-        logf_(s, now, "%s: %s", what, how[rc]);
-        *said = rc;
-    }
-}
-
-/* A position and velocity in wire units (mas, cm, cm/s) in the model's. */
-static sim_pos_t wire_pos(int32_t lat, int32_t lon, int32_t height, int16_t vn, int16_t ve,
-                          int16_t vd)
-{
-    sim_pos_t p;
-    p.lat = tase_units_mas_to_deg(lat);
-    p.lon = tase_units_mas_to_deg(lon);
-    p.height = tase_units_cm_to_m(height);
-    p.vn = tase_units_cmps_to_mps(vn);
-    p.ve = tase_units_cmps_to_mps(ve);
-    p.vd = tase_units_cmps_to_mps(vd);
-    return p;
-}
-
-static void on_frame(void *user, unsigned port, const tase_frame_t *f)
-{
-    sim_t *s = user;
-    tase_packet_msg_t msg;
-    uint16_t id = TASE_ID(f->group, f->type);
-    uint32_t now = tase_posix_now_ms();
-    int len = tase_packet_decode(f, &msg);
-    if (len < 0) {
-        logf_(s, now, "ignored frame 0x%02X/0x%02X (%u bytes): %s", f->group, f->type,
-              (unsigned)f->len, tase_strerror(len));
-        return;
-    }
-    switch (id) {
-    case TASE_ID_GIMBAL_CMD: {
-        const tase_gimbal_cmd_t *c = &msg.gimbal_cmd;
-        bool spoi = s->m.mode == SIM_MODE_SPOI;
-        int rc = sim_model_command(&s->m, c->pan / 100.0, c->tilt / 100.0, c->flags,
-                                   c->impulse_time / 100.0);
-        if (rc == SIM_CMD_UNKNOWN) {
-            logf_(s, now, "GIMBAL_CMD: unknown flags 0x%02X ignored", c->flags);
-        } else if (rc == SIM_CMD_NOT_DEPLOYED) {
-            logf_(s, now, "GIMBAL_CMD (flags 0x%02X, pan %.2f tilt %.2f) ignored: %s", c->flags,
-                  c->pan / 100.0, c->tilt / 100.0, not_deployed);
-        } else if (rc == SIM_CMD_NOT_SPOI) {
-            logf_(s, now,
-                  "GIMBAL_CMD: SPOI error%s (flags 0x%02X, pan %.2f tilt %.2f) ignored: not in "
-                  "SPOI mode; still in %s mode%s",
-                  c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR_RATE ? " rate" : "", c->flags,
-                  c->pan / 100.0, c->tilt / 100.0, mode_name(&s->m),
-                  s->m.stabilised ? ", stabilised" : "");
-        } else if (spoi && TASE_GIMBAL_KIND(c->flags) >= TASE_GIMBAL_KIND_IMPULSE) {
-            logf_(s, now,
-                  "GIMBAL_CMD: SPOI error %s pan %.2f tilt %.2f%s; SPOI error now %.2f/%.2f",
-                  c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR
-                      ? "set to"
-                      : (c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR_RATE ? "rate" : "impulse"),
-                  c->pan / 100.0, c->tilt / 100.0,
-                  TASE_GIMBAL_KIND(c->flags) == TASE_GIMBAL_KIND_IMPULSE ? " deg/s" : "",
-                  s->m.err_pan, s->m.err_tilt);
-        } else {
-            logf_(s, now, "GIMBAL_CMD: %s pan %.2f tilt %.2f%s", mode_name(&s->m), c->pan / 100.0,
-                  c->tilt / 100.0, s->m.stabilised ? ", stabilised" : "");
-        }
-        break;
-    }
-    case TASE_ID_GYRO_ZERO_CMD: logf_(s, now, "GYRO_ZERO_CMD: gyros zeroed"); break;
-    case TASE_ID_CAMERA_CMD: camera_cmd(s, &msg.camera_cmd, len, now); break;
-    case TASE_ID_LEGACY_CAMERA_CMD: {
-        int rc = sim_model_camera_legacy_zoom(&s->m, msg.legacy_camera_cmd.zoom);
-        if (rc != SIM_CAM_OK) {
-            logf_(s, now, "LEGACY_CAMERA_CMD ignored: %s", camera_refusal(rc));
-        } else {
-            logf_(s, now, "LEGACY_CAMERA_CMD: camera A HFOV %.2f deg", s->m.cam[0].hfov);
-        }
-        break;
-    }
-    case TASE_ID_CAMERA_PASS: camera_pass(s, port, &msg.camera_pass, now); break;
-    case TASE_ID_RETRACT_DEPLOY_CMD:
-        sim_model_retract_deploy(&s->m, msg.retract_deploy_cmd.deploy != 0);
-        logf_(s, now, "RETRACT_DEPLOY_CMD: %s",
-              msg.retract_deploy_cmd.deploy
-                  ? "deploying; the axes move again once deployed"
-                  : "retracting; the axes hold still (position hold) until deployed again");
-        break;
-    case TASE_ID_HOST_SENSOR:
-        s->p = msg.host_sensor.roll;
-        s->q = msg.host_sensor.pitch;
-        s->r = msg.host_sensor.yaw;
-        break;
-    case TASE_ID_HOST_ATTITUDE: {
-        sim_att_t a;
-        uint8_t fl = msg.host_attitude.flags;
-        a.roll = tase_units_cdeg_to_deg(msg.host_attitude.roll);
-        a.pitch = tase_units_cdeg_to_deg(msg.host_attitude.pitch);
-        a.yaw = tase_units_cdeg_to_deg(msg.host_attitude.yaw);
-        nav_said(s, now, &s->att_said,
-                 sim_model_host_attitude(&s->m, &a, (fl & TASE_HOST_ATT_OVERWRITE) != 0,
-                                         (fl & TASE_HOST_ATT_AID_YAW) != 0),
-                 "HOST_ATTITUDE");
-        break;
-    }
-    case TASE_ID_HOST_GPS_DATA: {
-        const tase_host_gps_t *g = &msg.host_gps;
-        sim_pos_t p = wire_pos(g->lat, g->lon, g->height, g->vnorth, g->veast, g->vdown);
-        nav_said(s, now, &s->gps_said, sim_model_host_gps(&s->m, &p, g->valid == 1u),
-                 "HOST_GPS_DATA");
-        break;
-    }
-    case TASE_ID_SPOI_CMD:
-        if (len == 0) {
-            send_spoi(s, port);
-        } else {
-            const tase_spoi_cmd_t *c = &msg.spoi_cmd;
-            sim_pos_t t = wire_pos(c->lat, c->lon, c->height, c->vnorth, c->veast, c->vdown);
-            if (sim_model_spoi(&s->m, &t) != SIM_CMD_OK) {
-                logf_(s, now, "SPOI_CMD (%.6f, %.6f, %.1f m) ignored: %s", t.lat, t.lon, t.height,
-                      not_deployed);
-            } else {
-                s->spoi_valid = true;
-                logf_(s, now, "SPOI_CMD: pointing at %.6f, %.6f, %.1f m%s", t.lat, t.lon, t.height,
-                      s->m.host.lat == s->m.own_pos.lat && !s->m.ext_gps
-                          ? " from the gimbal's own GPS/INS position (NAV_SOURCE)"
-                          : "");
-            }
-            if (msg.spoi_cmd.flags & TASE_SPOI_ECHO) {
-                send_spoi(s, port); /* the gimbal's flags, not the request's */
-            }
-        }
-        break;
-    default:
-        logf_(s, now, "%s: not an In packet, ignored",
-              tase_schema_packet_name(tase_schema_find(f->group, f->type)));
-        break;
-    }
 }
 
 /* ---- KLV ---- */
@@ -622,7 +400,7 @@ int main(int argc, char **argv)
     memset(&app, 0, sizeof(app));
     app.apply_setup_msg = apply_setup;
     app.fill_telemetry_msg = fill_telemetry;
-    app.on_frame = on_frame;
+    app.on_frame = sim_on_frame;
     app.user = &s;
     now = tase_posix_now_ms();
     s.t0 = now;
@@ -672,8 +450,9 @@ int main(int argc, char **argv)
         if (dt > 0 && sim_model_step(&s.m, (dt > 1000u ? 1000u : dt) / 1000.0)) {
             tase_retract_deploy_cmd_t rd;
             rd.deploy = s.m.tax == SIM_3AX_DEPLOYED ? 1u : 0u;
-            send_packet(&s, s.link, TASE_ID_RETRACT_DEPLOY_CMD, &rd);
-            logf_(&s, now, "RETRACT_DEPLOY_CMD: %s, echoed", rd.deploy ? "deployed" : "retracted");
+            sim_send_packet(&s, s.link, TASE_ID_RETRACT_DEPLOY_CMD, &rd);
+            sim_log(&s, now, "RETRACT_DEPLOY_CMD: %s, echoed",
+                    rd.deploy ? "deployed" : "retracted");
         }
         if (slave_fd >= 0 && tk_pty_unread(slave_fd) > 2048) {
             /* nobody has read the link for a while: keep only fresh data */
@@ -700,8 +479,8 @@ int main(int argc, char **argv)
     if (have_klv) {
         tk_pty_unlink(klv_link, klv_path);
     }
-    logf_(&s, tase_posix_now_ms(), "stopped: %lu frames in, %lu out",
-          (unsigned long)s.g.stats.frames_rx, (unsigned long)s.g.stats.frames_tx);
+    sim_log(&s, tase_posix_now_ms(), "stopped: %lu frames in, %lu out",
+            (unsigned long)s.g.stats.frames_rx, (unsigned long)s.g.stats.frames_tx);
     tk_link_close(&dl);
     return 0;
 }

@@ -41,8 +41,22 @@
  *    bytes when it is due.
  *
  *  - EVERYTHING ELSE (commands, host sensor/attitude/GPS, SPOI, unknown
- *    setup types) goes to the application's on_frame() callback, which may
- *    answer with tase_gimbal_send_msg() (e.g. a zero-length SPOI_CMD query).
+ *    setup types) is the application's to act on: the role does not
+ *    move the gimbal. It goes either to the application's dispatcher
+ *    (app.dispatch, TYPED COMMANDS below) or as raw bytes to its on_frame()
+ *    callback, which may answer with tase_gimbal_send_msg() (e.g. a
+ *    zero-length SPOI_CMD query).
+ *
+ * TYPED COMMANDS. Set app.dispatch to a tase_dispatch_t (tase/dispatch.h)
+ * that the application initialised with its handler table, e.g.
+ *     [TASE_PKT_GIMBAL_CMD] = on_gimbal_cmd, [TASE_PKT_SPOI_CMD] = on_spoi,
+ *     [TASE_PKT_RETRACT_DEPLOY_CMD] = on_retract, ...
+ * and every frame the role does not answer itself goes through it: a
+ * GIMBAL_CMD arrives in on_gimbal_cmd as a decoded tase_gimbal_cmd_t, a
+ * zero-length query as a zeroed struct with frame->len 0, a wrong length
+ * at the dispatcher's error hook, the rest at its default handler.
+ * tase_gimbal_frame_port() tells a handler which port the frame came in
+ * on. The setups stay the role's (they never reach the dispatcher).
  *
  * TYPED OR BYTES. Each application callback that carries packet data has
  * a typed form taking the packet's struct (tase/codec.h) and a form taking
@@ -81,8 +95,10 @@
  * and every slot is sent, within the poll interval of its due time.
  *
  * PRIORITY AND CAPACITY. Setup echoes, query answers and the
- * application's own sends are written at once, as the frame that asks for
- * them is handled (tase_gimbal_service() reads and answers before it
+ * application's own sends are written before the call that received the
+ * frame returns (tase_gimbal_handle_frame() at once; tase_gimbal_feed()
+ * when its receiver has handed over the frames of each 64-byte piece of
+ * input, see there; tase_gimbal_service() reads and answers before it
  * polls telemetry), and are never held back. Telemetry is what yields: a
  * link carries only so many bytes per second (9600 baud 8N1: 960 B/s),
  * and PACKET_RATE may ask for far more (255/255/255 is 28,305 B/s). Bytes
@@ -124,15 +140,25 @@
  * TIME comes in as `now_ms` (monotonic, wraps modulo 2^32; e.g. a port's
  * now_ms()). Nothing here reads a clock, allocates or uses globals.
  *
+ * STACK. Nothing the size of a frame or a packet struct is on the
+ * stack: typed callbacks get a struct in the instance and telemetry is
+ * built there, and
+ * tase_gimbal_feed() hands the receiver's frames over with little stack
+ * and writes their echoes after the receiver returns. docs/FOOTPRINT.md
+ * lists the deepest stack of every entry point on Cortex-M (the
+ * application's callbacks and the port's functions not included).
+ *
  * REENTRANCY. Not reentrant per instance, not ISR-safe: call everything
  * from one context (the main loop draining the UART rings). Callbacks run
  * inside tase_gimbal_feed()/_handle_frame()/_poll(); they may call
- * tase_gimbal_send() and tase_gimbal_setup_get(), nothing else of the
- * same instance.
+ * tase_gimbal_send(), tase_gimbal_send_msg(), tase_gimbal_setup_get() and
+ * tase_gimbal_frame_port(), nothing else of the same instance.
  */
 #ifndef TASE_GIMBAL_H
 #define TASE_GIMBAL_H
 
+#include "tase/codec.h"
+#include "tase/dispatch.h"
 #include "tase/frame.h"
 #include "tase/port.h"
 
@@ -149,6 +175,10 @@ extern "C" {
 #define TASE_STREAM_ANGLE 0u  /* GIMBAL_ANGLE 0x08/0x10 */
 #define TASE_STREAM_RATE 1u   /* GIMBAL_RATE 0x08/0x40 */
 #define TASE_STREAM_GEOREF 2u /* GEOREFERENCE_DATA 0x10/0x41 */
+
+/* The longest telemetry packet's data (GEOREFERENCE_DATA, 63 bytes): the
+ * room fill_telemetry() gets. */
+#define TASE_GIMBAL_TELEMETRY_MAX 63u
 
 /* Percentage of a port's capacity telemetry may use (see PRIORITY AND
  * CAPACITY); the rest is kept for echoes and answers. */
@@ -168,8 +198,10 @@ typedef struct {
     int (*apply_setup)(void *user, unsigned port, uint8_t type, uint8_t *data, size_t len);
     /* Telemetry packet `id` (TASE_ID_GIMBAL_ANGLE, _GIMBAL_RATE,
      * _GEOREFERENCE_DATA) is due on `port`: write its data into
-     * data[0..cap) (cap is 253) and return the length, or a negative value
-     * to skip this slot (stats.telemetry_skipped). NULL: nothing is sent. */
+     * data[0..cap) (cap is TASE_GIMBAL_TELEMETRY_MAX, 63: GEOREFERENCE_DATA's
+     * length, the longest) and return the length, or a negative value to
+     * skip this slot (stats.telemetry_skipped); a length over cap skips it
+     * too. NULL: nothing is sent. */
     int (*fill_telemetry)(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
                           uint32_t now_ms);
     /* Every other valid frame received on `port`. */
@@ -186,6 +218,10 @@ typedef struct {
      * is encoded, stored and echoed; reserved bytes as zero) or < 0 to
      * refuse (the current settings are echoed). */
     int (*apply_setup_msg)(void *user, unsigned port, uint16_t id, void *msg);
+    /* Typed commands (TYPED COMMANDS above): the application's dispatcher,
+     * given every frame the role does not answer itself, instead of
+     * on_frame (init refuses both). It must outlive the role. */
+    tase_dispatch_t *dispatch;
 } tase_gimbal_app_t;
 
 /* Statistics; only incremented by the library, wrap modulo 2^32. */
@@ -213,8 +249,9 @@ typedef struct {
     uint8_t rate; /* packets per second, 0 = off */
 } tase_gimbal_sched_t;
 
-/* Gimbal instance (about 350 bytes on Cortex-M; the receivers are the caller's, see
- * tase_gimbal_init()). Treat every field except `stats` as private. */
+/* Gimbal instance (516 bytes on Cortex-M, docs/FOOTPRINT.md; the
+ * receivers are the caller's, see tase_gimbal_init()). Treat every field
+ * except `stats` as private. */
 typedef struct {
     tase_gimbal_stats_t stats;
     tase_gimbal_app_t app;
@@ -225,6 +262,18 @@ typedef struct {
     uint32_t capacity[TASE_GIMBAL_PORTS]; /* bytes/s */
     uint32_t demand[TASE_GIMBAL_PORTS];   /* telemetry bytes/s the rates ask */
     uint8_t setup[TASE_GIMBAL_SETUP_BYTES];
+    /* The frame being handled: its port, or 0xFF outside a callback; the
+     * port and time of the bytes tase_gimbal_feed() is feeding. */
+    uint8_t frame_port;
+    uint8_t feed_port;
+    uint32_t feed_now;
+    /* Echoes owed by tase_gimbal_feed(): how many of each setup type
+     * (index TASE_GIMBAL_SETUP_TYPES: AXIS_SETTING in its 22-byte layout). */
+    uint8_t echo[TASE_GIMBAL_SETUP_TYPES + 1u];
+    /* Not on the stack: the packet struct of a typed callback (telemetry
+     * to fill, a setting to apply) and the frame telemetry is built in. */
+    tase_packet_msg_t msg;
+    uint8_t tx_frame[TASE_GIMBAL_TELEMETRY_MAX + TASE_FRAME_OVERHEAD];
 } tase_gimbal_t;
 
 /* Initialise: ports[0..nports) are copied (nports 0..3; an entry whose ops
@@ -240,7 +289,8 @@ typedef struct {
  * tase_gimbal_handle_frame() (firmware that dispatches every frame
  * itself saves the RAM). Returns TASE_OK, or TASE_EARG (g NULL, ports
  * NULL with nports > 0, nports > 3, a present port without write, app
- * with both forms of fill_telemetry or of apply_setup). O(1). */
+ * with both forms of fill_telemetry or of apply_setup, or with both
+ * on_frame and dispatch). O(1). */
 int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, size_t nports,
                      const tase_gimbal_app_t *app, uint32_t now_ms);
 
@@ -250,6 +300,12 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
  * (bytes may be NULL) whenever a look at the port's receive buffer found
  * nothing waiting, so that frames held behind noise come out once the line
  * has been quiet for the bound. Never with bytes still waiting unread.
+ * The bytes go to the receiver in pieces of up to 64; the frames of a
+ * piece are handled as the receiver hands them over (a setup is offered to
+ * apply_setup and stored, anything else goes to the dispatcher or
+ * on_frame), and the setup echoes they owe are written when the receiver
+ * has returned, before the next piece: one echo per setup frame, grouped
+ * by setup type, each carrying the settings in force when it is written.
  * Returns frames received (>= 0), TASE_EARG (g NULL, port >= nports,
  * bytes NULL with n > 0) or TASE_ESTATE (initialised without receivers).
  * Worst case O(n * TASE_FRAME_MAX). */
@@ -262,6 +318,11 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
  * counted but not answered. O(len). */
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
                              uint32_t now_ms);
+
+/* Inside a callback of this role (apply_setup, on_frame, the
+ * dispatcher's handlers): the port index the frame being handled came in
+ * on. TASE_EARG (g NULL) or TASE_ESTATE (no frame is being handled). */
+int tase_gimbal_frame_port(const tase_gimbal_t *g);
 
 /* Set the capacity of port index `port` in bytes per second, e.g.
  * TASE_UART_BYTES_PER_S(9600) for a 9600-baud line; 0 goes back to the

@@ -17,10 +17,11 @@ if(TARGET tase_socketcan)
   set(TASE_CAN_VM_TARGETS "")
   if(TARGET tase_capture AND TARGET tase_sim_model)
     # libpcap.a needs libdbus-1.a, and that two libsystemd calls (shim).
-    add_executable(tase_can_vm_cli EXCLUDE_FROM_ALL ${PROJECT_SOURCE_DIR}/tools/tase.c
+    # TASE_CLI_SOURCES, TASE_SIM_SOURCES: tools/CMakeLists.txt
+    add_executable(tase_can_vm_cli EXCLUDE_FROM_ALL ${TASE_CLI_SOURCES}
                                    ${CMAKE_CURRENT_SOURCE_DIR}/vm/libsystemd_stub.c)
     target_link_libraries(tase_can_vm_cli PRIVATE tase_capture pcap dbus-1)
-    add_executable(tase_can_vm_sim EXCLUDE_FROM_ALL ${PROJECT_SOURCE_DIR}/tools/tase_sim.c)
+    add_executable(tase_can_vm_sim EXCLUDE_FROM_ALL ${TASE_SIM_SOURCES})
     target_link_libraries(tase_can_vm_sim PRIVATE tase_toolkit tase_sim_model)
     foreach(t tase_can_vm_cli tase_can_vm_sim)
       target_link_options(${t} PRIVATE -static)

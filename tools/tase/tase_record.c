@@ -1,0 +1,150 @@
+/* tase: `record` and `replay`, the command lines of the capture loops of
+ * tk_capture.h. */
+#include <errno.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "tase_cli.h"
+#include "tk_capture.h"
+
+int cli_cmd_record(cli_args_t *a)
+{
+    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, NULL};
+    const char *out = NULL, *tap_in = NULL, *v;
+    double seconds = 0.0;
+    tk_cap_writer_t w;
+    while (a->i < a->argc) {
+        if (cli_common_opt(a) || cli_link_opt(a, &lo)) {
+            continue;
+        }
+        if (cli_opt(a, "-o", true, &v) || cli_opt(a, "--output", true, &v)) {
+            if (out != NULL) {
+                tk_usage_error("option -o/--output given twice");
+            }
+            out = v;
+            continue;
+        }
+        if (cli_opt(a, "--tap-in", true, &tap_in)) {
+            continue;
+        }
+        if (cli_opt(a, "--seconds", true, &v)) {
+            if (tk_parse_seconds(v, &seconds) != 0 || seconds <= 0.0) {
+                tk_usage_error("bad --seconds value '%s'", v);
+            }
+        } else {
+            cli_bad_arg(a);
+        }
+    }
+    if (lo.record != NULL) {
+        tk_usage_error("record writes its capture with -o FILE (--record is for the other "
+                       "commands)");
+    }
+    if (out == NULL) {
+        tk_usage_error("record needs an output file: -o FILE");
+    }
+    if ((lo.serial != NULL) == (lo.can != NULL)) {
+        tk_usage_error("give either --serial DEV or --can IFACE");
+    }
+    if (tap_in != NULL && lo.serial == NULL) {
+        tk_usage_error("--tap-in is the second line of a serial tap: it needs --serial");
+    }
+    /* a signal is the normal end of a recording: the loops stop on it and
+     * close the capture, and the command succeeds */
+    if (lo.serial != NULL) {
+        tk_cap_record_serial(&w, out, lo.serial, tap_in, lo.baud, seconds);
+    } else {
+        tk_cap_record_can(&w, out, lo.can, seconds);
+    }
+    return TK_EXIT_OK;
+}
+
+int cli_cmd_replay(cli_args_t *a)
+{
+    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, NULL};
+    tk_replay_opts_t ro;
+    const char *path = NULL, *v;
+    static uint8_t head[CLI_READ_CHUNK];
+    unsigned long bad, backward;
+    tk_cap_reader_t r;
+    cli_input_t in;
+    size_t n;
+    memset(&ro, 0, sizeof(ro));
+    ro.speed = 1.0;
+    ro.dirs = (tk_cap_dirs_t)0; /* no default: --dir is required */
+    while (a->i < a->argc) {
+        if (cli_common_opt(a) || cli_link_opt(a, &lo)) {
+            continue;
+        }
+        if (cli_opt(a, "--speed", true, &v)) {
+            if (tk_parse_seconds(v, &ro.speed) != 0) {
+                tk_usage_error("bad --speed value '%s' (a factor: 1 recorded timing, 2 twice as "
+                               "fast, 0 no waiting)",
+                               v);
+            }
+        } else if (cli_opt(a, "--dir", true, &v)) {
+            if (strcmp(v, "out") == 0) {
+                ro.dirs = TK_CAP_DIR_OUT;
+            } else if (strcmp(v, "in") == 0) {
+                ro.dirs = TK_CAP_DIR_IN;
+            } else if (strcmp(v, "all") == 0) {
+                ro.dirs = TK_CAP_DIR_ALL;
+            } else {
+                tk_usage_error("bad --dir value '%s' (out, in or all)", v);
+            }
+        } else if (path == NULL && cli_is_arg(a, false)) {
+            path = a->argv[a->i++];
+        } else {
+            cli_bad_arg(a);
+        }
+    }
+    if (path == NULL) {
+        tk_usage_error("replay needs a capture file (written by 'tase record')");
+    }
+    if (lo.record != NULL) {
+        tk_usage_error("--record is not available with replay");
+    }
+    if ((lo.serial != NULL) == (lo.can != NULL)) {
+        tk_usage_error("give either --serial DEV or --can IFACE");
+    }
+    if (ro.dirs == 0) {
+        tk_usage_error("replay needs --dir: out = the gimbal's side, to exercise a host (its "
+                       "echoes are commands to a gimbal); in = the host's commands (moves a "
+                       "gimbal); all = both (moves a gimbal)");
+    }
+    cli_input_open(&in, path, 0);
+    n = cli_input_head(&in, head, sizeof(head));
+    if (!tk_cap_is_capture(head, n)) {
+        tk_die("%s is not a pcap or pcapng capture (candump logs: can-utils' canplayer "
+               "replays them)",
+               in.name);
+    }
+    ro.serial = lo.serial;
+    ro.baud = lo.baud;
+    ro.can = lo.can;
+    /* The whole capture is checked before anything is sent: read it once
+     * (so it must be a file, not a pipe), then again to send. */
+    if (lseek(in.fd, 0, SEEK_SET) != 0) {
+        tk_die("%s: replay reads its capture twice (checked before anything is sent): give a "
+               "file, not a pipe",
+               in.name);
+    }
+    tk_cap_reader_open(&r, in.fd, NULL, 0, in.name);
+    bad = tk_cap_check(&r, &ro, &backward);
+    tk_cap_reader_close(&r);
+    if (bad > 0) {
+        tk_exit(TK_EXIT_INPUT, "%s: %lu bad record%s: nothing was sent", in.name, bad,
+                bad == 1 ? "" : "s");
+    }
+    if (lseek(in.fd, 0, SEEK_SET) != 0) {
+        tk_die("cannot read %s again: %s", in.name, strerror(errno));
+    }
+    tk_cap_reader_open(&r, in.fd, NULL, 0, in.name);
+    bad = tk_cap_replay(&r, &ro);
+    tk_cap_reader_close(&r);
+    cli_input_close(&in);
+    tk_exit_if_signalled();
+    if (bad > 0) {
+        tk_exit(TK_EXIT_INPUT, "%s: %lu bad record%s skipped", in.name, bad, bad == 1 ? "" : "s");
+    }
+    return TK_EXIT_OK;
+}
