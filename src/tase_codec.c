@@ -195,7 +195,7 @@ static void unpack_fields(tase_field_iter_t *it, const uint8_t *data, void *msg)
         unsigned k;
         uint64_t v = 0u;
         uint32_t keep;
-        if (!it->within) {
+        if (!it->within || data == NULL) { /* data is NULL only at length 0 */
             if (tase_field_iter_keep_bits(it, &keep)) {
                 member_store(m, w, keep);
             }

@@ -257,29 +257,27 @@ int tase_field_offset(const tase_packet_desc_t *p, size_t i, size_t len)
     return seek(&it, p, i, len) ? (int)it.offset : TASE_EARG;
 }
 
-int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
-                   int64_t *value)
+int tase_field_iter_get(const tase_field_iter_t *it, const uint8_t *data, int64_t *value)
 {
-    tase_field_iter_t it;
     unsigned k;
     uint64_t v = 0u;
-    if (!seek(&it, p, i, len) || value == NULL || (data == NULL && len > 0u)) {
+    if (it == NULL || it->field == NULL || value == NULL || (data == NULL && it->len > 0u)) {
         return TASE_EARG;
     }
-    /* data is NULL only with len 0, where no field fits. */
-    if (data == NULL || !it.within) {
+    /* data is NULL only with length 0, where no field fits. */
+    if (data == NULL || !it->within) {
         return TASE_ETRUNC;
     }
-    for (k = 0; k < it.width; k++) {
-        v = (v << 8) | data[it.offset + k];
+    for (k = 0; k < it->width; k++) {
+        v = (v << 8) | data[it->offset + k];
     }
     /* Big-endian: the sign bit is the top bit of the first byte. */
-    if (TASE_FIELD_IS_SIGNED(it.field) && (data[it.offset] & 0x80u) != 0u) {
+    if (TASE_FIELD_IS_SIGNED(it->field) && (data[it->offset] & 0x80u) != 0u) {
         /* Two's complement by arithmetic, without an implementation-
          * defined conversion of an out-of-range unsigned value. */
         uint64_t mag = ~v;
-        if (it.width < 8u) {
-            unsigned bits = 8u * it.width;
+        if (it->width < 8u) {
+            unsigned bits = 8u * it->width;
             uint64_t mask = ((uint64_t)1u << bits) - 1u;
             mag &= mask;
         }
@@ -288,6 +286,16 @@ int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, s
         *value = (int64_t)v;
     }
     return TASE_OK;
+}
+
+int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
+                   int64_t *value)
+{
+    tase_field_iter_t it;
+    if (!seek(&it, p, i, len) || value == NULL || (data == NULL && len > 0u)) {
+        return TASE_EARG;
+    }
+    return tase_field_iter_get(&it, data, value);
 }
 
 /* The keep value of the field `it` is on (TASE_EUNKNOWN: it has none). */

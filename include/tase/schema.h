@@ -293,6 +293,18 @@ static inline bool tase_field_iter_keep_bits(const tase_field_iter_t *it, uint32
     }
 }
 
+/* The value of the walk's current field in data[0..it->len) (the length
+ * the walk was begun for; data NULL only when it is 0): big-endian,
+ * sign-extended when the field is signed (a width-8 unsigned field above
+ * INT64_MAX would wrap; the spec has none). Returns TASE_OK and sets
+ * *value, or
+ *   TASE_EARG   it or value is NULL, no field is current, or data is NULL
+ *               with a length above 0;
+ *   TASE_ETRUNC the field does not lie within the data (it->within false:
+ *               a query, a short form).
+ * O(width). */
+int tase_field_iter_get(const tase_field_iter_t *it, const uint8_t *data, int64_t *value);
+
 /* ---- one field by index: conveniences built on the iterator ------------
  *
  * Each call binds an iterator to p (tase_field_iter_init(): p must be a
