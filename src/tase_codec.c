@@ -1,16 +1,17 @@
 /*
- * Generic typed codec: one loop over the schema's fields moves each
- * member between the typed struct and big-endian wire bytes. Members are
- * accessed through memcpy at their offsetof() position, so no struct
- * layout or host byte order is assumed. int16_t and friends are two's
- * complement by definition, so copying the unsigned bit pattern of a
- * width into a signed member gives the right value.
+ * Generic typed codec: one walk over the packet's fields (the schema's
+ * field iterator, tase/schema.h) moves each member between the typed
+ * struct and big-endian wire bytes. A walk calls into the schema once, to
+ * bind the iterator; the layout, offsets, widths and "do not change"
+ * values then come from the iterator inline. Members are accessed through
+ * memcpy at their offsetof() position, so no struct layout or host byte
+ * order is assumed. int16_t and friends are two's complement by
+ * definition, so copying the unsigned bit pattern of a width into a
+ * signed member gives the right value.
  */
 #include "tase/codec.h"
 
 #include <string.h>
-
-#include "tase_schema_layout.h"
 
 /* The member's own type is not known here, only its width: hence void. */
 static uint64_t member_load(const void *src, unsigned w)
@@ -40,33 +41,32 @@ static void member_store(void *dst, unsigned w, uint64_t v)
     }
 }
 
-/* The fields of msg that lie within len bytes, big-endian into body, at
- * the offsets of the layout that len selects (AXIS_SETTING 22 or 23). */
-static void pack_fields(const tase_packet_desc_t *p, const void *msg, size_t len, uint8_t *body)
+/* The fields of msg that lie within the walk's length, big-endian into
+ * body, at the offsets of the layout the length selects (AXIS_SETTING 22
+ * or 23). */
+static void pack_fields(tase_field_iter_t *it, const void *msg, uint8_t *body)
 {
-    size_t i;
-    bool short_layout = tase_layout_is_short(p, len);
-    for (i = 0; i < p->nfields; i++) {
-        const tase_field_t *f = tase_schema_field(p, i);
-        unsigned w = TASE_FIELD_WIDTH(f);
-        size_t at = tase_layout_offset(f, short_layout);
+    while (tase_field_iter_next(it)) {
+        unsigned w = it->width;
         uint64_t v;
-        if (at + w > len) {
+        if (!it->within) {
             continue; /* short form: CAMERA_CMD camera byte only */
         }
-        v = member_load((const uint8_t *)msg + f->member, w);
+        v = member_load((const uint8_t *)msg + it->field->member, w);
         while (w > 0u) {
             w--;
-            body[at + w] = (uint8_t)v;
+            body[it->offset + w] = (uint8_t)v;
             v >>= 8;
         }
     }
 }
 
 /* The checks both encoders make before writing, in the order codec.h
- * documents (the output buffer and its capacity are the caller's). */
-static int encode_check(const tase_packet_desc_t *p, const void *msg, size_t len)
+ * documents (the output buffer and its capacity are the caller's); the
+ * walk was begun at len. */
+static int encode_check(const tase_field_iter_t *it, const void *msg, size_t len)
 {
+    const tase_packet_desc_t *p = it->packet;
     const tase_camera_pass_t *cp = msg;
     if (msg == NULL && len > 0u) {
         return TASE_EARG;
@@ -82,16 +82,17 @@ static int encode_check(const tase_packet_desc_t *p, const void *msg, size_t len
             return TASE_ELENGTH;
         }
     }
-    return tase_schema_length_ok(p, len) ? TASE_OK : TASE_ELENGTH;
+    return it->accepted ? TASE_OK : TASE_ELENGTH;
 }
 
 /* The len data bytes of msg into body (checked by encode_check()). */
-static void encode_body(const tase_packet_desc_t *p, const void *msg, size_t len, uint8_t *body)
+static void encode_body(tase_field_iter_t *it, const void *msg, size_t len, uint8_t *body)
 {
     const tase_camera_pass_t *cp = msg;
+    size_t table = it->packet->len;
     size_t fixed;
-    if (len > p->len) {
-        fixed = p->len;
+    if (len > table) {
+        fixed = table;
         /* The tail first: its source may lie anywhere in the output. */
         (void)memmove(&body[fixed], cp->data, len - fixed);
     } else {
@@ -99,33 +100,35 @@ static void encode_body(const tase_packet_desc_t *p, const void *msg, size_t len
     }
     (void)memset(body, 0, fixed); /* reserved bytes */
     if (msg != NULL) {            /* else a query: no data */
-        pack_fields(p, msg, len, body);
+        pack_fields(it, msg, body);
     }
 }
 
-/* The table length of p for msg (CAMERA_PASS: plus its tail). */
-static size_t table_len(const tase_packet_desc_t *p, const void *msg)
+/* A caller's data length for a walk: every length above TASE_DATA_MAX is
+ * refused alike, and SIZE_MAX must not read as TASE_FIELD_ITER_TABLE_LEN
+ * (codec.h: any size_t up to SIZE_MAX gives TASE_ELENGTH). */
+static size_t walk_len(size_t len)
 {
-    size_t len = p->len;
-    if ((p->flags & TASE_LEN_TAIL) != 0u && msg != NULL) {
-        len += ((const tase_camera_pass_t *)msg)->len;
-    }
-    return len;
+    return len > TASE_DATA_MAX ? TASE_DATA_MAX + 1u : len;
 }
 
-/* Every encoder: packet `id` from msg at data length *len (NULL: the table
- * length) into out[0..cap), as a whole frame or as its data only. */
-static int encode(uint16_t id, const void *msg, const size_t *len, uint8_t *out, size_t cap,
-                  bool frame)
+/* Every encoder: packet `id` from msg at data length `len`
+ * (TASE_FIELD_ITER_TABLE_LEN: the table length, CAMERA_PASS's tail added)
+ * into out[0..cap), as a whole frame or as its data only. */
+static int encode(uint8_t *out, size_t cap, uint16_t id, const void *msg, size_t len, bool frame)
 {
-    const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
-    size_t n;
+    tase_field_iter_t it;
+    const tase_packet_desc_t *p;
+    size_t n = len;
     size_t header = 0u;
     size_t overhead = 0u;
     int r;
     if (out == NULL) {
         return TASE_EARG;
     }
+    /* The one call into the schema: the packet found, the length checked
+     * and the walk begun. */
+    p = tase_field_iter_find(&it, TASE_ID_GROUP(id), TASE_ID_TYPE(id), len);
     if (p == NULL) {
         return TASE_EUNKNOWN;
     }
@@ -133,15 +136,20 @@ static int encode(uint16_t id, const void *msg, const size_t *len, uint8_t *out,
         header = TASE_FRAME_HEADER;
         overhead = TASE_FRAME_OVERHEAD;
     }
-    n = len != NULL ? *len : table_len(p, msg);
-    r = encode_check(p, msg, n);
+    if (len == TASE_FIELD_ITER_TABLE_LEN) {
+        n = it.len; /* every field lies within it, as within the tail form */
+        if ((p->flags & TASE_LEN_TAIL) != 0u && msg != NULL) {
+            n += ((const tase_camera_pass_t *)msg)->len;
+        }
+    }
+    r = encode_check(&it, msg, n);
     if (r != TASE_OK) {
         return r;
     }
     if (cap < n + overhead) {
         return TASE_ENOSPC;
     }
-    encode_body(p, msg, n, out + header);
+    encode_body(&it, msg, n, out + header);
     if (!frame) {
         return (int)n;
     }
@@ -150,22 +158,22 @@ static int encode(uint16_t id, const void *msg, const size_t *len, uint8_t *out,
 
 int tase_packet_encode(uint16_t id, const void *msg, uint8_t *out, size_t cap)
 {
-    return encode(id, msg, NULL, out, cap, true);
+    return encode(out, cap, id, msg, TASE_FIELD_ITER_TABLE_LEN, true);
 }
 
 int tase_packet_encode_len(uint16_t id, const void *msg, size_t len, uint8_t *out, size_t cap)
 {
-    return encode(id, msg, &len, out, cap, true);
+    return encode(out, cap, id, msg, walk_len(len), true);
 }
 
 int tase_packet_encode_data(uint16_t id, const void *msg, uint8_t *data, size_t cap)
 {
-    return encode(id, msg, NULL, data, cap, false);
+    return encode(data, cap, id, msg, TASE_FIELD_ITER_TABLE_LEN, false);
 }
 
 int tase_packet_encode_data_len(uint16_t id, const void *msg, size_t len, uint8_t *data, size_t cap)
 {
-    return encode(id, msg, &len, data, cap, false);
+    return encode(data, cap, id, msg, walk_len(len), false);
 }
 
 int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap)
@@ -173,49 +181,40 @@ int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap)
     return tase_packet_encode_len(id, NULL, 0u, out, cap);
 }
 
-/* The fields that lie within the frame's data, into msg. Only the wire
- * bits are needed (no sign extension: see the top of this file), and
- * reading them inline instead of through tase_field_get() keeps the
- * receive path's stack small. A field a short form leaves out (CAMERA_CMD's
- * 1-byte form) takes its "do not change" value, so a handler that ignores
- * the length never acts on a zero it was not sent; fields without one stay
- * zero. */
-static void unpack_fields(const tase_packet_desc_t *p, const uint8_t *data, size_t len, void *msg)
+/* The fields of the walk, from the frame's data into msg. Only the wire
+ * bits are needed (no sign extension: see the top of this file), read
+ * inline so that the receive path's stack stays small. A field a short
+ * form leaves out (CAMERA_CMD's 1-byte form) takes its "do not change"
+ * value, so a handler that ignores the length never acts on a zero it was
+ * not sent; fields without one stay zero. */
+static void unpack_fields(tase_field_iter_t *it, const uint8_t *data, void *msg)
 {
-    size_t i;
-    bool short_layout = tase_layout_is_short(p, len);
-    for (i = 0; i < p->nfields; i++) {
-        const tase_field_t *fd = tase_schema_field(p, i);
-        unsigned w = TASE_FIELD_WIDTH(fd);
-        size_t at = tase_layout_offset(fd, short_layout);
+    while (tase_field_iter_next(it)) {
+        uint8_t *m = (uint8_t *)msg + it->field->member;
+        unsigned w = it->width;
         unsigned k;
         uint64_t v = 0u;
         uint32_t keep;
-        if (at + w > len) {
-            if (tase_layout_keep_bits(fd, &keep)) {
-                member_store((uint8_t *)msg + fd->member, w, keep);
+        if (!it->within || data == NULL) { /* data is NULL only at length 0 */
+            if (tase_field_iter_keep_bits(it, &keep)) {
+                member_store(m, w, keep);
             }
             continue;
         }
         for (k = 0; k < w; k++) {
-            v = (v << 8) | data[at + k];
+            v = (v << 8) | data[it->offset + k];
         }
-        member_store((uint8_t *)msg + fd->member, w, v);
+        member_store(m, w, v);
     }
 }
 
-int tase_packet_decode_desc(const tase_packet_desc_t *p, const uint8_t *data, size_t len, void *msg)
+/* Every decoder, once the walk is begun at the frame's length: data into
+ * msg (data NULL only with length 0, checked by the caller). */
+static int decode(tase_field_iter_t *it, const uint8_t *data, void *msg)
 {
-    if (data == NULL && len > 0u) {
-        return TASE_EARG;
-    }
-    if (p == NULL) {
-        return TASE_EUNKNOWN;
-    }
-    if (tase_schema_at(p->index) != p) {
-        return TASE_EARG; /* not a descriptor of the table: its size is not to be trusted */
-    }
-    if (!tase_schema_length_ok(p, len)) {
+    const tase_packet_desc_t *p = it->packet;
+    size_t len = it->len;
+    if (!it->accepted) {
         return TASE_ELENGTH;
     }
     if (msg == NULL) {
@@ -223,7 +222,7 @@ int tase_packet_decode_desc(const tase_packet_desc_t *p, const uint8_t *data, si
     }
     (void)memset(msg, 0, p->size);
     if (len > 0u) { /* else a query: no data, every member zero */
-        unpack_fields(p, data, len, msg);
+        unpack_fields(it, data, msg);
     }
     if ((p->flags & TASE_LEN_TAIL) != 0u) {
         tase_camera_pass_t *cp = msg;
@@ -233,10 +232,45 @@ int tase_packet_decode_desc(const tase_packet_desc_t *p, const uint8_t *data, si
     return (int)len;
 }
 
+int tase_packet_decode_iter(tase_field_iter_t *it, const uint8_t *data, void *msg)
+{
+    if (it == NULL || it->packet == NULL || (data == NULL && it->len > 0u)) {
+        return TASE_EARG;
+    }
+    it->next = 0u; /* back to the first field; the length stays checked */
+    return decode(it, data, msg);
+}
+
+int tase_packet_decode_desc(const tase_packet_desc_t *p, const uint8_t *data, size_t len, void *msg)
+{
+    tase_field_iter_t it;
+    int r;
+    if (data == NULL && len > 0u) {
+        return TASE_EARG;
+    }
+    /* TASE_EUNKNOWN for NULL; TASE_EARG for a pointer that is not a
+     * descriptor of the table (its size is not to be trusted) */
+    r = tase_field_iter_init(&it, p, walk_len(len));
+    return r != TASE_OK ? r : decode(&it, data, msg);
+}
+
+/* tase_packet_decode_data() and tase_packet_decode(): the packet looked up
+ * as the walk is bound. */
+static int decode_find(uint8_t group, uint8_t type, const uint8_t *data, size_t len, void *msg)
+{
+    tase_field_iter_t it;
+    if (data == NULL && len > 0u) {
+        return TASE_EARG;
+    }
+    if (tase_field_iter_find(&it, group, type, walk_len(len)) == NULL) {
+        return TASE_EUNKNOWN;
+    }
+    return decode(&it, data, msg);
+}
+
 int tase_packet_decode_data(uint16_t id, const uint8_t *data, size_t len, void *msg)
 {
-    return tase_packet_decode_desc(tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id)), data, len,
-                                   msg);
+    return decode_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id), data, len, msg);
 }
 
 int tase_packet_decode(const tase_frame_t *f, void *msg)
@@ -244,5 +278,5 @@ int tase_packet_decode(const tase_frame_t *f, void *msg)
     if (f == NULL) {
         return TASE_EARG;
     }
-    return tase_packet_decode_desc(tase_schema_find(f->group, f->type), f->data, f->len, msg);
+    return decode_find(f->group, f->type, f->data, f->len, msg);
 }

@@ -23,17 +23,20 @@ int tase_dispatch_init(tase_dispatch_t *d, const tase_packet_handler_t *handlers
 void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
 {
     tase_dispatch_t *d = dispatcher;
+    tase_field_iter_t it;
     const tase_packet_desc_t *p;
     tase_packet_handler_t h = NULL;
+    void *msg;
     if (d == NULL || frame == NULL) {
         return;
     }
-    p = tase_schema_find(frame->group, frame->type);
+    /* The one call into the schema: the packet found and the walk bound. */
+    p = tase_field_iter_find(&it, frame->group, frame->type, frame->len);
     if (p == NULL) {
         if (d->stats != NULL) {
             d->stats->unknown++;
         }
-    } else if (!tase_schema_length_ok(p, frame->len)) {
+    } else if (!it.accepted) {
         if (d->stats != NULL) {
             d->stats->bad_length++;
         }
@@ -53,7 +56,8 @@ void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
         return;
     }
     /* Cannot fail: the packet is known and its length accepted. Decoded
-     * with the descriptor in hand, not looked up a second time. */
-    (void)tase_packet_decode_desc(p, frame->data, frame->len, p->size != 0u ? &d->msg : NULL);
-    h(d->user, frame, p->size != 0u ? &d->msg : NULL);
+     * with the walk in hand, not looked up a second time. */
+    msg = p->size != 0u ? &d->msg : NULL;
+    (void)tase_packet_decode_iter(&it, frame->data, msg);
+    h(d->user, frame, msg);
 }

@@ -259,28 +259,26 @@ int tase_gimbal_setup_get(const tase_gimbal_t *g, uint8_t type, uint8_t *out, si
 static void setup_copy(const tase_packet_desc_t *p, const uint8_t *src, size_t src_len,
                        uint8_t *dst, size_t dst_len, const uint8_t *cur)
 {
-    size_t i;
-    bool src_short = tase_layout_is_short(p, src_len);
+    tase_field_iter_t it; /* the walk of the source's layout */
     bool dst_short = tase_layout_is_short(p, dst_len);
     (void)memset(dst, 0, dst_len);
-    for (i = 0; i < p->nfields; i++) {
-        const tase_field_t *f = tase_schema_field(p, i);
-        unsigned w = TASE_FIELD_WIDTH(f);
-        const uint8_t *from = &src[tase_layout_offset(f, src_short)];
+    (void)tase_field_iter_init(&it, p, src_len); /* p: the table's, found by the caller */
+    while (tase_field_iter_next(&it)) {
+        const uint8_t *from = &src[it.offset];
         uint32_t keep;
-        if (cur != NULL && tase_layout_keep_bits(f, &keep)) {
+        if (cur != NULL && tase_field_iter_keep_bits(&it, &keep)) {
             /* the wire bits against the "do not change" bits (fields
              * with one are at most 4 bytes wide) */
             uint32_t bits = 0;
             unsigned k;
-            for (k = 0; k < w; k++) {
+            for (k = 0; k < it.width; k++) {
                 bits = (bits << 8) | from[k];
             }
             if (bits == keep) {
-                from = &cur[tase_layout_offset(f, false)]; /* stored: table layout */
+                from = &cur[tase_layout_offset(it.field, false)]; /* stored: table layout */
             }
         }
-        (void)memcpy(&dst[tase_layout_offset(f, dst_short)], from, w);
+        (void)memcpy(&dst[tase_layout_offset(it.field, dst_short)], from, it.width);
     }
 }
 

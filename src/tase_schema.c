@@ -6,7 +6,6 @@
 #include "tase/schema.h"
 
 #include "tase/codec.h"
-#include "tase_schema_layout.h"
 
 /* Field index bookkeeping: FIRST_x / END_x are the flat field indices of
  * packet x. Each marker rewinds the counter so it takes no slot. */
@@ -66,7 +65,7 @@ typedef char chk_count
 typedef char chk_fields[(FIELD_TOTAL < 256) ? 1 : -1];
 
 /* Generated from the list like its siblings here, so it stays at file
- * scope although only tase_schema_field() reads it. */
+ * scope although only bind() reads it. */
 /* cppcheck-suppress misra-c2012-8.9 */
 static const tase_field_t fields[FIELD_TOTAL] = {
 #define P(N, g, t, fl, l, sz)
@@ -156,21 +155,9 @@ const tase_packet_desc_t *tase_schema_at(size_t i)
     return i < TASE_PKT_COUNT ? &packets[i] : NULL;
 }
 
-const tase_field_t *tase_schema_field(const tase_packet_desc_t *p, size_t i)
+/* tase_schema_length_ok() for a descriptor that is not NULL. */
+static bool length_ok(const tase_packet_desc_t *p, size_t len)
 {
-    /* The second bound only matters for a descriptor that is not one of
-     * the table's (a corrupted copy): it keeps the index inside fields[]. */
-    if (p == NULL || i >= p->nfields || (size_t)p->first_field + i >= (size_t)FIELD_TOTAL) {
-        return NULL;
-    }
-    return &fields[p->first_field + i];
-}
-
-bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len)
-{
-    if (p == NULL) {
-        return false;
-    }
     if (len == p->len) {
         return true;
     }
@@ -180,10 +167,15 @@ bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len)
     if (len == 1u) {
         return (p->flags & TASE_LEN_SHORT1) != 0u;
     }
-    if (len + 1u == p->len && (p->flags & TASE_LEN_SHORT) != 0u) {
+    if (tase_schema_short_(p, len)) {
         return true;
     }
     return (p->flags & TASE_LEN_TAIL) != 0u && len > p->len && len <= TASE_DATA_MAX;
+}
+
+bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len)
+{
+    return p != NULL && length_ok(p, len);
 }
 
 bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len)
@@ -191,42 +183,101 @@ bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len)
     return p != NULL && len == 0u && (p->flags & TASE_LEN_QUERY) != 0u;
 }
 
-int tase_field_offset(const tase_packet_desc_t *p, size_t i, size_t len)
+bool tase_field_iter_begin(tase_field_iter_t *it, size_t len)
 {
-    const tase_field_t *f = tase_schema_field(p, i);
-    if (f == NULL) {
-        return TASE_EARG;
+    const tase_packet_desc_t *p = it->packet;
+    it->field = NULL;
+    it->next = 0u;
+    if (p == NULL) {
+        it->len = len;
+        it->accepted = false;
+        it->short_layout = false;
+        return false;
     }
-    return (int)tase_layout_offset(f, tase_layout_is_short(p, len));
+    it->len = (len == TASE_FIELD_ITER_TABLE_LEN) ? p->len : len;
+    it->accepted = length_ok(p, it->len);
+    it->short_layout = tase_schema_short_(p, it->len);
+    return it->accepted;
 }
 
-int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
-                   int64_t *value)
+/* Bind it to p, a descriptor of the table or NULL, and begin a walk. */
+static void bind(tase_field_iter_t *it, const tase_packet_desc_t *p, size_t len)
 {
-    const tase_field_t *f = tase_schema_field(p, i);
-    size_t at;
-    unsigned w;
-    unsigned k;
-    uint64_t v = 0u;
-    if (f == NULL || value == NULL || (data == NULL && len > 0u)) {
+    it->packet = p;
+    it->count = (p != NULL) ? p->nfields : 0u;
+    it->fields = (p != NULL) ? &fields[p->first_field] : NULL;
+    (void)tase_field_iter_begin(it, len);
+}
+
+const tase_packet_desc_t *tase_field_iter_find(tase_field_iter_t *it, uint8_t group, uint8_t type,
+                                               size_t len)
+{
+    const tase_packet_desc_t *p = tase_schema_find(group, type);
+    if (it == NULL) {
+        return NULL;
+    }
+    bind(it, p, len);
+    return p;
+}
+
+int tase_field_iter_init(tase_field_iter_t *it, const tase_packet_desc_t *p, size_t len)
+{
+    if (it == NULL) {
         return TASE_EARG;
     }
-    w = TASE_FIELD_WIDTH(f);
-    at = (size_t)tase_field_offset(p, i, len); /* >= 0: f is valid */
-    /* data is NULL only with len 0, where no field fits. */
-    if (data == NULL || at + w > len) {
+    if (p == NULL) {
+        bind(it, NULL, len);
+        return TASE_EUNKNOWN;
+    }
+    /* Only the table's own descriptors: a copy's first_field and nfields
+     * could index past the field table. */
+    if (tase_schema_at(p->index) != p) {
+        bind(it, NULL, len);
+        return TASE_EARG;
+    }
+    bind(it, p, len);
+    return TASE_OK;
+}
+
+/* The by-index functions: field i of p in a walk of len data bytes. */
+static bool seek(tase_field_iter_t *it, const tase_packet_desc_t *p, size_t i, size_t len)
+{
+    return tase_field_iter_init(it, p, len) == TASE_OK && tase_field_iter_seek(it, i);
+}
+
+const tase_field_t *tase_schema_field(const tase_packet_desc_t *p, size_t i)
+{
+    tase_field_iter_t it;
+    return seek(&it, p, i, 0u) ? it.field : NULL;
+}
+
+int tase_field_offset(const tase_packet_desc_t *p, size_t i, size_t len)
+{
+    tase_field_iter_t it;
+    return seek(&it, p, i, len) ? (int)it.offset : TASE_EARG;
+}
+
+int tase_field_iter_get(const tase_field_iter_t *it, const uint8_t *data, int64_t *value)
+{
+    unsigned k;
+    uint64_t v = 0u;
+    if (it == NULL || it->field == NULL || value == NULL || (data == NULL && it->len > 0u)) {
+        return TASE_EARG;
+    }
+    /* data is NULL only with length 0, where no field fits. */
+    if (data == NULL || !it->within) {
         return TASE_ETRUNC;
     }
-    for (k = 0; k < w; k++) {
-        v = (v << 8) | data[at + k];
+    for (k = 0; k < it->width; k++) {
+        v = (v << 8) | data[it->offset + k];
     }
     /* Big-endian: the sign bit is the top bit of the first byte. */
-    if (TASE_FIELD_IS_SIGNED(f) && (data[at] & 0x80u) != 0u) {
+    if (TASE_FIELD_IS_SIGNED(it->field) && (data[it->offset] & 0x80u) != 0u) {
         /* Two's complement by arithmetic, without an implementation-
          * defined conversion of an out-of-range unsigned value. */
         uint64_t mag = ~v;
-        if (w < 8u) {
-            unsigned bits = 8u * w;
+        if (it->width < 8u) {
+            unsigned bits = 8u * it->width;
             uint64_t mask = ((uint64_t)1u << bits) - 1u;
             mag &= mask;
         }
@@ -237,33 +288,49 @@ int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, s
     return TASE_OK;
 }
 
-/* All bits of an unsigned field of w (1..4, checked at build time) bytes. */
-int tase_field_keep(const tase_packet_desc_t *p, size_t i, int64_t *value)
+int tase_field_get(const tase_packet_desc_t *p, size_t i, const uint8_t *data, size_t len,
+                   int64_t *value)
 {
-    const tase_field_t *f = tase_schema_field(p, i);
-    uint32_t bits;
-    if (f == NULL || value == NULL) {
+    tase_field_iter_t it;
+    if (!seek(&it, p, i, len) || value == NULL || (data == NULL && len > 0u)) {
         return TASE_EARG;
     }
-    if (!tase_layout_keep_bits(f, &bits)) {
+    return tase_field_iter_get(&it, data, value);
+}
+
+/* The keep value of the field `it` is on (TASE_EUNKNOWN: it has none). */
+static int keep_value(const tase_field_iter_t *it, int64_t *value)
+{
+    uint32_t bits;
+    if (!tase_field_iter_keep_bits(it, &bits)) {
         return TASE_EUNKNOWN;
     }
     /* all ones of a signed field is -1 (HFOV "do not change") */
-    *value = (TASE_FIELD_KEEP(f) == TASE_FIELD_KEEP_ONES && TASE_FIELD_IS_SIGNED(f))
+    *value = (TASE_FIELD_KEEP(it->field) == TASE_FIELD_KEEP_ONES && TASE_FIELD_IS_SIGNED(it->field))
                  ? -1
                  : (int64_t)bits;
     return TASE_OK;
 }
 
+int tase_field_keep(const tase_packet_desc_t *p, size_t i, int64_t *value)
+{
+    tase_field_iter_t it;
+    if (!seek(&it, p, i, 0u) || value == NULL) {
+        return TASE_EARG;
+    }
+    return keep_value(&it, value);
+}
+
 bool tase_field_is_keep(const tase_packet_desc_t *p, size_t i, int64_t value)
 {
+    tase_field_iter_t it;
     int64_t keep;
-    if (tase_field_keep(p, i, &keep) != TASE_OK) {
+    if (!seek(&it, p, i, 0u) || keep_value(&it, &keep) != TASE_OK) {
         return false;
     }
     /* MSB (unsigned fields only): any value of the field with its top bit
      * set, i.e. from the keep value up to all ones. */
-    if (TASE_FIELD_KEEP(tase_schema_field(p, i)) == TASE_FIELD_KEEP_MSB) {
+    if (TASE_FIELD_KEEP(it.field) == TASE_FIELD_KEEP_MSB) {
         return value >= keep && value <= 2 * keep - 1;
     }
     return value == keep;

@@ -539,6 +539,165 @@ static void schema_api_rejects_bad_arguments(void **state)
     assert_null(tase_schema_packet_name(&forged));
 }
 
+/* The field walk (tase_field_iter_t) visits every field of every packet in
+ * order, at every data length 0..TASE_DATA_MAX, with the same descriptor,
+ * offset (layout applied), width, "within" and value as the by-index
+ * functions, and says whether the length is accepted as
+ * tase_schema_length_ok() does; tase_field_iter_find() and _init() agree;
+ * seek() moves to a field as next() would; begin() restarts a walk. */
+static void the_field_walk_agrees_with_the_by_index_functions(void **state)
+{
+    uint8_t data[TASE_DATA_MAX];
+    size_t i, len, k;
+    (void)state;
+    for (k = 0; k < sizeof data; k++) {
+        data[k] = (uint8_t)(0x9Bu * k + 0x41u); /* sign bits set and clear */
+    }
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        tase_field_iter_t it, by_id;
+        for (len = 0; len <= TASE_DATA_MAX + 1u; len++) {
+            assert_int_equal(tase_field_iter_init(&it, p, len), TASE_OK);
+            assert_ptr_equal(
+                tase_field_iter_find(&by_id, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), len), p);
+            assert_ptr_equal(it.packet, p);
+            assert_null(it.field);
+            assert_int_equal(it.len, len);
+            assert_int_equal(it.accepted, tase_schema_length_ok(p, len));
+            assert_int_equal(by_id.accepted, it.accepted);
+            k = 0;
+            while (tase_field_iter_next(&it)) {
+                const tase_field_t *f = tase_schema_field(p, k);
+                int off = tase_field_offset(p, k, len);
+                int64_t a = 1, b = 2;
+                int ra, rb;
+                assert_true(tase_field_iter_next(&by_id));
+                assert_ptr_equal(by_id.field, it.field);
+                assert_ptr_equal(it.field, f);
+                assert_int_equal(it.index, k);
+                assert_int_equal(it.width, TASE_FIELD_WIDTH(f));
+                assert_int_equal((int)it.offset, off);
+                assert_int_equal(it.within, (size_t)off + it.width <= len);
+                ra = tase_field_iter_get(&it, data, &a);
+                rb = tase_field_get(p, k, data, len <= TASE_DATA_MAX ? len : 0u, &b);
+                if (len <= TASE_DATA_MAX) {
+                    assert_int_equal(ra, rb);
+                    if (ra == TASE_OK) {
+                        assert_true(a == b);
+                    }
+                }
+                assert_int_equal(ra, it.within ? TASE_OK : TASE_ETRUNC);
+                k++;
+            }
+            assert_int_equal(k, p->nfields);
+            assert_false(tase_field_iter_next(&it)); /* stays at the end */
+            assert_false(tase_field_iter_next(&by_id));
+            /* seek: the same field as the walk; out of range changes nothing */
+            for (k = p->nfields; k-- > 0;) {
+                assert_true(tase_field_iter_seek(&it, k));
+                assert_ptr_equal(it.field, tase_schema_field(p, k));
+                assert_int_equal((int)it.offset, tase_field_offset(p, k, len));
+            }
+            k = it.index;
+            assert_false(tase_field_iter_seek(&it, p->nfields));
+            assert_false(tase_field_iter_seek(&it, SIZE_MAX));
+            assert_int_equal(it.index, k);
+            /* begin: the same packet anew at another length */
+            assert_int_equal(tase_field_iter_begin(&it, p->len), true);
+            assert_null(it.field);
+            assert_int_equal(it.len, p->len);
+        }
+        /* the table length, whatever it is */
+        assert_int_equal(tase_field_iter_init(&it, p, TASE_FIELD_ITER_TABLE_LEN), TASE_OK);
+        assert_int_equal(it.len, p->len);
+        assert_true(it.accepted);
+        while (tase_field_iter_next(&it)) {
+            assert_true(it.within);
+            assert_int_equal(it.offset, tase_schema_field(p, it.index)->offset);
+        }
+    }
+}
+
+/* AXIS_SETTING's 22-byte layout and CAMERA_CMD's 1-byte form in a walk:
+ * shifted fields one byte earlier, fields the short form leaves out not
+ * within it, with their "do not change" bits at hand. */
+static void the_field_walk_applies_the_layout_and_the_keep_bits(void **state)
+{
+    tase_field_iter_t it;
+    uint32_t bits = 0;
+    unsigned within = 0;
+    (void)state;
+    assert_non_null(tase_field_iter_find(&it, TASE_ID_GROUP(TASE_ID_AXIS_SETTING),
+                                         TASE_ID_TYPE(TASE_ID_AXIS_SETTING), 22));
+    assert_true(it.accepted);
+    assert_true(tase_field_iter_seek(&it, 7)); /* tilt_max_rate: 14 in the table */
+    assert_int_equal(it.offset, 13);
+    assert_int_equal(tase_field_iter_begin(&it, 23), true);
+    assert_true(tase_field_iter_seek(&it, 7));
+    assert_int_equal(it.offset, 14);
+    assert_int_equal(tase_field_iter_begin(&it, 21), false); /* refused; still walks */
+    assert_true(tase_field_iter_next(&it));
+
+    assert_non_null(tase_field_iter_find(&it, TASE_ID_GROUP(TASE_ID_CAMERA_CMD),
+                                         TASE_ID_TYPE(TASE_ID_CAMERA_CMD), 1));
+    assert_true(it.accepted);
+    assert_false(tase_field_iter_keep_bits(&it, &bits)); /* no field yet */
+    while (tase_field_iter_next(&it)) {
+        int64_t keep;
+        bool has = tase_field_iter_keep_bits(&it, &bits);
+        assert_int_equal(has, tase_field_keep(it.packet, it.index, &keep) == TASE_OK);
+        if (has) {
+            /* the wire bits of the keep value: -1 (hfov) is all ones */
+            uint64_t ones = it.width >= 8u ? UINT64_MAX : (1ull << (8u * it.width)) - 1u;
+            assert_true(bits == ((uint64_t)keep & ones));
+        }
+        within += it.within ? 1u : 0u;
+    }
+    assert_int_equal(within, 1); /* the camera byte alone */
+}
+
+/* Bad arguments of the iterator: documented codes, and an iterator bound
+ * to no packet walks nothing. A copy of a descriptor is refused (its
+ * first_field and nfields could index past the field table). */
+static void the_field_walk_rejects_bad_arguments(void **state)
+{
+    const tase_packet_desc_t *p = tase_schema_at(0);
+    tase_packet_desc_t forged;
+    tase_field_iter_t it;
+    uint8_t data[TASE_DATA_MAX] = {0};
+    int64_t v = 77;
+    (void)state;
+    assert_null(tase_field_iter_find(NULL, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), 0));
+    assert_null(tase_field_iter_find(&it, 0x28, 0x01, 0));
+    assert_null(it.packet);
+    assert_false(it.accepted);
+    assert_false(tase_field_iter_next(&it));
+    assert_false(tase_field_iter_begin(&it, 0));
+    assert_int_equal(tase_field_iter_init(NULL, p, 0), TASE_EARG);
+    assert_int_equal(tase_field_iter_init(&it, NULL, 0), TASE_EUNKNOWN);
+    assert_false(tase_field_iter_next(&it));
+    forged = *p;
+    forged.first_field = 255;
+    forged.nfields = 200;
+    assert_int_equal(tase_field_iter_init(&it, &forged, forged.len), TASE_EARG);
+    assert_null(it.packet);
+    assert_false(tase_field_iter_next(&it));
+    assert_int_equal(tase_field_iter_init(&it, p, p->len), TASE_OK);
+    assert_int_equal(tase_field_iter_get(&it, data, &v), TASE_EARG); /* no field yet */
+    assert_true(tase_field_iter_next(&it));
+    assert_int_equal(tase_field_iter_get(NULL, data, &v), TASE_EARG);
+    assert_int_equal(tase_field_iter_get(&it, data, NULL), TASE_EARG);
+    assert_int_equal(tase_field_iter_get(&it, NULL, &v), TASE_EARG);
+    assert_int_equal(v, 77);
+    assert_int_equal(tase_field_iter_init(&it, p, 0), TASE_OK); /* a query */
+    assert_true(tase_field_iter_next(&it));
+    assert_int_equal(tase_field_iter_get(&it, NULL, &v), TASE_ETRUNC);
+    assert_int_equal(v, 77);
+    /* lengths above TASE_DATA_MAX are never accepted */
+    assert_int_equal(tase_field_iter_init(&it, p, TASE_DATA_MAX + 1u), TASE_OK);
+    assert_false(it.accepted);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -554,6 +713,9 @@ int main(void)
         cmocka_unit_test(keep_values_are_exactly_the_specs),
         cmocka_unit_test(camera_flags_with_the_msb_set_all_mean_no_change),
         cmocka_unit_test(keep_api_rejects_bad_arguments),
+        cmocka_unit_test(the_field_walk_agrees_with_the_by_index_functions),
+        cmocka_unit_test(the_field_walk_applies_the_layout_and_the_keep_bits),
+        cmocka_unit_test(the_field_walk_rejects_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

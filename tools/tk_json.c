@@ -415,13 +415,14 @@ size_t tk_format_time(char *buf, const tk_time_t *t)
 
 static void json_units(sb_t *b, const tase_packet_desc_t *p, const tase_frame_t *f)
 {
-    unsigned i;
+    tase_field_iter_t it;
     bool any = false;
-    for (i = 0; i < p->nfields; i++) {
-        const char *name = tase_schema_field_name(p, i);
+    (void)tase_field_iter_init(&it, p, f->len);
+    while (tase_field_iter_next(&it)) {
+        const char *name = tase_schema_field_name(p, it.index);
         const unit_t *u = unit_of(p, name);
-        long long v;
-        if (u == NULL || !tk_field_get(p, i, f->data, f->len, &v)) {
+        int64_t v;
+        if (u == NULL || tase_field_iter_get(&it, f->data, &v) != TASE_OK) {
             continue;
         }
         sb_str(b, any ? ",\"" : ",\"units\":{\"");
@@ -610,7 +611,7 @@ static void text_time(sb_t *b, const tk_time_t *t)
 static void text_frame(sb_t *b, const tk_fmt_t *fmt, const tk_meta_t *m, const tase_frame_t *f)
 {
     const tase_packet_desc_t *p = tase_schema_find(f->group, f->type);
-    unsigned i;
+    tase_field_iter_t it;
     if (fmt->time && m->time != NULL) {
         text_time(b, m->time);
     }
@@ -632,11 +633,12 @@ static void text_frame(sb_t *b, const tk_fmt_t *fmt, const tk_meta_t *m, const t
         sb_str(b, p->len == 0 ? "\n" : " (query)\n");
         return;
     }
-    for (i = 0; i < p->nfields; i++) {
-        const char *name = tase_schema_field_name(p, i);
+    (void)tase_field_iter_init(&it, p, f->len);
+    while (tase_field_iter_next(&it)) {
+        const char *name = tase_schema_field_name(p, it.index);
         const unit_t *u;
-        long long v;
-        if (!tk_field_get(p, i, f->data, f->len, &v)) {
+        int64_t v;
+        if (tase_field_iter_get(&it, f->data, &v) != TASE_OK) {
             break;
         }
         sb_c(b, ' ');

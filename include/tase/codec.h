@@ -381,13 +381,22 @@ int tase_packet_encode_data_len(uint16_t id, const void *msg, size_t len, uint8_
  * into data. On error msg is unchanged. O(length). */
 int tase_packet_decode_data(uint16_t id, const uint8_t *data, size_t len, void *msg);
 
-/* tase_packet_decode_data() for a descriptor already looked up (the
- * dispatcher's path: tase_schema_find() once per frame). p NULL gives
- * TASE_EUNKNOWN (so the result of tase_schema_find() can be passed as it
- * is); a pointer that is not a descriptor of the schema table gives
+/* tase_packet_decode_data() for a descriptor already looked up. p NULL
+ * gives TASE_EUNKNOWN (so the result of tase_schema_find() can be passed
+ * as it is); a pointer that is not a descriptor of the schema table gives
  * TASE_EARG. O(length). */
 int tase_packet_decode_desc(const tase_packet_desc_t *p, const uint8_t *data, size_t len,
                             void *msg);
+
+/* Decode data[0..it->len) into msg for the packet the field walk `it`
+ * (tase/schema.h) is bound to, at the length it was begun for: the
+ * dispatcher's path, which found the packet and checked the length in one
+ * call (tase_field_iter_find()) and decodes with the descriptors in hand,
+ * no second lookup. The walk is restarted and run to its end. Same
+ * results as tase_packet_decode_data() for that packet and length
+ * (TASE_ELENGTH when it->accepted is false), and TASE_EARG when it is
+ * NULL or bound to no packet. O(length). */
+int tase_packet_decode_iter(tase_field_iter_t *it, const uint8_t *data, void *msg);
 
 #ifdef __cplusplus
 }

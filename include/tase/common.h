@@ -38,6 +38,16 @@ extern "C" {
 #define TASE_CAST_(type, value) ((type)(value))
 #endif
 
+/* Private: `inline` for the static inline functions of the public headers
+ * that sit in a loop of the library (the field iterator's step): GCC and
+ * clang inline them even at -Os, where a call per field cost the codec up
+ * to 13% more instructions on a Cortex-M0+. */
+#if defined(__GNUC__)
+#define TASE_INLINE_ __inline__ __attribute__((always_inline))
+#else
+#define TASE_INLINE_ inline
+#endif
+
 /* Error codes. Stable: values never change meaning once released. */
 /* Bytes per second a UART carries at `baud` with 8N1 framing (10 bits per
  * byte: start, 8 data, stop): TASE_UART_BYTES_PER_S(57600) is 5760. The

@@ -17,8 +17,10 @@
  *      stats->bad_length is incremented and the error hook gets the frame
  *      with TASE_ELENGTH. It never reaches a typed handler.
  *   3. Known packet, accepted length, typed handler set: the frame is
- *      decoded (tase_packet_decode()) into the dispatcher's buffer and the handler
- *      gets the frame and the typed struct (tase/codec.h; NULL for
+ *      decoded into the dispatcher's buffer, as tase_packet_decode() would
+ *      but with the field walk of the lookup above (tase_field_iter_find(),
+ *      tase_packet_decode_iter(): one call into the schema per frame), and
+ *      the handler gets the frame and the typed struct (tase/codec.h; NULL for
  *      GYRO_ZERO_CMD). A query (tase_schema_is_query()) arrives as a
  *      zeroed struct with frame->len == 0; a 1-byte CAMERA_CMD has
  *      frame->len == 1.

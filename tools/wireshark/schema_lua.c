@@ -11,7 +11,7 @@
 int main(void)
 {
     size_t i;
-    unsigned j;
+    tase_field_iter_t it;
     puts("-- BEGIN GENERATED (tools/wireshark/schema_lua.c; do not edit by hand)");
     puts("-- {group, type, name, data length, flags, {{field, offset, width, signed}...}}");
     puts("-- flags: q = zero-length query form, 1 = one-byte form, t = free bytes after");
@@ -24,11 +24,11 @@ int main(void)
                (p->flags & TASE_LEN_QUERY) != 0u ? "q" : "",
                (p->flags & TASE_LEN_SHORT1) != 0u ? "1" : "",
                (p->flags & TASE_LEN_TAIL) != 0u ? "t" : "");
-        for (j = 0; j < p->nfields; j++) {
-            const tase_field_t *f = tase_schema_field(p, j);
-            printf("%s{\"%s\", %u, %u, %s},", j % 3u == 0u ? "\n        " : " ",
-                   tase_schema_field_name(p, j), (unsigned)f->offset, TASE_FIELD_WIDTH(f),
-                   TASE_FIELD_IS_SIGNED(f) ? "true" : "false");
+        (void)tase_field_iter_init(&it, p, TASE_FIELD_ITER_TABLE_LEN);
+        while (tase_field_iter_next(&it)) {
+            printf("%s{\"%s\", %u, %u, %s},", it.index % 3u == 0u ? "\n        " : " ",
+                   tase_schema_field_name(p, it.index), (unsigned)it.offset, (unsigned)it.width,
+                   TASE_FIELD_IS_SIGNED(it.field) ? "true" : "false");
         }
         puts(p->nfields > 0 ? "\n    }}," : "}},");
     }
