@@ -85,8 +85,11 @@ static int encode_check(const tase_field_iter_t *it, const void *msg, size_t len
     return it->accepted ? TASE_OK : TASE_ELENGTH;
 }
 
-/* The len data bytes of msg into body (checked by encode_check()). */
-static void encode_body(tase_field_iter_t *it, const void *msg, size_t len, uint8_t *body)
+/* The len data bytes of msg into body (checked by encode_check()). Not
+ * inlined: the walk's registers stay out of encode()'s frame, which is
+ * live while it calls tase_frame_encode() (the deepest path). */
+TASE_NOINLINE_ static void encode_body(tase_field_iter_t *it, const void *msg, size_t len,
+                                       uint8_t *body)
 {
     const tase_camera_pass_t *cp = msg;
     size_t table = it->packet->len;

@@ -20,18 +20,19 @@ int tase_dispatch_init(tase_dispatch_t *d, const tase_packet_handler_t *handlers
     return TASE_OK;
 }
 
-void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
+/* Where frame goes (the contract's order): looks its packet up once, then
+ * counts an unknown packet or a wrong length, and for a typed handler
+ * decodes the frame into d->msg with the walk of that lookup. Returns the
+ * handler (NULL: the default handler), or sets *refused for a wrong
+ * length. Not inlined, so that the walk is off the stack while the
+ * application's handler runs. */
+TASE_NOINLINE_ static tase_packet_handler_t route(tase_dispatch_t *d, const tase_frame_t *frame,
+                                                  void **msg, bool *refused)
 {
-    tase_dispatch_t *d = dispatcher;
     tase_field_iter_t it;
-    const tase_packet_desc_t *p;
+    const tase_packet_desc_t *p = tase_field_iter_find(&it, frame->group, frame->type, frame->len);
     tase_packet_handler_t h = NULL;
-    void *msg;
-    if (d == NULL || frame == NULL) {
-        return;
-    }
-    /* The one call into the schema: the packet found and the walk bound. */
-    p = tase_field_iter_find(&it, frame->group, frame->type, frame->len);
+    *refused = false;
     if (p == NULL) {
         if (d->stats != NULL) {
             d->stats->unknown++;
@@ -40,24 +41,39 @@ void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
         if (d->stats != NULL) {
             d->stats->bad_length++;
         }
-        if (d->on_error != NULL) {
-            d->on_error(d->user, frame, TASE_ELENGTH);
-        }
-        return;
+        *refused = true;
     } else if (d->handlers != NULL) {
         h = d->handlers[p->index];
     } else {
         /* no handler table: everything goes to on_default */
     }
-    if (h == NULL) {
+    if (h != NULL) {
+        /* Cannot fail: the packet is known and its length accepted. */
+        *msg = p->size != 0u ? &d->msg : NULL;
+        (void)tase_packet_decode_iter(&it, frame->data, *msg);
+    }
+    return h;
+}
+
+void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
+{
+    tase_dispatch_t *d = dispatcher;
+    tase_packet_handler_t h;
+    void *msg = NULL;
+    bool refused;
+    if (d == NULL || frame == NULL) {
+        return;
+    }
+    h = route(d, frame, &msg, &refused);
+    if (refused) {
+        if (d->on_error != NULL) {
+            d->on_error(d->user, frame, TASE_ELENGTH);
+        }
+    } else if (h == NULL) {
         if (d->on_default != NULL) {
             d->on_default(d->user, frame);
         }
-        return;
+    } else {
+        h(d->user, frame, msg);
     }
-    /* Cannot fail: the packet is known and its length accepted. Decoded
-     * with the walk in hand, not looked up a second time. */
-    msg = p->size != 0u ? &d->msg : NULL;
-    (void)tase_packet_decode_iter(&it, frame->data, msg);
-    h(d->user, frame, msg);
 }

@@ -188,13 +188,15 @@ bool tase_field_iter_begin(tase_field_iter_t *it, size_t len)
     const tase_packet_desc_t *p = it->packet;
     it->field = NULL;
     it->next = 0u;
+    if (len > TASE_DATA_MAX) {
+        len = (len == TASE_FIELD_ITER_TABLE_LEN && p != NULL) ? p->len : TASE_DATA_MAX + 1u;
+    }
+    it->len = (uint8_t)len; /* <= TASE_DATA_MAX + 1 */
     if (p == NULL) {
-        it->len = len;
         it->accepted = false;
         it->short_layout = false;
         return false;
     }
-    it->len = (len == TASE_FIELD_ITER_TABLE_LEN) ? p->len : len;
     it->accepted = length_ok(p, it->len);
     it->short_layout = tase_schema_short_(p, it->len);
     return it->accepted;

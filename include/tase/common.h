@@ -48,6 +48,15 @@ extern "C" {
 #define TASE_INLINE_ inline
 #endif
 
+/* Private: keeps a helper out of its caller, so that the caller's stack
+ * frame (on a path that goes deeper elsewhere) does not take the helper's
+ * registers and locals too. */
+#if defined(__GNUC__)
+#define TASE_NOINLINE_ __attribute__((noinline))
+#else
+#define TASE_NOINLINE_
+#endif
+
 /* Error codes. Stable: values never change meaning once released. */
 /* Bytes per second a UART carries at `baud` with 8N1 framing (10 bits per
  * byte: start, 8 data, stop): TASE_UART_BYTES_PER_S(57600) is 5760. The

@@ -182,17 +182,17 @@ bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len);
 typedef struct {
     const tase_packet_desc_t *packet; /* the bound packet; NULL: none (walks nothing) */
     const tase_field_t *field;        /* the current field; NULL before the first */
-    size_t len;                       /* the data length of the walk */
-    bool accepted;                    /* len is an accepted length of the packet */
-    bool within;                      /* offset + width <= len: the field is in the data */
-    uint8_t index;                    /* the field's index, 0..nfields-1 */
-    uint8_t width;                    /* its width in bytes: 1, 2, 4 or 8 */
-    size_t offset;                    /* its byte offset in len bytes (layout applied) */
+    uint8_t len;    /* the data length of the walk (one above TASE_DATA_MAX: too long) */
+    uint8_t offset; /* the field's byte offset in len bytes (layout applied) */
+    uint8_t width;  /* its width in bytes: 1, 2, 4 or 8 */
+    uint8_t index;  /* its index, 0..nfields-1 */
+    bool accepted;  /* len is an accepted length of the packet */
+    bool within;    /* offset + width <= len: the field is in the data */
     /* private */
     bool short_layout;          /* len is the packet's short layout */
-    uint8_t count;              /* fields of the bound packet */
     uint8_t next;               /* index of the next field */
     const tase_field_t *fields; /* the bound packet's first field */
+    uint8_t count;              /* fields of the bound packet */
 } tase_field_iter_t;
 
 /* `len` for tase_field_iter_find(), tase_field_iter_init() and
@@ -223,8 +223,9 @@ int tase_field_iter_init(tase_field_iter_t *it, const tase_packet_desc_t *p, siz
 /* Begin the walk over the bound packet's fields anew, for a frame of `len`
  * data bytes (any size_t, or TASE_FIELD_ITER_TABLE_LEN): the length selects
  * the layout (TWO LAYOUTS above) and which fields lie within the data.
- * Sets it->len and it->accepted (len is an accepted length of the packet,
- * as tase_schema_length_ok()) and returns it->accepted; the walk works
+ * Sets it->len (a length above TASE_DATA_MAX is kept as TASE_DATA_MAX + 1)
+ * and it->accepted (len is an accepted length of the packet, as
+ * tase_schema_length_ok()) and returns it->accepted; the walk works
  * either way. False when `it` is bound to no packet. O(1). */
 bool tase_field_iter_begin(tase_field_iter_t *it, size_t len);
 
@@ -261,8 +262,8 @@ static TASE_INLINE_ bool tase_field_iter_seek(tase_field_iter_t *it, size_t i)
     it->index = TASE_CAST_(uint8_t, i);
     it->next = TASE_CAST_(uint8_t, i + 1u);
     it->width = TASE_CAST_(uint8_t, TASE_FIELD_WIDTH(f));
-    it->offset = tase_field_at_(f, it->short_layout);
-    it->within = it->offset + it->width <= it->len;
+    it->offset = TASE_CAST_(uint8_t, tase_field_at_(f, it->short_layout));
+    it->within = (unsigned)it->offset + it->width <= it->len;
     return true;
 }
 
