@@ -186,12 +186,13 @@ bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len)
 bool tase_field_iter_begin(tase_field_iter_t *it, size_t len)
 {
     const tase_packet_desc_t *p = it->packet;
+    size_t n = len;
     it->field = NULL;
     it->next = 0u;
-    if (len > TASE_DATA_MAX) {
-        len = (len == TASE_FIELD_ITER_TABLE_LEN && p != NULL) ? p->len : TASE_DATA_MAX + 1u;
+    if (n > TASE_DATA_MAX) {
+        n = (n == TASE_FIELD_ITER_TABLE_LEN && p != NULL) ? p->len : TASE_DATA_MAX + 1u;
     }
-    it->len = (uint8_t)len; /* <= TASE_DATA_MAX + 1 */
+    it->len = (uint8_t)n; /* <= TASE_DATA_MAX + 1 */
     if (p == NULL) {
         it->accepted = false;
         it->short_layout = false;

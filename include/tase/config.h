@@ -118,7 +118,7 @@
  * schema lookups) are not guarded: a program that only encodes or
  * decodes is not caught this way, though a change to a message struct's
  * layout raises the level all the same. */
-/* core (libtase): tase/frame.h, dispatch.h, can.h, klv.h, host.h, gimbal.h */
+/* core (libtase): tase/frame.h, dispatch.h, can.h, klv.h, host.h, gimbal.h, schema.h */
 #define tase_rx_init TASE_CONFIG_LINK_NAME(tase_rx_init_)
 #define tase_dispatch_init TASE_CONFIG_LINK_NAME(tase_dispatch_init_)
 #define tase_can_rx_init TASE_CONFIG_LINK_NAME(tase_can_rx_init_)
@@ -126,6 +126,9 @@
 #define tase_klv_rx_init TASE_CONFIG_LINK_NAME(tase_klv_rx_init_)
 #define tase_host_init TASE_CONFIG_LINK_NAME(tase_host_init_)
 #define tase_gimbal_init TASE_CONFIG_LINK_NAME(tase_gimbal_init_)
+/* tase/schema.h: the field iterator, bound by either of these */
+#define tase_field_iter_find TASE_CONFIG_LINK_NAME(tase_field_iter_find_)
+#define tase_field_iter_init TASE_CONFIG_LINK_NAME(tase_field_iter_init_)
 /* ports: tase/ring.h, bm_uart.h and bm_dma.h (libtase_baremetal), posix_uart.h
  * (libtase_posix_uart), socketcan.h (libtase_socketcan) */
 #define tase_ring_init TASE_CONFIG_LINK_NAME(tase_ring_init_)

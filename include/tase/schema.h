@@ -263,7 +263,7 @@ static TASE_INLINE_ bool tase_field_iter_seek(tase_field_iter_t *it, size_t i)
     it->next = TASE_CAST_(uint8_t, i + 1u);
     it->width = TASE_CAST_(uint8_t, TASE_FIELD_WIDTH(f));
     it->offset = TASE_CAST_(uint8_t, tase_field_at_(f, it->short_layout));
-    it->within = (unsigned)it->offset + it->width <= it->len;
+    it->within = it->offset + it->width <= it->len;
     return true;
 }
 
@@ -282,10 +282,10 @@ static TASE_INLINE_ bool tase_field_iter_next(tase_field_iter_t *it)
 static inline bool tase_field_iter_keep_bits(const tase_field_iter_t *it, uint32_t *bits)
 {
     uint32_t ones;
-    if (it->field == NULL) {
+    if (it->next == 0u) { /* no field yet: begin() or bound to none */
         return false;
     }
-    ones = (it->width >= 4u) ? 0xFFFFFFFFu : (TASE_CAST_(uint32_t, 1u) << (8u * it->width)) - 1u;
+    ones = (it->width >= 4u) ? 0xFFFFFFFFu : (UINT32_C(1) << (8u * it->width)) - 1u;
     switch (TASE_FIELD_KEEP(it->field)) {
     case TASE_FIELD_KEEP_ONES: *bits = ones; return true;
     case TASE_FIELD_KEEP_ZERO: *bits = 0u; return true;
