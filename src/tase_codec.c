@@ -194,20 +194,14 @@ static void unpack_fields(tase_field_iter_t *it, const uint8_t *data, void *msg)
 {
     while (tase_field_iter_next(it)) {
         uint8_t *m = (uint8_t *)msg + it->field->member;
-        unsigned w = it->width;
-        unsigned k;
-        uint64_t v = 0u;
         uint32_t keep;
         if (!it->within || data == NULL) { /* data is NULL only at length 0 */
             if (tase_field_iter_keep_bits(it, &keep)) {
-                member_store(m, w, keep);
+                member_store(m, it->width, keep);
             }
             continue;
         }
-        for (k = 0; k < w; k++) {
-            v = (v << 8) | data[it->offset + k];
-        }
-        member_store(m, w, v);
+        member_store(m, it->width, tase_field_iter_bits_(it, data));
     }
 }
 

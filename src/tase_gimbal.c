@@ -266,17 +266,11 @@ static void setup_copy(const tase_packet_desc_t *p, const uint8_t *src, size_t s
     while (tase_field_iter_next(&it)) {
         const uint8_t *from = &src[it.offset];
         uint32_t keep;
-        if (cur != NULL && tase_field_iter_keep_bits(&it, &keep)) {
-            /* the wire bits against the "do not change" bits (fields
-             * with one are at most 4 bytes wide) */
-            uint32_t bits = 0;
-            unsigned k;
-            for (k = 0; k < it.width; k++) {
-                bits = (bits << 8) | from[k];
-            }
-            if (bits == keep) {
-                from = &cur[tase_layout_offset(it.field, false)]; /* stored: table layout */
-            }
+        /* the wire bits against the "do not change" bits (no setup field
+         * has the MSB kind, where any value with the top bit set would do) */
+        if (cur != NULL && tase_field_iter_keep_bits(&it, &keep) &&
+            tase_field_iter_bits_(&it, src) == keep) {
+            from = &cur[tase_layout_offset(it.field, false)]; /* stored: table layout */
         }
         (void)memcpy(&dst[tase_layout_offset(it.field, dst_short)], from, it.width);
     }
@@ -377,13 +371,14 @@ static int apply_setup(tase_gimbal_t *g, unsigned port, uint8_t type, uint8_t *d
     return r;
 }
 
-/* Write the echo of setup `type` on port: what is in force now, in the
- * 22-byte layout of AXIS_SETTING when `short_axis`. */
-static void send_echo(tase_gimbal_t *g, unsigned port, uint8_t type, bool short_axis)
+/* Write echo e (an echo[] index: a setup type, or ECHO_SHORT_AXIS for
+ * AXIS_SETTING in its 22-byte layout) on port: what is in force now. */
+static void send_echo(tase_gimbal_t *g, unsigned port, unsigned e)
 {
+    uint8_t type = e == ECHO_SHORT_AXIS ? SETUP_AXIS_SETTING : (uint8_t)e;
     const uint8_t *cur = &g->setup[setup_off[type]];
     size_t len = setup_len[type];
-    if (short_axis) {
+    if (e == ECHO_SHORT_AXIS) {
         /* laid out in the frame buffer, free outside tase_gimbal_poll() */
         len = (size_t)setup_len[type] - 1u;
         setup_copy(setup_desc(type), cur, setup_len[type], g->tx_frame, len, NULL);
@@ -426,16 +421,6 @@ static int handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f, 
     return short_axis ? (int)ECHO_SHORT_AXIS : (int)type;
 }
 
-/* Write echo e (an echo[] index) on port. */
-static void send_echo_of(tase_gimbal_t *g, unsigned port, unsigned e)
-{
-    if (e == ECHO_SHORT_AXIS) {
-        send_echo(g, port, SETUP_AXIS_SETTING, true);
-    } else {
-        send_echo(g, port, (uint8_t)e, false);
-    }
-}
-
 /* Write the echoes the frames of the last piece owe, by setup type. */
 static void send_echoes(tase_gimbal_t *g, unsigned port)
 {
@@ -443,7 +428,7 @@ static void send_echoes(tase_gimbal_t *g, unsigned port)
     for (i = 0; i <= ECHO_SHORT_AXIS; i++) {
         while (g->echo[i] > 0u) {
             g->echo[i]--;
-            send_echo_of(g, port, i);
+            send_echo(g, port, i);
         }
     }
 }
@@ -473,14 +458,13 @@ static int handle(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame, ui
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
                              uint32_t now_ms)
 {
+    int e;
     if (g == NULL || frame == NULL || frame->data == NULL || port >= TASE_GIMBAL_PORTS) {
         return TASE_EARG;
     }
-    {
-        int e = handle(g, port, frame, now_ms);
-        if (e >= 0) {
-            send_echo_of(g, port, (unsigned)e);
-        }
+    e = handle(g, port, frame, now_ms);
+    if (e >= 0) {
+        send_echo(g, port, (unsigned)e);
     }
     return TASE_OK;
 }

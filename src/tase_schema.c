@@ -262,8 +262,7 @@ int tase_field_offset(const tase_packet_desc_t *p, size_t i, size_t len)
 
 int tase_field_iter_get(const tase_field_iter_t *it, const uint8_t *data, int64_t *value)
 {
-    unsigned k;
-    uint64_t v = 0u;
+    uint64_t v;
     if (it == NULL || it->field == NULL || value == NULL || (data == NULL && it->len > 0u)) {
         return TASE_EARG;
     }
@@ -271,9 +270,7 @@ int tase_field_iter_get(const tase_field_iter_t *it, const uint8_t *data, int64_
     if (data == NULL || !it->within) {
         return TASE_ETRUNC;
     }
-    for (k = 0; k < it->width; k++) {
-        v = (v << 8) | data[it->offset + k];
-    }
+    v = tase_field_iter_bits_(it, data);
     /* Big-endian: the sign bit is the top bit of the first byte. */
     if (TASE_FIELD_IS_SIGNED(it->field) && (data[it->offset] & 0x80u) != 0u) {
         /* Two's complement by arithmetic, without an implementation-

@@ -274,6 +274,20 @@ static TASE_INLINE_ bool tase_field_iter_next(tase_field_iter_t *it)
     return tase_field_iter_seek(it, it->next);
 }
 
+/* Private: the wire bits of the current field in data (big-endian,
+ * it->width bytes at it->offset; the caller has checked it->within). The
+ * one reader of a field's bytes: the codec, tase_field_iter_get() and the
+ * gimbal role's setup copy. */
+static inline uint64_t tase_field_iter_bits_(const tase_field_iter_t *it, const uint8_t *data)
+{
+    uint64_t v = 0u;
+    unsigned k;
+    for (k = 0u; k < it->width; k++) {
+        v = (v << 8) | data[it->offset + k];
+    }
+    return v;
+}
+
 /* The wire bits of the current field's "do not change" value (all ones of
  * its width, zero, or its top bit; tase_field_keep() gives the value):
  * sets *bits and returns true, or returns false when the field has none
