@@ -72,11 +72,11 @@ static int encode_check(const tase_field_iter_t *it, const void *msg, size_t len
         return TASE_EARG;
     }
     if ((p->flags & TASE_LEN_TAIL) != 0u && len > 0u) {
+        if (cp->data == NULL && cp->len > 0u) {
+            return TASE_EARG; /* before ETOOLONG, in codec.h's order */
+        }
         if (cp->len > TASE_CAMERA_PASS_MAX) {
             return TASE_ETOOLONG;
-        }
-        if (cp->data == NULL && cp->len > 0u) {
-            return TASE_EARG;
         }
         if (len != (size_t)p->len + cp->len) {
             return TASE_ELENGTH;

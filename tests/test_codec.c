@@ -595,8 +595,9 @@ static void data_only_codec_rejects_bad_arguments(void **state)
     assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, NULL, out, 8), TASE_EARG);
     assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, out, sizeof out),
                      TASE_ETOOLONG);
+    cp.data = NULL; /* both wrong: TASE_EARG first, in the documented order */
+    assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, out, sizeof out), TASE_EARG);
     cp.len = 3;
-    cp.data = NULL;
     assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, out, sizeof out), TASE_EARG);
     for (cap = 0; cap < 8; cap++) {
         assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &cmd, out, cap), TASE_ENOSPC);
