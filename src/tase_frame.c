@@ -428,13 +428,11 @@ RX_INLINE static bool hunt(tase_rx_t *rx, uint8_t byte)
     return false;
 }
 
-/* Start a call that may deliver frames: `busy` set and `end` zero for
- * its whole length (see the file comment). */
-static void begin(tase_rx_t *rx, rx_call_t *c, tase_rx_handler_t on_frame, void *user)
+/* Start a call that may deliver frames (its rx_call_t set up by the
+ * caller): `busy` set and `end` blocked for its whole length (see the
+ * file comment). */
+static void begin(tase_rx_t *rx)
 {
-    c->on_frame = on_frame;
-    c->user = user;
-    c->count = 0u;
     rx->busy = 1u;
     rx->end = RX_BLOCKED;
 }
@@ -472,10 +470,10 @@ static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
 static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx_handler_t on_frame,
                void *user)
 {
-    rx_call_t c;
+    rx_call_t c = {on_frame, user, 0u};
     size_t i = 0;
     bool live = true;
-    begin(rx, &c, on_frame, user);
+    begin(rx);
     if (n == 0u && rx->lag != 0u) {
         live = advance(rx, &c, RX_BUDGET, false);
     }
@@ -563,12 +561,12 @@ static int rx_check(const tase_rx_t *rx)
  * does for each byte), a call from a callback, or a corrupted instance. */
 RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c;
+    rx_call_t c = {on_frame, user, 0u}; /* before the check: fewer registers kept */
     int r = rx_check(rx);
     if (r != TASE_OK) {
         return r;
     }
-    begin(rx, &c, on_frame, user);
+    begin(rx);
     return finish(rx, &c, put(rx, &c, b) && advance(rx, &c, RX_BUDGET, false));
 }
 
@@ -579,9 +577,9 @@ RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
  * that any split of the stream gives the same result. */
 RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c;
+    rx_call_t c = {on_frame, user, 0u};
     size_t len = rx->len;
-    begin(rx, &c, on_frame, user);
+    begin(rx);
     rx->stats.checksum_errors++;
     rx->buf[len] = b;
     rx->len = (uint16_t)(len + 1u);
