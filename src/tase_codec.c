@@ -117,14 +117,15 @@ static size_t walk_len(size_t len)
 
 /* Every encoder: packet `id` from msg at data length `len`
  * (TASE_FIELD_ITER_TABLE_LEN: the table length, CAMERA_PASS's tail added)
- * into out[0..cap), as a whole frame or as its data only. */
-static int encode(uint8_t *out, size_t cap, uint16_t id, const void *msg, size_t len, bool frame)
+ * into out[header..cap), header 0 for the data only or TASE_FRAME_HEADER
+ * to leave room for a frame around it. Returns the data length. */
+static int encode(uint8_t *out, size_t cap, size_t header, uint16_t id, const void *msg,
+                  size_t len)
 {
     tase_field_iter_t it;
     const tase_packet_desc_t *p;
     size_t n = len;
-    size_t header = 0u;
-    size_t overhead = 0u;
+    size_t overhead = header > 0u ? TASE_FRAME_OVERHEAD : 0u;
     int r;
     if (out == NULL) {
         return TASE_EARG;
@@ -134,10 +135,6 @@ static int encode(uint8_t *out, size_t cap, uint16_t id, const void *msg, size_t
     p = tase_field_iter_find(&it, TASE_ID_GROUP(id), TASE_ID_TYPE(id), len);
     if (p == NULL) {
         return TASE_EUNKNOWN;
-    }
-    if (frame) {
-        header = TASE_FRAME_HEADER;
-        overhead = TASE_FRAME_OVERHEAD;
     }
     if (len == TASE_FIELD_ITER_TABLE_LEN) {
         n = it.len; /* every field lies within it, as within the tail form */
@@ -153,30 +150,40 @@ static int encode(uint8_t *out, size_t cap, uint16_t id, const void *msg, size_t
         return TASE_ENOSPC;
     }
     encode_body(&it, msg, n, out + header);
-    if (!frame) {
-        return (int)n;
+    return (int)n;
+}
+
+/* A whole frame around the data encode() wrote: the frame encoder is
+ * called from here, so the data-only encoders never reach it (their
+ * stack is the data's alone). */
+static int encode_frame(uint8_t *out, size_t cap, uint16_t id, const void *msg, size_t len)
+{
+    int r = encode(out, cap, TASE_FRAME_HEADER, id, msg, len);
+    if (r < 0) {
+        return r;
     }
-    return tase_frame_encode(out, cap, TASE_ID_GROUP(id), TASE_ID_TYPE(id), out + header, n);
+    return tase_frame_encode(out, cap, TASE_ID_GROUP(id), TASE_ID_TYPE(id), out + TASE_FRAME_HEADER,
+                             (size_t)r);
 }
 
 int tase_packet_encode(uint16_t id, const void *msg, uint8_t *out, size_t cap)
 {
-    return encode(out, cap, id, msg, TASE_FIELD_ITER_TABLE_LEN, true);
+    return encode_frame(out, cap, id, msg, TASE_FIELD_ITER_TABLE_LEN);
 }
 
 int tase_packet_encode_len(uint16_t id, const void *msg, size_t len, uint8_t *out, size_t cap)
 {
-    return encode(out, cap, id, msg, walk_len(len), true);
+    return encode_frame(out, cap, id, msg, walk_len(len));
 }
 
 int tase_packet_encode_data(uint16_t id, const void *msg, uint8_t *data, size_t cap)
 {
-    return encode(data, cap, id, msg, TASE_FIELD_ITER_TABLE_LEN, false);
+    return encode(data, cap, 0u, id, msg, TASE_FIELD_ITER_TABLE_LEN);
 }
 
 int tase_packet_encode_data_len(uint16_t id, const void *msg, size_t len, uint8_t *data, size_t cap)
 {
-    return encode(data, cap, id, msg, walk_len(len), false);
+    return encode(data, cap, 0u, id, msg, walk_len(len));
 }
 
 int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap)

@@ -4,7 +4,7 @@
  * per call, re-entrancy) is in frame.h; comments here explain how. The
  * receiver's set-up and its time bound (tase_rx_init(),
  * tase_rx_stats_reset(), tase_rx_set_timing(), tase_rx_tick(),
- * tase_rx_quiet_ms()) are src/tase_frame_time.c.
+ * tase_rx_quiet_ms()) and tase_rx_stop() are src/tase_frame_time.c.
  *
  * The receiver runs the greedy scan of frame.h online, over a window
  * buf[0..len) of the bytes received and not yet decided. buf[scan] is the
@@ -288,7 +288,7 @@ static void hold(tase_rx_t *rx, size_t s, size_t flen)
 static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
 {
     uint32_t budget = allowance;
-    for (;;) {
+    while (rx->stop == 0u) { /* tase_rx_stop() ends the call (and sets lag) */
         size_t s = rx->scan;
         size_t len = rx->len;
         size_t avail = len - s;
@@ -349,6 +349,9 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
                                  c->user)) {
                         return false;
                     }
+                    if (rx->stop != 0u) {
+                        rx->lag = 1u; /* the next call goes on from here */
+                    }
                     continue;
                 }
                 rx->stats.checksum_errors++;
@@ -366,17 +369,21 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
         rx->stats.bytes_discarded++;
         rx->scan = (uint16_t)(s + 1u);
     }
+    return true;
 }
 
 /* Store one byte, making room first if the window is full: one step of
  * the scan if it is at buf[0] (a lagging scan: a caught-up one holds at
  * most a frame there), then compact(). Returns false when a callback
  * re-initialised the receiver. */
-static bool put(tase_rx_t *rx, rx_call_t *c, uint8_t b)
+RX_INLINE static bool put(tase_rx_t *rx, rx_call_t *c, uint8_t b)
 {
     if (rx->len == RX_CAP) {
         if (rx->scan == 0u && !advance(rx, c, 1u, false)) {
             return false;
+        }
+        if (rx->stop != 0u) {
+            return true; /* stopped: not taken (compact() would move the frame) */
         }
         if (rx->scan > 0u) {
             compact(rx);
@@ -421,13 +428,11 @@ RX_INLINE static bool hunt(tase_rx_t *rx, uint8_t byte)
     return false;
 }
 
-/* Start a call that may deliver frames: `busy` set and `end` zero for
- * its whole length (see the file comment). */
-static void begin(tase_rx_t *rx, rx_call_t *c, tase_rx_handler_t on_frame, void *user)
+/* Start a call that may deliver frames (its rx_call_t set up by the
+ * caller): `busy` set and `end` blocked for its whole length (see the
+ * file comment). */
+static void begin(tase_rx_t *rx)
 {
-    c->on_frame = on_frame;
-    c->user = user;
-    c->count = 0u;
     rx->busy = 1u;
     rx->end = RX_BLOCKED;
 }
@@ -449,6 +454,7 @@ static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
             /* hunting */
         }
         rx->end = end;
+        rx->stop = 0u;
         rx->busy = 0u;
     }
     return (c->count > (uint32_t)INT_MAX) ? INT_MAX : (int)c->count;
@@ -464,14 +470,14 @@ static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
 static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx_handler_t on_frame,
                void *user)
 {
-    rx_call_t c;
+    rx_call_t c = {on_frame, user, 0u};
     size_t i = 0;
     bool live = true;
-    begin(rx, &c, on_frame, user);
+    begin(rx);
     if (n == 0u && rx->lag != 0u) {
         live = advance(rx, &c, RX_BUDGET, false);
     }
-    while (live && i < n) {
+    while (live && i < n && rx->stop == 0u) {
         if (rx->lag == 0u) {
             size_t k = 0;
             size_t s = rx->scan;
@@ -523,7 +529,7 @@ static bool rx_sane(const tase_rx_t *rx)
     size_t len = rx->len;
     size_t s = rx->scan;
     size_t end = rx->end;
-    if (len > RX_CAP || s > len || rx->lag > 1u) {
+    if (len > RX_CAP || s > len || rx->lag > 1u || rx->stop != 0u) {
         return false;
     }
     if (rx->lag != 0u) {
@@ -555,12 +561,12 @@ static int rx_check(const tase_rx_t *rx)
  * does for each byte), a call from a callback, or a corrupted instance. */
 RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c;
+    rx_call_t c = {on_frame, user, 0u}; /* before the check: fewer registers kept */
     int r = rx_check(rx);
     if (r != TASE_OK) {
         return r;
     }
-    begin(rx, &c, on_frame, user);
+    begin(rx);
     return finish(rx, &c, put(rx, &c, b) && advance(rx, &c, RX_BUDGET, false));
 }
 
@@ -571,9 +577,9 @@ RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
  * that any split of the stream gives the same result. */
 RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c;
+    rx_call_t c = {on_frame, user, 0u};
     size_t len = rx->len;
-    begin(rx, &c, on_frame, user);
+    begin(rx);
     rx->stats.checksum_errors++;
     rx->buf[len] = b;
     rx->len = (uint16_t)(len + 1u);
@@ -607,8 +613,9 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     rx->busy = 1u;
     rx->end = RX_BLOCKED;
     (void)deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), on_frame, user);
-    /* hunting from here; also right when the callback re-initialised rx */
+    /* hunting from here; also right when the callback re-initialised or stopped rx */
     rx->end = 0u;
+    rx->stop = 0u;
     rx->busy = 0u;
     return 1;
 }

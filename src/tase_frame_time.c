@@ -2,8 +2,8 @@
  * The receiver's set-up and its time bound (include/tase/frame.h, TIME
  * BOUND): tase_rx_init() and tase_rx_stats_reset(), which also set and
  * reset the time bound's state, tase_rx_set_timing(), tase_rx_tick() and
- * tase_rx_quiet_ms(). A settle is the end of input of the scan in
- * src/tase_frame.c, reached through tase_rx_continue().
+ * tase_rx_quiet_ms(); and tase_rx_stop(). A settle is the end of input of
+ * the scan in src/tase_frame.c, reached through tase_rx_continue().
  */
 #include "tase/frame.h"
 
@@ -20,6 +20,21 @@ int tase_rx_init(tase_rx_t *rx)
      * sees that and returns without touching it again. */
     (void)memset(rx, 0, sizeof(*rx));
     rx->margin_ms = (uint16_t)TASE_RX_QUIET_MS;
+    return TASE_OK;
+}
+
+/* The call in progress ends after the frame its callback is handling:
+ * advance() and run() in src/tase_frame.c look at `stop`, finish() clears
+ * it. */
+int tase_rx_stop(tase_rx_t *rx)
+{
+    if (rx == NULL) {
+        return TASE_EARG;
+    }
+    if (rx->busy != 1u) {
+        return TASE_ESTATE;
+    }
+    rx->stop = 1u;
     return TASE_OK;
 }
 

@@ -18,9 +18,8 @@
 #define SETUP_APPLY_MAX 23u    /* longest writable setup packet: AXIS_SETTING */
 #define SERVICE_CHUNK 64u
 #define SERVICE_READS 64u
-#define FEED_PIECE 64u     /* tase_gimbal_feed()'s pieces: echoes in between */
 #define NO_FRAME 0xFFu     /* frame_port outside a callback */
-#define ECHO_SHORT_AXIS 8u /* echo[] index: AXIS_SETTING, 22-byte layout */
+#define ECHO_SHORT_AXIS 8u /* an echo: AXIS_SETTING in its 22-byte layout */
 /* g->tx_frame is telemetry's frame during tase_gimbal_poll() and the
  * setup path's scratch otherwise: the setting offered to the application
  * at TX_APPLY, the bytes being stored at TX_STORE, an echo's short layout
@@ -371,9 +370,9 @@ static int apply_setup(tase_gimbal_t *g, unsigned port, uint8_t type, uint8_t *d
     return r;
 }
 
-/* Write echo e (an echo[] index: a setup type, or ECHO_SHORT_AXIS for
- * AXIS_SETTING in its 22-byte layout) on port: what is in force now. */
-static void send_echo(tase_gimbal_t *g, unsigned port, unsigned e)
+/* Write echo e (a setup type, or ECHO_SHORT_AXIS for AXIS_SETTING in its
+ * 22-byte layout) on port: what is in force now. */
+TASE_NOINLINE_ static void send_echo(tase_gimbal_t *g, unsigned port, unsigned e)
 {
     uint8_t type = e == ECHO_SHORT_AXIS ? SETUP_AXIS_SETTING : (uint8_t)e;
     const uint8_t *cur = &g->setup[setup_off[type]];
@@ -387,8 +386,8 @@ static void send_echo(tase_gimbal_t *g, unsigned port, unsigned e)
     (void)gimbal_write(g, tase_port_send_frame(&g->port[port], TASE_GROUP_SETUP, type, cur, len));
 }
 
-/* Handle setup frame f: apply it. Returns the echo it owes (an echo[]
- * index), or -1 for none; the caller writes it or notes it. */
+/* Handle setup frame f: apply it. Returns the echo it owes (as
+ * send_echo() takes it), or -1 for none; the caller writes it. */
 static int handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f, uint32_t now_ms)
 {
     uint8_t type = f->type;
@@ -421,20 +420,9 @@ static int handle_setup(tase_gimbal_t *g, unsigned port, const tase_frame_t *f, 
     return short_axis ? (int)ECHO_SHORT_AXIS : (int)type;
 }
 
-/* Write the echoes the frames of the last piece owe, by setup type. */
-static void send_echoes(tase_gimbal_t *g, unsigned port)
-{
-    unsigned i;
-    for (i = 0; i <= ECHO_SHORT_AXIS; i++) {
-        while (g->echo[i] > 0u) {
-            g->echo[i]--;
-            send_echo(g, port, i);
-        }
-    }
-}
-
 /* Handle one frame; returns the echo it owes (handle_setup()) or -1. */
-static int handle(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame, uint32_t now_ms)
+TASE_NOINLINE_ static int handle(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
+                                 uint32_t now_ms)
 {
     uint8_t outer = g->frame_port; /* a handler may hand over another frame */
     int echo = -1;
@@ -455,17 +443,23 @@ static int handle(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame, ui
     return echo;
 }
 
-int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
-                             uint32_t now_ms)
+/* Handle one frame and write the echo it owes. */
+static void handle_and_echo(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
+                            uint32_t now_ms)
 {
-    int e;
-    if (g == NULL || frame == NULL || frame->data == NULL || port >= TASE_GIMBAL_PORTS) {
-        return TASE_EARG;
-    }
-    e = handle(g, port, frame, now_ms);
+    int e = handle(g, port, frame, now_ms);
     if (e >= 0) {
         send_echo(g, port, (unsigned)e);
     }
+}
+
+int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
+                             uint32_t now_ms)
+{
+    if (g == NULL || frame == NULL || frame->data == NULL || port >= TASE_GIMBAL_PORTS) {
+        return TASE_EARG;
+    }
+    handle_and_echo(g, port, frame, now_ms);
     return TASE_OK;
 }
 
@@ -477,24 +471,24 @@ int tase_gimbal_frame_port(const tase_gimbal_t *g)
     return g->frame_port == NO_FRAME ? TASE_ESTATE : (int)g->frame_port;
 }
 
-/* The receiver's callback inside tase_gimbal_feed(): g->feed_port and
- * g->feed_now say where and when. */
+/* The receiver's callback inside tase_gimbal_feed(): the frame is noted
+ * and the receiver stopped (tase_rx_stop()), so that the frame is handled
+ * by rx_round() with the receiver's stack unwound. */
 static void gimbal_rx(void *user, const tase_frame_t *frame)
 {
     tase_gimbal_t *g = user;
-    int e = handle(g, g->feed_port, frame, g->feed_now);
-    if (e >= 0) {
-        /* cannot saturate: a piece of input completes far fewer frames */
-        g->echo[e] = (uint8_t)(g->echo[e] < 0xFFu ? g->echo[e] + 1u : 0xFFu);
-    }
+    g->pending = *frame;
+    (void)tase_rx_stop(&g->rx[g->feed_port]);
 }
 
 int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
                      uint32_t now_ms)
 {
+    tase_rx_t *rx;
     size_t done = 0;
     int frames = 0;
-    int r;
+    bool tick = false;
+    bool stopped = false;
     if (g == NULL) {
         return TASE_EARG;
     }
@@ -504,27 +498,40 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
     if (port >= g->nrx || (bytes == NULL && n > 0u)) {
         return TASE_EARG;
     }
+    rx = &g->rx[port];
     g->feed_port = (uint8_t)port;
-    g->feed_now = now_ms;
-    /* Pieces: the receiver hands over the frames of a piece (a setup is
-     * applied there), and the echoes they owe are written here, with the
-     * receiver's stack unwound. The first round takes no byte when n is 0. */
-    do {
-        size_t k = n - done < FEED_PIECE ? n - done : FEED_PIECE;
-        r = tase_rx_feed(&g->rx[port], bytes != NULL ? &bytes[done] : NULL, k, gimbal_rx, g);
-        if (r >= 0) {
-            frames += r;
-            done += k;
+    /* Each frame ends the receiver's call (gimbal_rx()) and is handled
+     * here, between calls; after it a 0-byte call goes on with the scan
+     * (frame.h, tase_rx_stop()). The first call takes no byte when n is
+     * 0. Then the time bound, the same way. */
+    for (;;) {
+        uint32_t in = rx->stats.bytes_in;
+        size_t k = stopped ? 0u : n - done;
+        int r;
+        g->pending.data = NULL;
+        if (tick) {
+            /* the bytes' arrival, or (n == 0) a look that found the line quiet */
+            r = tase_rx_tick(rx, now_ms, gimbal_rx, g);
+        } else {
+            r = tase_rx_feed(rx, k > 0u ? &bytes[done] : NULL, k, gimbal_rx, g);
         }
-        send_echoes(g, port);
         if (r < 0) {
             return r;
         }
-    } while (done < n);
-    /* the bytes' arrival, or (n == 0) a look that found the line quiet */
-    r = tase_rx_tick(&g->rx[port], now_ms, gimbal_rx, g);
-    send_echoes(g, port);
-    return r < 0 ? r : frames + r;
+        frames += r;
+        done += (size_t)(rx->stats.bytes_in - in);
+        stopped = g->pending.data != NULL;
+        if (stopped) {
+            handle_and_echo(g, port, &g->pending, now_ms);
+            g->pending.data = NULL;
+        } else if (tick) {
+            return frames;
+        } else if (done == n) {
+            tick = true;
+        } else {
+            /* more bytes to feed */
+        }
+    }
 }
 
 /* Move a stream to the first slot strictly after now_ms (a late poll

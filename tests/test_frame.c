@@ -29,6 +29,10 @@ typedef struct {
     tase_rx_t *rx;
     size_t n;
     size_t checked; /* f[0..checked) compared with the reference already */
+    bool stop;      /* record() calls tase_rx_stop() after each frame */
+    bool stopped;   /* ... and did in the last call */
+    size_t stops;   /* how many times */
+    const uint8_t *last; /* fr->data of the last frame */
     seen_t f[MAX_SEEN];
 } recorder_t;
 
@@ -45,6 +49,13 @@ static void record(void *user, const tase_frame_t *fr)
     assert_non_null(fr->data);
     memcpy(s->data, fr->data, fr->len);
     s->seen_at = r->rx->stats.bytes_in;
+    r->last = fr->data;
+    if (r->stop) {
+        assert_false(r->stopped); /* a stopped call delivers no more */
+        assert_int_equal(tase_rx_stop(r->rx), TASE_OK);
+        r->stopped = true;
+        r->stops++;
+    }
 }
 
 static recorder_t *new_recorder(tase_rx_t *rx)
@@ -165,7 +176,7 @@ static void assert_within_latency(const tase_rx_t *rx, const recorder_t *got,
     assert_true(rx->stats.bytes_discarded <= st->bytes_discarded);
 }
 
-enum { FEED_BYTES, FEED_CHUNKS, FEED_WHOLE };
+enum { FEED_BYTES, FEED_CHUNKS, FEED_WHOLE, FEED_STOP };
 
 /* Feed s[0..n) to `rx` (fresh) in the given way and to the reference: after
  * every call the frames delivered so far and the counters agree within the
@@ -179,18 +190,26 @@ static void differential(tase_rx_t *rx, recorder_t *got, recorder_t *want, const
     ref_t ref;
     size_t pos = 0, k, before;
     uint32_t framed = 0;
-    int r;
+    int r, total;
     assert_int_equal(tase_rx_init(rx), TASE_OK);
     got->rx = rx;
     got->n = 0;
     got->checked = 0;
     want->n = 0;
     ref_init(&ref, s, ref_record, want);
+    got->stop = mode == FEED_STOP;
+    got->stopped = false;
+    got->stops = 0;
     while (pos < n) {
         size_t chunk = (mode == FEED_BYTES) ? 1u : (mode == FEED_WHOLE) ? n : 1u + rnd() % 600u;
+        uint32_t in = rx->stats.bytes_in;
         if (chunk > n - pos) {
             chunk = n - pos;
         }
+        if (got->stopped) {
+            chunk = 0; /* frame.h: a 0-byte feed after a stop keeps the bound */
+        }
+        got->stopped = false;
         before = got->n;
         if (chunk == 1u && (pos / 7u) % 2u == 0u) {
             r = tase_rx_push(rx, s[pos], record, got);
@@ -198,13 +217,29 @@ static void differential(tase_rx_t *rx, recorder_t *got, recorder_t *want, const
             r = tase_rx_feed(rx, s + pos, chunk, record, got);
         }
         assert_int_equal(r, (int)(got->n - before));
-        pos += chunk;
+        /* a stopped call takes a prefix of its input: bytes_in says which */
+        if (got->stopped) {
+            /* the frame is still there for the caller to handle */
+            assert_memory_equal(got->last, got->f[got->n - 1u].data, got->f[got->n - 1u].len);
+            assert_true(rx->stats.bytes_in - in <= chunk);
+            assert_int_equal(tase_rx_stop(rx), TASE_ESTATE); /* outside a call */
+        } else {
+            assert_int_equal(rx->stats.bytes_in - in, chunk);
+        }
+        pos += rx->stats.bytes_in - in;
         ref_feed_to(&ref, pos);
         assert_within_latency(rx, got, want, &ref.st, pos);
     }
     before = got->n;
-    r = tase_rx_flush(rx, record, got);
-    assert_int_equal(r, (int)(got->n - before));
+    total = 0;
+    do { /* a stopped flush is repeated */
+        got->stopped = false;
+        r = tase_rx_flush(rx, record, got);
+        assert_true(r >= 0);
+        total += r;
+    } while (got->stopped);
+    assert_int_equal(total, (int)(got->n - before));
+    got->stop = false;
     ref_advance(&ref, true);
     assert_memory_equal(&rx->stats, &ref.st, sizeof(ref.st));
     assert_same_frames(got, want);
@@ -1041,9 +1076,10 @@ static void receiver_matches_the_reference_greedy_scan(void **state)
     for (seed = 1; seed <= 6; seed++) {
         rng_state = (uint32_t)(seed * 0x9E3779B9u);
         n = build_mixed_stream(buf, sizeof(buf));
-        for (mode = FEED_BYTES; mode <= FEED_WHOLE; mode++) {
+        for (mode = FEED_BYTES; mode <= FEED_STOP; mode++) {
             differential(&rx, got, want, buf, n, mode);
         }
+        assert_int_equal(got->stops, got->n); /* FEED_STOP: a stop per frame */
         total += got->n;
         for (k = 0; k < got->n; k++) {
             late += got->f[k].seen_at != got->f[k].offset + got->f[k].len + 8u;
@@ -1647,6 +1683,10 @@ static void frame_api_rejects_bad_arguments(void **state)
     memcpy(&copy, &rx, sizeof rx);
     assert_int_equal(tase_rx_feed(&rx, NULL, SIZE_MAX, NULL, NULL), TASE_EARG);
     assert_int_equal(tase_rx_feed(&rx, NULL, 0, NULL, NULL), 0);
+    assert_memory_equal(&rx, &copy, sizeof rx);
+    /* tase_rx_stop() only inside a call (its callback) */
+    assert_int_equal(tase_rx_stop(NULL), TASE_EARG);
+    assert_int_equal(tase_rx_stop(&rx), TASE_ESTATE);
     assert_memory_equal(&rx, &copy, sizeof rx);
 
     for (k = 0; k < 6; k++) {

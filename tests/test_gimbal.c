@@ -39,6 +39,7 @@ typedef struct {
     unsigned others;
     unsigned other_port;
     uint8_t other_group, other_type;
+    unsigned rx_busy; /* callbacks that ran inside a receiver call */
 } fix_t;
 
 static unsigned stream_of(uint16_t id)
@@ -57,7 +58,7 @@ static int app_apply(void *user, unsigned port, uint8_t type, uint8_t *data, siz
 {
     fix_t *x = user;
     size_t i;
-    (void)port;
+    x->rx_busy += x->rx[port].busy;
     x->applies++;
     memcpy(x->applied, data, len);
     x->applied_len = len;
@@ -107,6 +108,7 @@ static int app_fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_
 static void app_other(void *user, unsigned port, const tase_frame_t *f)
 {
     fix_t *x = user;
+    x->rx_busy += x->rx[port].busy;
     x->others++;
     x->other_port = port;
     x->other_group = f->group;
@@ -1560,6 +1562,42 @@ static void commands_reach_the_dispatcher_typed_with_their_port(void **state)
     free(x);
 }
 
+/* Issue 26: tase_gimbal_feed() handles every frame after its receiver has
+ * returned (it stops on each: tase_rx_stop()), so the handlers and the
+ * echo writes never sit on the receiver's stack; echoes follow the stream
+ * order, one per setup frame (they were grouped by setup type). */
+static void frames_are_handled_after_the_receiver_returns_in_stream_order(void **state)
+{
+    fix_t *x = make(0, 1, false);
+    static const uint8_t filter[2] = {50, 5};
+    static const uint8_t cmd[8] = {0, 0, 0, 0, 0, 0, 0xA0, 0};
+    uint8_t buf[128];
+    static const uint8_t want[5] = {0x00, 0x01, 0x00, 0x01, 0x00}; /* echo types */
+    size_t n = 0, at = 0;
+    unsigned i;
+    (void)state;
+    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x00, NULL, 0);
+    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x01, filter, 2);
+    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x00, 0x80, cmd, 8);
+    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x00, NULL, 0);
+    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x01, NULL, 0);
+    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x00, NULL, 0);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, buf, n, 5), 6);
+    assert_int_equal(x->applies, 1);
+    assert_int_equal(x->others, 1);
+    assert_int_equal(x->rx_busy, 0);
+    assert_int_equal(fake_frames_out(&x->port[0]), 5);
+    for (i = 0; i < 5; i++) {
+        assert_int_equal(x->port[0].out[at + 4u], 0x48);
+        assert_int_equal(x->port[0].out[at + 5u], want[i]);
+        at += (size_t)x->port[0].out[at + 3u] + 6u;
+    }
+    /* the receiver is left idle and consistent: a later frame comes out */
+    feed(x, 0, 0x00, 0x80, cmd, 8, 6);
+    assert_int_equal(x->others, 2);
+    free(x);
+}
+
 /* Echoes are written after the receiver returns: every setup frame of a
  * long buffer gets its own, none is lost (the count per type would wrap
  * at 256 in one piece; pieces of 64 bytes keep it far below). */
@@ -1665,6 +1703,7 @@ int main(void)
         cmocka_unit_test(the_gimbal_keeps_its_bounds_under_random_faults),
         cmocka_unit_test(commands_reach_the_dispatcher_typed_with_their_port),
         cmocka_unit_test(every_setup_in_a_long_buffer_gets_its_echo),
+        cmocka_unit_test(frames_are_handled_after_the_receiver_returns_in_stream_order),
         cmocka_unit_test(telemetry_longer_than_its_room_is_skipped),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

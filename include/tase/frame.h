@@ -138,7 +138,10 @@
  *   - tase_rx_init() is allowed: the receiver is reset, and the call that
  *     made the callback returns as soon as the callback does, with the
  *     number of frames it delivered; the rest of its input is not consumed
- *     (nor counted in bytes_in).
+ *     (nor counted in bytes_in);
+ *   - tase_rx_stop() is allowed: the call returns after this frame (see
+ *     there), so the frame can be handled with the receiver's stack
+ *     unwound.
  * Return values count the frames delivered by that call (never negative
  * except for an error code), whatever the callback does to the counters.
  * Different receivers are independent; one receiver must not be used from
@@ -216,10 +219,11 @@ typedef struct {
     uint16_t margin_ms;
     uint8_t ticked;
     /* `busy` is set while a call (and so its callback) runs; `lag` while
-     * the scan has not caught up with the bytes held. */
+     * the scan has not caught up with the bytes held; `stop` from
+     * tase_rx_stop() until that call returns. */
     uint8_t busy;
     uint8_t lag;
-    uint8_t spare;
+    uint8_t stop;
     /* buf[0..len) holds the bytes not yet decided from buf[scan] on (see
      * src/tase_frame.c); `end` is the index of the last byte of the
      * candidate held at buf[scan] once the scan has caught up (0 when
@@ -347,6 +351,24 @@ int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, voi
  * calls do); 0 also while the scan lags (ticks continue it). UINT32_MAX
  * for rx NULL. O(1), reentrant; allowed from the callback. */
 uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms);
+
+/* From inside rx's frame callback: end the call that delivers this frame
+ * as soon as the callback returns. That call returns the frames it
+ * delivered (this one the last); the frame's bytes stay where frame->data
+ * points until the next call on rx, so the caller can handle it there,
+ * with the receiver's stack unwound (the gimbal role does). Input the call
+ * had not taken in is not consumed: stats.bytes_in counts what was (it
+ * grows by exactly the bytes taken), the caller feeds the rest again. A
+ * scan the call had not finished goes on in the next call on rx, as a
+ * lagging scan does (a 0-byte tase_rx_feed(), tase_rx_tick() or
+ * tase_rx_flush() included; a stopped flush or settling tick is repeated
+ * until it returns 0). Frames, their order and offsets are the same as
+ * without stops. TASE_RX_LATE_MAX holds when every stop is followed by a
+ * 0-byte tase_rx_feed() before more bytes are fed (each such call brings
+ * a byte's budget, more than a stop forfeits).
+ * Returns TASE_OK; TASE_ESTATE when no call of rx is running (outside its
+ * callback); TASE_EARG for rx NULL. O(1). */
+int tase_rx_stop(tase_rx_t *rx);
 
 /* Zero every counter, nothing else. Returns TASE_OK or TASE_EARG (rx
  * NULL). Allowed from inside the receiver's own callback. */

@@ -143,8 +143,8 @@
  * STACK. Nothing the size of a frame or a packet struct is on the
  * stack: typed callbacks get a struct in the instance and telemetry is
  * built there, and
- * tase_gimbal_feed() hands the receiver's frames over with little stack
- * and writes their echoes after the receiver returns. docs/FOOTPRINT.md
+ * tase_gimbal_feed() handles the receiver's frames, and writes their
+ * echoes, after the receiver has returned (tase_rx_stop()). docs/FOOTPRINT.md
  * lists the deepest stack of every entry point on Cortex-M (the
  * application's callbacks and the port's functions not included).
  *
@@ -263,13 +263,11 @@ typedef struct {
     uint32_t demand[TASE_GIMBAL_PORTS];   /* telemetry bytes/s the rates ask */
     uint8_t setup[TASE_GIMBAL_SETUP_BYTES];
     /* The frame being handled: its port, or 0xFF outside a callback; the
-     * port and time of the bytes tase_gimbal_feed() is feeding. */
+     * port tase_gimbal_feed() is feeding, and the frame its receiver
+     * stopped on (data NULL: none), handled after the receiver returns. */
     uint8_t frame_port;
     uint8_t feed_port;
-    uint32_t feed_now;
-    /* Echoes owed by tase_gimbal_feed(): how many of each setup type
-     * (index TASE_GIMBAL_SETUP_TYPES: AXIS_SETTING in its 22-byte layout). */
-    uint8_t echo[TASE_GIMBAL_SETUP_TYPES + 1u];
+    tase_frame_t pending;
     /* Not on the stack: the packet struct of a typed callback (telemetry
      * to fill, a setting to apply) and the frame telemetry is built in. */
     tase_packet_msg_t msg;
@@ -300,12 +298,12 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
  * (bytes may be NULL) whenever a look at the port's receive buffer found
  * nothing waiting, so that frames held behind noise come out once the line
  * has been quiet for the bound. Never with bytes still waiting unread.
- * The bytes go to the receiver in pieces of up to 64; the frames of a
- * piece are handled as the receiver hands them over (a setup is offered to
- * apply_setup and stored, anything else goes to the dispatcher or
- * on_frame), and the setup echoes they owe are written when the receiver
- * has returned, before the next piece: one echo per setup frame, grouped
- * by setup type, each carrying the settings in force when it is written.
+ * Each frame is handled when the receiver has returned (it stops on
+ * every frame: tase_rx_stop()), so handlers run with the receiver's stack
+ * unwound: a setup is offered to apply_setup and stored and its echo
+ * written at once (one per setup frame, in stream order, carrying the
+ * settings in force after it), anything else goes to the dispatcher or
+ * on_frame.
  * Returns frames received (>= 0), TASE_EARG (g NULL, port >= nports,
  * bytes NULL with n > 0) or TASE_ESTATE (initialised without receivers).
  * Worst case O(n * TASE_FRAME_MAX). */
