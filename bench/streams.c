@@ -37,7 +37,7 @@ static int emit(uint8_t *buf, size_t cap, size_t *n, uint16_t id, const uint8_t 
     if (*n + TASE_FRAME_MAX > cap) {
         return 0;
     }
-    r = tase_frame_encode(&buf[*n], cap - *n, TASE_ID_GROUP(id), TASE_ID_TYPE(id), d, len);
+    r = tase_frame_build(TASE_ID_GROUP(id), TASE_ID_TYPE(id), d, len, &buf[*n], cap - *n);
     if (corrupt) {
         buf[*n + 3] = rnd8();
     }
@@ -116,7 +116,7 @@ static size_t gen_burst(uint8_t *buf, size_t cap)
         buf[n++] = 0x5A;
         buf[n++] = 0xFF;
         for (k = 0; k < 31u; k++) {
-            n += (size_t)tase_frame_encode(&buf[n], cap - n, 0x00, (uint8_t)k, NULL, 0u);
+            n += (size_t)tase_frame_build(0x00, (uint8_t)k, NULL, 0u, &buf[n], cap - n);
         }
         for (k = 0; k < 9u; k++) {
             buf[n++] = (uint8_t)(0x11u + k);

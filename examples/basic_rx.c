@@ -20,12 +20,12 @@ int main(void)
     int rc;
 
     stream[n++] = 0x42; /* line noise */
-    rc = tase_frame_encode(&stream[n], sizeof(stream) - n, 0x08, 0x10, angle, sizeof(angle));
+    rc = tase_frame_build(0x08, 0x10, angle, sizeof(angle), &stream[n], sizeof(stream) - n);
     stream[n + 3] = 0xFF; /* corrupt its Size: it now claims 253 data bytes */
     n += (size_t)rc;
-    rc = tase_frame_encode(&stream[n], sizeof(stream) - n, 0x08, 0x10, angle, sizeof(angle));
+    rc = tase_frame_build(0x08, 0x10, angle, sizeof(angle), &stream[n], sizeof(stream) - n);
     n += (size_t)rc;
-    rc = tase_frame_encode(&stream[n], sizeof(stream) - n, 0x00, 0x40, NULL, 0);
+    rc = tase_frame_build(0x00, 0x40, NULL, 0, &stream[n], sizeof(stream) - n);
     n += (size_t)rc;
 
     tase_rx_init(&rx);

@@ -74,7 +74,7 @@ static void on_frame(void *user, const tase_frame_t *fr)
     uint8_t enc[TASE_FRAME_MAX];
     size_t total = (size_t)fr->len + TASE_FRAME_OVERHEAD, k;
     const tase_can_rx_t *crx = user;
-    int n = tase_frame_encode(enc, sizeof(enc), fr->group, fr->type, fr->data, fr->len);
+    int n = tase_frame_build(fr->group, fr->type, fr->data, fr->len, enc, sizeof(enc));
     FZ_CHECK(n == (int)total);
     FZ_CHECK((size_t)fr->offset + total <= crx->rx.stats.bytes_in);
     FZ_CHECK(memcmp(enc, rxs + fr->offset, total) == 0);
@@ -231,7 +231,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (i = 0; i < len; i++) {
             buf[i] = fz_u8(&in);
         }
-        w = tase_frame_encode(txs + ntx, sizeof(txs) - ntx, group, type, buf, len);
+        w = tase_frame_build(group, type, buf, len, txs + ntx, sizeof(txs) - ntx);
         FZ_CHECK(w == (int)(len + TASE_FRAME_OVERHEAD));
         dl[k].start = (uint32_t)ntx;
         ntx += (size_t)w;

@@ -118,7 +118,7 @@ static void on_frame(void *user, const tase_frame_t *fr)
     /* the frame lies inside the bytes fed so far */
     FZ_CHECK((size_t)fr->offset + total <= (size_t)s->rx->stats.bytes_in);
     FZ_CHECK((size_t)fr->offset + total <= s->stream_len);
-    n = tase_frame_encode(enc, sizeof(enc), fr->group, fr->type, fr->data, fr->len);
+    n = tase_frame_build(fr->group, fr->type, fr->data, fr->len, enc, sizeof(enc));
     FZ_CHECK(n == (int)total);
     FZ_CHECK(memcmp(enc, s->stream + fr->offset, total) == 0);
     /* stream order, never inside (or overlapping) the previous one */
@@ -244,7 +244,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* flush left the receiver empty: a fresh frame is found at once, at
      * the offset that follows the input, and nothing else is */
     FZ_CHECK(rx.len == 0u && rx.end == 0u && rx.busy == 0u);
-    plen = tase_frame_encode(probe, sizeof(probe), 0x08, 0x10, data, size < 6u ? size : 6u);
+    plen = tase_frame_build(0x08, 0x10, data, size < 6u ? size : 6u, probe, sizeof(probe));
     FZ_CHECK(plen > 0);
     {
         uint32_t ok = rx.stats.frames_ok, disc = rx.stats.bytes_discarded;

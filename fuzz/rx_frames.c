@@ -132,7 +132,7 @@ static size_t build(fz_in_t *in, size_t *ntx)
             for (j = 0; j < len; j++) {
                 data[j] = fz_u8(in);
             }
-            w = tase_frame_encode(stream + n, TASE_FRAME_MAX, group, type, data, len);
+            w = tase_frame_build(group, type, data, len, stream + n, TASE_FRAME_MAX);
             FZ_CHECK(w == (int)(len + TASE_FRAME_OVERHEAD));
             tx[k].start = (uint32_t)n;
             tx[k].end = (uint32_t)(n + (size_t)w);

@@ -32,7 +32,7 @@ static void put_frame(uint8_t group, uint8_t type, size_t len, uint8_t fill)
     for (i = 0; i < len; i++) {
         data[i] = (uint8_t)(fill + i * 37u);
     }
-    n += (size_t)tase_frame_encode(buf + n, sizeof(buf) - n, group, type, data, len);
+    n += (size_t)tase_frame_build(group, type, data, len, buf + n, sizeof(buf) - n);
 }
 
 static int save(const char *dir, const char *harness, int idx)
@@ -85,8 +85,8 @@ static int seeds_rx_bytes(const char *dir)
     put_byte(0x55), put_byte(0x55);
     {
         uint8_t inner[32], outer[64];
-        int ni = tase_frame_encode(inner, sizeof(inner), 0x08, 0x10, (const uint8_t *)"abcdef", 6);
-        int no = tase_frame_encode(outer, sizeof(outer), 0x00, 0x42, inner, (size_t)ni);
+        int ni = tase_frame_build(0x08, 0x10, (const uint8_t *)"abcdef", 6, inner, sizeof(inner));
+        int no = tase_frame_build(0x00, 0x42, inner, (size_t)ni, outer, sizeof(outer));
         put(outer, (size_t)no);
     }
     put_frame(0xFF, 0xFF, TASE_DATA_MAX, 0xFF);

@@ -87,7 +87,7 @@ static int encode_check(const tase_field_iter_t *it, const void *msg, size_t len
 
 /* The len data bytes of msg into body (checked by encode_check()). Not
  * inlined: the walk's registers stay out of encode()'s frame, which is
- * live while it calls tase_frame_encode() (the deepest path). */
+ * live while it calls tase_frame_build() (the deepest path). */
 TASE_NOINLINE_ static void encode_body(tase_field_iter_t *it, const void *msg, size_t len,
                                        uint8_t *body)
 {
@@ -119,16 +119,18 @@ static size_t walk_len(size_t len)
  * (TASE_FIELD_ITER_TABLE_LEN: the table length, CAMERA_PASS's tail added)
  * into out[header..cap), header 0 for the data only or TASE_FRAME_HEADER
  * to leave room for a frame around it. Returns the data length. */
-static int encode(uint8_t *out, size_t cap, size_t header, uint16_t id, const void *msg,
-                  size_t len)
+static int encode(uint8_t *out, size_t cap, size_t header, uint16_t id, const void *msg, size_t len)
 {
     tase_field_iter_t it;
     const tase_packet_desc_t *p;
     size_t n = len;
-    size_t overhead = header > 0u ? TASE_FRAME_OVERHEAD : 0u;
+    size_t overhead = 0u;
     int r;
     if (out == NULL) {
         return TASE_EARG;
+    }
+    if (header > 0u) {
+        overhead = TASE_FRAME_OVERHEAD;
     }
     /* The one call into the schema: the packet found, the length checked
      * and the walk begun. */
@@ -162,8 +164,8 @@ static int encode_frame(uint8_t *out, size_t cap, uint16_t id, const void *msg, 
     if (r < 0) {
         return r;
     }
-    return tase_frame_encode(out, cap, TASE_ID_GROUP(id), TASE_ID_TYPE(id), out + TASE_FRAME_HEADER,
-                             (size_t)r);
+    return tase_frame_build(TASE_ID_GROUP(id), TASE_ID_TYPE(id), out + TASE_FRAME_HEADER, (size_t)r,
+                            out, cap);
 }
 
 int tase_packet_encode(uint16_t id, const void *msg, uint8_t *out, size_t cap)

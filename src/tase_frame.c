@@ -171,8 +171,8 @@ uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n)
     return (uint16_t)sum;
 }
 
-int tase_frame_encode(uint8_t *out, size_t cap, uint8_t group, uint8_t type, const uint8_t *data,
-                      size_t len)
+int tase_frame_build(uint8_t group, uint8_t type, const uint8_t *data, size_t len, uint8_t *out,
+                     size_t cap)
 {
     uint16_t sum;
     size_t total;

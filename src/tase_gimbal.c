@@ -571,8 +571,8 @@ static int telemetry_frame(tase_gimbal_t *g, unsigned port, uint16_t id, uint32_
     if (n < 0 || n > (int)TASE_GIMBAL_TELEMETRY_MAX) {
         return TASE_ERANGE;
     }
-    return tase_frame_encode(frame, sizeof g->tx_frame, TASE_ID_GROUP(id), TASE_ID_TYPE(id),
-                             frame + TASE_FRAME_HEADER, (size_t)n);
+    return tase_frame_build(TASE_ID_GROUP(id), TASE_ID_TYPE(id), frame + TASE_FRAME_HEADER,
+                            (size_t)n, frame, sizeof g->tx_frame);
 }
 
 /* One stream's due slot, if any. *failed: the port failed a write earlier

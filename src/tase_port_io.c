@@ -161,7 +161,7 @@ static int send_pieces(const tase_port_t *port, uint8_t group, uint8_t type, con
 int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *data,
                          size_t len)
 {
-    /* the encoder's checks first (tase_frame_encode()'s codes) */
+    /* the encoder's checks first (tase_frame_build()'s codes) */
     if (data == NULL && len > 0u) {
         return TASE_EARG;
     }

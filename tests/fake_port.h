@@ -39,7 +39,7 @@ static inline void fake_push_frame(fake_port_t *f, uint8_t group, uint8_t type, 
                                    size_t len)
 {
     uint8_t fr[TASE_FRAME_MAX];
-    int n = tase_frame_encode(fr, sizeof fr, group, type, data, len);
+    int n = tase_frame_build(group, type, data, len, fr, sizeof fr);
     if (n > 0) {
         fake_push(f, fr, (size_t)n);
     }

@@ -383,7 +383,7 @@ static void *isr_frames(void *arg)
         data[1] = (uint8_t)(seq >> 16);
         data[2] = (uint8_t)(seq >> 8);
         data[3] = (uint8_t)seq;
-        n = tase_frame_encode(frame, sizeof frame, 0x08, 0x10, data, sizeof data);
+        n = tase_frame_build(0x08, 0x10, data, sizeof data, frame, sizeof frame);
         for (i = 0; i < n; i++) {
             while (tase_ring_count(&s->u->rx) == tase_ring_capacity(&s->u->rx)) {
                 sched_yield();
@@ -552,7 +552,7 @@ static void poll_reports_a_receiver_error_and_loses_no_byte_to_it(void **state)
     memset(&hw, 0, sizeof hw);
     hw.uart = &u;
     assert_int_equal(tase_bm_uart_init(&u, storage, sizeof storage, &fake_hooks, &hw), TASE_OK);
-    n = tase_frame_encode(wire, sizeof wire, 0x48, 0x00, NULL, 0);
+    n = tase_frame_build(0x48, 0x00, NULL, 0, wire, sizeof wire);
     for (i = 0; i < n; i++) {
         tase_bm_uart_rx_isr(&u, wire[i]);
     }
@@ -599,8 +599,8 @@ static void poll_counts_the_frames_a_lagging_scan_releases(void **state)
         }
         for (k = 0; k < 8u; k++) {
             data[0] = (uint8_t)k;
-            n += (size_t)tase_frame_encode(&stream[n], sizeof stream - n, 0x08, 0x10, data,
-                                           sizeof data);
+            n += (size_t)tase_frame_build(0x08, 0x10, data, sizeof data, &stream[n],
+                                          sizeof stream - n);
         }
     }
     memset(&hw, 0, sizeof hw);

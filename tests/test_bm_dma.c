@@ -61,7 +61,7 @@ static size_t make_stream(uint8_t *s, size_t cap)
         for (k = 0; k < len; k++) {
             d[k] = (uint8_t)rnd(256u);
         }
-        m = tase_frame_encode(&s[n], cap - n, (uint8_t)rnd(256u), (uint8_t)rnd(256u), d, len);
+        m = tase_frame_build((uint8_t)rnd(256u), (uint8_t)rnd(256u), d, len, &s[n], cap - n);
         assert_true(m > 0);
         if (rnd(8u) == 0u) {
             s[n + 3] = (uint8_t)(s[n + 3] + 1u + rnd(200u)); /* Size corrupted upwards */
@@ -166,7 +166,7 @@ static void a_lap_is_reported_and_loses_only_what_was_overwritten(void **state)
     (void)state;
     for (i = 0; i < 60u; i++) { /* 16-byte frames, type = index */
         d[0] = (uint8_t)i;
-        n += (size_t)tase_frame_encode(&stream[n], sizeof stream - n, 0x08, (uint8_t)i, d, 8);
+        n += (size_t)tase_frame_build(0x08, (uint8_t)i, d, 8, &stream[n], sizeof stream - n);
     }
     got.n = want.n = 0;
     (void)tase_rx_init(&rx);
@@ -214,7 +214,7 @@ static void an_empty_poll_ticks_the_time_bound(void **state)
     tase_rx_t rx;
     tase_bm_dma_t rd;
     dma_t dma = {buf, sizeof buf, 0};
-    int m = tase_frame_encode(fr, sizeof fr, 0x00, 0x80, NULL, 0); /* GYRO_ZERO-like, no data */
+    int m = tase_frame_build(0x00, 0x80, NULL, 0, fr, sizeof fr); /* GYRO_ZERO-like, no data */
     (void)state;
     memcpy(s, noise, 4);
     memcpy(s + 4, fr, (size_t)m);
@@ -252,7 +252,7 @@ static void bad_arguments_and_a_busy_receiver_read_nothing(void **state)
     nest_t x = {&rd, &rx, 1, 0};
     static const uint8_t angle[6] = {1, 2, 3, 4, 5, 6};
     uint8_t fr[16];
-    int m = tase_frame_encode(fr, sizeof fr, 0x08, 0x10, angle, sizeof angle);
+    int m = tase_frame_build(0x08, 0x10, angle, sizeof angle, fr, sizeof fr);
     (void)state;
     (void)tase_rx_init(&rx);
     assert_int_equal(tase_bm_dma_init(NULL, buf, 16), TASE_EARG);

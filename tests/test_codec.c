@@ -267,8 +267,8 @@ static void every_packet_round_trips_random_and_extreme_values(void **state)
                     memcpy(data + len, tail, extra);
                     len += extra;
                 }
-                n = tase_frame_encode(wire, sizeof(wire), TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id),
-                                      data, len);
+                n = tase_frame_build(TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len, wire,
+                                     sizeof(wire));
                 assert_int_equal(n, (int)len + 8);
                 f = frame_of(wire, n);
                 /* wire -> struct: every member equals the raw field value */
@@ -535,8 +535,8 @@ static void data_only_codec_matches_the_frame_codec_for_every_packet(void **stat
                 for (k = 0; k < len; k++) {
                     data[k] = (uint8_t)rnd();
                 }
-                n = tase_frame_encode(wire, sizeof wire, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id),
-                                      data, len);
+                n = tase_frame_build(TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len, wire,
+                                     sizeof wire);
                 f = frame_of(wire, n);
                 memset(&by_frame, 0x11, sizeof by_frame);
                 memset(&by_data, 0x22, sizeof by_data);

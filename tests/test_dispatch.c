@@ -83,7 +83,7 @@ static void feed(tase_rx_t *rx, tase_dispatch_t *d, uint8_t g, uint8_t t, size_t
     uint8_t data[TASE_DATA_MAX], out[TASE_FRAME_MAX];
     int n;
     memset(data, fill, sizeof(data));
-    n = tase_frame_encode(out, sizeof(out), g, t, data, len);
+    n = tase_frame_build(g, t, data, len, out, sizeof(out));
     assert_true(n > 0);
     assert_int_equal(tase_rx_feed(rx, out, (size_t)n, tase_dispatch_frame, d), 1);
 }

@@ -28,10 +28,10 @@ typedef struct {
 typedef struct {
     tase_rx_t *rx;
     size_t n;
-    size_t checked; /* f[0..checked) compared with the reference already */
-    bool stop;      /* record() calls tase_rx_stop() after each frame */
-    bool stopped;   /* ... and did in the last call */
-    size_t stops;   /* how many times */
+    size_t checked;      /* f[0..checked) compared with the reference already */
+    bool stop;           /* record() calls tase_rx_stop() after each frame */
+    bool stopped;        /* ... and did in the last call */
+    size_t stops;        /* how many times */
     const uint8_t *last; /* fr->data of the last frame */
     seen_t f[MAX_SEEN];
 } recorder_t;
@@ -85,7 +85,7 @@ static size_t make_frame(uint8_t *out, uint8_t group, uint8_t type, size_t len)
     for (i = 0; i < len; i++) {
         data[i] = (uint8_t)rnd();
     }
-    n = tase_frame_encode(out, TASE_FRAME_MAX, group, type, data, len);
+    n = tase_frame_build(group, type, data, len, out, TASE_FRAME_MAX);
     assert_true(n > 0);
     return (size_t)n;
 }
@@ -257,7 +257,7 @@ static void encode_zero_length_frame_matches_hand_computed_bytes(void **state)
     static const uint8_t expect[] = {0x00, 0xFF, 0x5A, 0x02, 0x00, 0x40, 0x01, 0x9B};
     uint8_t out[16];
     (void)state;
-    assert_int_equal(tase_frame_encode(out, sizeof(out), 0x00, 0x40, NULL, 0), 8);
+    assert_int_equal(tase_frame_build(0x00, 0x40, NULL, 0, out, sizeof(out)), 8);
     assert_memory_equal(out, expect, sizeof(expect));
 }
 
@@ -270,8 +270,38 @@ static void encode_with_data_matches_hand_computed_bytes(void **state)
                                      0xE8, 0xFE, 0x0C, 0x00, 0x00, 0x03, 0x6E};
     uint8_t out[32];
     (void)state;
-    assert_int_equal(tase_frame_encode(out, sizeof(out), 0x08, 0x10, data, sizeof(data)), 14);
+    assert_int_equal(tase_frame_build(0x08, 0x10, data, sizeof(data), out, sizeof(out)), 14);
     assert_memory_equal(out, expect, sizeof(expect));
+}
+
+/* Issue 26 item 6: tase_frame_encode() (output first, deprecated) is
+ * tase_frame_build() (output last) in the old order: same bytes, same
+ * errors, nothing written on error. */
+static void deprecated_frame_encode_is_frame_build_in_the_old_order(void **state)
+{
+    static const uint8_t data[] = {0x03, 0xE8, 0xFE, 0x0C, 0x00, 0x00};
+    uint8_t a[32], b[32];
+    size_t cap;
+    (void)state;
+    for (cap = 0; cap <= sizeof a; cap++) {
+        int ra, rb;
+        memset(a, 0x5A, sizeof a);
+        memset(b, 0x5A, sizeof b);
+        rb = tase_frame_build(0x08, 0x10, data, sizeof data, b, cap);
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+#endif
+        ra = tase_frame_encode(a, cap, 0x08, 0x10, data, sizeof data);
+        assert_int_equal(tase_frame_encode(NULL, cap, 0x08, 0x10, data, 1), TASE_EARG);
+        assert_int_equal(tase_frame_encode(a, cap, 0x08, 0x10, data, 254), TASE_ETOOLONG);
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+        assert_int_equal(ra, rb);
+        assert_int_equal(rb, cap < 14u ? TASE_ENOSPC : 14);
+        assert_memory_equal(a, b, sizeof a);
+    }
 }
 
 static void encode_checksum_wraps_modulo_65536(void **state)
@@ -282,7 +312,7 @@ static void encode_checksum_wraps_modulo_65536(void **state)
     (void)state;
     memset(data, 0xFF, sizeof(data));
     sum += 0xFFu * TASE_DATA_MAX; /* 0x1040E: wraps */
-    assert_int_equal(tase_frame_encode(out, sizeof(out), 0xFF, 0xFF, data, sizeof(data)),
+    assert_int_equal(tase_frame_build(0xFF, 0xFF, data, sizeof(data), out, sizeof(out)),
                      (int)TASE_FRAME_MAX);
     assert_int_equal(out[3], 0xFF);
     assert_int_equal(out[TASE_FRAME_MAX - 2], (sum >> 8) & 0xFF);
@@ -299,15 +329,15 @@ static void encode_rejects_bad_arguments_without_writing(void **state)
     memset(data, 0x11, sizeof(data));
     memset(out, 0xA5, sizeof(out));
     memcpy(untouched, out, sizeof(out));
-    assert_int_equal(tase_frame_encode(NULL, 64, 0, 0, data, 1), TASE_EARG);
-    assert_int_equal(tase_frame_encode(out, sizeof(out), 0, 0, NULL, 1), TASE_EARG);
-    assert_int_equal(tase_frame_encode(out, sizeof(out), 0, 0, data, TASE_DATA_MAX + 1),
+    assert_int_equal(tase_frame_build(0, 0, data, 1, NULL, 64), TASE_EARG);
+    assert_int_equal(tase_frame_build(0, 0, NULL, 1, out, sizeof(out)), TASE_EARG);
+    assert_int_equal(tase_frame_build(0, 0, data, TASE_DATA_MAX + 1, out, sizeof(out)),
                      TASE_ETOOLONG);
-    assert_int_equal(tase_frame_encode(out, 7, 0, 0, NULL, 0), TASE_ENOSPC);
-    assert_int_equal(tase_frame_encode(out, 10 + 7, 0, 0, data, 10), TASE_ENOSPC);
+    assert_int_equal(tase_frame_build(0, 0, NULL, 0, out, 7), TASE_ENOSPC);
+    assert_int_equal(tase_frame_build(0, 0, data, 10, out, 10 + 7), TASE_ENOSPC);
     assert_memory_equal(out, untouched, sizeof(out));
     /* Exactly enough room is fine. */
-    assert_int_equal(tase_frame_encode(out, 18, 0, 0, data, 10), 18);
+    assert_int_equal(tase_frame_build(0, 0, data, 10, out, 18), 18);
 }
 
 static void encode_in_place_payload_needs_no_copy(void **state)
@@ -315,10 +345,10 @@ static void encode_in_place_payload_needs_no_copy(void **state)
     uint8_t a[32], b[32];
     static const uint8_t data[] = {1, 2, 3, 4, 5};
     (void)state;
-    assert_int_equal(tase_frame_encode(a, sizeof(a), 0x10, 0x41, data, sizeof(data)), 13);
+    assert_int_equal(tase_frame_build(0x10, 0x41, data, sizeof(data), a, sizeof(a)), 13);
     memcpy(b + TASE_FRAME_HEADER, data, sizeof(data));
     assert_int_equal(
-        tase_frame_encode(b, sizeof(b), 0x10, 0x41, b + TASE_FRAME_HEADER, sizeof(data)), 13);
+        tase_frame_build(0x10, 0x41, b + TASE_FRAME_HEADER, sizeof(data), b, sizeof(b)), 13);
     assert_memory_equal(a, b, 13);
 }
 
@@ -357,16 +387,16 @@ static void api_extreme_lengths_give_error_codes_and_change_nothing(void **state
     memset(out, 0x5C, sizeof(out));
     memcpy(untouched, out, sizeof(out));
     /* lengths near SIZE_MAX must not overflow len + 8 into a small total */
-    assert_int_equal(tase_frame_encode(out, SIZE_MAX, 0, 0, data, SIZE_MAX), TASE_ETOOLONG);
-    assert_int_equal(tase_frame_encode(out, SIZE_MAX, 0, 0, data, SIZE_MAX - 7u), TASE_ETOOLONG);
-    assert_int_equal(tase_frame_encode(out, 0, 0, 0, NULL, 0), TASE_ENOSPC);
-    assert_int_equal(tase_frame_encode(NULL, 0, 0, 0, NULL, SIZE_MAX), TASE_EARG);
+    assert_int_equal(tase_frame_build(0, 0, data, SIZE_MAX, out, SIZE_MAX), TASE_ETOOLONG);
+    assert_int_equal(tase_frame_build(0, 0, data, SIZE_MAX - 7u, out, SIZE_MAX), TASE_ETOOLONG);
+    assert_int_equal(tase_frame_build(0, 0, NULL, 0, out, 0), TASE_ENOSPC);
+    assert_int_equal(tase_frame_build(0, 0, NULL, SIZE_MAX, NULL, 0), TASE_EARG);
     assert_memory_equal(out, untouched, sizeof(out));
     /* a NULL buffer is never read, whatever the length */
     assert_int_equal(tase_checksum(0x1234, NULL, SIZE_MAX), 0x1234);
     /* a rejected feed leaves the whole receiver as it was, mid-frame too */
     assert_int_equal(tase_rx_init(&rx), TASE_OK);
-    assert_int_equal(tase_frame_encode(out, sizeof(out), 0x08, 0x10, data, 4), 12);
+    assert_int_equal(tase_frame_build(0x08, 0x10, data, 4, out, sizeof(out)), 12);
     assert_int_equal(tase_rx_feed(&rx, out, 7, NULL, NULL), 0);
     memcpy(&copy, &rx, sizeof(rx));
     assert_int_equal(tase_rx_feed(&rx, NULL, SIZE_MAX, NULL, NULL), TASE_EARG);
@@ -985,7 +1015,7 @@ static void frames_inside_a_valid_frame_are_data_and_outside_it_are_frames(void 
     data[nd++] = 40;
     memcpy(data + nd, b, nb);
     nd += nb;
-    w = tase_frame_encode(buf, sizeof(buf), 0x00, 0x42, data, nd);
+    w = tase_frame_build(0x00, 0x42, data, nd, buf, sizeof(buf));
     assert_true(w > 0);
     n = (size_t)w;
     memcpy(buf + n, a, na);
@@ -1043,7 +1073,7 @@ static size_t build_mixed_stream(uint8_t *buf, size_t cap)
                 }
                 d += make_frame(data + d, (uint8_t)(rnd() % 4 * 8), (uint8_t)rnd(), rnd() % 40);
             }
-            m = (size_t)tase_frame_encode(buf + n, TASE_FRAME_MAX, 0x00, 0x42, data, d);
+            m = (size_t)tase_frame_build(0x00, 0x42, data, d, buf + n, TASE_FRAME_MAX);
             n += m;
         } else if (kind == 3) { /* Size corrupted upwards */
             m = make_frame(buf + n, 0x08, 0x41, rnd() % 64);
@@ -1100,7 +1130,7 @@ static void receiver_matches_the_reference_greedy_scan(void **state)
 static size_t point_zero(uint8_t *out)
 {
     static const uint8_t cmd[8] = {0, 0, 0, 0, 0, 0, 0xA0, 0};
-    int n = tase_frame_encode(out, TASE_FRAME_MAX, 0x00, 0x80, cmd, sizeof cmd);
+    int n = tase_frame_build(0x00, 0x80, cmd, sizeof cmd, out, TASE_FRAME_MAX);
     assert_int_equal(n, 16);
     return (size_t)n;
 }
@@ -1349,7 +1379,7 @@ static void one_byte_never_decides_the_whole_window_at_once(void **state)
         buf[n++] = 0x5A;
         buf[n++] = 0xFF;
         for (k = 0; k < 31; k++) {
-            n += (size_t)tase_frame_encode(buf + n, 8, 0x00, (uint8_t)k, NULL, 0);
+            n += (size_t)tase_frame_build(0x00, (uint8_t)k, NULL, 0, buf + n, 8);
         }
         for (k = 0; k < 9; k++) {
             buf[n++] = (uint8_t)(0x11 + k);
@@ -1393,7 +1423,7 @@ static void sync_inside_a_delivered_frame_starts_nothing(void **state)
     (void)state;
     /* payload ends in 00 FF 5A 02 00 40: a sync whose frame would run past
      * the end of the valid frame that contains it */
-    n = tase_frame_encode(buf, sizeof(buf), 0x00, 0x42, data, sizeof(data));
+    n = tase_frame_build(0x00, 0x42, data, sizeof(data), buf, sizeof(buf));
     assert_int_equal(tase_rx_feed(&rx, buf, (size_t)n, record, r), 1);
     assert_int_equal(tase_rx_flush(&rx, record, r), 0);
     assert_int_equal(rx.stats.checksum_errors, 0);
@@ -1667,14 +1697,14 @@ static void frame_api_rejects_bad_arguments(void **state)
 
     memset(out, 0xA5, sizeof out);
     memcpy(before, out, sizeof out);
-    assert_int_equal(tase_frame_encode(NULL, sizeof out, 0, 0, NULL, 0), TASE_EARG);
-    assert_int_equal(tase_frame_encode(out, sizeof out, 0, 0, NULL, 1), TASE_EARG);
-    assert_int_equal(tase_frame_encode(out, sizeof out, 0, 0, NULL, SIZE_MAX), TASE_EARG);
-    assert_int_equal(tase_frame_encode(out, sizeof out, 0, 0, bytes, TASE_DATA_MAX + 1u),
+    assert_int_equal(tase_frame_build(0, 0, NULL, 0, NULL, sizeof out), TASE_EARG);
+    assert_int_equal(tase_frame_build(0, 0, NULL, 1, out, sizeof out), TASE_EARG);
+    assert_int_equal(tase_frame_build(0, 0, NULL, SIZE_MAX, out, sizeof out), TASE_EARG);
+    assert_int_equal(tase_frame_build(0, 0, bytes, TASE_DATA_MAX + 1u, out, sizeof out),
                      TASE_ETOOLONG);
-    assert_int_equal(tase_frame_encode(out, sizeof out, 0, 0, bytes, SIZE_MAX), TASE_ETOOLONG);
-    assert_int_equal(tase_frame_encode(out, 0, 0, 0, NULL, 0), TASE_ENOSPC);
-    assert_int_equal(tase_frame_encode(out, 11, 0, 0, bytes, 4), TASE_ENOSPC);
+    assert_int_equal(tase_frame_build(0, 0, bytes, SIZE_MAX, out, sizeof out), TASE_ETOOLONG);
+    assert_int_equal(tase_frame_build(0, 0, NULL, 0, out, 0), TASE_ENOSPC);
+    assert_int_equal(tase_frame_build(0, 0, bytes, 4, out, 11), TASE_ENOSPC);
     assert_memory_equal(out, before, sizeof out);
     assert_int_equal(tase_checksum(0x1234u, NULL, SIZE_MAX), 0x1234u);
 
@@ -1725,6 +1755,7 @@ int main(void)
         cmocka_unit_test(frame_api_rejects_bad_arguments),
         cmocka_unit_test(encode_zero_length_frame_matches_hand_computed_bytes),
         cmocka_unit_test(encode_with_data_matches_hand_computed_bytes),
+        cmocka_unit_test(deprecated_frame_encode_is_frame_build_in_the_old_order),
         cmocka_unit_test(encode_checksum_wraps_modulo_65536),
         cmocka_unit_test(encode_rejects_bad_arguments_without_writing),
         cmocka_unit_test(encode_in_place_payload_needs_no_copy),

@@ -140,7 +140,7 @@ static void feed(fix_t *x, unsigned port, uint8_t group, uint8_t type, const uin
                  uint32_t now)
 {
     uint8_t fr[TASE_FRAME_MAX];
-    int n = tase_frame_encode(fr, sizeof fr, group, type, d, len);
+    int n = tase_frame_build(group, type, d, len, fr, sizeof fr);
     assert_true(n > 0);
     assert_int_equal(tase_gimbal_feed(&x->g, port, fr, (size_t)n, now), 1);
 }
@@ -824,8 +824,8 @@ static void noise_before_a_command_delays_it_only_up_to_the_quiet_limit(void **s
     int n, m;
     (void)state;
 
-    n = tase_frame_encode(fr, sizeof fr, 0x00, 0x80, cmd, sizeof cmd);
-    m = tase_frame_encode(fr + n, sizeof fr - (size_t)n, 0x48, 0x00, NULL, 0);
+    n = tase_frame_build(0x00, 0x80, cmd, sizeof cmd, fr, sizeof fr);
+    m = tase_frame_build(0x48, 0x00, NULL, 0, fr + n, sizeof fr - (size_t)n);
     assert_true(n > 0 && m > 0);
     assert_int_equal(tase_gimbal_feed(&x->g, 0, noise, sizeof noise, 10), 0);
     assert_int_equal(tase_gimbal_feed(&x->g, 0, fr, (size_t)(n + m), 11), 0);
@@ -1065,7 +1065,7 @@ static void a_typed_setting_is_decoded_applied_stored_and_echoed(void **state)
     tase_nav_source_t ns;
     int n;
     (void)state;
-    n = tase_frame_encode(fr, sizeof fr, 0x48, 0x01, (const uint8_t *)"\xFA\x07", 2);
+    n = tase_frame_build(0x48, 0x01, (const uint8_t *)"\xFA\x07", 2, fr, sizeof fr);
     assert_int_equal(tase_gimbal_feed(&x->g, 0, fr, (size_t)n, 5), 1);
     assert_int_equal(x->a.applies, 1);
     assert_int_equal(x->a.last_id, TASE_ID_SENSOR_FILTER);
@@ -1076,7 +1076,7 @@ static void a_typed_setting_is_decoded_applied_stored_and_echoed(void **state)
     assert_int_equal(sf.cutoff, 200);
     assert_int_equal(sf.decimation, 7);
     /* a refused setting echoes what is in force */
-    n = tase_frame_encode(fr, sizeof fr, 0x48, 0x04, (const uint8_t *)"\x01\x01", 2);
+    n = tase_frame_build(0x48, 0x04, (const uint8_t *)"\x01\x01", 2, fr, sizeof fr);
     assert_int_equal(tase_gimbal_feed(&x->g, 0, fr, (size_t)n, 6), 1);
     assert_int_equal(only_frame(&x->fp, &grp, &typ, d), 2);
     assert_int_equal(d[0], 0);
@@ -1269,7 +1269,7 @@ static line_run_t run_on_a_9600_baud_line(uint32_t port_rate, uint32_t capacity)
         assert_int_equal(tase_gimbal_set_capacity(&g, 0, capacity), TASE_OK);
     }
     assert_int_equal(tase_gimbal_setup_set(&g, 0x00, fast, sizeof fast, 0), TASE_OK);
-    n = tase_frame_encode(q, sizeof q, 0x48, 0x00, NULL, 0);
+    n = tase_frame_build(0x48, 0x00, NULL, 0, q, sizeof q);
     for (t = 1; t <= 6000u; t++) {
         uint64_t before;
         if (l.now_us < (uint64_t)t * 1000u) {
@@ -1404,7 +1404,7 @@ static void the_gimbal_keeps_its_bounds_under_random_faults(void **state)
     static tase_rx_t rx;
     uint8_t q[8];
     uint32_t seed;
-    int n = tase_frame_encode(q, sizeof q, 0x48, 0x01, NULL, 0);
+    int n = tase_frame_build(0x48, 0x01, NULL, 0, q, sizeof q);
     (void)state;
     assert_non_null(f);
     for (seed = 1; seed <= 500u; seed++) {
@@ -1538,23 +1538,23 @@ static void commands_reach_the_dispatcher_typed_with_their_port(void **state)
     assert_int_equal(a.cmd.tilt, -250);
     assert_int_equal(tase_gimbal_frame_port(&x->g), TASE_ESTATE);
     /* a SPOI_CMD query: a zeroed struct, frame->len 0 */
-    n = tase_frame_encode(fr, sizeof fr, TASE_ID_GROUP(TASE_ID_SPOI_CMD),
-                          TASE_ID_TYPE(TASE_ID_SPOI_CMD), NULL, 0);
+    n = tase_frame_build(TASE_ID_GROUP(TASE_ID_SPOI_CMD), TASE_ID_TYPE(TASE_ID_SPOI_CMD), NULL, 0,
+                         fr, sizeof fr);
     assert_int_equal(tase_gimbal_feed(&x->g, 0, fr, (size_t)n, 6), 1);
     assert_int_equal(a.queries, 1);
     assert_int_equal(a.port, 0);
     /* a GIMBAL_CMD of a wrong length: the error hook, no handler */
-    n = tase_frame_encode(fr, sizeof fr, TASE_ID_GROUP(TASE_ID_GIMBAL_CMD),
-                          TASE_ID_TYPE(TASE_ID_GIMBAL_CMD), data, 3);
+    n = tase_frame_build(TASE_ID_GROUP(TASE_ID_GIMBAL_CMD), TASE_ID_TYPE(TASE_ID_GIMBAL_CMD), data,
+                         3, fr, sizeof fr);
     assert_int_equal(tase_gimbal_feed(&x->g, 1, fr, (size_t)n, 7), 1);
     assert_int_equal(a.errors, 1);
     assert_int_equal(a.cmds, 1);
     /* a packet without a handler: the default handler */
-    n = tase_frame_encode(fr, sizeof fr, 0x28, 0x01, data, 2);
+    n = tase_frame_build(0x28, 0x01, data, 2, fr, sizeof fr);
     assert_int_equal(tase_gimbal_feed(&x->g, 1, fr, (size_t)n, 8), 1);
     assert_int_equal(a.defaults, 1);
     /* setups stay the role's: answered, never dispatched */
-    n = tase_frame_encode(fr, sizeof fr, 0x48, 0x00, NULL, 0);
+    n = tase_frame_build(0x48, 0x00, NULL, 0, fr, sizeof fr);
     assert_int_equal(tase_gimbal_feed(&x->g, 1, fr, (size_t)n, 9), 1);
     assert_int_equal(only_frame(&x->port[1], &g, &t, data), 16);
     assert_int_equal(a.cmds + a.queries + a.errors + a.defaults, 4);
@@ -1576,12 +1576,12 @@ static void frames_are_handled_after_the_receiver_returns_in_stream_order(void *
     size_t n = 0, at = 0;
     unsigned i;
     (void)state;
-    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x00, NULL, 0);
-    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x01, filter, 2);
-    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x00, 0x80, cmd, 8);
-    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x00, NULL, 0);
-    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x01, NULL, 0);
-    n += (size_t)tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x00, NULL, 0);
+    n += (size_t)tase_frame_build(0x48, 0x00, NULL, 0, &buf[n], sizeof buf - n);
+    n += (size_t)tase_frame_build(0x48, 0x01, filter, 2, &buf[n], sizeof buf - n);
+    n += (size_t)tase_frame_build(0x00, 0x80, cmd, 8, &buf[n], sizeof buf - n);
+    n += (size_t)tase_frame_build(0x48, 0x00, NULL, 0, &buf[n], sizeof buf - n);
+    n += (size_t)tase_frame_build(0x48, 0x01, NULL, 0, &buf[n], sizeof buf - n);
+    n += (size_t)tase_frame_build(0x48, 0x00, NULL, 0, &buf[n], sizeof buf - n);
     assert_int_equal(tase_gimbal_feed(&x->g, 0, buf, n, 5), 6);
     assert_int_equal(x->applies, 1);
     assert_int_equal(x->others, 1);
@@ -1613,9 +1613,9 @@ static void every_setup_in_a_long_buffer_gets_its_echo(void **state)
     while (n + 30u + 8u < sizeof buf) {
         int k;
         if (q % 5u == 4u) { /* an AXIS_SETTING in its 22-byte layout */
-            k = tase_frame_encode(&buf[n], sizeof buf - n, 0x48, 0x02, axis22, sizeof axis22);
+            k = tase_frame_build(0x48, 0x02, axis22, sizeof axis22, &buf[n], sizeof buf - n);
         } else {
-            k = tase_frame_encode(&buf[n], sizeof buf - n, 0x48, (uint8_t)(q % 2u), NULL, 0);
+            k = tase_frame_build(0x48, (uint8_t)(q % 2u), NULL, 0, &buf[n], sizeof buf - n);
         }
         assert_true(k > 0);
         n += (size_t)k;

@@ -76,7 +76,7 @@ static void feed_frame(fix_t *x, uint8_t group, uint8_t type, const uint8_t *d, 
                        uint32_t now)
 {
     uint8_t fr[TASE_FRAME_MAX];
-    int n = tase_frame_encode(fr, sizeof fr, group, type, d, len);
+    int n = tase_frame_build(group, type, d, len, fr, sizeof fr);
     assert_true(n > 0);
     assert_int_equal(tase_host_feed(&x->host, fr, (size_t)n, now), 1);
 }
@@ -274,7 +274,7 @@ static void transact_blocks_until_the_scripted_gimbal_answers(void **state)
     /* The fake gimbal answers only the third attempt. */
     x->port.reply_after = 3;
     x->port.nreply =
-        (size_t)tase_frame_encode(x->port.reply, sizeof x->port.reply, 0x48, 0x03, rates, 16);
+        (size_t)tase_frame_build(0x48, 0x03, rates, 16, x->port.reply, sizeof x->port.reply);
     x->port.now = 777;
     n = tase_host_transact(&x->host, 0x48, 0x03, NULL, 0, reply, sizeof reply, 250, 5);
     assert_int_equal(n, 16);
@@ -300,7 +300,7 @@ static void noise_before_the_echo_delays_it_only_up_to_the_quiet_limit(void **st
     int n;
 
     memcpy(x->port.reply, noise, sizeof noise);
-    n = tase_frame_encode(x->port.reply + 4, sizeof x->port.reply - 4u, 0x48, 0x03, rates, 16);
+    n = tase_frame_build(0x48, 0x03, rates, 16, x->port.reply + 4, sizeof x->port.reply - 4u);
     assert_int_equal(n, 24);
     x->port.nreply = 4u + (size_t)n;
     x->port.reply_after = 1;
@@ -315,7 +315,7 @@ static void noise_before_the_echo_delays_it_only_up_to_the_quiet_limit(void **st
      * limit, and the wait asked for (1000 ms) is cut to it */
     x->port.now = 5000;
     fake_push(&x->port, noise, sizeof noise);
-    n = tase_frame_encode(fr, sizeof fr, 0x00, 0x80, rates, 8);
+    n = tase_frame_build(0x00, 0x80, rates, 8, fr, sizeof fr);
     fake_push(&x->port, fr, (size_t)n);
     assert_int_equal(tase_host_service(&x->host, 1000), 4 + n);
     assert_int_equal(x->others, 0);
@@ -700,8 +700,8 @@ static void transact_msg_decodes_the_scripted_gimbal_answer(void **state)
     want.camera_b = 0xFF;
     assert_int_equal(tase_packet_encode_data(TASE_ID_SYSTEM_VERSION, &want, data, sizeof data), 42);
     x->port.reply_after = 2; /* the second attempt is answered */
-    x->port.nreply = (size_t)tase_frame_encode(x->port.reply, sizeof x->port.reply, 0x48, 0x03,
-                                               data, sizeof data);
+    x->port.nreply = (size_t)tase_frame_build(0x48, 0x03, data, sizeof data, x->port.reply,
+                                              sizeof x->port.reply);
     memset(&v, 0xAB, sizeof v);
     n = tase_host_transact_msg(&x->host, TASE_ID_SYSTEM_VERSION, NULL, &v, 100, 3);
     assert_int_equal(n, 42);
@@ -797,8 +797,8 @@ static void transact_keeps_its_contract_under_random_faults(void **state)
         fp.stale_max_ms = 1u + fault_rand(&fp) % 50u;
         fp.hangup_after = seed % 7u == 0u ? 1u + fault_rand(&fp) % 30u : 0u;
         x->port.reply_after = fault_rand(&fp) % 5u; /* 0: the gimbal never answers */
-        x->port.nreply = (size_t)tase_frame_encode(x->port.reply, sizeof x->port.reply, 0x48, 0x03,
-                                                   rates, sizeof rates);
+        x->port.nreply = (size_t)tase_frame_build(0x48, 0x03, rates, sizeof rates, x->port.reply,
+                                                  sizeof x->port.reply);
         p = fault_port(&fp);
         assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_OK);
         t0 = x->port.now;

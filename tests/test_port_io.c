@@ -102,7 +102,7 @@ static void send_frame_writes_one_encoded_frame(void **state)
     uint8_t want[TASE_FRAME_MAX];
     int n;
     (void)state;
-    n = tase_frame_encode(want, sizeof want, 0x48, 0x00, (const uint8_t *)"\x01\x02", 2);
+    n = tase_frame_build(0x48, 0x00, (const uint8_t *)"\x01\x02", 2, want, sizeof want);
     assert_int_equal(tase_port_send_frame(&p, 0x48, 0x00, (const uint8_t *)"\x01\x02", 2), n);
     assert_int_equal(f->nout, (size_t)n);
     assert_memory_equal(f->out, want, (size_t)n);
@@ -358,7 +358,7 @@ static void send_msg_writes_the_codec_frame_and_checks_it_first(void **state)
 }
 
 /* Issue 26: a frame goes out in pieces of at most 24 bytes (no frame
- * buffer on the stack), byte for byte the frame tase_frame_encode() and
+ * buffer on the stack), byte for byte the frame tase_frame_build() and
  * tase_packet_encode() build, every piece but the last a multiple of 8
  * bytes (a CAN port packs it into whole CAN frames, as one write). Every
  * data length, with a port taking all and a port taking 5 bytes a call. */
@@ -382,7 +382,7 @@ static void frames_go_out_in_staged_pieces_byte_for_byte(void **state)
     for (limit = 0; limit <= 5; limit += 5) {
         f->write_limit = limit;
         for (len = 0; len <= TASE_DATA_MAX; len++) {
-            n = tase_frame_encode(want, sizeof want, 0x12, 0x34, data, len);
+            n = tase_frame_build(0x12, 0x34, data, len, want, sizeof want);
             f->nout = 0;
             f->writes = 0;
             assert_int_equal(tase_port_send_frame(&p, 0x12, 0x34, data, len), n);

@@ -78,7 +78,7 @@ static int make_packet(uint8_t *wire, uint8_t type, size_t len)
     for (i = 0; i < len; i++) {
         data[i] = (uint8_t)(i ^ 0x5Au);
     }
-    return tase_frame_encode(wire, TASE_FRAME_MAX, 0x00, type, data, len);
+    return tase_frame_build(0x00, type, data, len, wire, TASE_FRAME_MAX);
 }
 
 /* Reads from the port until `want` bytes came or the port times out. */

@@ -68,7 +68,7 @@ NOINLINE static void c_checksum(void *ctx)
 NOINLINE static void c_encode(void *ctx)
 {
     (void)ctx;
-    (void)tase_frame_encode(out, sizeof(out), 0x08u, 0x10u, data, TASE_DATA_MAX);
+    (void)tase_frame_build(0x08u, 0x10u, data, TASE_DATA_MAX, out, sizeof(out));
 }
 
 NOINLINE static void c_init(void *ctx)
@@ -165,7 +165,7 @@ static void receiver(void)
     arg_n = TASE_FRAME_MAX;
     report("tase_checksum", measure_exact(nothing, c_checksum, NULL), "261_bytes_(a_whole_frame)");
     memset(data, 0xA5, sizeof(data));
-    report("tase_frame_encode", measure_exact(nothing, c_encode, NULL), "253_data_bytes");
+    report("tase_frame_build", measure_exact(nothing, c_encode, NULL), "253_data_bytes");
     report("tase_rx_init", measure_exact(nothing, c_init, NULL), "any_state");
     report("tase_rx_stats_reset", measure_exact(nothing, c_stats_reset, NULL), "any_state");
     (void)tase_rx_init(&rx_snap);
@@ -318,7 +318,7 @@ static void can(void)
     static char what[64];
     size_t i, s;
     unsigned long e, best = 0;
-    int n = tase_frame_encode(out, sizeof(out), 0x08u, 0x10u, data, TASE_DATA_MAX);
+    int n = tase_frame_build(0x08u, 0x10u, data, TASE_DATA_MAX, out, sizeof(out));
     (void)tase_can_split_init(&split_snap, TASE_CAN_ROLE_GIMBAL, out, (size_t)n);
     report("tase_can_split_next", measure_exact(restore_split, c_split_next, NULL),
            "8_of_a_261-byte_frame");

@@ -3,7 +3,7 @@
  * retract/deploy drive frames (section 5.3). Pure C99, no OS.
  *
  * ENCAPSULATION. Over CAN the datalink is unchanged: the bytes of encoded
- * frames (tase_frame_encode()) are cut into consecutive CAN frames of 1..8
+ * frames (tase_frame_build()) are cut into consecutive CAN frames of 1..8
  * bytes, all with 29-bit extended IDs:
  *
  *     0x11000000  bytes going to the gimbal   (sent by the host)

@@ -11,6 +11,12 @@
  *    reported to an error hook.
  *  - All state is owned by the caller; the library keeps no globals and
  *    never allocates.
+ *  - Arguments come in one order: the instance (rx, g, port, ...), then
+ *    what (group and type of a frame, the TASE_ID of a packet), then the
+ *    input (data and its length, or the message struct), then the output
+ *    and its capacity last: tase_frame_build(group, type, data, len, out,
+ *    cap), tase_packet_encode(id, msg, out, cap),
+ *    tase_packet_decode_data(id, data, len, msg).
  */
 #ifndef TASE_COMMON_H
 #define TASE_COMMON_H
@@ -55,6 +61,15 @@ extern "C" {
 #define TASE_NOINLINE_ __attribute__((noinline))
 #else
 #define TASE_NOINLINE_
+#endif
+
+/* Marks a function kept for a release after its replacement came (the
+ * compiler names the replacement where it is used); define
+ * TASE_ALLOW_DEPRECATED to silence it while migrating. */
+#if defined(__GNUC__) && !defined(TASE_ALLOW_DEPRECATED)
+#define TASE_DEPRECATED_(msg) __attribute__((deprecated(msg)))
+#else
+#define TASE_DEPRECATED_(msg)
 #endif
 
 /* Error codes. Stable: values never change meaning once released. */

@@ -257,7 +257,10 @@ typedef void (*tase_rx_handler_t)(void *user, const tase_frame_t *frame);
  * p == NULL (any n) returns seed without reading. O(n), reentrant. */
 uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n);
 
-/* Encode one frame into out[0..cap).
+/* Build one frame of (group, type) carrying data[0..len) into
+ * out[0..cap). The arguments come in the order of every encoder of the
+ * library: what, then the input, then the output (as
+ * tase_packet_encode(id, msg, out, cap)).
  * Returns the frame length (len + 8) or
  *   TASE_EARG     out is NULL, or data is NULL with len > 0;
  *   TASE_ETOOLONG len > TASE_DATA_MAX;
@@ -265,6 +268,13 @@ uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n);
  * On error nothing is written. `data` may point at out + TASE_FRAME_HEADER
  * (encode the payload in place, then frame it without a copy); any other
  * overlap is allowed too. O(len), reentrant, ISR-safe. */
+int tase_frame_build(uint8_t group, uint8_t type, const uint8_t *data, size_t len, uint8_t *out,
+                     size_t cap);
+
+/* Deprecated since 0.3.0, removed in 0.4.0: tase_frame_build() with the
+ * output first, tase_frame_build(group, type, data, len, out, cap) in
+ * the old order. Same results. */
+TASE_DEPRECATED_("use tase_frame_build(group, type, data, len, out, cap)")
 int tase_frame_encode(uint8_t *out, size_t cap, uint8_t group, uint8_t type, const uint8_t *data,
                       size_t len);
 

@@ -65,7 +65,7 @@ uint32_t tase_port_elapsed_ms(uint32_t now_ms, uint32_t since_ms);
 int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n);
 
 /* Write one frame of (group, type) around data[0..len), exactly the bytes
- * tase_frame_encode() gives, with the retries and the one deadline of
+ * tase_frame_build() gives, with the retries and the one deadline of
  * tase_port_write_all(). No frame buffer: the frame goes out in pieces of
  * at most 24 bytes staged on the stack and summed on the way (a multiple
  * of 8, so a CAN port packs them into the same whole CAN frames as one

@@ -633,7 +633,7 @@ def encode(packet):
         raise TypeError("encode() takes a tase.Packet, not %s" % type(packet).__name__)
     data = packet.payload
     out = ffi.new("uint8_t[]", lib.TASE_FRAME_MAX)
-    r = lib.tase_frame_encode(out, lib.TASE_FRAME_MAX, packet.group, packet.type, data, len(data))
+    r = lib.tase_frame_build(packet.group, packet.type, data, len(data), out, lib.TASE_FRAME_MAX)
     if r < 0:
         raise error(r, "encode %s" % packet.name)
     return ffi.buffer(out, r)[:]

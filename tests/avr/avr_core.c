@@ -152,8 +152,8 @@ static uint32_t every_packet(void)
                     }
                     len += extra;
                 }
-                n = tase_frame_encode(wire, sizeof wire, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id),
-                                      data, len);
+                n = tase_frame_build(TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len, wire,
+                                     sizeof wire);
                 check(n == (int)len + 8, "frame_encode", (uint32_t)i);
                 f = frame_view(wire, n);
                 memset(&m1, 0x55, sizeof m1);
@@ -262,8 +262,8 @@ static uint32_t noisy_stream(void)
             for (i = 0; i < len; i++) {
                 item[TASE_FRAME_HEADER + i] = rnd8();
             }
-            n = tase_frame_encode(item, sizeof item, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id),
-                                  item + TASE_FRAME_HEADER, len);
+            n = tase_frame_build(TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id),
+                                 item + TASE_FRAME_HEADER, len, item, sizeof item);
             check(n == (int)len + 8, "stream encode", (uint32_t)round);
             if (kind == 6u) {
                 item[n - 1] ^= (uint8_t)(rnd8() | 1u); /* broken checksum */

@@ -139,7 +139,7 @@ static size_t make_packet(uint8_t *out)
     for (i = 0; i < len; i++) {
         data[i] = (uint8_t)rnd64();
     }
-    return (size_t)tase_frame_encode(out, TASE_FRAME_MAX, group, type, data, len);
+    return (size_t)tase_frame_build(group, type, data, len, out, TASE_FRAME_MAX);
 }
 
 typedef struct {

@@ -85,12 +85,12 @@ static int send_what(const char *ifname, tase_socketcan_t *s, const char *what)
         return 0;
     }
     if (strcmp(what, "angle") == 0) {
-        n = tase_frame_encode(wire, sizeof(wire), 0x08, 0x10, angle, sizeof(angle));
+        n = tase_frame_build(0x08, 0x10, angle, sizeof(angle), wire, sizeof(wire));
     } else if (strcmp(what, "max") == 0) {
         for (i = 0; i < sizeof(data); i++) {
             data[i] = (uint8_t)(i * 3u + 7u);
         }
-        n = tase_frame_encode(wire, sizeof(wire), 0x00, 0x42, data, sizeof(data));
+        n = tase_frame_build(0x00, 0x42, data, sizeof(data), wire, sizeof(wire));
     }
     if (n <= 0 || tase_socketcan_write(s, wire, (size_t)n) != n) {
         return 1;
