@@ -15,6 +15,7 @@ if(TARGET tase_cli AND TARGET tase_sim)
                    $<TARGET_FILE:tase_sim> $<TARGET_FILE:tase_schema_lua>
                    ${PROJECT_SOURCE_DIR}/tests/data)
   set_tests_properties(tools_capture wireshark PROPERTIES LABELS "check;e2e" TIMEOUT 180)
+  tase_python_tests(tools_capture wireshark) # capture_util.py imports the tase package
   # tools_capture checks replay timing on the real clock: it runs alone.
   set_tests_properties(tools_capture PROPERTIES RUN_SERIAL TRUE)
 endif()

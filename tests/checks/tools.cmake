@@ -13,6 +13,7 @@ if(TARGET tase_cli AND TARGET tase_sim)
            COMMAND ${PROJECT_SOURCE_DIR}/tests/tools/e2e.sh $<TARGET_FILE:tase_cli>
                    $<TARGET_FILE:tase_sim>)
   set_tests_properties(tools_decode tools_cli tools_e2e PROPERTIES LABELS "check;e2e" TIMEOUT 180)
+  tase_python_tests(tools_cli) # frames built and read by the tase package
   # tools_e2e drives real processes on the real clock (timeouts, rates): it
   # runs alone, so the fuzzers and sanitizer builds cannot starve it.
   set_tests_properties(tools_e2e PROPERTIES RUN_SERIAL TRUE)

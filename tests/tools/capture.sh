@@ -6,11 +6,13 @@
 # tap, and `tase replay` through a pair of joined pseudo-terminals, byte for
 # byte and on time. (CAN recording and replay run in the CAN VM test.)
 # Usage: tests/tools/capture.sh TASE TASE_SIM DATA_DIR
+# (capture_util.py imports the tase Python package: PYTHONPATH=build/python and
+# TASE_PYTHON, the python3 it was built for, as ctest sets them)
 set -uo pipefail
 TASE=$1
 SIM=$2
 DATA=$3
-U="python3 $(dirname "$0")/capture_util.py"
+U="${TASE_PYTHON:-python3} $(dirname "$0")/capture_util.py"
 dir=$(mktemp -d)
 pids=()
 cleanup() {

@@ -1,8 +1,14 @@
 #!/usr/bin/env python3
 """Test helpers for the capture checks (tests/tools/capture.sh,
-tests/tools/wireshark.sh). Written from the format descriptions
-(docs/TOOLS.md "Captures", tcpdump.org's LINKTYPE_CAN_SOCKETCAN), not from
-the tools' code, so they check it rather than repeat it.
+tests/tools/wireshark.sh). Frames are built and captures read by the tase
+Python package (on PYTHONPATH: build/python, as ctest sets it). What the
+tools must print is worked out here from how each capture was built, never
+by a receiver (the generator's expected lines at the records completing
+them, the greedy scan's frames from the streams as assembled). The
+captures are written byte by byte from the format descriptions
+(docs/TOOLS.md "Captures", tcpdump.org's LINKTYPE_CAN_SOCKETCAN), not by the
+package's writer: some are damaged on purpose, and the tools' reader is
+checked against a writer other than its own.
 
   serial-pcap OUT SEED GAPS BIN:DIR...  a nanosecond pcap, link type 147,
         of the raw byte streams BIN (DIR out = from the gimbal, in = to it)
@@ -16,6 +22,12 @@ the tools' code, so they check it rather than repeat it.
         log (nanosecond timestamps, big-endian identifiers with flags).
   bad-pcap OUT                     a serial pcap with a bad direction byte, a
         record with no bytes, and good records around them.
+  quiet OUT GAP                    a false sync, then GAP seconds later the
+        bytes completing it as a frame (the receiver's time bound).
+  times OUT                        records stamped past 2038 and with a
+        fraction of 10^9 ns or more.
+  replay-checks CUT BAD BACK       captures `tase replay` must refuse (cut,
+        bad direction byte) or replay across a clock stepped back.
   pty-pair A B                     two pseudo-terminals (symlinks A and B)
         joined like a null-modem cable, raw, until killed.
   compare-pdml PDML JSONL          the dissector's packets (tshark -T pdml)
@@ -57,6 +69,8 @@ import tty
 import xml.etree.ElementTree as ET
 from decimal import ROUND_DOWN, Decimal
 
+import tase
+
 USEC = Decimal("0.000001")
 
 LINKTYPE_SERIAL = 147
@@ -65,6 +79,8 @@ DIRS = {"out": 0, "in": 1}
 T0 = 1700000000
 
 
+# The capture writer of the checks (see the module's docstring): a
+# nanosecond pcap header and records of any (sec, nsec), bytes as given.
 def pcap_header(linktype, snaplen=65535):
     return struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, snaplen, linktype)
 
@@ -74,22 +90,10 @@ def pcap_record(sec, nsec, data):
 
 
 def read_pcap(path):
-    """[(Decimal time, bytes)] of a pcap (micro or nanosecond, either order)."""
-    raw = open(path, "rb").read()
-    magic = struct.unpack("<I", raw[:4])[0]
-    if magic in (0xA1B2C3D4, 0xA1B23C4D):
-        e = "<"
-    else:
-        e = ">"
-        magic = struct.unpack(">I", raw[:4])[0]
-    scale = Decimal("1e-9") if magic == 0xA1B23C4D else Decimal("1e-6")
-    linktype = struct.unpack(e + "I", raw[20:24])[0]
-    out, i = [], 24
-    while i < len(raw):
-        sec, frac, cap, _ = struct.unpack(e + "IIII", raw[i:i + 16])
-        out.append((Decimal(sec) + frac * scale, raw[i + 16:i + 16 + cap]))
-        i += 16 + cap
-    return linktype, out
+    """[(Decimal time, linktype, bytes)] of the records of a capture, by the
+    package's reader (times in whole microseconds, as `tase decode`)."""
+    return [(Decimal(t).scaleb(-6), lt, data)
+            for _, lt, t, data, _ in tase.capture.records(path)]
 
 
 def cut(data, rng):
@@ -116,7 +120,7 @@ def cut_at_frames(data, jsonl):
     return out
 
 
-def serial_pcap(out, seed, gaps, specs):
+def serial_pcap(out, seed, gaps, *specs):
     """A serial capture of the streams SPEC (FILE.bin:DIR), records of 1..64
     bytes from either direction at random, GAPS ms ("LO-HI") apart. Gaps a
     live receiver would see as the line going quiet (HI >= 20 ms, its time
@@ -141,8 +145,8 @@ def serial_pcap(out, seed, gaps, specs):
             f.write(pcap_record(T0 + ns // 10**9, ns % 10**9, bytes([d]) + q.pop(0)))
 
 
-def expect_serial(pcap, specs):
-    _, recs = read_pcap(pcap)
+def expect_serial(pcap, *specs):
+    recs = [(t, rec) for t, _, rec in read_pcap(pcap)]
     pending = {}
     for spec in specs:
         path, d = spec.rsplit(":", 1)
@@ -178,8 +182,7 @@ def can_pcap(out, log):
 
 
 def bad_pcap(out):
-    angle = bytes([0x00, 0xFF, 0x5A, 0x08, 0x08, 0x10, 0x03, 0xE8, 0xFE, 0x0C, 0x00, 0x00,
-                   0x03, 0x6E])  # GIMBAL_ANGLE pan 1000 tilt -500, framed by hand
+    angle = gimbal_angle(1000, -500)[1]
     with open(out, "wb") as f:
         f.write(pcap_header(LINKTYPE_SERIAL))
         f.write(pcap_record(T0, 1, b"\x00" + angle))
@@ -308,29 +311,21 @@ def compare_pdml(pdml, jsonl):
     return 0 if bad == 0 else 1
 
 
-def frame(group, ptype, data):
-    """A TASE frame, from the wire format in docs/PROTOCOL-NOTES.md / the
-    spec: 00 FF 5A, Size = data length + 2, group, type, data, the 16-bit
-    sum of every byte before it, most significant byte first."""
-    body = bytes([0x00, 0xFF, 0x5A, len(data) + 2, group, ptype]) + bytes(data)
-    total = sum(body) & 0xFFFF
-    return body + bytes([total >> 8, total & 0xFF])
-
-
-def s16(*vals):
-    return b"".join(struct.pack(">h", v) for v in vals)
+def packet(name, data=b"", **raw):
+    """(name, frame) of a packet from wire integers, by the package."""
+    return name, tase.Packet(name, raw=raw, data=data).encode()
 
 
 def gimbal_angle(pan, tilt):
-    return ("GIMBAL_ANGLE", frame(0x08, 0x10, s16(pan, tilt, 0)))
+    return packet("GIMBAL_ANGLE", pan=pan, tilt=tilt, roll=0)
 
 
 def gimbal_cmd(pan, tilt, flags):
-    return ("GIMBAL_CMD", frame(0x00, 0x80, s16(pan, tilt, 0) + bytes([flags, 0])))
+    return packet("GIMBAL_CMD", pan=pan, tilt=tilt, roll=0, flags=flags, impulse_time=0)
 
 
 def camera_pass(camera_bytes):
-    return ("CAMERA_PASS", frame(0x00, 0x42, bytes([1, 8, 0, 0]) + camera_bytes))
+    return packet("CAMERA_PASS", camera_bytes, camera=1, baud=8)
 
 
 def false_start(size):
@@ -390,9 +385,8 @@ class Stream:
                     fr[3] = None  # the candidate never completes
         for fr in self.frames:
             assert fr[3] is None or fr[3] <= len(self.data)
-        for start, end in self.candidates:  # each one fails its checksum
-            raw = self.data[start:end]
-            assert len(raw) < end - start or sum(raw[:-2]) & 0xFFFF != raw[-2] * 256 + raw[-1]
+        for start, end in self.candidates:  # each one is cut or fails its checksum
+            assert all(p.offset > 0 for p in tase.decode(self.data[start:end]))
 
 
 # The issue 12 repro's inner frame: GIMBAL_CMD pan 90.00, tilt -10.00.
@@ -406,7 +400,7 @@ def scenario(name):
         out.noise(b"\x07\x5a")
         out.good(gimbal_angle(-1, 1))
         out.good(gimbal_angle(17999, 0))
-        inn.good(("RETRACT_DEPLOY_CMD", frame(0x00, 0x43, bytes([1, 0]))))
+        inn.good(packet("RETRACT_DEPLOY_CMD", deploy=1))
         inn.good(camera_pass(INNER))
         inn.good(gimbal_cmd(1000, -500, 0xA0))
         inn.good(camera_pass(b"\x55" + INNER + b"\x66" * 12))
@@ -418,8 +412,8 @@ def scenario(name):
         start = out.false(200)
         out.good(gimbal_angle(-300, 400))
         out.noise(b"\x01\x02\x03")
-        out.good(("GIMBAL_RATE", frame(0x08, 0x40, struct.pack(">I", 77) + s16(1, 2, 3, 4, 5, 6)
-                                       + b"\x00\x81")))
+        out.good(packet("GIMBAL_RATE", time=77, pan_rate=1, tilt_rate=2, roll_rate=3, p=4, q=5,
+                        r=6, mode=0x81))
         out.good(gimbal_angle(500, -600))
         out.noise(b"\x11" * (out.candidate_end - len(out.data) - 5))
         straddle = len(out.data)
@@ -453,7 +447,7 @@ def quiet(out, gap):
     so the GIMBAL_CMD, then the GIMBAL_ANGLE; with a shorter gap the
     261-byte frame (hiding the GIMBAL_CMD), then the GIMBAL_ANGLE."""
     inner = gimbal_cmd(9000, -1000, 0xA0)[1]
-    cand = frame(0x00, 0xFF, inner[2:] + bytes(253 - len(inner) + 2))
+    cand = tase.Packet.from_data(0x00, 0xFF, inner[2:] + bytes(253 - len(inner) + 2)).encode()
     assert cand[:4] == bytes([0x00, 0xFF, 0x5A, 0xFF]) and cand[4:4 + len(inner)] == inner
     first = cand[:4 + len(inner)]
     rest = cand[4 + len(inner):] + gimbal_angle(100, 200)[1]
@@ -637,8 +631,7 @@ def pdml_3ax(pdml):
 
 
 def records(pcap):
-    linktype, recs = read_pcap(pcap)
-    for t, r in recs:
+    for t, linktype, r in read_pcap(pcap):
         if linktype == LINKTYPE_SERIAL:
             print(t, r[0], r[1:].hex().upper())
         else:
@@ -648,10 +641,8 @@ def records(pcap):
 
 def timing(sent, got, d, speed, tol):
     want = DIRS[d]
-    _, srecs = read_pcap(sent)
-    _, grecs = read_pcap(got)
-    sbytes = [(t, b) for t, r in srecs if r[0] == want for b in r[1:]]
-    gbytes = [(t, b) for t, r in grecs if r[0] == 0 for b in r[1:]]
+    sbytes = [(t, b) for t, _, r in read_pcap(sent) if r[0] == want for b in r[1:]]
+    gbytes = [(t, b) for t, _, r in read_pcap(got) if r[0] == 0 for b in r[1:]]
     if [b for _, b in sbytes] != [b for _, b in gbytes]:
         print("replayed bytes differ: sent %d, received %d" % (len(sbytes), len(gbytes)))
         return 1
@@ -665,40 +656,14 @@ def timing(sent, got, d, speed, tol):
 
 
 def main(argv):
-    cmd, args = argv[1], argv[2:]
-    if cmd == "serial-pcap":
-        serial_pcap(args[0], args[1], args[2], args[3:])
-    elif cmd == "expect-serial":
-        expect_serial(args[0], args[1:])
-    elif cmd == "can-pcap":
-        can_pcap(args[0], args[1])
-    elif cmd == "replay-checks":
-        replay_checks(args[0], args[1], args[2])
-    elif cmd == "times":
-        times(args[0])
-    elif cmd == "quiet":
-        quiet(args[0], args[1])
-    elif cmd == "bad-pcap":
-        bad_pcap(args[0])
-    elif cmd == "pty-pair":
-        pty_pair(args[0], args[1])
-    elif cmd == "compare-pdml":
-        return compare_pdml(args[0], args[1])
-    elif cmd == "greedy":
-        greedy(*args)
-    elif cmd == "expect-decode":
-        return expect_decode(args[0], args[1])
-    elif cmd == "expect-pdml":
-        return expect_pdml(args[0], args[1], args[2])
-    elif cmd == "pdml-3ax":
-        pdml_3ax(args[0])
-    elif cmd == "records":
-        records(args[0])
-    elif cmd == "timing":
-        return timing(*args)
-    else:
-        raise SystemExit("unknown command " + cmd)
-    return 0
+    """Run the command argv[1]: the function of that name (- for _)."""
+    commands = {f.__name__.replace("_", "-"): f for f in (
+        serial_pcap, expect_serial, can_pcap, replay_checks, times, quiet, bad_pcap, pty_pair,
+        compare_pdml, greedy, expect_decode, expect_pdml, pdml_3ax, records, timing)}
+    if len(argv) < 2 or argv[1] not in commands:
+        raise SystemExit("usage: capture_util.py COMMAND ARGS... (commands: %s)"
+                         % ", ".join(commands))
+    return commands[argv[1]](*argv[2:]) or 0
 
 
 if __name__ == "__main__":

@@ -7,6 +7,8 @@
 # offsets, times, field names and values, data bytes, errors. Also the 3AX
 # frames against hand-made values, a bad direction byte, a display filter.
 # Usage: tests/tools/wireshark.sh TASE TASE_SIM SCHEMA_LUA DATA_DIR
+# (capture_util.py imports the tase Python package: PYTHONPATH=build/python and
+# TASE_PYTHON, the python3 it was built for, as ctest sets them)
 #        tests/tools/wireshark.sh --fix SCHEMA_LUA   (rewrite the table)
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -31,7 +33,7 @@ TASE=$1
 SIM=$2
 SCHEMA_LUA=$3
 DATA=$4
-U="python3 $here/capture_util.py"
+U="${TASE_PYTHON:-python3} $here/capture_util.py"
 dir=$(mktemp -d)
 sim_pid=""
 cleanup() {
