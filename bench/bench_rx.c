@@ -1,6 +1,6 @@
 /*
  * Receiver benchmark: feeds a synthetic stream through tase_rx_feed() and
- * prints what came out. Run by scripts/bench.sh under callgrind (which
+ * prints what came out. Run by bench/bench.sh under callgrind (which
  * counts only the instructions inside tase_rx_feed) and natively for MB/s.
  *
  *   bench_rx STREAM CHUNK MODE [DISPATCH]

@@ -1,6 +1,6 @@
 # CMake toolchain file: Linux on IBM Z (s390x, big-endian) with Debian's
 # cross compiler, programs run under qemu-user. Used by
-# scripts/check-s390x.sh to run the unit tests on a big-endian CPU:
+# scripts/checks/s390x.sh to run the unit tests on a big-endian CPU:
 #
 #   cmake -S . -B build-s390x -DCMAKE_TOOLCHAIN_FILE=cmake/s390x-linux-gnu.cmake \
 #         -DTASE_BUILD_TESTS=ON && cmake --build build-s390x && ctest --test-dir build-s390x -L unit

@@ -5,7 +5,7 @@
 #                CMake package, pkg-config files
 #   tase-tools   the component "tools": tase, tase-sim and their manual
 #   python3-tase the component "python": the Python package (python/)
-# scripts/check-packages.sh builds both, unpacks them and builds consumer
+# scripts/checks/packages.sh builds both, unpacks them and builds consumer
 # programs from the unpacked tree.
 set(CPACK_PACKAGE_NAME tase)
 set(CPACK_PACKAGE_VENDOR "The tase-gimbal-stack authors")

@@ -3,10 +3,10 @@
  *
  * Every harness is one file fuzz/<name>.c that defines
  * LLVMFuzzerTestOneInput() and nothing else global. It is built two ways:
- *   - by scripts/check-fuzz.sh with clang -fsanitize=fuzzer,address,undefined
+ *   - by scripts/checks/fuzz.sh with clang -fsanitize=fuzzer,address,undefined
  *     (the bounded fuzz run, tests/checks/fuzz.cmake);
  *   - with fuzz/replay_main.c by any C compiler, to replay a corpus (the
- *     fuzz_replay_<name> tests and scripts/check-sanitize.sh).
+ *     fuzz_replay_<name> tests and scripts/checks/sanitize.sh).
  * A harness reports a broken invariant with FZ_CHECK, which aborts: the
  * fuzzer then saves the input as a crash artifact.
  */

@@ -1,6 +1,6 @@
 /*
  * Writes the committed seed corpus: fuzz/corpus/<harness>/seed-NN.
- * Run by scripts/fuzz-seeds.sh; the output is deterministic so re-running
+ * Run by scripts/dev/fuzz-seeds.sh; the output is deterministic so re-running
  * it changes nothing in git. A new harness adds a seeds_<name>() here.
  * Host-only helper (stdio).
  */

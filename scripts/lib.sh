@@ -1,4 +1,4 @@
-# Shared by the scripts in this folder; source it, do not run it.
+# Shared by the scripts under scripts/ and bench/; source it, do not run it.
 # shellcheck shell=bash
 
 TASE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

@@ -1587,7 +1587,7 @@ static size_t run_plan(tase_rx_t *rx, reenter_t *e, const uint8_t *s, const plan
  * tase_rx_flush()). feed/push/flush are refused with TASE_EBUSY and change
  * nothing; stats_reset and init are allowed; every call returns the frames
  * it delivered, never a negative count. Run under ASan/UBSan by
- * scripts/check-sanitize.sh. */
+ * scripts/checks/sanitize.sh. */
 static void every_call_from_inside_the_callback_is_refused_or_safe(void **state)
 {
     static uint8_t s[1024];

@@ -27,7 +27,7 @@
  * then print a summary (with its own flash/RAM/stack numbers) through
  * semihosting and exit 0 on success, 1 on any failure.
  *
- * The peer is whatever is on the UART: scripts/check-autopilot.sh wires it
+ * The peer is whatever is on the UART: scripts/checks/autopilot.sh wires it
  * to a live tase-sim (no canned replies), at the link's real pace.
  */
 #include <math.h>

@@ -1,6 +1,6 @@
 /*
  * The core on an 8-bit AVR, where int and size_t are 16 bits wide: run
- * under simavr (ATmega2560) by scripts/check-avr.sh, which reads the
+ * under simavr (ATmega2560) by scripts/checks/avr.sh, which reads the
  * UART output. Two parts:
  *
  *  1. every packet of the schema, with extreme and pseudo-random field

@@ -3,7 +3,7 @@
 # guest's UART. Real clock, about 12 s of mission after the build.
 if(TARGET tase_sim)
   add_test(NAME autopilot_qemu
-           COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-autopilot.sh $<TARGET_FILE:tase_sim>
+           COMMAND ${PROJECT_SOURCE_DIR}/scripts/checks/autopilot.sh $<TARGET_FILE:tase_sim>
                    ${CMAKE_BINARY_DIR}/autopilot)
   # RUN_SERIAL: QEMU and tase-sim both run on the real clock, and the image
   # counts the telemetry it receives against the rates it asked for; beside

@@ -8,13 +8,14 @@ if(TARGET tase_cli AND TARGET tase_sim)
   target_link_libraries(tase_schema_lua PRIVATE tase)
   target_compile_options(tase_schema_lua PRIVATE ${TASE_WARNINGS})
   add_test(NAME tools_capture
-           COMMAND ${PROJECT_SOURCE_DIR}/scripts/tools-capture.sh $<TARGET_FILE:tase_cli>
+           COMMAND ${PROJECT_SOURCE_DIR}/tests/tools/capture.sh $<TARGET_FILE:tase_cli>
                    $<TARGET_FILE:tase_sim> ${PROJECT_SOURCE_DIR}/tests/data)
   add_test(NAME wireshark
-           COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-wireshark.sh $<TARGET_FILE:tase_cli>
+           COMMAND ${PROJECT_SOURCE_DIR}/tests/tools/wireshark.sh $<TARGET_FILE:tase_cli>
                    $<TARGET_FILE:tase_sim> $<TARGET_FILE:tase_schema_lua>
                    ${PROJECT_SOURCE_DIR}/tests/data)
   set_tests_properties(tools_capture wireshark PROPERTIES LABELS "check;e2e" TIMEOUT 180)
+  tase_python_tests(tools_capture wireshark) # capture_util.py imports the tase package
   # tools_capture checks replay timing on the real clock: it runs alone.
   set_tests_properties(tools_capture PROPERTIES RUN_SERIAL TRUE)
 endif()

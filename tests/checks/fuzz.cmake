@@ -7,7 +7,7 @@
 # Keep the sum of the times <= ~240 s: ctest runs two at a time on 2 cores.
 function(tase_fuzz name seconds)
   add_test(NAME fuzz_${name}
-           COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-fuzz.sh ${name} ${seconds} ${CMAKE_BINARY_DIR}/fuzz)
+           COMMAND ${PROJECT_SOURCE_DIR}/scripts/checks/fuzz.sh ${name} ${seconds} ${CMAKE_BINARY_DIR}/fuzz)
   math(EXPR limit "${seconds} + 300")
   set_tests_properties(fuzz_${name} PROPERTIES LABELS "check;fuzz" TIMEOUT ${limit})
   add_executable(fuzz_replay_${name} ${PROJECT_SOURCE_DIR}/fuzz/${name}.c

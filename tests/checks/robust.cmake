@@ -1,12 +1,12 @@
 # Issue 9's robustness checks (docs/ROBUSTNESS.md). Each script also runs
 # on its own from the source tree.
-add_test(NAME format COMMAND ${PROJECT_SOURCE_DIR}/scripts/format.sh)
-add_test(NAME sanitize COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-sanitize.sh ${CMAKE_BINARY_DIR}/sanitize)
-add_test(NAME valgrind COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-valgrind.sh ${CMAKE_BINARY_DIR})
+add_test(NAME format COMMAND ${PROJECT_SOURCE_DIR}/scripts/dev/format.sh)
+add_test(NAME sanitize COMMAND ${PROJECT_SOURCE_DIR}/scripts/checks/sanitize.sh ${CMAKE_BINARY_DIR}/sanitize)
+add_test(NAME valgrind COMMAND ${PROJECT_SOURCE_DIR}/scripts/checks/valgrind.sh ${CMAKE_BINARY_DIR})
 set_tests_properties(format sanitize valgrind PROPERTIES LABELS check TIMEOUT 900)
-add_test(NAME coverage COMMAND ${PROJECT_SOURCE_DIR}/scripts/coverage.sh ${CMAKE_BINARY_DIR}/coverage)
+add_test(NAME coverage COMMAND ${PROJECT_SOURCE_DIR}/scripts/dev/coverage.sh ${CMAKE_BINARY_DIR}/coverage)
 set_tests_properties(coverage PROPERTIES LABELS check TIMEOUT 900)
-add_test(NAME static_analysis COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-static.sh ${CMAKE_BINARY_DIR}/static)
+add_test(NAME static_analysis COMMAND ${PROJECT_SOURCE_DIR}/scripts/checks/static.sh ${CMAKE_BINARY_DIR}/static)
 set_tests_properties(static_analysis PROPERTIES LABELS check TIMEOUT 900)
 # Bit-error sweep (tests/robust/ber_sweep.c): 1e6 packets per channel
 # through flips/drops/inserts; --check asserts zero collateral loss, no

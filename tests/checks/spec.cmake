@@ -6,7 +6,7 @@
 # behaving like a real TASE; see the script's header). About 35 s.
 if(TARGET tase_cli AND TARGET tase_sim)
   add_test(NAME spec_e2e
-           COMMAND ${PROJECT_SOURCE_DIR}/scripts/check-spec-e2e.sh $<TARGET_FILE:tase_cli>
+           COMMAND ${PROJECT_SOURCE_DIR}/tests/tools/spec.sh $<TARGET_FILE:tase_cli>
                    $<TARGET_FILE:tase_sim>)
   # a real process pair on the real clock: alone, like tools_e2e
   set_tests_properties(spec_e2e PROPERTIES LABELS "check;e2e" TIMEOUT 60 RUN_SERIAL TRUE)

@@ -4,15 +4,16 @@
 # pseudo-terminal (tools_e2e).
 if(TARGET tase_cli AND TARGET tase_sim)
   add_test(NAME tools_decode
-           COMMAND ${PROJECT_SOURCE_DIR}/scripts/tools-decode.sh $<TARGET_FILE:tase_cli>
+           COMMAND ${PROJECT_SOURCE_DIR}/tests/tools/decode.sh $<TARGET_FILE:tase_cli>
                    ${PROJECT_SOURCE_DIR}/tests/data)
   add_test(NAME tools_cli
-           COMMAND ${PROJECT_SOURCE_DIR}/scripts/tools-cli.py $<TARGET_FILE:tase_cli>
+           COMMAND ${PROJECT_SOURCE_DIR}/tests/tools/cli.py $<TARGET_FILE:tase_cli>
                    $<TARGET_FILE:tase_sim>)
   add_test(NAME tools_e2e
-           COMMAND ${PROJECT_SOURCE_DIR}/scripts/tools-e2e.sh $<TARGET_FILE:tase_cli>
+           COMMAND ${PROJECT_SOURCE_DIR}/tests/tools/e2e.sh $<TARGET_FILE:tase_cli>
                    $<TARGET_FILE:tase_sim>)
   set_tests_properties(tools_decode tools_cli tools_e2e PROPERTIES LABELS "check;e2e" TIMEOUT 180)
+  tase_python_tests(tools_cli) # frames built and read by the tase package
   # tools_e2e drives real processes on the real clock (timeouts, rates): it
   # runs alone, so the fuzzers and sanitizer builds cannot starve it.
   set_tests_properties(tools_e2e PROPERTIES RUN_SERIAL TRUE)

@@ -1,5 +1,5 @@
 /* A small application as a user writes it, built by every consumer kind of
- * scripts/check-integration.sh: a GIMBAL_CMD goes through the encoder,
+ * scripts/checks/integration.sh: a GIMBAL_CMD goes through the encoder,
  * the receiver and the dispatcher into a typed handler, a CAN receiver
  * (whose instance holds a tase_rx_t) is initialised, and, when the build
  * links a port, that port is exercised a little; a stalling port checks

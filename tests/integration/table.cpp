@@ -1,4 +1,4 @@
-// C++ consumer of scripts/check-integration.sh: includes every public
+// C++ consumer of scripts/checks/integration.sh: includes every public
 // header (tase_all.h, generated from the installed or source headers) and
 // builds its dispatcher table as tase/dispatch.h documents for C++, a
 // constexpr table set up at compile time. The script checks that the table

@@ -17,7 +17,7 @@
  *     satisfy the checksum (the receiver accepted nothing the sum rejects);
  *   - misframed false frames stay within 4x + 3 of the expectation
  *     (candidates that reached a checksum test / 65536).
- * --markdown prints the table of docs/ROBUSTNESS.md (scripts/ber-sweep.sh).
+ * --markdown prints the table of docs/ROBUSTNESS.md (bench/ber-sweep.sh).
  */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime */
 #include <math.h>

@@ -2,7 +2,7 @@
  * schema (tase/schema.h), so the dissector names every packet and field
  * exactly as `tase list` and the JSON contract do. The generated block sits
  * between the "BEGIN GENERATED" and "END GENERATED" lines of tase.lua;
- * scripts/check-wireshark.sh fails when they differ (`--fix` rewrites it).
+ * tests/tools/wireshark.sh fails when they differ (`--fix` rewrites it).
  * Usage: tase-schema-lua > block */
 #include <stdio.h>
 

@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# Build the example autopilot firmware (examples/autopilot) for Cortex-M4F
+# and fly its SPOI mission under QEMU's mps2-an386 against a live tase-sim:
+# the simulator serves a pty, QEMU connects the guest's UART0 to it, and
+# both run on the real clock (no -icount: SysTick follows host time).
+# Passes only when the image reports PASS and exits 0, and the simulator's
+# log shows the PACKET_RATE setting and the SPOI command the image sent.
+# Everything it starts is stopped and the link removed, also on failure.
+# Packages: scripts/packages.d/firmware.txt.
+# Usage: scripts/checks/autopilot.sh TASE_SIM [outdir]
+set -uo pipefail
+. "$(dirname "$0")/../lib.sh"
+sim=${1:?usage: scripts/checks/autopilot.sh TASE_SIM [outdir]}
+out=${2:-$TASE_ROOT/build-autopilot}
+dir=$(mktemp -d)
+sim_pid=""
+qemu_pid=""
+cleanup() {
+    [ -n "$qemu_pid" ] && kill "$qemu_pid" 2>/dev/null
+    [ -n "$sim_pid" ] && kill "$sim_pid" 2>/dev/null
+    wait 2>/dev/null
+    rm -rf "$dir"
+}
+trap cleanup EXIT
+fail() {
+    echo "FAIL: $*"
+    echo "--- image output:"; cat "$dir/image.log" 2>/dev/null
+    echo "--- tase-sim log:"; cat "$dir/sim.log" 2>/dev/null
+    exit 1
+}
+
+cmake -S "$TASE_ROOT/examples/autopilot" -B "$out" \
+      -DCMAKE_TOOLCHAIN_FILE="$TASE_ROOT/cmake/arm-none-eabi.cmake" -DTASE_CPU=cortex-m4 \
+      >/dev/null || exit 1
+cmake --build "$out" -j2 || exit 1
+
+# --seconds bounds the simulator even if this script is killed outright.
+"$sim" --link "$dir/gimbal" --seconds 150 >"$dir/sim.log" 2>&1 &
+sim_pid=$!
+for _ in $(seq 100); do
+    [ -L "$dir/gimbal" ] && break
+    sleep 0.05
+done
+[ -L "$dir/gimbal" ] || fail "tase-sim did not create its link"
+
+# The image bounds its own mission (30 s); timeout covers a hung guest.
+timeout 120 qemu-system-arm -M mps2-an386 -nographic -monitor none \
+    -chardev serial,id=gimbal,path="$dir/gimbal" -serial chardev:gimbal \
+    -semihosting-config enable=on,target=native \
+    -kernel "$out/tase_autopilot.elf" >"$dir/image.log" 2>&1 &
+qemu_pid=$!
+wait "$qemu_pid"
+rc=$?
+qemu_pid=""
+# Stop the simulator so that it writes its closing counters.
+kill "$sim_pid" 2>/dev/null
+wait "$sim_pid" 2>/dev/null
+sim_pid=""
+
+cat "$dir/image.log"
+[ "$rc" -eq 0 ] || fail "the image exited with status $rc"
+grep -q '^PASS: 0 of [0-9]* checks failed' "$dir/image.log" || fail "the image did not report PASS"
+
+# The simulator saw the setup exchange and the SPOI command the image sent.
+grep -q 'PACKET_RATE: port 2 (this link) angle 20/s, rate 10/s, georef 10/s' "$dir/sim.log" ||
+    fail "tase-sim's log lacks the PACKET_RATE setting"
+spoi=$(sed -n 's/^SPOI_CMD at \([-0-9.]*, [-0-9.]*, [-0-9.]* m\), echo confirmed.*/\1/p' \
+       "$dir/image.log")
+[ -n "$spoi" ] || fail "the image did not report its SPOI command"
+grep -q "SPOI_CMD: pointing at $spoi" "$dir/sim.log" ||
+    fail "tase-sim's log lacks the SPOI command at $spoi"
+frames=$(sed -n 's/.*stopped: \([0-9]*\) frames in.*/\1/p' "$dir/sim.log")
+sent=$(sed -n 's/^host role: \([0-9]*\) frames sent.*/\1/p' "$dir/image.log")
+[ -n "$frames" ] && [ "$frames" = "$sent" ] ||
+    fail "tase-sim received ${frames:-?} frames, the image sent ${sent:-?}"
+echo "--- tase-sim log:"
+cat "$dir/sim.log"
+echo "autopilot mission against tase-sim: ok"

@@ -1,0 +1,120 @@
+#!/usr/bin/env bash
+# Debian packages (issue 13): build libtase-dev and tase-tools with CPack
+# from a /usr build, check their control fields and contents, unpack them
+# into a scratch root and use them from there as a user of the installed
+# packages would: a CMake project with find_package(tase CONFIG) and
+# tase::socketcan, a pkg-config Makefile build (PKG_CONFIG_SYSROOT_DIR),
+# and the programs, whose --version must be the library's version.
+# Usage: scripts/checks/packages.sh [outdir]
+set -euo pipefail
+. "$(dirname "$0")/../lib.sh"
+out=${1:-$TASE_ROOT/build-packages}
+cons="$TASE_ROOT/tests/integration"
+rm -rf "$out"
+mkdir -p "$out"
+version=$(tase_version)
+arch=$(dpkg --print-architecture)
+triplet=$(gcc -print-multiarch)
+
+tase_step "build with -DCMAKE_INSTALL_PREFIX=/usr and run cpack -G DEB"
+cmake -S "$TASE_ROOT" -B "$out/build" -DCMAKE_INSTALL_PREFIX=/usr -DTASE_BUILD_TESTS=OFF \
+    -DTASE_CHECKS=OFF >/dev/null
+cmake --build "$out/build" -j2 >/dev/null
+(cd "$out/build" && cpack -G DEB >"$out/cpack.log" 2>&1) || {
+    cat "$out/cpack.log"
+    tase_fail "cpack"
+}
+dev="$out/build/packages/libtase-dev_${version}-1_${arch}.deb"
+tools="$out/build/packages/tase-tools_${version}-1_${arch}.deb"
+for deb in "$dev" "$tools"; do
+    [ -f "$deb" ] || {
+        ls "$out/build/packages"
+        tase_fail "no $(basename "$deb")"
+    }
+done
+
+tase_step "control fields and contents"
+# field DEB NAME EXPECTED-REGEX
+field() {
+    local v
+    v=$(dpkg-deb -f "$1" "$2")
+    [[ $v =~ $3 ]] || tase_fail "$(basename "$1"): $2 is '$v', expected /$3/"
+}
+field "$dev" Package '^libtase-dev$'
+field "$tools" Package '^tase-tools$'
+for deb in "$dev" "$tools"; do
+    field "$deb" Version "^${version}-1$"
+    field "$deb" Architecture "^${arch}$"
+    field "$deb" Maintainer '.+'
+    field "$deb" Description '.+'
+done
+field "$dev" Section '^libdevel$'
+field "$dev" Description '^TASE gimbal protocol stack: static libraries and headers'
+field "$tools" Description '^TASE gimbal bench tools'
+field "$tools" Depends 'libc6'
+dpkg-deb -c "$dev" | awk '{print $6}' | sed 's|^\./||' >"$out/dev.list"
+dpkg-deb -c "$tools" | awk '{print $6}' | sed 's|^\./||' >"$out/tools.list"
+for f in usr/include/tase/frame.h usr/include/tase/config.h usr/include/tase/version.h \
+    usr/include/tase/posix_uart.h usr/include/tase/socketcan.h usr/include/tase/bm_uart.h \
+    usr/include/tase/ring.h "usr/lib/$triplet/libtase.a" "usr/lib/$triplet/libtase_posix_uart.a" \
+    "usr/lib/$triplet/libtase_socketcan.a" "usr/lib/$triplet/libtase_baremetal.a" \
+    "usr/lib/$triplet/cmake/tase/tase-config.cmake" "usr/lib/$triplet/cmake/tase/tase-config-version.cmake" \
+    "usr/lib/$triplet/cmake/tase/tase-targets.cmake" "usr/lib/$triplet/pkgconfig/tase.pc" \
+    "usr/lib/$triplet/pkgconfig/tase-socketcan.pc" usr/share/doc/libtase-dev/copyright \
+    usr/share/doc/libtase-dev/CHANGELOG.md; do
+    grep -qx "$f" "$out/dev.list" || tase_fail "libtase-dev lacks /$f"
+done
+for f in usr/bin/tase usr/bin/tase-sim usr/share/doc/tase-tools/copyright; do
+    grep -qx "$f" "$out/tools.list" || tase_fail "tase-tools lacks /$f"
+done
+if grep -q '^usr/bin/' "$out/dev.list" || grep -q '^usr/include/' "$out/tools.list"; then
+    tase_fail "a file is in the wrong package"
+fi
+echo "   libtase-dev: $(grep -c '[^/]$' "$out/dev.list") files; tase-tools: $(grep -c '[^/]$' "$out/tools.list") files"
+
+grep -q "^## \[$version\]" "$TASE_ROOT/CHANGELOG.md" || tase_fail "CHANGELOG.md has no section for $version"
+
+tase_step "unpack both and build consumers from the unpacked tree"
+root="$out/root"
+dpkg-deb -x "$dev" "$root"
+dpkg-deb -x "$tools" "$root"
+# CMake: find_package searches <prefix>/lib/<triplet>/cmake as on an
+# installed system.
+cmake -S "$cons/consumer" -B "$out/cmake" -DHOW=package -DTASE_WANT="$version" -DPORT=socketcan \
+    -DCMAKE_PREFIX_PATH="$root/usr" >"$out/cmake.log"
+grep -q "consumer: tase $version from $root/usr/lib/$triplet/cmake/tase" "$out/cmake.log" || {
+    cat "$out/cmake.log"
+    tase_fail "find_package did not take the unpacked package"
+}
+cmake --build "$out/cmake" -j2 >/dev/null
+"$out/cmake/app"
+# pkg-config: the .pc files say /usr; the sysroot points it at the tree.
+PKG_CONFIG_SYSROOT_DIR="$root" PKG_CONFIG_LIBDIR="$root/usr/lib/$triplet/pkgconfig" \
+    make -s -C "$cons/pkgconfig" BUILD="$out/pc" >/dev/null
+"$out/pc/app"
+
+tase_step "the programs"
+for p in tase tase-sim; do
+    "$root/usr/bin/$p" --help >/dev/null 2>&1 || tase_fail "$p --help"
+    if v=$("$root/usr/bin/$p" --version 2>/dev/null); then
+        [[ $v == *"$version"* ]] || tase_fail "$p --version says '$v', the library is $version"
+        echo "   $p --version: $v"
+    elif grep -rq --include='*.c' -- '"--version"' "$TASE_ROOT/tools/"; then
+        tase_fail "$p --version failed"
+    else
+        echo "   $p: no --version option in tools/ yet (issue 15); --help runs"
+    fi
+done
+tase_step "python3-tase (issue 22): fields, contents, import from the unpacked tree"
+py="$out/build/packages/python3-tase_${version}-1_${arch}.deb"
+[ -f "$py" ] || tase_fail "no $(basename "$py") (python3-cffi, python3-dev installed?)"
+field "$py" Package '^python3-tase$'
+field "$py" Version "^${version}-1$"
+field "$py" Depends 'python3 \(>= 3\.[0-9]+\), python3 \(<< 3\.[0-9]+\), python3-cffi-backend'
+dpkg-deb -x "$py" "$root"
+v=$(cd / && PYTHONPATH="$root/usr/lib/python3/dist-packages" /usr/bin/python3 -c \
+    'import tase; print(tase.__version__, tase.__file__)')
+[[ $v == "$version $root/usr/lib/python3/dist-packages/tase/__init__.py" ]] ||
+    tase_fail "python3-tase: import tase gave '$v'"
+echo "   python3-tase: import tase: $v"
+tase_step "packages: built, checked, unpacked and used"

@@ -1,0 +1,328 @@
+#!/usr/bin/env bash
+# Captures end to end (issue 15 item 5): `tase decode` of pcap/pcapng
+# captures written by an independent writer (tests/tools/capture_util.py) from
+# the generator's test streams, malformed records, `--record` of a live
+# session with tase-sim, `tase record` of a serial line and of a two-line
+# tap, and `tase replay` through a pair of joined pseudo-terminals, byte for
+# byte and on time. (CAN recording and replay run in the CAN VM test.)
+# Usage: tests/tools/capture.sh TASE TASE_SIM DATA_DIR
+# (capture_util.py imports the tase Python package: PYTHONPATH=build/python and
+# TASE_PYTHON, the python3 it was built for, as ctest sets them)
+set -uo pipefail
+TASE=$1
+SIM=$2
+DATA=$3
+U="${TASE_PYTHON:-python3} $(dirname "$0")/capture_util.py"
+dir=$(mktemp -d)
+pids=()
+cleanup() {
+    local p
+    for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
+    wait 2>/dev/null
+    rm -rf "$dir"
+}
+trap cleanup EXIT
+
+. "$(dirname "$0")/check-lib.sh"
+under_valgrind TASE SIM
+# Timing tolerances (seconds of replay jitter, ms for a --speed 0 run);
+# looser when scripts/checks/valgrind.sh runs the programs under memcheck.
+tol=0.250 fast_ms=350
+[ -n "${TASE_UNDER_VALGRIND:-}" ] && tol=0.300 fast_ms=5000
+# json_int LINE KEY: the integer value of "KEY": in a JSON line
+json_int() { sed -n "s/.*\"$2\":\(-\{0,1\}[0-9][0-9]*\).*/\1/p" <<<"$1"; }
+# same_lines A B: files equal, or the diff shown
+same_lines() { diff -u "$1" "$2" | head -20; cmp -s "$1" "$2"; }
+# Each direction in stream order, exactly. Across directions the order is
+# the order the receivers decided the frames: a frame held behind a longer
+# candidate of its own direction (at most 253 bytes) may come after a
+# later frame of the other one, still with the time its last byte came.
+same_per_dir() {
+    local d
+    for d in out in; do
+        same_lines <(grep "\"dir\":\"$d\"" "$1") <(grep "\"dir\":\"$d\"" "$2") || return 1
+    done
+}
+
+# ---- decode: serial pcap of both directions, files, pipes, pcapng ----
+$U serial-pcap "$dir/noisy.pcap" 1 0.001-3 "$DATA/decode_noisy.bin:out" "$DATA/decode_noisy.bin:in"
+$U expect-serial "$dir/noisy.pcap" "$DATA/decode_noisy.jsonl:out" "$DATA/decode_noisy.jsonl:in" \
+    >"$dir/noisy.expect"
+"$TASE" decode "$dir/noisy.pcap" >"$dir/noisy.json"
+rc=$?
+check "decode of a serial pcap (both directions, 1..64-byte records): every packet with dir and time, exit 0" \
+    eval '[ $rc -eq 0 ] && same_per_dir "$dir/noisy.expect" "$dir/noisy.json"'
+# issue 25 item 6: record times past 2038-01-19 03:14:07 (the unsigned
+# 32-bit seconds of classic pcap) and a fraction of 10^9 ns or more
+$U times "$dir/times.pcap"
+t=$("$TASE" decode "$dir/times.pcap" | sed -n 's/.*"time":\([0-9.-]*\),.*/\1/p' | tr '\n' ' ')
+check "decode: times past 2038 and unnormalised fractions ($t)" \
+    test "$t" = "2147483647.750000 2147483648.250000 1700000001.500000 "
+"$TASE" decode - <"$dir/noisy.pcap" | cmp -s - "$dir/noisy.json"
+check "decode of the serial pcap from standard input (a file)" [ $? -eq 0 ]
+cat "$dir/noisy.pcap" | "$TASE" decode | cmp -s - "$dir/noisy.json"
+check "decode of the serial pcap through a pipe" [ $? -eq 0 ]
+editcap -F pcapng "$dir/noisy.pcap" "$dir/noisy.pcapng" >/dev/null 2>&1 &&
+    "$TASE" decode "$dir/noisy.pcapng" | cmp -s - "$dir/noisy.json"
+check "decode of the same capture as pcapng (editcap)" [ $? -eq 0 ]
+
+# ---- decode: SocketCAN pcap of the candump test log ----
+$U can-pcap "$dir/can.pcap" "$DATA/decode_candump.log"
+sed 's/"interface":"vcan0",//' "$DATA/decode_candump.jsonl" >"$dir/can.expect"
+"$TASE" decode "$dir/can.pcap" >"$dir/can.json"
+check "decode of a LINKTYPE_CAN_SOCKETCAN pcap: as the candump log (no interface name in a pcap)" \
+    same_lines "$dir/can.expect" "$dir/can.json"
+"$TASE" decode --candump "$DATA/decode_candump.log" | grep -c '"time":1700000000\.[0-9]\{6\},' >"$dir/n"
+check "decode --candump gives each packet its line's time (6 decimals): all $(wc -l <"$DATA/decode_candump.jsonl")" \
+    [ "$(cat "$dir/n")" = "$(wc -l <"$DATA/decode_candump.jsonl")" ]
+
+# ---- malformed records and files ----
+$U bad-pcap "$dir/bad.pcap"
+"$TASE" decode "$dir/bad.pcap" >"$dir/bad.json" 2>"$dir/bad.err"
+rc=$?
+check "malformed records: exit 4, records 2 and 3 named, the two good ones decoded ($(tr '\n' '|' <"$dir/bad.err"))" \
+    eval '[ $rc -eq 4 ] && [ "$(wc -l <"$dir/bad.err")" -eq 3 ] &&
+          grep -q "record 2 skipped: direction byte 0x07" "$dir/bad.err" &&
+          grep -q "record 3 skipped: no bytes after the direction byte" "$dir/bad.err" &&
+          grep -q "2 bad records (the rest was decoded)" "$dir/bad.err" &&
+          [ "$(grep -c "\"name\":\"GIMBAL_ANGLE\",\"size\":6,\"fields\":{\"pan\":1000,\"tilt\":-500,\"roll\":0}" "$dir/bad.json")" = 2 ] &&
+          grep -q "\"dir\":\"out\"" "$dir/bad.json" && grep -q "\"dir\":\"in\"" "$dir/bad.json"'
+python3 -c 'import struct,sys; open(sys.argv[1],"wb").write(struct.pack("<IHHiIII",0xA1B2C3D4,2,4,0,0,65535,1))' "$dir/eth.pcap"
+expect_error "decode of an Ethernet pcap" 1 "link type 1 (EN10MB) is neither TASE serial" \
+    "$TASE" decode "$dir/eth.pcap"
+head -c 30 "$dir/noisy.pcap" >"$dir/cut.pcap"
+expect_error "decode of a pcap cut inside a record header" 1 "cut.pcap" "$TASE" decode "$dir/cut.pcap"
+expect_error "replay of a raw byte file" 1 "is not a pcap or pcapng capture" \
+    "$TASE" replay "$DATA/decode_noisy.bin" --serial /dev/null --dir out
+expect_error "replay without a link" 2 "give either --serial DEV or --can IFACE" \
+    "$TASE" replay "$dir/noisy.pcap"
+# Nothing is replayed on a default: a capture's gimbal side holds echoes a
+# gimbal takes as commands (RETRACT_DEPLOY_CMD, SPOI_CMD, setup packets).
+expect_error "replay without --dir: refused, each choice explained" 2 \
+    "replay needs --dir: out = the gimbal's side, to exercise a host (its echoes are commands to a gimbal); in = the host's commands (moves a gimbal); all = both (moves a gimbal)" \
+    "$TASE" replay "$dir/noisy.pcap" --serial /dev/null
+expect_error "replay --dir sideways" 2 "bad --dir value 'sideways'" \
+    "$TASE" replay "$dir/noisy.pcap" --serial /dev/null --dir sideways
+expect_error "replay --speed -1" 2 "bad --speed value" \
+    "$TASE" replay "$dir/noisy.pcap" --serial /dev/null --speed -1
+expect_error "record without -o" 2 "record needs an output file" "$TASE" record --serial /dev/null
+expect_error "record --tap-in without --serial" 2 "needs --serial" \
+    "$TASE" record --can vcan0 --tap-in /dev/null -o "$dir/x.pcap"
+expect_error "--record on a CAN link" 2 "on CAN run 'tase record --can can0" \
+    "$TASE" query SYSTEM_VERSION --can can0 --record "$dir/x.pcap"
+# issue 25 item 1: a record that cannot start never touches an existing
+# capture (it was cut to 24 bytes before the device open failed)
+head -c 262184 /dev/urandom >"$dir/precious.pcap"
+cp "$dir/precious.pcap" "$dir/precious.copy"
+expect_error "record from a missing device: refused" 1 "cannot open serial device" \
+    "$TASE" record --serial "$dir/no-such-tty" -o "$dir/precious.pcap"
+check "... and the existing capture is untouched, no partial file left" \
+    eval 'cmp -s "$dir/precious.pcap" "$dir/precious.copy" && ! ls "$dir"/precious.pcap.partial-* >/dev/null 2>&1'
+
+# ---- a live session with tase-sim, recorded with --record ----
+"$SIM" --quiet --link "$dir/gimbal" --seconds 120 >"$dir/sim.log" 2>&1 &
+pids+=($!)
+for _ in $(seq 100); do [ -L "$dir/gimbal" ] && break; sleep 0.05; done
+L=(--serial "$dir/gimbal" --record "$dir/session.pcap")
+t_start=$(date +%s.%N)
+v=$("$TASE" query SYSTEM_VERSION "${L[@]}" --json)
+e=$("$TASE" send PACKET_RATE angle_2=20 "${L[@]}" --json | tail -1) # the echo (the link is port 2)
+"$TASE" monitor "${L[@]}" --json --seconds 1 >"$dir/mon.json"
+t_end=$(date +%s.%N)
+"$TASE" decode "$dir/session.pcap" >"$dir/session.json"
+rc=$?
+check "--record: three commands appended into one capture, decoded" \
+    eval '[ $rc -eq 0 ] && [ -s "$dir/session.json" ]'
+$U records "$dir/session.pcap" >"$dir/session.rec"
+check "--record: the first record is the query as sent, byte for byte (to the gimbal: 00 FF 5A 02 48 03 01 A6)" \
+    eval '[ "$(head -1 "$dir/session.rec" | cut -d" " -f2-)" = "1 00FF5A02480301A6" ]'
+q=$(grep -m1 '"name":"SYSTEM_VERSION"' "$dir/session.json")
+a=$(grep '"dir":"out"' "$dir/session.json" | grep -m1 '"name":"SYSTEM_VERSION"')
+check "--record: query (in, size 0) and answer (out) equal to what query printed" \
+    eval '[[ "$q" == *"\"dir\":\"in\",\"group\":72,\"type\":3,\"name\":\"SYSTEM_VERSION\",\"size\":0,"* ]] &&
+          [ "${a#*\"fields\"}" = "${v#*\"fields\"}" ]'
+check "--record: PACKET_RATE sent (in) and echoed (out) with angle_2 20 (the link's port)" \
+    eval '[ "$(grep "\"name\":\"PACKET_RATE\",\"size\":16," "$dir/session.json" | grep -c "\"angle_2\":20,")" = 2 ] &&
+          [ "$(json_int "$e" angle_2)" = 20 ]'
+nmon=$(grep -c . "$dir/mon.json")
+ncap=$(grep '"dir":"out"' "$dir/session.json" | grep -c -e GIMBAL_ANGLE -e GIMBAL_RATE -e GEOREFERENCE_DATA)
+check "--record: the $nmon packets monitor printed are all in the capture ($ncap telemetry packets)" \
+    [ "$ncap" -ge "$nmon" ]
+python3 - "$dir/session.json" "$t_start" "$t_end" <<'PY'
+import json, sys
+from decimal import Decimal
+objs = [json.loads(l, parse_float=Decimal) for l in open(sys.argv[1])]
+lo, hi = Decimal(sys.argv[2]), Decimal(sys.argv[3])
+last = {}
+for o in objs:
+    t = o["time"]
+    assert lo <= t <= hi, (t, lo, hi)
+    assert t >= last.get(o["dir"], t), o
+    last[o["dir"]] = t
+PY
+check "--record: every time is wall-clock seconds within the session, non-decreasing per direction" [ $? -eq 0 ]
+$U can-pcap "$dir/other.pcap" "$DATA/decode_candump.log"
+expect_error "--record appending to a capture of another link type" 1 "cannot write capture" \
+    "$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/other.pcap"
+
+# issue 25 item 2: --record onto a full disk (here: a file size limit,
+# SIGXFSZ ignored, so writes fail with EFBIG as on a full disk). The
+# GIMBAL_CMD reaches the gimbal: exit 5, one message saying it was sent.
+cp "$dir/session.pcap" "$dir/full.pcap"
+kb=$(($(stat -c %s "$dir/full.pcap") / 1024)) # below its size: no write fits
+(
+    trap '' XFSZ
+    ulimit -f "$kb"
+    exec "$TASE" point 12 -3 --serial "$dir/gimbal" --record "$dir/full.pcap"
+) >"$dir/full.out" 2>"$dir/full.err.all"
+rc=$?
+grep -v '^==[0-9]*== ' "$dir/full.err.all" >"$dir/full.err" # memcheck's notes are not ours
+check "--record on a full disk: the command was carried out, exit $rc (5), '$(cat "$dir/full.err")'" \
+    eval '[ $rc -eq 5 ] && [ "$(wc -l <"$dir/full.err")" -eq 1 ] &&
+          grep -q "cannot write capture .*(GIMBAL_CMD was sent)" "$dir/full.err" &&
+          grep -q "^sent GIMBAL_CMD pan=1200 tilt=-300" "$dir/full.out"'
+check "... and the capture still ends at a whole record (tshark reads it cleanly)" \
+    eval 'tshark -r "$dir/full.pcap" >/dev/null 2>"$dir/full.tshark" && ! grep -v "Running as user" "$dir/full.tshark" | grep -q .'
+# issue 25 item 3: appending to a capture a crash cut inside a record
+cp "$dir/session.pcap" "$dir/crashed.pcap"
+truncate -s -5 "$dir/crashed.pcap"
+"$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/crashed.pcap" >/dev/null 2>"$dir/crashed.err"
+rc=$?
+check "--record appending to a capture cut inside a record: repaired first, said so, readable ($(cat "$dir/crashed.err"))" \
+    eval '[ $rc -eq 0 ] && grep -q "ended inside a record .* bytes of it removed before appending" "$dir/crashed.err" &&
+          tshark -r "$dir/crashed.pcap" >/dev/null 2>"$dir/crashed.tshark" && ! grep -v "Running as user" "$dir/crashed.tshark" | grep -q . &&
+          [ "$("$TASE" decode "$dir/crashed.pcap" | grep -c SYSTEM_VERSION)" -ge 2 ]'
+expect_error "record to an unwritable file (the device opens first)" 1 "cannot write capture" \
+    "$TASE" record --serial "$dir/gimbal" -o "$dir/no/such/dir.pcap" --seconds 0.5
+expect_error "record onto a full disk (/dev/full)" 1 "cannot write capture /dev/full: No space left on device" \
+    "$TASE" record --serial "$dir/gimbal" -o /dev/full --seconds 0.5
+
+# ---- tase record of the gimbal's line; SIGINT ends it cleanly ----
+"$TASE" record --serial "$dir/gimbal" -o "$dir/tele.pcap" >"$dir/rec.out" 2>&1 &
+rp=$!
+wait_for "$dir/rec.out" recording
+sleep 1.2
+kill -INT $rp
+wait $rp
+rc=$?
+"$TASE" decode "$dir/tele.pcap" >"$dir/tele.json"
+na=$(grep -c '"dir":"out".*"name":"GIMBAL_ANGLE"' "$dir/tele.json")
+nr=$($U records "$dir/tele.pcap" | grep -c .)
+check "record --serial, stopped by SIGINT: exit $rc, '$(tail -1 "$dir/rec.out")', $nr records, $na GIMBAL_ANGLE (20/s set above)" \
+    eval '[ $rc -eq 0 ] && grep -q "^recorded $nr records" "$dir/rec.out" && [ "$na" -ge 15 ] &&
+          ! grep -q "\"dir\":\"in\"" "$dir/tele.json"'
+# a recording killed outright (SIGKILL) leaves the previous capture as it
+# was and its own records in the partial file beside it
+cp "$dir/tele.pcap" "$dir/tele.copy"
+"$TASE" record --serial "$dir/gimbal" -o "$dir/tele.pcap" >"$dir/rec2.out" 2>&1 &
+rp=$!
+wait_for "$dir/rec2.out" recording
+sleep 0.5
+kill -KILL $rp
+wait $rp 2>/dev/null
+check "record killed with SIGKILL: the previous capture is unchanged, the partial one kept beside it" \
+    eval 'cmp -s "$dir/tele.pcap" "$dir/tele.copy" && ls "$dir"/tele.pcap.partial-* >/dev/null 2>&1'
+rm -f "$dir"/tele.pcap.partial-*
+
+# ---- the recorded device goes away: record stops (it spun at 75% CPU) ----
+"$TASE" record --serial "$dir/gimbal" -o "$dir/gone.pcap" >"$dir/gone.out" 2>"$dir/gone.err" &
+rp=$!
+wait_for "$dir/gone.out" recording
+sleep 0.3
+kill "${pids[0]}"
+for _ in $(seq 40); do kill -0 $rp 2>/dev/null || break; sleep 0.05; done
+if kill -0 $rp 2>/dev/null; then
+    cpu=$(ps -o time= -p $rp)
+    kill -INT $rp
+fi
+wait $rp
+rc=$?
+"$TASE" decode "$dir/gone.pcap" >"$dir/gone.json"
+check "record when the device hangs up: stops within 2 s, exit $rc, '$(cat "$dir/gone.err")'${cpu:+ (still running, CPU $cpu)}" \
+    eval '[ $rc -eq 1 ] && [ "$(grep -vc "^==" "$dir/gone.err")" = 1 ] &&
+          grep -q "^tase: cannot read .*gimbal: the device went away or hung up$" "$dir/gone.err"'
+check "... the records so far kept and closed: '$(cat "$dir/gone.out" | tail -1)', $(grep -c . "$dir/gone.json") packets decoded" \
+    eval 'grep -q "^recorded [1-9][0-9]* records" "$dir/gone.out" && grep -q GIMBAL_ANGLE "$dir/gone.json"'
+
+# ---- replay through joined pseudo-terminals, recorded on the other side ----
+$U pty-pair "$dir/A" "$dir/B" &
+pids+=($!)
+$U pty-pair "$dir/C" "$dir/D" &
+pids+=($!)
+for _ in $(seq 100); do [ -L "$dir/B" ] && [ -L "$dir/D" ] && break; sleep 0.05; done
+$U serial-pcap "$dir/slow.pcap" 3 40-120 "$DATA/decode_noisy.bin:out" "$DATA/decode_noisy.bin:in"
+
+# replay_to NAME REPLAY-ARGS...: record B (and D) while replaying; the
+# recorder is stopped (SIGINT) 0.2 s after the replay ends.
+replay_to() {
+    local name=$1
+    shift
+    "$TASE" record --serial "$dir/B" --tap-in "$dir/D" -o "$dir/$name.pcap" >"$dir/$name.rec" 2>&1 &
+    local rp=$!
+    wait_for "$dir/$name.rec" recording
+    "$@" >"$dir/$name.out" 2>&1
+    sleep 0.2
+    kill -INT $rp
+    wait $rp
+}
+bytes=$(wc -c <"$DATA/decode_noisy.bin")
+replay_to got "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out
+check "replay --dir out (the gimbal's side): $(cat "$dir/got.out")" \
+    grep -q "^replayed [1-9][0-9]* of [0-9]* records ($bytes bytes)" "$dir/got.out"
+check "replay: every byte from the gimbal arrived, in order, within $tol s of its recorded time" \
+    $U timing "$dir/slow.pcap" "$dir/got.pcap" out 1 $tol
+replay_to fast "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out --speed 2
+check "replay --speed 2: the same bytes at half the recorded intervals" \
+    $U timing "$dir/slow.pcap" "$dir/fast.pcap" out 2 $tol
+replay_to in "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir in
+check "replay --dir in: the bytes sent to the gimbal" \
+    $U timing "$dir/slow.pcap" "$dir/in.pcap" in 1 $tol
+# Recorded like the others, so that no byte of it is left in the joined
+# ptys for the next recorder to find (under load the relay can lag).
+replay_fast() {
+    local start
+    start=$(date +%s%N)
+    "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out --speed 0 >/dev/null
+    echo $((($(date +%s%N) - start) / 1000000)) >"$dir/zero.ms"
+}
+replay_to zero replay_fast
+ms=$(cat "$dir/zero.ms")
+check "replay --speed 0 sends without waiting (${ms} ms for a 1.5 s capture)" [ "$ms" -lt "$fast_ms" ]
+
+# issue 25 item 7: the whole capture is checked before anything is sent
+# (what arrives is recorded on B as cutrx.pcap etc.)
+$U replay-checks "$dir/cut-in.pcap" "$dir/bad-in.pcap" "$dir/back-in.pcap"
+replay_to cutrx "$TASE" replay "$dir/cut-in.pcap" --serial "$dir/A" --dir out
+check "replay of a capture cut in its last record: refused before sending ('$(tail -1 "$dir/cutrx.out")'), nothing arrived" \
+    eval '! grep -q "^replayed" "$dir/cutrx.out" && [ "$($U records "$dir/cutrx.pcap" | grep -c .)" = 0 ]'
+replay_to badrx "$TASE" replay "$dir/bad-in.pcap" --serial "$dir/A" --dir out
+check "replay of a capture with a bad record: nothing sent ('$(tail -1 "$dir/badrx.out")')" \
+    eval 'grep -q "1 bad record: nothing was sent" "$dir/badrx.out" && [ "$($U records "$dir/badrx.pcap" | grep -c .)" = 0 ]'
+replay_to backrx "$TASE" replay "$dir/back-in.pcap" --serial "$dir/A" --dir out
+t_back=$(sed -n 's/^replayed 4 of 4 records (56 bytes) to .* in \([0-9.]*\) s$/\1/p' "$dir/backrx.out")
+check "replay across a clock stepped back: warned, the later gaps kept (${t_back:-?} s; 1.0 s of gaps, was 0.7)" \
+    eval 'grep -q "record 3 is 0.300000 s earlier than record 2" "$dir/backrx.out" &&
+          awk -v t="${t_back:-0}" "BEGIN { exit !(t >= 0.95 && t < 1.0 + $tol) }"'
+
+# A two-line tap: the gimbal's line into A (recorded on B), the host's line
+# into C (recorded on D with --tap-in), both replayed at once.
+replay_both() {
+    "$TASE" replay "$dir/slow.pcap" --serial "$dir/A" --dir out &
+    "$TASE" replay "$dir/slow.pcap" --serial "$dir/C" --dir in
+    wait $!
+}
+replay_to tap replay_both
+"$TASE" decode "$dir/tap.pcap" >"$dir/tap.json"
+for d in out in; do
+    grep "\"dir\":\"$d\"" "$dir/tap.json" | sed -E 's/"time":[0-9.]+,//; s/"dir":"[a-z]+",//' >"$dir/tap.$d"
+done
+check "record --tap-in: both lines decoded, each direction exactly the generator's packets" \
+    eval 'same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.out" && same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.in"'
+
+# (last: no recorder follows to find its bytes in the joined ptys)
+expect_error "replay > /dev/full: exit 5, the message says data was sent" 5 \
+    "replayed data was sent; cannot write to standard output: No space left on device" \
+    sh -c 'exec "$0" replay "$1" --serial "$2" --dir out --speed 0 >/dev/full' "$TASE" "$dir/slow.pcap" "$dir/A"
+
+check_summary capture
+echo "captures: decode, record, --record, tap and replay all passed"

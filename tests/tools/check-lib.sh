@@ -1,0 +1,57 @@
+# Assertions shared by the capture and dissector checks; source it after
+# setting `dir` (a scratch directory). Each check prints "ok" or "FAIL" and
+# the script ends with `check_summary WHAT`.
+# shellcheck shell=bash
+fails=0
+ok() { echo "ok   $*"; }
+bad() { echo "FAIL $*"; fails=$((fails + 1)); }
+# check NAME CONDITION-COMMAND...: a named assertion
+check() {
+    local name=$1
+    shift
+    if "$@"; then ok "$name"; else bad "$name"; fi
+}
+# wait_for FILE PATTERN: up to 5 s for PATTERN to appear in FILE
+wait_for() {
+    local i
+    for i in $(seq 100); do
+        grep -q -- "$2" "$1" 2>/dev/null && return 0
+        sleep 0.05
+    done
+    return 1
+}
+# expect_error NAME STATUS PATTERN CMD...: CMD exits with STATUS and prints
+# exactly one line on stderr, matching PATTERN
+expect_error() {
+    local name=$1 want=$2 pat=$3 rc lines
+    shift 3
+    "$@" >"$dir/out" 2>"$dir/err.all" </dev/null
+    rc=$?
+    grep -v '^==[0-9]*==' "$dir/err.all" >"$dir/err" # memcheck's own notes
+    lines=$(wc -l <"$dir/err")
+    if [ "$rc" = "$want" ] && [ "$lines" -eq 1 ] && grep -q -- "$pat" "$dir/err"; then
+        ok "$name: exit $rc, $(cat "$dir/err")"
+    else
+        bad "$name: exit $rc, $lines stderr lines: $(head -c 300 "$dir/err")"
+    fi
+}
+# under_valgrind VAR...: under scripts/checks/valgrind.sh (TASE_UNDER_VALGRIND=1)
+# the shell itself is not traced, so the programs named by the variables
+# are wrapped in memcheck here (an error exits 99 and fails the check).
+under_valgrind() {
+    local v
+    [ "${TASE_UNDER_VALGRIND:-}" = 1 ] || return 0
+    for v in "$@"; do
+        printf '#!/bin/sh\nexec valgrind -q --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect --show-leak-kinds=definite,indirect "%s" "$@"\n' \
+            "${!v}" >"$dir/vg-$v"
+        chmod +x "$dir/vg-$v"
+        eval "$v=\$dir/vg-\$v"
+    done
+}
+# check_summary WHAT: exit 1 when a check failed
+check_summary() {
+    if [ $fails -ne 0 ]; then
+        echo "$fails $1 check(s) failed"
+        exit 1
+    fi
+}

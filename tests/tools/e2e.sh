@@ -1,0 +1,492 @@
+#!/usr/bin/env bash
+# End-to-end test of the bench tools: a real tase-sim process on a pty and
+# the tase command line against it, plus every error path.
+# Usage: tests/tools/e2e.sh TASE TASE_SIM   (registered by tests/checks/tools.cmake)
+set -uo pipefail
+TASE=$1
+SIM=$2
+dir=$(mktemp -d)
+sim_pid=""
+fails=0
+cleanup() {
+    [ -n "$sim_pid" ] && kill -CONT "$sim_pid" 2>/dev/null && kill "$sim_pid" 2>/dev/null
+    wait 2>/dev/null
+    rm -rf "$dir"
+}
+trap cleanup EXIT
+
+# Under scripts/checks/valgrind.sh this shell runs natively (system programs
+# are not traced), so the programs are put under memcheck here, through
+# wrappers (an error exits 99 and fails the check); they start slowly, so
+# time limits scale.
+slow=1
+settle=0.5 # for a program started in the background to set itself up
+if [ "${TASE_UNDER_VALGRIND:-}" = 1 ]; then
+    slow=10
+    settle=4
+    for p in TASE SIM; do
+        printf '#!/bin/sh\nexec valgrind -q --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect --show-leak-kinds=definite,indirect "%s" "$@"\n' \
+            "${!p}" >"$dir/vg-$p"
+        chmod +x "$dir/vg-$p"
+        eval "$p=\$dir/vg-\$p"
+    done
+fi
+
+ok() { echo "ok   $*"; }
+bad() { echo "FAIL $*"; fails=$((fails + 1)); }
+
+# check NAME CONDITION-COMMAND...: a named assertion
+check() {
+    local name=$1
+    shift
+    if "$@"; then ok "$name"; else bad "$name"; fi
+}
+
+# quiet CMD...: run CMD, its output to the log only
+quiet() { "$@" >>"$dir/quiet.log" 2>&1; }
+
+# json_int LINE KEY: the integer value of "KEY": in a JSON line
+json_int() { sed -n "s/.*\"$2\":\(-\{0,1\}[0-9][0-9]*\).*/\1/p" <<<"$1"; }
+
+# near A B TOL: |A - B| <= TOL (integers)
+near() { local d=$(($1 - $2)); [ "${d#-}" -le "$3" ]; }
+
+# expect_error NAME STATUS PATTERN CMD...: CMD exits with STATUS (any
+# non-zero if STATUS is "nz") and prints exactly one line on stderr that
+# matches PATTERN.
+expect_error() {
+    local name=$1 want=$2 pat=$3 rc lines
+    shift 3
+    "$@" >"$dir/out" 2>"$dir/err.all" </dev/null
+    rc=$?
+    # memcheck's own notes (==PID== lines, e.g. on TIOCEXCL) are not ours;
+    # a memory error shows as exit 99
+    grep -v '^==[0-9]*== ' "$dir/err.all" >"$dir/err"
+    lines=$(wc -l <"$dir/err")
+    if { [ "$want" = nz ] && [ $rc -ne 0 ] || [ "$rc" = "$want" ]; } &&
+        [ "$lines" -eq 1 ] && grep -q -- "$pat" "$dir/err"; then
+        ok "$name: exit $rc, $(cat "$dir/err")"
+    else
+        bad "$name: exit $rc, $lines stderr lines: $(head -c 300 "$dir/err")"
+    fi
+}
+
+start_sim() {
+    "$SIM" --link "$dir/gimbal" --klv-link "$dir/klv" --seconds 120 >"$dir/sim.log" 2>&1 &
+    sim_pid=$!
+    for _ in $(seq 100); do
+        [ -L "$dir/gimbal" ] && [ -L "$dir/klv" ] && return 0
+        sleep 0.05
+    done
+    echo "tase-sim did not start: $(cat "$dir/sim.log")"
+    exit 1
+}
+
+# last_angle: the last GIMBAL_ANGLE line of a short monitor run
+last_angle() { "$TASE" monitor "${L[@]}" --json --count 40 2>/dev/null | grep '"GIMBAL_ANGLE"' | tail -1; }
+# sim_says PATTERN: how many lines of the simulator's log match
+sim_says() { grep -c -- "$1" "$dir/sim.log"; }
+
+L=(--serial "$dir/gimbal")
+start_sim
+
+# ---- version query ----
+v=$("$TASE" query SYSTEM_VERSION "${L[@]}" --json)
+check "query SYSTEM_VERSION answers with the version and cameras" \
+    grep -q '"name":"SYSTEM_VERSION","size":42,"fields":{"major":2,"minor":5,.*"camera_a":68,' <<<"$v"
+
+# ---- setup echo and persistence ----
+# tase-sim's 57600-baud link is PACKET_RATE's port 2 (PROTOCOL-NOTES A2)
+e=$("$TASE" send PACKET_RATE angle_2=20 rate_2=5 geo_ref_2=2 "${L[@]}" --json | grep '"dir":"out"')
+check "send PACKET_RATE prints the gimbal's echo" \
+    test "$(json_int "$e" angle_2)/$(json_int "$e" rate_2)/$(json_int "$e" geo_ref_2)" = 20/5/2
+q=$("$TASE" query PACKET_RATE "${L[@]}" --json)
+check "PACKET_RATE persists (query after set)" test "$(json_int "$q" angle_2)" = 20
+# temporary left out is 1 (not written to non-volatile storage), and says so
+out=$("$TASE" send PACKET_RATE angle_1=20 "${L[@]}")
+check "send PACKET_RATE without temporary: sent temporary=1, the output says it is not stored" \
+    eval 'grep -q "^sent PACKET_RATE .* temporary=1$" <<<"$out" &&
+          grep -q "temporary=1 (the default): not written to the gimbal.s non-volatile storage" <<<"$out" &&
+          sleep 0.1 && [ "$(sim_says "PACKET_RATE: .* (temporary)$")" = 2 ]'
+out=$("$TASE" send PACKET_RATE angle_1=20 temporary=0 "${L[@]}")
+check "send PACKET_RATE temporary=0: sent as asked, to be stored" \
+    eval 'grep -q "^sent PACKET_RATE .* temporary=0$" <<<"$out" && ! grep -q "the default" <<<"$out" &&
+          sleep 0.1 && [ "$(sim_says "PACKET_RATE: .* (a gimbal would store it in non-volatile memory)$")" = 1 ]' 
+check "read-modify-write kept the other ports' rates" test "$(json_int "$q" angle_3)" = 10
+t0=$(date +%s)
+mon=$("$TASE" monitor "${L[@]}" --json --time --units --seconds 2 2>"$dir/mon.err")
+na=$(grep -c '"name":"GIMBAL_ANGLE"' <<<"$mon")
+nr=$(grep -c '"name":"GIMBAL_RATE"' <<<"$mon")
+check "telemetry follows PACKET_RATE (2 s: $na angle ~40, $nr rate ~10)" \
+    eval 'near $na 40 10 && near $nr 10 4'
+first=$(grep -m1 '"GIMBAL_ANGLE"' <<<"$mon")
+check "monitor --time: host time of arrival in \"time\" ($first)" \
+    eval 'near "$(json_int "$first" time)" "$t0" 3'
+check "monitor --units: engineering units beside the raw fields" \
+    grep -q '"fields":{"pan":[-0-9]*,"tilt":[-0-9]*,"roll":0},"units":{"pan_deg":[-0-9.]*,"tilt_deg"' <<<"$mon"
+check "monitor prints a summary on exit ($(cat "$dir/mon.err"))" \
+    grep -q "^tase: summary: $((na + nr + $(grep -c GEOREFERENCE <<<"$mon"))) frames (0 unknown, 0 wrong length), 0 checksum errors" "$dir/mon.err"
+
+# ---- pan/tilt position command: the verb, and send without a mode ----
+out=$("$TASE" point 30 -15 "${L[@]}")
+check "tase point prints what it sent (flags 0xA0: position, stabilised)" \
+    grep -q "^sent GIMBAL_CMD pan=3000 tilt=-1500 roll=0 flags=160 impulse_time=0" <<<"$out"
+sleep 2.5
+last=$(last_angle)
+check "tase point moves the gimbal to 30/-15 deg ($last)" \
+    eval 'near "$(json_int "$last" pan)" 3000 2 && near "$(json_int "$last" tilt)" -1500 2'
+rate=$("$TASE" monitor "${L[@]}" --json --count 40 2>/dev/null | grep '"GIMBAL_RATE"' | tail -1)
+mode=$(json_int "$rate" mode)
+check "GIMBAL_RATE mode: stabilised, deployed, position ($mode)" test "$mode" = $((128 + 64 + 1))
+n=$(sim_says GIMBAL_CMD)
+expect_error "send GIMBAL_CMD without flags refused, with the modes" 2 "needs flags.*0xA0 position" \
+    "$TASE" send GIMBAL_CMD pan=4500 tilt=-2000 "${L[@]}"
+sleep 0.3
+last=$(last_angle)
+check "... and nothing reached the gimbal: it stays at 30/-15 ($last)" \
+    eval '[ "$(sim_says GIMBAL_CMD)" = "$n" ] && near "$(json_int "$last" pan)" 3000 2'
+
+# ---- issue 27: four bytes of noise (00 FF 5A FF, a false sync claiming
+# 257 more bytes) must not make the link deaf: the gimbal's receiver judges
+# the held candidate false once the line has been quiet for its limit ----
+noise() {
+    python3 -c 'import os, sys
+fd = os.open(sys.argv[1], os.O_WRONLY | os.O_NOCTTY)
+os.write(fd, bytes([0x00, 0xFF, 0x5A, 0xFF]))
+os.close(fd)' "$dir/gimbal"
+}
+ms() { date +%s%3N; }
+noise
+t0=$(ms)
+v=$("$TASE" query SYSTEM_VERSION "${L[@]}" --json --retries 0 2>&1)
+rc=$?
+t1=$(ms)
+check "after noise a query is answered within 100 ms at 57600 baud (exit $rc, $((t1 - t0)) ms)" \
+    eval '[ $rc = 0 ] && [ $((t1 - t0)) -le $((100 * slow)) ] && grep -q "\"SYSTEM_VERSION\"" <<<"$v"'
+bad_q=0
+for _ in 1 2 3; do
+    quiet "$TASE" query PACKET_RATE "${L[@]}" --retries 0 || bad_q=$((bad_q + 1))
+done
+check "... and so are the next queries ($bad_q of 3 failed)" test $bad_q = 0
+n=$(sim_says "GIMBAL_CMD: position pan 30.00 tilt -15.00")
+noise
+quiet "$TASE" point 30 -15 "${L[@]}"
+sleep "$(awk "BEGIN { print 0.1 * $slow }")"
+check "after noise tase point is carried out within 100 ms, not when 257 more bytes came" \
+    test "$(sim_says "GIMBAL_CMD: position pan 30.00 tilt -15.00")" = $((n + 1))
+
+# SPOI error forms outside SPOI mode change nothing: the log says so (that
+# the model's state is unchanged is tests/test_sim_model.c's).
+quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xC0 impulse_time=0 "${L[@]}"
+quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xD0 impulse_time=0 "${L[@]}"
+sleep 0.3
+check "tase-sim logs SPOI error GIMBAL_CMDs as ignored, the mode kept ($(grep 'SPOI error' "$dir/sim.log" | head -1 | cut -c12-))" \
+    eval '[ "$(sim_says "GIMBAL_CMD: SPOI error (flags 0xC0, pan 1.00 tilt 2.00) ignored: not in SPOI mode; still in position mode, stabilised")" = 1 ] &&
+          [ "$(sim_says "GIMBAL_CMD: SPOI error rate (flags 0xD0, pan 1.00 tilt 2.00) ignored")" = 1 ] &&
+          [ "$(sim_says "GIMBAL_CMD: .* pan 1.00 tilt 2.00, stabilised$")" = 0 ]'
+
+# A command whose output cannot be written was still sent: the status (5)
+# and the message say so, so a script does not send it again.
+n=$(sim_says GIMBAL_CMD)
+expect_error "point > /dev/full: exit 5, the message says GIMBAL_CMD was sent" 5 \
+    "GIMBAL_CMD was sent; cannot write to standard output: No space left on device" \
+    sh -c 'exec "$0" point 30 -15 --serial "$1" >/dev/full' "$TASE" "$dir/gimbal"
+expect_error "point into a closed pipe: exit 5 (not a quiet 141), GIMBAL_CMD was sent" 5 \
+    "GIMBAL_CMD was sent; cannot write to standard output: Broken pipe" \
+    python3 -c 'import os,subprocess,sys; r,w=os.pipe(); os.close(r); sys.exit(subprocess.call(sys.argv[1:], stdout=w))' \
+    "$TASE" point 30 -15 "${L[@]}"
+sleep 0.2
+check "... and both reached the gimbal" test "$(sim_says GIMBAL_CMD)" = $((n + 2))
+
+# ---- numbers as typed, sent packets printed ----
+s1=$("$TASE" send HOST_SENSOR roll=010 pitch=+5 yaw=-0x10 --zero "${L[@]}" --json)
+check "send --json prints a packet without echo; 010 is ten, +5 five, -0x10 -16 ($s1)" \
+    grep -q '"dir":"in",.*"name":"HOST_SENSOR",.*"fields":{"time":0,"roll":10,"pitch":5,"yaw":-16,' <<<"$s1"
+
+# ---- no-go zone: a rate command stops at its edge ----
+quiet "$TASE" send AXIS_SETTING pan_nogo_center=6000 pan_nogo_range=2000 "${L[@]}"
+out=$("$TASE" rate 50 0 --stab off "${L[@]}")
+check "tase rate prints what it sent (flags 0x10: rate, not stabilised)" \
+    grep -q "^sent GIMBAL_CMD pan=5000 tilt=0 roll=0 flags=16 " <<<"$out"
+sleep 1.5
+last=$(last_angle)
+check "rate command stops at the pan no-go edge 50 deg ($last)" \
+    near "$(json_int "$last" pan)" 5000 2
+ax=$("$TASE" query AXIS_SETTING "${L[@]}" --json)
+check "AXIS_SETTING fields left out kept their values (tilt no-go 90/60)" \
+    test "$(json_int "$ax" tilt_nogo_center)/$(json_int "$ax" tilt_nogo_range)" = 9000/6000
+
+# ---- a setting the gimbal refuses is not success ----
+expect_error "AXIS_SETTING pan_max_rate=0: echo differs, exit 3 names the field" 3 \
+    "AXIS_SETTING not applied as sent: pan_max_rate sent 0, gimbal has 60" \
+    "$TASE" send AXIS_SETTING pan_max_rate=0 "${L[@]}"
+
+# ---- SPOI: host at 0/0, 100 m up, heading north; target 100 m east on the ground ----
+# (each step is checked, so a failure names its cause, not just the angle)
+# Commands nobody echoes go back to back, with no pause: the next program's
+# open must not drop what the last one left for the simulator to read.
+# the host's data is used only where NAV_SOURCE selects it (spec 4.4.5)
+check "NAV_SOURCE: host attitude and GPS" \
+    quiet "$TASE" send NAV_SOURCE external_attitude=1 external_gps=1 "${L[@]}"
+check "HOST_GPS_DATA sent" quiet "$TASE" send HOST_GPS_DATA lat=0 lon=0 height=10000 valid=1 --zero "${L[@]}"
+check "HOST_ATTITUDE sent" quiet "$TASE" send HOST_ATTITUDE roll=0 pitch=0 yaw=0 --zero "${L[@]}"
+check "AXIS_SETTING pan no-go range 0 echoed" quiet "$TASE" send AXIS_SETTING pan_nogo_range=0 "${L[@]}"
+# 100 m east at the equator (WGS-84 a = 6378137 m) = 0.00089832 deg = 3233.9 mas
+out=$("$TASE" spoi 0 0.0008983 0 "${L[@]}")
+check "tase spoi sends the position in milli-arcseconds and cm, echoed ($(head -1 <<<"$out"))" \
+    grep -q "^sent SPOI_CMD lat=0 lon=3234 height=0 vnorth=0 veast=0 vdown=0 flags=128" <<<"$out"
+sleep 2
+last=$(last_angle)
+check "SPOI points at 90 deg pan, -45 deg tilt ($last)" \
+    eval 'near "$(json_int "$last" pan)" 9000 3 && near "$(json_int "$last" tilt)" -4500 3'
+sq=$("$TASE" query SPOI_CMD "${L[@]}" --json)
+check "SPOI_CMD query returns the SPOI ($sq)" test "$(json_int "$sq" lon)" = 3234
+
+# ---- retract/deploy: echoed when the move completes ----
+out=$("$TASE" retract "${L[@]}" --wait 4)
+check "tase retract --wait: sent, then the echo when the move completed" \
+    eval '[ "$(grep -c "RETRACT_DEPLOY_CMD deploy=0" <<<"$out")" = 2 ]'
+check "tase gyro-zero reaches the gimbal" \
+    eval '"$TASE" gyro-zero "${L[@]}" | grep -q "^sent GYRO_ZERO_CMD" && sleep 0.1 && [ "$(sim_says GYRO_ZERO)" = 1 ]'
+# Twenty programs back to back, each writing a command nobody answers and
+# exiting at once: the next one's open must not drop what the last one
+# left queued for the simulator (opening a port discards input only).
+for i in $(seq 20); do quiet "$TASE" gyro-zero "${L[@]}"; done
+sleep 0.3
+check "20 back-to-back gyro-zero commands from 20 programs all reach the gimbal" \
+    test "$(sim_says GYRO_ZERO)" = 21
+
+# ---- camera: select, field of view ----
+quiet "$TASE" camera A --hfov 10 "${L[@]}"
+geo=$("$TASE" monitor "${L[@]}" --json --seconds 1.2 2>/dev/null | grep '"GEOREFERENCE_DATA"' | tail -1)
+check "tase camera A --hfov 10 shows in GEOREFERENCE_DATA" test "$(json_int "$geo" hfov)" = 1000
+n=$(sim_says CAMERA_CMD)
+expect_error "tase camera C on a gimbal without camera C: refused (SYSTEM_VERSION says none), nothing sent" 1 \
+    "the gimbal has no camera C (SYSTEM_VERSION: type 0xFF, none); CAMERA_CMD was not sent" \
+    "$TASE" camera C "${L[@]}"
+out=$("$TASE" camera B "${L[@]}")
+check "... and camera B, which it has, is selected ($out)" \
+    eval 'grep -q "= camera B selected (type 97 in SYSTEM_VERSION)" <<<"$out" && sleep 0.1 &&
+          [ "$(sim_says CAMERA_CMD)" = $((n + 1)) ]' 
+out=$("$TASE" send CAMERA_CMD hfov=1500 "${L[@]}" --json 2>&1)
+check "send CAMERA_CMD hfov=1500: the fields left out go as \"do not change\" ($out)" \
+    grep -q '"fields":{"camera":255,"hfov":1500,"focus":65535,"exposure":255,"shutter_speed":255,"bright":255,"flags":128}' <<<"$out"
+geo=$("$TASE" monitor "${L[@]}" --json --seconds 1.2 2>/dev/null | grep '"GEOREFERENCE_DATA"' | tail -1)
+check "... and the gimbal stays on camera B ($(json_int "$geo" camera))" \
+    test "$(json_int "$geo" camera)" = 1
+
+# ---- KLV output ----
+timeout 2.5 cat "$dir/klv" >"$dir/klv.bin" 2>/dev/null
+k=$("$TASE" klv "$dir/klv.bin")
+nk=$(grep -c '"fields":{"utc"' <<<"$k")
+check "KLV output: $nk packets in 2.5 s (about one per 900 ms)" eval '[ $nk -ge 2 ] && [ $nk -le 4 ]'
+check "KLV packet carries the simulated pan (90 deg = raw 16384)" \
+    grep -q '"pan":1638[3-5],' <<<"$k"
+
+# ---- monitor on a line that carries no TASE frame (the KLV pty) ----
+"$TASE" monitor --serial "$dir/klv" --seconds 1.2 >"$dir/out" 2>"$dir/mon.err"
+rc=$?
+check "monitor of bytes without a frame: exit $rc, the summary and a hint ($(tr '\n' '|' <"$dir/mon.err"))" \
+    eval '[ $rc = 4 ] && [ ! -s "$dir/out" ] && [ "$(grep -vc "^==" "$dir/mon.err")" = 2 ] &&
+          grep -q "^tase: summary: 0 frames .* of [1-9][0-9]* bytes discarded" "$dir/mon.err" &&
+          grep -q "^tase: no TASE frame in the [1-9][0-9]* bytes received on .*klv: a wrong --baud (57600), or not the gimbal.s datalink port (its KLV line?)$" "$dir/mon.err"'
+
+# ---- human-readable monitor ----
+t=$("$TASE" monitor "${L[@]}" --count 3 --units 2>/dev/null)
+check "monitor prints readable lines with units" grep -q '^GIMBAL_ANGLE pan=[-0-9]* ([-0-9.]* deg) ' <<<"$t"
+
+# ---- output errors ----
+expect_error "monitor > /dev/full" 1 "cannot write to standard output" \
+    sh -c 'exec "$0" monitor --serial "$1" --count 3 >/dev/full' "$TASE" "$dir/gimbal"
+expect_error "query > /dev/full" 1 "cannot write to standard output" \
+    sh -c 'exec "$0" query SYSTEM_VERSION --serial "$1" >/dev/full' "$TASE" "$dir/gimbal"
+
+# ---- telemetry never asks more than the link carries ----
+quiet "$TASE" send PACKET_RATE angle_2=255 rate_2=255 geo_ref_2=255 "${L[@]}"
+mon=$("$TASE" monitor "${L[@]}" --json --seconds 2 2>"$dir/mon.err")
+na=$(grep -c '"name":"GIMBAL_ANGLE"' <<<"$mon")
+bytes=$(sed -n 's/.* of \([0-9]*\) bytes discarded.*/\1/p' "$dir/mon.err")
+check "PACKET_RATE 255/255/255 on a 57600-baud link: $na GIMBAL_ANGLE and $bytes bytes in 2 s (at most 2 x 5760)" \
+    eval '[ "$na" -gt 20 ] && [ "$na" -lt 300 ] && [ "$bytes" -le 11520 ]'
+quiet "$TASE" send PACKET_RATE angle_2=20 rate_2=5 geo_ref_2=2 "${L[@]}"
+
+# ---- the device is left as found and held exclusively; signals ----
+stty -F "$dir/gimbal" 9600 min 1 time 5
+before=$(stty -F "$dir/gimbal" -g)
+quiet "$TASE" query SYSTEM_VERSION "${L[@]}"
+check "tase query leaves the device's termios as it found them (9600 baud, VMIN 1, VTIME 5)" \
+    test "$(stty -F "$dir/gimbal" -g)" = "$before"
+n=$(timeout 3 head -c 100 "$dir/gimbal" | wc -c)
+check "cat of the device after tase still reads the telemetry ($n of 100 bytes)" test "$n" = 100
+"$TASE" monitor "${L[@]}" >/dev/null 2>"$dir/sig.err" &
+mpid=$!
+sleep "$settle"
+expect_error "a second program on the device gets the busy error" 1 \
+    "cannot open serial device .*gimbal: device busy: in use by another program" \
+    "$TASE" query SYSTEM_VERSION "${L[@]}"
+kill -TERM $mpid
+wait $mpid
+rc=$?
+check "monitor stops on SIGTERM with exit 0 and its summary (exit $rc)" \
+    eval '[ $rc = 0 ] && grep -q "^tase: summary: [1-9][0-9]* frames" "$dir/sig.err"'
+check "... and gives the device back as found" test "$(stty -F "$dir/gimbal" -g)" = "$before"
+"$TASE" monitor "${L[@]}" >/dev/null 2>&1 &
+mpid=$!
+sleep "$settle"
+kill -HUP $mpid
+wait $mpid
+rc=$?
+check "monitor on SIGHUP (its terminal closed): exit $rc, device as found" \
+    eval '[ $rc = 0 ] && [ "$(stty -F "$dir/gimbal" -g)" = "$before" ]'
+
+# ---- timeout: a gimbal that does not answer ----
+kill -STOP "$sim_pid"
+expect_error "query timeout" 1 "timeout: no answer to PACKET_RATE after 2 attempts" \
+    "$TASE" query PACKET_RATE "${L[@]}" --timeout 100 --retries 1
+expect_error "send timeout on its query: says the setting was not sent" 1 \
+    "timeout: no answer to PACKET_RATE after 2 attempts of 100 ms (only the query went out, to read the gimbal's settings; the new setting was not sent)$" \
+    "$TASE" send PACKET_RATE angle_1=5 "${L[@]}" --timeout 100 --retries 1
+"$TASE" query PACKET_RATE "${L[@]}" --timeout 20000 >/dev/null 2>"$dir/sig.err" &
+qpid=$!
+sleep "$settle"
+t1=$(date +%s%N)
+kill -INT $qpid
+wait $qpid
+rc=$?
+t2=$(date +%s%N)
+check "a waiting query stops on SIGINT at once: exit 130 in $(((t2 - t1) / 1000000)) ms ($(cat "$dir/sig.err"))" \
+    eval '[ $rc = 130 ] && [ $(((t2 - t1) / 1000000)) -lt $((500 * slow)) ] && grep -q "interrupted by SIGINT" "$dir/sig.err"'
+check "... and gives the device back as found" test "$(stty -F "$dir/gimbal" -g)" = "$before"
+t1=$(date +%s%N)
+out=$("$TASE" send PACKET_RATE angle_1=20 rate_1=5 geo_ref_1=2 camera_1=0 angle_2=10 rate_2=10 \
+    geo_ref_2=4 camera_2=0 angle_3=10 rate_3=10 geo_ref_3=4 camera_3=0 temporary=1 \
+    --no-wait "${L[@]}" 2>&1)
+rc=$?
+t2=$(date +%s%N)
+check "--no-wait waits for nothing, setup packets included (exit $rc in $(((t2 - t1) / 1000000)) ms)" \
+    eval '[ $rc = 0 ] && [ $(((t2 - t1) / 1000000)) -lt $((400 * slow)) ]'
+kill -CONT "$sim_pid"
+
+# ---- the simulator's links ----
+expect_error "a second tase-sim on a live link is refused, naming the owner" 1 \
+    "gimbal is the link of a running tase-sim (pid $sim_pid)" \
+    "$SIM" --link "$dir/gimbal" --seconds 1
+check "... and the link still leads to the first simulator" \
+    eval '"$TASE" query SYSTEM_VERSION "${L[@]}" >/dev/null'
+expect_error "--klv-link equal to --link refused" 2 "--klv-link must differ from --link" \
+    "$SIM" --link "$dir/x" --klv-link "$dir/./x" --seconds 1
+"$SIM" --link "$dir/hup" --klv-link "$dir/hupk" --seconds 30 >"$dir/hup.log" 2>&1 &
+hpid=$!
+for _ in $(seq 100); do [ -L "$dir/hupk" ] && break; sleep 0.05; done
+kill -HUP $hpid
+wait $hpid
+rc=$?
+check "tase-sim cleans up on SIGHUP: exit $rc, both links removed" \
+    eval '[ $rc = 0 ] && [ ! -e "$dir/hup" ] && [ ! -L "$dir/hup" ] && [ ! -L "$dir/hupk" ]'
+"$SIM" --link "$dir/own" --seconds 30 >"$dir/own.log" 2>&1 &
+opid=$!
+for _ in $(seq 100); do [ -L "$dir/own" ] && break; sleep 0.05; done
+ln -sfn /dev/null "$dir/own"
+kill -TERM $opid
+wait $opid
+check "tase-sim removes only its own links (a link repointed meanwhile stays)" \
+    eval '[ "$(readlink "$dir/own")" = /dev/null ]'
+
+# A user's own symlink at --link is never taken over (nor deleted at exit);
+# a stale link of a killed simulator (into /dev/pts/, unclaimed) is replaced.
+ln -s /dev/null "$dir/users"
+expect_error "tase-sim --link over a user's symlink: refused, naming its target" 1 \
+    "users is a symlink to /dev/null, not a link left by tase-sim" \
+    "$SIM" --link "$dir/users" --seconds 1
+check "... and the user's symlink is untouched" test "$(readlink "$dir/users")" = /dev/null
+"$SIM" --quiet --link "$dir/stale" --seconds 30 >/dev/null 2>&1 &
+kpid=$!
+for _ in $(seq 100); do [ -L "$dir/stale" ] && break; sleep 0.05; done
+kill -KILL $kpid
+wait $kpid 2>/dev/null
+old=$(readlink "$dir/stale")
+"$SIM" --link "$dir/stale" --seconds 30 >"$dir/stale.log" 2>&1 &
+kpid=$!
+for _ in $(seq 100); do grep -q -e "simulated gimbal" -e "tase-sim:" "$dir/stale.log" && break; sleep 0.05; done
+check "a killed simulator's stale link ($old) is replaced by the next one ($(head -1 "$dir/stale.log"))" \
+    eval 'grep -q "simulated gimbal on .*(link .*stale)" "$dir/stale.log" &&
+          "$TASE" query SYSTEM_VERSION --serial "$dir/stale" >/dev/null'
+kill $kpid
+wait $kpid
+
+# ---- the device goes away (the simulator exits): said so, never a bare I/O error ----
+# hang_up [--frozen] TASE-ARGS...: tase ARGS on a simulator of its own,
+# which exits while tase runs (--frozen: it never answers, stopped from the
+# start, then killed); sets rc to tase's status, its stderr in $dir/hang.err
+hang_up() {
+    local dpid tpid frozen=""
+    [ "$1" = --frozen ] && frozen=1 && shift
+    "$SIM" --quiet --link "$dir/dying" --seconds 60 >/dev/null 2>&1 &
+    dpid=$!
+    for _ in $(seq 100); do [ -L "$dir/dying" ] && break; sleep 0.05; done
+    [ -n "$frozen" ] && kill -STOP $dpid
+    "$TASE" "$@" --serial "$dir/dying" >/dev/null 2>"$dir/hang.err" &
+    tpid=$!
+    sleep "$settle"
+    kill ${frozen:+-KILL} $dpid
+    wait $dpid 2>/dev/null
+    wait $tpid
+    rc=$?
+}
+hang_up monitor
+check "monitor when the device hangs up: exit $rc, its summary, then why ($(tr '\n' '|' <"$dir/hang.err"))" \
+    eval '[ $rc = 1 ] && [ "$(grep -vc "^==" "$dir/hang.err")" = 2 ] &&
+          grep -q "^tase: summary: [1-9][0-9]* frames" "$dir/hang.err" &&
+          grep -q "^tase: cannot read .*dying: the device went away or hung up$" "$dir/hang.err"'
+# (frozen, so that the move's echo cannot end the wait first however slow
+# the run; the killed simulator's stale link is replaced by the next one)
+hang_up --frozen retract --wait 30
+check "retract --wait when the device hangs up: exit $rc, why, and that the command went out ($(cat "$dir/hang.err"))" \
+    eval '[ $rc = 1 ] && grep -q "^tase: cannot read .*dying: the device went away or hung up (RETRACT_DEPLOY_CMD was sent)$" "$dir/hang.err"'
+
+# ---- error paths ----
+expect_error "no command" 2 "no command" "$TASE"
+expect_error "unknown command" 2 "unknown command 'frobnicate'" "$TASE" frobnicate
+expect_error "missing device" 1 "cannot open serial device /nonexistent/tty" \
+    "$TASE" query SYSTEM_VERSION --serial /nonexistent/tty
+expect_error "monitor missing device" 1 "cannot open serial device" \
+    "$TASE" monitor --serial /nonexistent/tty
+expect_error "not a tty" 1 "cannot open serial device /dev/null: not a terminal" \
+    "$TASE" query SYSTEM_VERSION --serial /dev/null
+expect_error "no link" 2 "no link given" "$TASE" query SYSTEM_VERSION
+expect_error "both links" 2 "either --serial or --can" \
+    "$TASE" monitor --serial "$dir/gimbal" --can can0
+expect_error "unknown packet" 2 "unknown packet name 'GIMBAL_FOO'" \
+    "$TASE" send GIMBAL_FOO "${L[@]}"
+expect_error "unknown field" 2 "GIMBAL_CMD has no field 'yaw'" \
+    "$TASE" send GIMBAL_CMD yaw=3 "${L[@]}"
+expect_error "value out of range" 2 "bad value '40000' for GIMBAL_CMD.pan: out of range -32768..32767" \
+    "$TASE" send GIMBAL_CMD pan=40000 "${L[@]}"
+expect_error "not a number" 2 "bad value 'ten'" "$TASE" send GIMBAL_CMD pan=ten "${L[@]}"
+expect_error "out packet" 2 "GIMBAL_ANGLE is sent by the gimbal" \
+    "$TASE" send GIMBAL_ANGLE pan=1 "${L[@]}"
+expect_error "query of a command" 2 "GIMBAL_CMD has no zero-length query" \
+    "$TASE" query GIMBAL_CMD "${L[@]}"
+expect_error "unknown option" 2 "unknown option '--bogus'" "$TASE" monitor --bogus
+expect_error "missing option value" 2 "option --baud needs a value" \
+    "$TASE" monitor --serial "$dir/gimbal" --baud
+expect_error "bad baud" 2 "unsupported baud rate 12345" \
+    "$TASE" monitor --serial "$dir/gimbal" --baud 12345
+expect_error "bad count" 2 "bad --count value" "$TASE" monitor "${L[@]}" --count 0
+expect_error "bad length" 2 "does not accept a data length of 3" \
+    "$TASE" send CAMERA_CMD --len 3 "${L[@]}"
+expect_error "missing capture" 1 "cannot open /nonexistent.bin" "$TASE" decode /nonexistent.bin
+expect_error "missing KLV capture" 1 "cannot open /nonexistent.klv" "$TASE" klv /nonexistent.klv
+expect_error "sim bad argument" 2 "unknown argument '--bogus'" "$SIM" --bogus
+expect_error "sim symlink over a file" 1 "exists and is not a symlink" \
+    "$SIM" --link "$dir/sim.log" --seconds 1
+
+# ---- --help on every command ----
+for c in point rate camera gyro-zero deploy retract spoi monitor send query decode klv list; do
+    check "tase $c --help" eval '"$TASE" $c --help | grep -qE "^usage: tase ([a-z-]+[|])?$c([ |]|\$)"'
+done
+check "tase --help" eval '"$TASE" --help | grep -q "^usage: tase <command>"'
+check "tase-sim --help" eval '"$SIM" --help | grep -q "^usage: tase-sim"'
+
+echo "$fails failure(s)"
+[ $fails -eq 0 ]
