@@ -156,13 +156,18 @@ os.write(fd, bytes([0x00, 0xFF, 0x5A, 0xFF]))
 os.close(fd)' "$dir/gimbal"
 }
 ms() { date +%s%3N; }
+# The same query on a clean line first: what the tool itself takes (start-up,
+# open, the exchange; about 1 s under memcheck) is not the noise's delay.
+t0=$(ms)
+quiet "$TASE" query SYSTEM_VERSION "${L[@]}" --json --retries 0
+base=$(($(ms) - t0))
 noise
 t0=$(ms)
 v=$("$TASE" query SYSTEM_VERSION "${L[@]}" --json --retries 0 2>&1)
 rc=$?
 t1=$(ms)
-check "after noise a query is answered within 100 ms at 57600 baud (exit $rc, $((t1 - t0)) ms)" \
-    eval '[ $rc = 0 ] && [ $((t1 - t0)) -le $((100 * slow)) ] && grep -q "\"SYSTEM_VERSION\"" <<<"$v"'
+check "after noise a query is answered within 100 ms at 57600 baud (exit $rc, $((t1 - t0)) ms, $base ms on a clean line)" \
+    eval '[ $rc = 0 ] && [ $((t1 - t0 - base)) -le $((100 * slow)) ] && grep -q "\"SYSTEM_VERSION\"" <<<"$v"'
 bad_q=0
 for _ in 1 2 3; do
     quiet "$TASE" query PACKET_RATE "${L[@]}" --retries 0 || bad_q=$((bad_q + 1))
