@@ -640,7 +640,7 @@ def main():
             cols.append(str(worst_stack(fn, own, edges, names, memo)[0]) if fn in own else "-")
         d, chain, ext = worst_stack(fn, own4, edges4, names4, memo4)
         ext = sorted(e.replace("__indirect_call", "callback") for e in ext)
-        mark = " (encoder)" if "encode" in fn else ""
+        mark = " (encoder)" if "encode" in fn or fn == "tase_frame_build" else ""
         p("| `%s`%s | %s | %s | %s |" % (fn, mark, " | ".join(cols), " > ".join(chain),
                                         ", ".join(ext) or "-"))
     p("")

@@ -1599,8 +1599,7 @@ static void frames_are_handled_after_the_receiver_returns_in_stream_order(void *
 }
 
 /* Echoes are written after the receiver returns: every setup frame of a
- * long buffer gets its own, none is lost (the count per type would wrap
- * at 256 in one piece; pieces of 64 bytes keep it far below). */
+ * long buffer gets its own, none is lost, each in the layout asked for. */
 static void every_setup_in_a_long_buffer_gets_its_echo(void **state)
 {
     fix_t *x = make(0, 3, false);

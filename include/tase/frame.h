@@ -174,8 +174,11 @@ extern "C" {
  * not part of any link name, and an application may set it differently
  * from its library. */
 
-/* A received frame. `data` points into the receiver's window or into the
- * caller's input buffer and is valid only until the callback returns. */
+/* A received frame, passed to the callback. The struct itself lives only
+ * while the callback runs (copy it to keep it); `data` points into the
+ * receiver's window or into the caller's input buffer and is valid until
+ * the callback returns, or, after tase_rx_stop(), until the next call on
+ * the receiver. */
 typedef struct {
     /* Stream offset of the first sync byte, counted like stats.bytes_in:
      * from tase_rx_init() or the last tase_rx_stats_reset(), modulo 2^32. */
@@ -292,6 +295,9 @@ int tase_rx_init(tase_rx_t *rx);
  *              (held length, held candidate's end and Size disagree);
  *   TASE_EBUSY called from inside a callback of this receiver;
  * and then nothing is consumed and rx is unchanged.
+ * All n bytes are taken in unless the callback stopped the call
+ * (tase_rx_stop()) or re-initialised rx: stats.bytes_in then says how
+ * many were.
  * Feeding a stream one byte at a time or in any split gives the same
  * frames, offsets, counters and moments of delivery. Feeding 0 bytes
  * continues a lagging scan. Cost O(n): per byte taken in, at most a fixed
@@ -305,7 +311,9 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
  * byte inside a frame is only stored, and a frame's sync, Size and last
  * byte are handled here too, so a clean stream never takes the general
  * path. Returns the number of frames delivered (0 or 1 on a clean stream;
- * a few more while a lagging scan releases frames), or TASE_EARG (rx NULL
+ * a few more while a lagging scan releases frames; the byte is not taken
+ * in if a callback stopped the call before room was made for it:
+ * stats.bytes_in says), or TASE_EARG (rx NULL
  * or visibly corrupted) / TASE_EBUSY (inside a callback of this
  * receiver), receiver unchanged. Longest block: one byte's budget of scan
  * work plus one compaction of the window and the callbacks of the frames
@@ -364,16 +372,31 @@ uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms);
 
 /* From inside rx's frame callback: end the call that delivers this frame
  * as soon as the callback returns. That call returns the frames it
- * delivered (this one the last); the frame's bytes stay where frame->data
- * points until the next call on rx, so the caller can handle it there,
- * with the receiver's stack unwound (the gimbal role does). Input the call
- * had not taken in is not consumed: stats.bytes_in counts what was (it
- * grows by exactly the bytes taken), the caller feeds the rest again. A
- * scan the call had not finished goes on in the next call on rx, as a
- * lagging scan does (a 0-byte tase_rx_feed(), tase_rx_tick() or
- * tase_rx_flush() included; a stopped flush or settling tick is repeated
- * until it returns 0). Frames, their order and offsets are the same as
- * without stops. TASE_RX_LATE_MAX holds when every stop is followed by a
+ * delivered (this one the last). Copy *frame in the callback (the struct
+ * is the receiver's local); the bytes at frame->data stay valid until the
+ * next call on rx, so the caller can handle the frame there, with the
+ * receiver's stack unwound (the gimbal role does). Input the call had not
+ * taken in is not consumed: stats.bytes_in counts what was (it grows by
+ * exactly the bytes taken, unless the callback also reset the counters),
+ * the caller feeds the rest again. A scan the call had not finished goes
+ * on in the next call on rx, as a lagging scan does (a 0-byte
+ * tase_rx_feed(), tase_rx_tick() or tase_rx_flush() included); that call
+ * may stop on a frame too, so a caller repeats it while its callback
+ * stops (a stopped flush or settling tick likewise, until it returns 0).
+ * Frames, their order and offsets are the same as without stops. A
+ * caller that handles every frame outside the callback (the callback
+ * copies *frame to f and stops; n bytes at p to feed):
+ *     bool stopped = false;
+ *     do {
+ *         uint32_t in = rx.stats.bytes_in;
+ *         f.data = NULL;
+ *         (void)tase_rx_feed(&rx, p, stopped ? 0u : n, cb, &f);
+ *         p += rx.stats.bytes_in - in;
+ *         n -= rx.stats.bytes_in - in;
+ *         stopped = f.data != NULL;
+ *         if (stopped) handle(&f);
+ *     } while (stopped || n > 0u);
+ * (tase_gimbal_feed() in src/tase_gimbal.c is this loop.) TASE_RX_LATE_MAX holds when every stop is followed by a
  * 0-byte tase_rx_feed() before more bytes are fed (each such call brings
  * a byte's budget, more than a stop forfeits).
  * Returns TASE_OK; TASE_ESTATE when no call of rx is running (outside its

@@ -97,8 +97,8 @@
  * PRIORITY AND CAPACITY. Setup echoes, query answers and the
  * application's own sends are written before the call that received the
  * frame returns (tase_gimbal_handle_frame() at once; tase_gimbal_feed()
- * when its receiver has handed over the frames of each 64-byte piece of
- * input, see there; tase_gimbal_service() reads and answers before it
+ * right after each frame, in stream order, see there;
+ * tase_gimbal_service() reads and answers before it
  * polls telemetry), and are never held back. Telemetry is what yields: a
  * link carries only so many bytes per second (9600 baud 8N1: 960 B/s),
  * and PACKET_RATE may ask for far more (255/255/255 is 28,305 B/s). Bytes
