@@ -473,7 +473,7 @@ int tase_gimbal_frame_port(const tase_gimbal_t *g)
 
 /* The receiver's callback inside tase_gimbal_feed(): the frame is noted
  * and the receiver stopped (tase_rx_stop()), so that the frame is handled
- * by rx_round() with the receiver's stack unwound. */
+ * by tase_gimbal_feed() with the receiver's stack unwound. */
 static void gimbal_rx(void *user, const tase_frame_t *frame)
 {
     tase_gimbal_t *g = user;
