@@ -7,7 +7,6 @@ TASE=$1
 SIM=$2
 dir=$(mktemp -d)
 sim_pid=""
-fails=0
 cleanup() {
     [ -n "$sim_pid" ] && kill -CONT "$sim_pid" 2>/dev/null && kill "$sim_pid" 2>/dev/null
     wait 2>/dev/null
@@ -15,32 +14,18 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# Under scripts/checks/valgrind.sh this shell runs natively (system programs
-# are not traced), so the programs are put under memcheck here, through
-# wrappers (an error exits 99 and fails the check); they start slowly, so
-# time limits scale.
+# shellcheck source=tests/tools/check-lib.sh
+. "$(dirname "$0")/check-lib.sh" # ok, bad, check, expect_error, under_valgrind
+
+# Under scripts/checks/valgrind.sh the programs run under memcheck
+# (under_valgrind); they start slowly, so time limits scale.
 slow=1
 settle=0.5 # for a program started in the background to set itself up
 if [ "${TASE_UNDER_VALGRIND:-}" = 1 ]; then
     slow=10
     settle=4
-    for p in TASE SIM; do
-        printf '#!/bin/sh\nexec valgrind -q --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect --show-leak-kinds=definite,indirect "%s" "$@"\n' \
-            "${!p}" >"$dir/vg-$p"
-        chmod +x "$dir/vg-$p"
-        eval "$p=\$dir/vg-\$p"
-    done
 fi
-
-ok() { echo "ok   $*"; }
-bad() { echo "FAIL $*"; fails=$((fails + 1)); }
-
-# check NAME CONDITION-COMMAND...: a named assertion
-check() {
-    local name=$1
-    shift
-    if "$@"; then ok "$name"; else bad "$name"; fi
-}
+under_valgrind TASE SIM
 
 # quiet CMD...: run CMD, its output to the log only
 quiet() { "$@" >>"$dir/quiet.log" 2>&1; }
@@ -50,26 +35,6 @@ json_int() { sed -n "s/.*\"$2\":\(-\{0,1\}[0-9][0-9]*\).*/\1/p" <<<"$1"; }
 
 # near A B TOL: |A - B| <= TOL (integers)
 near() { local d=$(($1 - $2)); [ "${d#-}" -le "$3" ]; }
-
-# expect_error NAME STATUS PATTERN CMD...: CMD exits with STATUS (any
-# non-zero if STATUS is "nz") and prints exactly one line on stderr that
-# matches PATTERN.
-expect_error() {
-    local name=$1 want=$2 pat=$3 rc lines
-    shift 3
-    "$@" >"$dir/out" 2>"$dir/err.all" </dev/null
-    rc=$?
-    # memcheck's own notes (==PID== lines, e.g. on TIOCEXCL) are not ours;
-    # a memory error shows as exit 99
-    grep -v '^==[0-9]*== ' "$dir/err.all" >"$dir/err"
-    lines=$(wc -l <"$dir/err")
-    if { [ "$want" = nz ] && [ $rc -ne 0 ] || [ "$rc" = "$want" ]; } &&
-        [ "$lines" -eq 1 ] && grep -q -- "$pat" "$dir/err"; then
-        ok "$name: exit $rc, $(cat "$dir/err")"
-    else
-        bad "$name: exit $rc, $lines stderr lines: $(head -c 300 "$dir/err")"
-    fi
-}
 
 start_sim() {
     "$SIM" --link "$dir/gimbal" --klv-link "$dir/klv" --seconds 120 >"$dir/sim.log" 2>&1 &
