@@ -523,7 +523,6 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
         stopped = g->pending.data != NULL;
         if (stopped) {
             handle_and_echo(g, port, &g->pending, now_ms);
-            g->pending.data = NULL;
         } else if (tick) {
             return frames;
         } else if (done == n) {
