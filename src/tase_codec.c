@@ -13,20 +13,7 @@
 
 #include <string.h>
 
-/* The member's own type is not known here, only its width: hence void. */
-static uint64_t member_load(const void *src, unsigned w)
-{
-    uint8_t b;
-    uint16_t h;
-    uint32_t x;
-    uint64_t q;
-    switch (w) {
-    case 1: (void)memcpy(&b, src, 1); return b;
-    case 2: (void)memcpy(&h, src, 2); return h;
-    case 4: (void)memcpy(&x, src, 4); return x;
-    default: (void)memcpy(&q, src, 8); return q;
-    }
-}
+#include "tase_codec_private.h"
 
 static void member_store(void *dst, unsigned w, uint64_t v)
 {
@@ -52,7 +39,7 @@ static void pack_fields(tase_field_iter_t *it, const void *msg, uint8_t *body)
         if (!it->within) {
             continue; /* short form: CAMERA_CMD camera byte only */
         }
-        v = member_load((const uint8_t *)msg + it->field->member, w);
+        v = tase_member_load((const uint8_t *)msg + it->field->member, w);
         while (w > 0u) {
             w--;
             body[it->offset + w] = (uint8_t)v;
@@ -115,44 +102,72 @@ static size_t walk_len(size_t len)
     return len > TASE_DATA_MAX ? TASE_DATA_MAX + 1u : len;
 }
 
-/* Every encoder: packet `id` from msg at data length `len`
+/* The walk of packet `id` begun for msg at data length `len`
  * (TASE_FIELD_ITER_TABLE_LEN: the table length, CAMERA_PASS's tail added)
- * into out[header..cap), header 0 for the data only or TASE_FRAME_HEADER
- * to leave room for a frame around it. Returns the data length. */
+ * and checked in codec.h's order: the one call into the schema (the
+ * packet found, the length checked, the walk begun). Returns the data
+ * length or an error. */
+static TASE_INLINE_ int encode_begin(tase_field_iter_t *it, uint16_t id, const void *msg,
+                                     size_t len)
+{
+    const tase_packet_desc_t *p;
+    size_t n = len;
+    int r;
+    p = tase_field_iter_find(it, TASE_ID_GROUP(id), TASE_ID_TYPE(id), len);
+    if (p == NULL) {
+        return TASE_EUNKNOWN;
+    }
+    if (len == TASE_FIELD_ITER_TABLE_LEN) {
+        n = it->len; /* every field lies within it, as within the tail form */
+        if ((p->flags & TASE_LEN_TAIL) != 0u && msg != NULL) {
+            n += ((const tase_camera_pass_t *)msg)->len;
+        }
+    }
+    r = encode_check(it, msg, n);
+    return r != TASE_OK ? r : (int)n;
+}
+
+/* Every encoder: packet `id` from msg at data length `len` (as
+ * encode_begin()) into out[header..cap), header 0 for the data only or
+ * TASE_FRAME_HEADER to leave room for a frame around it. Returns the data
+ * length. */
 static int encode(uint8_t *out, size_t cap, size_t header, uint16_t id, const void *msg, size_t len)
 {
     tase_field_iter_t it;
-    const tase_packet_desc_t *p;
-    size_t n = len;
     size_t overhead = 0u;
-    int r;
+    int n;
     if (out == NULL) {
         return TASE_EARG;
     }
     if (header > 0u) {
         overhead = TASE_FRAME_OVERHEAD;
     }
-    /* The one call into the schema: the packet found, the length checked
-     * and the walk begun. */
-    p = tase_field_iter_find(&it, TASE_ID_GROUP(id), TASE_ID_TYPE(id), len);
-    if (p == NULL) {
-        return TASE_EUNKNOWN;
+    n = encode_begin(&it, id, msg, len);
+    if (n < 0) {
+        return n;
     }
-    if (len == TASE_FIELD_ITER_TABLE_LEN) {
-        n = it.len; /* every field lies within it, as within the tail form */
-        if ((p->flags & TASE_LEN_TAIL) != 0u && msg != NULL) {
-            n += ((const tase_camera_pass_t *)msg)->len;
-        }
-    }
-    r = encode_check(&it, msg, n);
-    if (r != TASE_OK) {
-        return r;
-    }
-    if (cap < n + overhead) {
+    if (cap < (size_t)n + overhead) {
         return TASE_ENOSPC;
     }
-    encode_body(&it, msg, n, out + header);
-    return (int)n;
+    encode_body(&it, msg, (size_t)n, out + header);
+    return n;
+}
+
+int tase_wire_begin(tase_wire_t *w, uint16_t id, const void *msg)
+{
+    tase_field_iter_t it;
+    int n = encode_begin(&it, id, msg, msg != NULL ? TASE_FIELD_ITER_TABLE_LEN : 0u);
+    if (n < 0) {
+        return n;
+    }
+    w->msg = msg;
+    w->field = it.fields; /* the walk at the table length: table offsets */
+    w->nfields = it.count;
+    w->fixed = it.len; /* CAMERA_PASS: its 4, the camera bytes follow */
+    if ((size_t)n < it.len) {
+        w->fixed = (uint8_t)n; /* the zero-length form */
+    }
+    return n;
 }
 
 /* A whole frame around the data encode() wrote: the frame encoder is

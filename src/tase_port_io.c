@@ -8,6 +8,8 @@
 #include "tase/frame.h"
 #include "tase/ids.h"
 
+#include "tase_codec_private.h"
+
 uint32_t tase_port_elapsed_ms(uint32_t now_ms, uint32_t since_ms)
 {
     uint32_t d = now_ms - since_ms;
@@ -20,16 +22,16 @@ typedef struct {
     const tase_port_t *port;
     uint32_t start;  /* now_ms() at the first write */
     uint32_t waited; /* the longest wait seen, ms */
-    unsigned idle;   /* write() calls that took nothing */
-    size_t done;     /* bytes the port took */
+    uint8_t idle;    /* write() calls that took nothing (< TASE_PORT_WRITE_TRIES) */
+    bool done;       /* the port took some of the frame */
     bool clock;
 } wr_t;
 
-static void wr_init(wr_t *w, const tase_port_t *port)
+static TASE_INLINE_ void wr_init(wr_t *w, const tase_port_t *port)
 {
     w->port = port;
     w->idle = 0;
-    w->done = 0;
+    w->done = false;
     w->waited = 0;
     w->start = 0;
     w->clock = port->ops->now_ms != NULL;
@@ -40,7 +42,7 @@ static void wr_init(wr_t *w, const tase_port_t *port)
 
 /* Write data[0..n) as the next piece of the frame; TASE_OK when all of it
  * went, else the result tase_port_write_all() documents. */
-static int wr_put(wr_t *w, const uint8_t *data, size_t n)
+static TASE_INLINE_ int wr_put(wr_t *w, const uint8_t *data, size_t n)
 {
     const tase_port_t *port = w->port;
     size_t off = 0;
@@ -51,7 +53,7 @@ static int wr_put(wr_t *w, const uint8_t *data, size_t n)
                 return TASE_EIO; /* a port claiming more than asked is broken */
             }
             off += (size_t)r;
-            w->done += (size_t)r;
+            w->done = true;
         } else if (r != 0 && r != TASE_EAGAIN && r != TASE_ENOBUFS) {
             return r;
         } else {
@@ -67,7 +69,7 @@ static int wr_put(wr_t *w, const uint8_t *data, size_t n)
             /* The port kept refusing until the deadline: its queue is full.
              * Nothing went out, or part of the frame did (the receiver drops
              * a cut frame by its checksum and finds the next one). */
-            if (w->done == 0) {
+            if (!w->done) {
                 return r < 0 ? r : TASE_EAGAIN;
             }
             return TASE_ENOBUFS;
@@ -96,66 +98,59 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n)
     return r < 0 ? r : (int)n;
 }
 
-/* A frame goes out in pieces of up to STAGE bytes, summed on the way: no
- * frame buffer on the stack. STAGE is a multiple of 8, so a CAN port packs
- * every piece but the last into whole 8-byte frames, as it would the
- * frame in one write. */
-#define STAGE 24u
+/* A frame goes out in pieces of up to STAGE bytes, produced and summed
+ * on the way: no frame or packet buffer on the stack. STAGE is a multiple
+ * of 8, so a CAN port packs every piece but the last into whole 8-byte
+ * frames, as it would the frame in one write. */
+#define STAGE 16u
 
-/* Write the frame of (group, type) whose data is a[0..na) then b[0..nb)
- * (na + nb <= 253, checked by the callers) to port: header, data and
- * checksum staged through STAGE bytes. */
-static int send_pieces(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *a,
-                       size_t na, const uint8_t *b, size_t nb)
+/* Write the frame of (group, type) with `len` data bytes (<= 253, checked
+ * by the callers) to port: the w->fixed bytes of a typed packet (w NULL:
+ * none), then tail[0..len - fixed). The one path of both senders; the
+ * write loop is inlined here, so the port's write() is called from this
+ * frame and nothing deeper (tase_port_send_msg() <= 128 B of stack on
+ * Cortex-M4 -Os, issue 26). */
+static int send_stream(const tase_port_t *port, uint8_t group, uint8_t type, tase_wire_t *w,
+                       const uint8_t *tail, size_t len)
 {
     uint8_t st[STAGE];
-    wr_t w;
-    const uint8_t *src = a;
-    size_t len = na; /* bytes of src */
-    size_t off = 0;  /* of them staged */
-    bool second = false;
-    size_t n = TASE_FRAME_HEADER;
+    wr_t wr;
+    size_t fixed = w != NULL ? w->fixed : 0u;
+    size_t d;
+    size_t n = TASE_FRAME_HEADER; /* bytes staged */
     uint16_t sum;
-    int r;
-
-    st[0] = 0x00u;
-    st[1] = 0xFFu;
-    st[2] = 0x5Au;
-    st[3] = (uint8_t)(na + nb + 2u);
+    st[0] = TASE_SYNC1;
+    st[1] = TASE_SYNC2;
+    st[2] = TASE_SYNC3;
+    st[3] = (uint8_t)(len + 2u);
     st[4] = group;
     st[5] = type;
-    sum = tase_checksum(0u, st, TASE_FRAME_HEADER);
-    wr_init(&w, port);
-    for (;;) {
-        size_t k = len - off;
-        if (k > STAGE - n) {
-            k = STAGE - n;
+    sum = (uint16_t)(TASE_SYNC1 + TASE_SYNC2 + TASE_SYNC3 + len + 2u + group + type);
+    wr_init(&wr, port);
+    for (d = 0; d < len + 2u; d++) {
+        uint8_t b;
+        if (d >= len) {
+            b = (uint8_t)(d == len ? sum >> 8 : sum); /* the checksum, big-endian */
+        } else {
+            if (d < fixed) {
+                b = tase_wire_byte(w, d);
+            } else {
+                /* the callers pass a tail whenever len > fixed */
+                b = tail != NULL ? tail[d - fixed] : 0u;
+            }
+            sum = (uint16_t)(sum + b);
         }
-        if (k > 0u) {
-            (void)memcpy(&st[n], &src[off], k);
-            sum = tase_checksum(sum, &st[n], k);
-            n += k;
-            off += k;
+        st[n] = b;
+        n++;
+        if (n == STAGE || d == len + 1u) {
+            int r = wr_put(&wr, st, n);
+            if (r < 0) {
+                return r;
+            }
+            n = 0;
         }
-        if (off == len && !second) {
-            second = true; /* the second span (maybe empty) */
-            src = b;
-            len = nb;
-            off = 0;
-            continue;
-        }
-        if (off == len && n + 2u <= STAGE) {
-            st[n] = (uint8_t)(sum >> 8);
-            st[n + 1u] = (uint8_t)sum;
-            r = wr_put(&w, st, n + 2u);
-            return r < 0 ? r : (int)(na + nb + TASE_FRAME_OVERHEAD);
-        }
-        r = wr_put(&w, st, n);
-        if (r < 0) {
-            return r;
-        }
-        n = 0;
     }
+    return (int)(len + TASE_FRAME_OVERHEAD);
 }
 
 int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *data,
@@ -171,47 +166,24 @@ int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, c
     if (!port_writable(port)) {
         return TASE_EARG;
     }
-    return send_pieces(port, group, type, data, len, NULL, 0u);
+    return send_stream(port, group, type, NULL, data, len);
 }
-
-/* The longest fixed data of a typed packet (GEOREFERENCE_DATA's 63);
- * CAMERA_PASS's camera bytes go out from the caller's buffer.
- * tests/test_port_io.c sends every packet of the schema through it. */
-#define MSG_FIXED_MAX 63u
 
 int tase_port_send_msg(const tase_port_t *port, uint16_t id, const void *msg)
 {
-    uint8_t data[MSG_FIXED_MAX];
+    tase_wire_t w;
     const uint8_t *tail = NULL;
-    size_t ntail = 0;
-    int n;
-
-    if (id == TASE_ID_CAMERA_PASS && msg != NULL) {
-        /* the fixed bytes here, the camera bytes where they are */
-        tase_camera_pass_t head = *(const tase_camera_pass_t *)msg;
-        if (head.data == NULL && head.len > 0u) {
-            return TASE_EARG; /* the codec's order: EARG, then ETOOLONG */
-        }
-        if (head.len > TASE_CAMERA_PASS_MAX) {
-            return TASE_ETOOLONG;
-        }
-        tail = head.data;
-        ntail = head.len;
-        head.len = 0;
-        head.data = NULL;
-        n = tase_packet_encode_data(id, &head, data, sizeof data);
-    } else if (msg != NULL) {
-        n = tase_packet_encode_data(id, msg, data, sizeof data);
-    } else {
-        n = tase_packet_encode_data_len(id, NULL, 0u, data, sizeof data);
-    }
+    int n = tase_wire_begin(&w, id, msg); /* the codec's checks first */
     if (n < 0) {
         return n;
     }
     if (!port_writable(port)) {
         return TASE_EARG;
     }
-    return send_pieces(port, TASE_ID_GROUP(id), TASE_ID_TYPE(id), data, (size_t)n, tail, ntail);
+    if ((size_t)n > w.fixed) { /* CAMERA_PASS: the camera bytes where they are */
+        tail = ((const tase_camera_pass_t *)msg)->data;
+    }
+    return send_stream(port, TASE_ID_GROUP(id), TASE_ID_TYPE(id), &w, tail, (size_t)n);
 }
 
 int tase_port_count_tx(int r, uint32_t *sent, uint32_t *errors)

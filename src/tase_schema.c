@@ -43,16 +43,16 @@ enum {
 #define SHIFT TASE_FIELD_SHIFT
 
 /* C99 has no _Static_assert: a negative array size fails the build.
- * Every member must be as wide as its field, a field with a "do not
- * change" value at most 4 bytes wide (unsigned if MSB: tase_field_keep()
- * relies on both), and the enumeration in schema.h must follow the list. */
+ * Every member must be as wide as its field, every field at most 4 bytes
+ * wide (the frame writer's byte producer, tase_codec_private.h, and
+ * tase_field_keep() rely on it), a field whose "do not change" value is
+ * MSB unsigned, and the enumeration in schema.h must follow the list. */
 #define P(N, g, t, fl, l, sz)                                                                      \
     typedef char chk_idx_##N[((int)TASE_PKT_##N == (int)PKTIDX_##N) ? 1 : -1];
 /* T is a type and m a member name: neither can be parenthesised. */
 /* cppcheck-suppress misra-c2012-20.7 */
 #define F(T, m, o, w, s, k)                                                                        \
-    typedef char chk_##T##_##m[(sizeof(((T *)0)->m) == (w) && offsetof(T, m) < 256u &&             \
-                                (((k)&TASE_FIELD_KEEP_MASK) == 0u || (w) <= 4) &&                  \
+    typedef char chk_##T##_##m[(sizeof(((T *)0)->m) == (w) && offsetof(T, m) < 256u && (w) <= 4 && \
                                 (((k)&TASE_FIELD_KEEP_MASK) != MSB || FMT_##s == 0u))              \
                                    ? 1                                                             \
                                    : -1];

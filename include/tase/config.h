@@ -95,6 +95,9 @@
 #ifndef TASE_PORT_WRITE_TRIES
 #define TASE_PORT_WRITE_TRIES 64u
 #endif
+#if TASE_PORT_WRITE_TRIES < 1 || TASE_PORT_WRITE_TRIES > 255
+#error "TASE_PORT_WRITE_TRIES must be 1..255"
+#endif
 
 /* The link-name tag: "abi" and the ABI level. An option that changes a
  * layout adds its value as one more operand of the paste, through a chain

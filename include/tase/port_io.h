@@ -67,27 +67,29 @@ int tase_port_write_all(const tase_port_t *port, const uint8_t *data, size_t n);
 /* Write one frame of (group, type) around data[0..len), exactly the bytes
  * tase_frame_build() gives, with the retries and the one deadline of
  * tase_port_write_all(). No frame buffer: the frame goes out in pieces of
- * at most 24 bytes staged on the stack and summed on the way (a multiple
+ * at most 16 bytes staged on the stack and summed on the way (a multiple
  * of 8, so a CAN port packs them into the same whole CAN frames as one
- * write; a frame of up to 16 data bytes is one write).
+ * write; a frame of up to 8 data bytes is one write).
  * Returns the frame length, an encoder error (TASE_EARG: data NULL with
  * len > 0; TASE_ETOOLONG: len > 253; checked first, nothing sent),
  * TASE_EARG for port NULL (or without write), or a tase_port_write_all()
- * error. Stack: docs/FOOTPRINT.md (about 130 bytes on Cortex-M4 -Os). */
+ * error. Stack: docs/FOOTPRINT.md (104 bytes on Cortex-M4 -Os, the port's
+ * write() and now_ms() not included). */
 int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, const uint8_t *data,
                          size_t len);
 
-/* Encode the data of packet `id` from its typed struct (tase/codec.h)
- * into a 63-byte stack buffer (the longest fixed packet,
- * GEOREFERENCE_DATA; CAMERA_PASS's camera bytes are sent from the
- * caller's buffer) and write the frame as tase_port_send_frame() does.
- * msg NULL sends the zero-length form (a query, or GYRO_ZERO_CMD).
- * Returns the frame length, a codec error (checked first, nothing sent:
- * TASE_EUNKNOWN id not in the schema; TASE_ELENGTH msg NULL for a packet
- * without a zero-length form; TASE_EARG / TASE_ETOOLONG for a bad
- * CAMERA_PASS tail), TASE_EARG for port NULL, or a tase_port_write_all()
- * error. Stack: docs/FOOTPRINT.md (about 240 bytes on Cortex-M4 -Os, the
- * codec's encoder included). */
+/* Write the frame of packet `id` from its typed struct (tase/codec.h):
+ * the bytes tase_packet_encode() gives, produced field by field into the
+ * pieces tase_port_send_frame() writes, so no packet or frame buffer is
+ * on the stack (CAMERA_PASS's camera bytes are sent from the caller's
+ * buffer). msg NULL sends the zero-length form (a query, or
+ * GYRO_ZERO_CMD). Returns the frame length, a codec error (checked first,
+ * nothing sent: TASE_EUNKNOWN id not in the schema; TASE_ELENGTH msg NULL
+ * for a packet without a zero-length form; TASE_EARG / TASE_ETOOLONG for
+ * a bad CAMERA_PASS tail), TASE_EARG for port NULL, or a
+ * tase_port_write_all() error. Stack: docs/FOOTPRINT.md (120 bytes on
+ * Cortex-M4 -Os, the codec's checks included, the port's write() and
+ * now_ms() not). */
 int tase_port_send_msg(const tase_port_t *port, uint16_t id, const void *msg);
 
 /* Count the result r of a frame write (tase_port_send_frame(),
