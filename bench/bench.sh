@@ -172,13 +172,14 @@ worstof() {
 }
 
 # 4. docs/TIMING.md: worst case per call of the public functions of src/
-# (bench/cm/timing.c), M4 -O2 and M0+ -Os, beside the receiver's longest
+# (bench/cm/timing*.c), M4 -O2 and M0+ -Os, beside the receiver's longest
 # push/feed calls of part 3.
 timing_out="$(dirname "$out")/TIMING.md"
 declare -A tm
 timing_cmd() {
     echo "arm-none-eabi-gcc -std=c99 -mcpu=$1 -mthumb -$2 -g ${cmwarn[*]}" \
          "-ffunction-sections -fdata-sections -Iinclude src/*.c bench/streams.c bench/cm/timing.c" \
+         "bench/cm/timing_codec.c bench/cm/timing_schema.c bench/cm/timing_roles.c bench/cm/timing_misc.c" \
          "bench/cm/measure.c bench/cm/startup.c -T bench/cm/mps2.ld --specs=rdimon.specs" \
          "-nostartfiles -Wl,--gc-sections -o ${bdir#$TASE_ROOT/}/timing_$1_$2.elf"
 }
@@ -186,16 +187,35 @@ timing_fns=()
 for t in "cortex-m4 O2" "cortex-m0plus Os"; do
     set -- $t
     key="$1-$2"
-    eval "$(timing_cmd "$1" "$2")" || { echo "bench/cm/timing.c no longer builds against src/: adapt it"; exit 1; }
+    eval "$(timing_cmd "$1" "$2")" || { echo "bench/cm/timing*.c no longer build against src/: adapt it"; exit 1; }
     timeout 900 qemu-system-arm -M mps2-an386 -nographic -monitor none -icount shift=0 \
         -semihosting-config enable=on,target=native -kernel "$bdir/timing_$1_$2.elf" > "$bdir/timing_$key.txt"
     grep -qx done "$bdir/timing_$key.txt" || { echo "timing run ($key) did not finish"; exit 1; }
     while read -r kind fn insns input; do
         [ "$kind" = timing ] || continue
         [ "$key" = cortex-m4-O2 ] && timing_fns+=("$fn")
-        tm[$key,$fn]=$insns tm[input,$fn]=${input//_/ }
+        tm[$key,$fn]=$insns tm[$key,input,$fn]=$input
     done < "$bdir/timing_$key.txt"
 done
+# both_inputs FN: the input each target found worst, once when they agree, else
+# "M4: a; M0+: b" with the ending they share (from a separator on) written once
+both_inputs() {
+    local a=${tm[cortex-m4-O2,input,$1]} b=${tm[cortex-m0plus-Os,input,$1]:-} n=0 tail=""
+    if [ -z "$b" ] || [ "$a" = "$b" ]; then
+        echo "$a"
+        return
+    fi
+    while [ $n -lt ${#a} ] && [ $n -lt ${#b} ] &&
+          [ "${a:${#a}-n-1:1}" = "${b:${#b}-n-1:1}" ]; do
+        n=$((n + 1))
+    done
+    tail=${a:${#a}-n}
+    case $tail in
+        *" ("* | *"; "* | *", "*) tail=$(grep -o -E '(; |, | \().*' <<<"$tail" | head -1) ;;
+        *) tail="" ;;
+    esac
+    echo "M4: ${a:0:${#a}-${#tail}}; M0+: ${b:0:${#b}-${#tail}}$tail"
+}
 # every public function of src/ (the headers' declarations), to list what is not measured
 mapfile -t public_fns < <(grep -ho '^[a-z][a-z0-9_ *]* \**tase_[a-z0-9_]*(' include/tase/*.h |
                           sed 's/($//; s/.*[ *]//' | sort -u)
@@ -389,7 +409,7 @@ echo "wrote $out"
     echo "makes it (its argument setup and branch included), from a state put back before every"
     echo "repetition (\`bench/cm/measure.c\`: 200 repetitions against the same loop around an empty"
     echo "function, exact after rounding). Callbacks are trivial (add a length to a counter)."
-    echo "Programs: \`bench/cm/timing.c\` (built with \`$(timing_cmd cortex-m4 O2)\`) and, for"
+    echo "Programs: \`bench/cm/timing*.c\` (\`timing.c\` and its parts, built with \`$(timing_cmd cortex-m4 O2)\`) and, for"
     echo "\`tase_rx_push\`/\`tase_rx_feed\`, \`bench/cm/bench_cm.c\` (the longest call over every"
     echo "call of the first 8 KiB of each stream of PERFORMANCE.md)."
     echo
@@ -401,7 +421,7 @@ echo "wrote $out"
         echo "| \`$f\` | $a | $b | one call of the $a_at stream (M4), $b_at (M0+); bench/streams.h |"
     done
     for f in "${timing_fns[@]}"; do
-        echo "| \`$f\` | ${tm[cortex-m4-O2,$f]} | ${tm[cortex-m0plus-Os,$f]:-?} | ${tm[input,$f]} |"
+        echo "| \`$f\` | ${tm[cortex-m4-O2,$f]} | ${tm[cortex-m0plus-Os,$f]:-?} | $(both_inputs "$f") |"
     done
     echo
     echo "\`tase_rx_flush\` and a settling \`tase_rx_tick\` decide the whole window at once (end of"
@@ -409,15 +429,44 @@ echo "wrote $out"
     echo "takes in (include/tase/frame.h, COST), so a \`tase_rx_feed\` of n bytes costs at most n times"
     echo "the longest \`tase_rx_push\` plus its copying."
     echo
-    echo "Public functions of src/ not measured here yet (their headers state their bounds in"
-    echo "O() terms):"
+    echo "How the inputs are built (\`bench/cm/timing*.c\`):"
     echo
+    echo "- **Per packet**: the codec, the typed senders and the typed requests are measured on every"
+    echo "  packet of the schema at its longest form (every member set; CAMERA_PASS with 249 camera"
+    echo "  bytes, 253 data bytes) and the slowest packet is named."
+    echo "- **Fake port**: the send path and the roles run over an in-memory port whose write() copies"
+    echo "  what it is given to RAM and takes it all, whose read() hands over scripted bytes at once"
+    echo "  (at most as many as asked), and whose now_ms() is a constant. The port's own cost is"
+    echo "  inside the count, as the input says; a real driver's write() and read() replace it."
+    echo "  \`tase_host_transact*\` block on the port's read() by design; measured here with a port"
+    echo "  that has the reply waiting, they are one request, its reply and the polls around it."
+    echo "- **Roles**: the gimbal has three ports with receivers; every setup packet is tried at each"
+    echo "  length it takes, with data bytes 0x01 and 0xFF (\"do not change\"), with typed and with byte"
+    echo "  callbacks (trivial: accept, leave the data; telemetry is a struct left zero or a memset)."
+    echo "  \`tase_gimbal_service\` reads its cap: 64 reads of 64 bytes on each of the 3 ports."
+    echo "- **O(n) calls** (feed, service, write_all, candump_parse, ...) have no worst case"
+    echo "  independent of their input's length: the count holds for the input named (one frame, one"
+    echo "  read, the longest line), and grows with it as their headers state."
+    echo "- **Numbers** (KLV units, \`tase/units.h\`, the GPS status word): the slowest of a spread of"
+    echo "  inputs (zero, signs, fractions, extremes, a subnormal, huge values, NaN, infinity); both"
+    echo "  cores here use soft-float, whose library calls are part of the call. Functions defined"
+    echo "  \`static inline\` in a header are called through a noinline wrapper, as said in the input."
+    echo
+    unmeasured=()
     for f in "${public_fns[@]}"; do
         case " ${timing_fns[*]} tase_rx_push tase_rx_feed " in
             *" $f "* | *" $f/"*) ;;
-            *) printf '%s' "\`$f\` " ;;
+            *) unmeasured+=("\`$f\`") ;;
         esac
     done
-    echo
+    if [ ${#unmeasured[@]} -eq 0 ]; then
+        echo "Every public function of src/ (every function the headers of include/tase/ declare) is"
+        echo "measured above."
+    else
+        echo "Public functions of src/ not measured here yet (their headers state their bounds in"
+        echo "O() terms):"
+        echo
+        echo "${unmeasured[*]}"
+    fi
 } > "$timing_out"
 echo "wrote $timing_out"

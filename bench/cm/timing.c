@@ -4,32 +4,31 @@
  * function is called on inputs built to be its worst (named in the
  * output), from a state put back before every call, and counted exactly
  * (measure.c). One line per function:
- *   timing FUNCTION INSTRUCTIONS WORST-CASE-INPUT (underscores for spaces)
+ *   timing FUNCTION INSTRUCTIONS WORST-CASE-INPUT (the rest of the line)
  *
- * The calls are written against today's API in this one file; a function
- * that is renamed or removed breaks the build (bench.sh stops there), and
- * bench.sh also checks that every function it lists was printed.
+ * This file has main(), the shared helpers (timing.h) and the receiver,
+ * CAN stream and KLV stream calls; timing_codec.c, timing_schema.c,
+ * timing_roles.c and timing_misc.c the rest. The calls are written
+ * against today's API; a function that is renamed or removed breaks the
+ * build (bench.sh stops there).
  */
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "../streams.h"
-#include "measure.h"
 #include "tase/can.h"
-#include "tase/codec.h"
-#include "tase/dispatch.h"
 #include "tase/frame.h"
 #include "tase/klv.h"
-#include "tase/schema.h"
-
-#define NOINLINE __attribute__((noinline, noipa))
+#include "timing.h"
 
 static uint8_t stream[16384];
 static size_t stream_n;
 static tase_rx_t rx, rx_snap;
 static uint8_t out[TASE_FRAME_MAX + 16u];
 static uint8_t data[TASE_DATA_MAX];
-static unsigned long sink;
+volatile unsigned long timing_sink;
+#define sink timing_sink
 
 static void on_frame(void *user, const tase_frame_t *f)
 {
@@ -37,14 +36,92 @@ static void on_frame(void *user, const tase_frame_t *f)
     sink += f->len;
 }
 
-static void report(const char *fn, unsigned long insns, const char *input)
+void report(const char *fn, unsigned long insns, const char *input)
 {
     printf("timing %s %lu %s\n", fn, insns, input);
 }
 
-static void nothing(void *ctx)
+void nothing(void *ctx)
 {
     (void)ctx;
+}
+
+unsigned long measure_plain(measure_fn call)
+{
+    return measure_exact(nothing, call, NULL);
+}
+
+void worst_try(worst_t *w, unsigned long insns, const char *fmt, ...)
+{
+    va_list ap;
+    if (insns <= w->insns) {
+        return;
+    }
+    w->insns = insns;
+    va_start(ap, fmt);
+    (void)vsnprintf(w->input, sizeof(w->input), fmt, ap);
+    va_end(ap);
+}
+
+void worst_report(const char *fn, const worst_t *w, const char *how)
+{
+    static char line[320];
+    (void)snprintf(line, sizeof(line), "%s%s", w->input, how);
+    report(fn, w->insns, line);
+}
+
+const tase_packet_desc_t *cur_pkt;
+size_t cur_len;
+tase_packet_msg_t full_msg;
+uint8_t camera_bytes[TASE_CAMERA_PASS_MAX];
+
+size_t fill_full_msg(const tase_packet_desc_t *p)
+{
+    memset(&full_msg, 0xA5, sizeof(full_msg));
+    if ((p->flags & TASE_LEN_TAIL) != 0u) {
+        memset(camera_bytes, 0x5A, sizeof(camera_bytes));
+        full_msg.camera_pass.camera = 1u;
+        full_msg.camera_pass.baud = 2u;
+        full_msg.camera_pass.len = (uint8_t)TASE_CAMERA_PASS_MAX;
+        full_msg.camera_pass.data = camera_bytes;
+        return (size_t)p->len + TASE_CAMERA_PASS_MAX;
+    }
+    return p->len;
+}
+
+uint8_t pkt_frame[TASE_FRAME_MAX + 16u];
+size_t pkt_frame_n;
+tase_frame_t pkt_f;
+
+bool prep_full_frame(const tase_packet_desc_t *p)
+{
+    int n;
+    cur_len = fill_full_msg(p);
+    n = tase_packet_encode(p->id, &full_msg, pkt_frame, sizeof(pkt_frame));
+    if (n < 0) {
+        return false;
+    }
+    pkt_frame_n = (size_t)n;
+    pkt_f.offset = 0u;
+    pkt_f.group = TASE_ID_GROUP(p->id);
+    pkt_f.type = TASE_ID_TYPE(p->id);
+    pkt_f.len = (uint8_t)cur_len;
+    pkt_f.data = &pkt_frame[TASE_FRAME_HEADER];
+    return true;
+}
+
+void over_packets(worst_t *w, bool (*prep)(const tase_packet_desc_t *p), measure_fn setup,
+                  measure_fn call)
+{
+    size_t i;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        cur_pkt = tase_schema_at(i);
+        if (cur_pkt == NULL || !prep(cur_pkt)) {
+            continue;
+        }
+        worst_try(w, measure_exact(setup, call, NULL), "%s (%lu data bytes)",
+                  tase_schema_packet_name(cur_pkt), (unsigned long)cur_len);
+    }
 }
 
 static void restore_rx(void *ctx)
@@ -163,13 +240,13 @@ static void receiver(void)
 
     arg_p = stream;
     arg_n = TASE_FRAME_MAX;
-    report("tase_checksum", measure_exact(nothing, c_checksum, NULL), "261_bytes_(a_whole_frame)");
+    report("tase_checksum", measure_exact(nothing, c_checksum, NULL), "261 bytes (a whole frame)");
     memset(data, 0xA5, sizeof(data));
-    report("tase_frame_build", measure_exact(nothing, c_encode, NULL), "253_data_bytes");
-    report("tase_rx_init", measure_exact(nothing, c_init, NULL), "any_state");
-    report("tase_rx_stats_reset", measure_exact(nothing, c_stats_reset, NULL), "any_state");
+    report("tase_frame_build", measure_exact(nothing, c_encode, NULL), "253 data bytes");
+    report("tase_rx_init", measure_exact(nothing, c_init, NULL), "any state");
+    report("tase_rx_stats_reset", measure_exact(nothing, c_stats_reset, NULL), "any state");
     (void)tase_rx_init(&rx_snap);
-    report("tase_rx_set_timing", measure_exact(restore_rx, c_set_timing, NULL), "any_state");
+    report("tase_rx_set_timing", measure_exact(restore_rx, c_set_timing, NULL), "any state");
 
     for (s = 0; s < sizeof(rx_streams) / sizeof(rx_streams[0]); s++) {
         stream_n = bench_stream(rx_streams[s], stream, sizeof(stream));
@@ -188,99 +265,14 @@ static void receiver(void)
             worst_quiet = e, quiet_in = rx_streams[s], quiet_at = at;
         }
     }
-    snprintf(what, sizeof(what), "after_%lu_bytes_of_%s_(settles_the_window)",
+    snprintf(what, sizeof(what), "after %lu bytes of %s (settles the window)",
              (unsigned long)flush_at, flush_in);
     report("tase_rx_flush", worst_flush, what);
-    snprintf(what, sizeof(what), "100_s_quiet_after_%lu_bytes_of_%s_(settles)",
+    snprintf(what, sizeof(what), "100 s quiet after %lu bytes of %s (settles)",
              (unsigned long)tick_at, tick_in);
     report("tase_rx_tick", worst_tick, what);
-    snprintf(what, sizeof(what), "after_%lu_bytes_of_%s", (unsigned long)quiet_at, quiet_in);
+    snprintf(what, sizeof(what), "after %lu bytes of %s", (unsigned long)quiet_at, quiet_in);
     report("tase_rx_quiet_ms", worst_quiet, what);
-}
-
-/* ---- codec and dispatch ------------------------------------------------ */
-
-static uint16_t arg_id;
-static size_t arg_len;
-static tase_frame_t arg_frame;
-static tase_packet_msg_t msg;
-static tase_dispatch_t disp;
-static tase_packet_handler_t handlers[TASE_PKT_COUNT];
-
-static void on_msg(void *user, const tase_frame_t *f, const void *m)
-{
-    (void)user;
-    (void)m;
-    sink += f->len;
-}
-
-NOINLINE static void c_packet_encode(void *ctx)
-{
-    (void)ctx;
-    (void)tase_packet_encode_len(arg_id, &msg, arg_len, out, sizeof(out));
-}
-
-NOINLINE static void c_packet_decode(void *ctx)
-{
-    (void)ctx;
-    (void)tase_packet_decode(&arg_frame, &msg);
-}
-
-NOINLINE static void c_dispatch(void *ctx)
-{
-    (void)ctx;
-    tase_dispatch_frame(&disp, &arg_frame);
-}
-
-static void codec(void)
-{
-    static char what[3][64];
-    size_t i;
-    unsigned long e, best[3] = {0, 0, 0};
-    for (i = 0; i < TASE_PKT_COUNT; i++) {
-        handlers[i] = on_msg;
-    }
-    (void)tase_dispatch_init(&disp, handlers, on_frame, NULL, NULL, &rx.stats);
-    for (i = 0; i < TASE_PKT_COUNT; i++) {
-        const tase_packet_desc_t *d = tase_schema_at(i);
-        int n;
-        if (d == NULL) {
-            continue;
-        }
-        memset(&msg, 0, sizeof(msg));
-        arg_id = d->id;
-        arg_len = d->len;
-        n = tase_packet_encode_len(arg_id, &msg, arg_len, out, sizeof(out));
-        if (n < 0) {
-            continue; /* a length this packet does not take with a zero message */
-        }
-        e = measure_exact(nothing, c_packet_encode, NULL);
-        if (e > best[0]) {
-            best[0] = e;
-            snprintf(what[0], sizeof(what[0]), "id_0x%04X_(%u_data_bytes)", (unsigned)d->id,
-                     (unsigned)d->len);
-        }
-        arg_frame.offset = 0u;
-        arg_frame.group = out[4];
-        arg_frame.type = out[5];
-        arg_frame.len = (uint8_t)(out[3] - 2u);
-        arg_frame.data = &out[TASE_FRAME_HEADER];
-        e = measure_exact(nothing, c_packet_decode, NULL);
-        if (e > best[1]) {
-            best[1] = e;
-            snprintf(what[1], sizeof(what[1]), "id_0x%04X_(%u_data_bytes)", (unsigned)d->id,
-                     (unsigned)d->len);
-        }
-        e = measure_exact(nothing, c_dispatch, NULL);
-        if (e > best[2]) {
-            best[2] = e;
-            snprintf(what[2], sizeof(what[2]), "id_0x%04X_(%u_data_bytes,_trivial_handler)",
-                     (unsigned)d->id, (unsigned)d->len);
-        }
-    }
-    report("tase_packet_encode_len", best[0], what[0]);
-    report("tase_packet_decode", best[1], what[1]);
-    report("tase_dispatch_frame", best[2], what[2]);
 }
 
 /* ---- CAN --------------------------------------------------------------- */
@@ -321,7 +313,7 @@ static void can(void)
     int n = tase_frame_build(0x08u, 0x10u, data, TASE_DATA_MAX, out, sizeof(out));
     (void)tase_can_split_init(&split_snap, TASE_CAN_ROLE_GIMBAL, out, (size_t)n);
     report("tase_can_split_next", measure_exact(restore_split, c_split_next, NULL),
-           "8_of_a_261-byte_frame");
+           "8 of a 261-byte frame");
     /* every 8-byte frame of the adversarial streams, as the gimbal sends them */
     for (s = 0; s < 3u; s++) {
         tase_can_split_t sp;
@@ -332,7 +324,7 @@ static void can(void)
             e = measure_exact(restore_crx, c_can_rx_feed, NULL);
             if (e > best) {
                 best = e;
-                snprintf(what, sizeof(what), "CAN_frame_%lu_of_%s", (unsigned long)i,
+                snprintf(what, sizeof(what), "CAN frame %lu of %s", (unsigned long)i,
                          rx_streams[s]);
             }
             (void)tase_can_rx_feed(&crx_snap, &cf, NULL, NULL);
@@ -386,6 +378,55 @@ NOINLINE static void c_klv_rx_feed(void *ctx)
     (void)tase_klv_rx_feed(&krx, arg_p, arg_n, on_klv, on_klv_error, NULL);
 }
 
+MEASURED(c_klv_rx_init, tase_klv_rx_init(&krx))
+MEASURED(c_klv_stats_reset, tase_klv_rx_stats_reset(&krx))
+MEASURED(c_klv_flush, tase_klv_rx_flush(&krx, on_klv, on_klv_error, NULL))
+
+/* A packet with the longest BER length (4 octets) cut one byte short (90
+ * bytes: the scanner holds it), every value byte `v`, or the values
+ * spelling as much of the key as they can (a false key in each value). */
+static size_t klv_cut_packet(uint8_t *buf, int v)
+{
+    static const uint8_t key[8] = {0x06, 0x0E, 0x2B, 0x34, 0x02, 0x03, 0x01, 0x01};
+    static const uint8_t lens[TASE_KLV_ITEMS] = {8, 4, 4, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2, 2};
+    static const uint8_t head[21] = {0x06, 0x0E, 0x2B, 0x34, 0x02, 0x03, 0x01, 0x01, 0, 0,   0,
+                                     0,    0,    0,    0,    0,    0x84, 0,    0,    0, 0x46};
+    size_t n = sizeof(head), t, i;
+    memcpy(buf, head, sizeof(head));
+    for (t = 0; t < TASE_KLV_ITEMS; t++) {
+        buf[n++] = (uint8_t)(t + 1u);
+        buf[n++] = lens[t];
+        for (i = 0; i < lens[t]; i++) {
+            buf[n++] = v >= 0 ? (uint8_t)v : key[i];
+        }
+    }
+    return n - 1u; /* the checksum's last byte missing */
+}
+
+/* The scanner's small calls, and flush on the windows that hold the
+ * most. */
+static void klv_scanner(void)
+{
+    static uint8_t buf[TASE_KLV_PACKET_MAX + 8u];
+    static const int fills[] = {0x06, -1, 0x00};
+    static const char *const names[] = {"every value byte 0x06 (a false key start each)",
+                                        "values spelling the key's first bytes",
+                                        "every value byte 0x00"};
+    worst_t w = {0, ""};
+    size_t k;
+    report("tase_klv_rx_init", measure_plain(c_klv_rx_init), "any state");
+    report("tase_klv_rx_stats_reset", measure_plain(c_klv_stats_reset), "any state");
+    for (k = 0; k < COUNT(fills); k++) {
+        size_t n = klv_cut_packet(buf, fills[k]);
+        (void)tase_klv_rx_init(&krx_snap);
+        (void)tase_klv_rx_feed(&krx_snap, buf, n, NULL, NULL, NULL);
+        worst_try(&w, measure_exact(restore_krx, c_klv_flush, NULL),
+                  "%u bytes held: a packet with a 4-octet BER length cut 1 byte short, %s",
+                  (unsigned)krx_snap.len, names[k]);
+    }
+    worst_report("tase_klv_rx_flush", &w, "");
+}
+
 static void klv_(void)
 {
     static char what[64];
@@ -395,8 +436,8 @@ static void klv_(void)
     memset(&klv, 0, sizeof(klv));
     n = tase_klv_encode(&klv, kbuf, sizeof(kbuf));
     klen = n > 0 ? (size_t)n : 0u;
-    report("tase_klv_encode", measure_exact(nothing, c_klv_encode, NULL), "a_full_packet");
-    report("tase_klv_decode", measure_exact(nothing, c_klv_decode, NULL), "a_full_packet");
+    report("tase_klv_encode", measure_exact(nothing, c_klv_encode, NULL), "a full packet");
+    report("tase_klv_decode", measure_exact(nothing, c_klv_decode, NULL), "a full packet");
     /* 64-byte feeds over packets, each with one byte corrupted, back to back */
     for (i = 0; i + klen <= sizeof(stream); i += klen) {
         memcpy(&stream[i], kbuf, klen);
@@ -409,11 +450,12 @@ static void klv_(void)
         e = measure_exact(restore_krx, c_klv_rx_feed, NULL);
         if (e > best) {
             best = e;
-            snprintf(what, sizeof(what), "64_bytes_at_%lu_of_corrupted_packets", (unsigned long)i);
+            snprintf(what, sizeof(what), "64 bytes at %lu of corrupted packets", (unsigned long)i);
         }
         (void)tase_klv_rx_feed(&krx_snap, arg_p, 64u, NULL, NULL, NULL);
     }
     report("tase_klv_rx_feed/64", best, what);
+    klv_scanner();
 }
 
 int main(void)
@@ -424,9 +466,12 @@ int main(void)
     measure_known_loop(1000000u);
     printf("calibration %lu\n", measure_since(t0));
     receiver();
-    codec();
+    timing_codec();
+    timing_schema();
+    timing_roles();
     can();
     klv_();
+    timing_misc();
     printf("done\n");
     return 0;
 }

@@ -1,0 +1,104 @@
+/*
+ * Worst case per call of the typed codec (tase/codec.h) and the
+ * dispatcher: every encoder and decoder over every packet of the schema,
+ * each at its longest form (all members set, CAMERA_PASS with 249 camera
+ * bytes: 253 data bytes), the worst packet named.
+ */
+#define TASE_ALLOW_DEPRECATED /* tase_frame_encode() is measured too */
+#include <string.h>
+
+#include "tase/dispatch.h"
+#include "tase/frame.h"
+#include "timing.h"
+
+static uint8_t out[TASE_FRAME_MAX + 16u];
+static tase_packet_msg_t dec;
+static tase_field_iter_t iter;
+static tase_dispatch_t disp;
+static tase_packet_handler_t handlers[TASE_PKT_COUNT];
+static tase_rx_stats_t stats;
+
+static void on_msg(void *user, const tase_frame_t *f, const void *m)
+{
+    (void)user;
+    (void)m;
+    timing_sink += f->len;
+}
+
+static void on_other(void *user, const tase_frame_t *f)
+{
+    (void)user;
+    timing_sink += f->len;
+}
+
+/* cur_pkt's full message and frame, and a walk bound at its length. */
+static bool prep_full(const tase_packet_desc_t *p)
+{
+    if (!prep_full_frame(p)) {
+        return false;
+    }
+    (void)tase_field_iter_find(&iter, pkt_f.group, pkt_f.type, cur_len);
+    return true;
+}
+
+/* Packets with a zero-length form (queries, GYRO_ZERO_CMD). */
+static bool prep_query(const tase_packet_desc_t *p)
+{
+    cur_len = 0u;
+    return tase_schema_length_ok(p, 0u);
+}
+
+MEASURED(c_encode, tase_packet_encode(cur_pkt->id, &full_msg, out, sizeof(out)))
+MEASURED(c_encode_len, tase_packet_encode_len(cur_pkt->id, &full_msg, cur_len, out, sizeof(out)))
+MEASURED(c_encode_query, tase_packet_encode_query(cur_pkt->id, out, sizeof(out)))
+MEASURED(c_encode_data, tase_packet_encode_data(cur_pkt->id, &full_msg, out, sizeof(out)))
+MEASURED(c_encode_data_len,
+         tase_packet_encode_data_len(cur_pkt->id, &full_msg, cur_len, out, sizeof(out)))
+MEASURED(c_decode, tase_packet_decode(&pkt_f, &dec))
+MEASURED(c_decode_data, tase_packet_decode_data(cur_pkt->id, pkt_f.data, cur_len, &dec))
+MEASURED(c_decode_desc, tase_packet_decode_desc(cur_pkt, pkt_f.data, cur_len, &dec))
+MEASURED(c_decode_iter, tase_packet_decode_iter(&iter, pkt_f.data, &dec))
+
+NOINLINE static void c_dispatch(void *ctx)
+{
+    (void)ctx;
+    tase_dispatch_frame(&disp, &pkt_f);
+}
+
+MEASURED(c_dispatch_init, tase_dispatch_init(&disp, handlers, on_other, NULL, NULL, &stats))
+
+MEASURED(c_frame_encode,
+         tase_frame_encode(out, sizeof(out), 0x00u, 0x42u, camera_bytes, TASE_DATA_MAX))
+
+/* One codec function over every packet prep() takes. */
+static void codec_one(const char *fn, bool (*prep)(const tase_packet_desc_t *p), measure_fn call,
+                      const char *how)
+{
+    worst_t w = {0, ""};
+    over_packets(&w, prep, nothing, call);
+    worst_report(fn, &w, how);
+}
+
+void timing_codec(void)
+{
+    size_t i;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        handlers[i] = on_msg;
+    }
+    (void)tase_dispatch_init(&disp, handlers, on_other, NULL, NULL, &stats);
+    codec_one("tase_packet_encode", prep_full, c_encode, ", every member set");
+    codec_one("tase_packet_encode_len", prep_full, c_encode_len, ", every member set");
+    codec_one("tase_packet_encode_query", prep_query, c_encode_query, "");
+    codec_one("tase_packet_encode_data", prep_full, c_encode_data, ", every member set");
+    codec_one("tase_packet_encode_data_len", prep_full, c_encode_data_len, ", every member set");
+    codec_one("tase_packet_decode", prep_full, c_decode, "");
+    codec_one("tase_packet_decode_data", prep_full, c_decode_data, "");
+    codec_one("tase_packet_decode_desc", prep_full, c_decode_desc, "");
+    codec_one("tase_packet_decode_iter", prep_full, c_decode_iter, ", walk bound at that length");
+    codec_one("tase_dispatch_frame", prep_full, c_dispatch, ", trivial handler");
+    report("tase_dispatch_init", measure_plain(c_dispatch_init),
+           "handler table, default handler and stats given");
+    memset(camera_bytes, 0x5A, sizeof(camera_bytes));
+    report("tase_frame_encode", measure_plain(c_frame_encode),
+           "253 data bytes (deprecated: calls tase_frame_build)");
+}
