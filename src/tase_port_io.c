@@ -116,8 +116,8 @@ static int send_stream(const tase_port_t *port, uint8_t group, uint8_t type, tas
     uint8_t st[STAGE];
     wr_t wr;
     size_t fixed = w != NULL ? w->fixed : 0u;
-    size_t d;
-    size_t n = TASE_FRAME_HEADER; /* bytes staged */
+    size_t d;                     /* data (then checksum) bytes staged */
+    size_t n = TASE_FRAME_HEADER; /* bytes in the stage */
     uint16_t sum;
     st[0] = TASE_SYNC1;
     st[1] = TASE_SYNC2;
@@ -127,28 +127,43 @@ static int send_stream(const tase_port_t *port, uint8_t group, uint8_t type, tas
     st[5] = type;
     sum = (uint16_t)(TASE_SYNC1 + TASE_SYNC2 + TASE_SYNC3 + len + 2u + group + type);
     wr_init(&wr, port);
-    for (d = 0; d < len + 2u; d++) {
-        uint8_t b;
-        if (d >= len) {
-            b = (uint8_t)(d == len ? sum >> 8 : sum); /* the checksum, big-endian */
-        } else {
+    d = 0;
+    while (d < len + 2u) {
+        int r;
+        /* fill the stage: the fields byte by byte, the tail in a run, then
+         * the checksum (big-endian) */
+        while (n < STAGE && d < len + 2u) {
             if (d < fixed) {
-                b = tase_wire_byte(w, d);
+                uint8_t b = tase_wire_byte(w, d);
+                st[n] = b;
+                sum = (uint16_t)(sum + b);
+                n++;
+                d++;
+            } else if (d < len) {
+                size_t k = STAGE - n;
+                size_t j;
+                if (k > len - d) {
+                    k = len - d;
+                }
+                for (j = 0; j < k; j++) {
+                    /* the callers pass a tail whenever len > fixed */
+                    uint8_t b = tail != NULL ? tail[d - fixed + j] : 0u;
+                    st[n + j] = b;
+                    sum = (uint16_t)(sum + b);
+                }
+                n += k;
+                d += k;
             } else {
-                /* the callers pass a tail whenever len > fixed */
-                b = tail != NULL ? tail[d - fixed] : 0u;
+                st[n] = (uint8_t)(d == len ? sum >> 8 : sum);
+                n++;
+                d++;
             }
-            sum = (uint16_t)(sum + b);
         }
-        st[n] = b;
-        n++;
-        if (n == STAGE || d == len + 1u) {
-            int r = wr_put(&wr, st, n);
-            if (r < 0) {
-                return r;
-            }
-            n = 0;
+        r = wr_put(&wr, st, n);
+        if (r < 0) {
+            return r;
         }
+        n = 0;
     }
     return (int)(len + TASE_FRAME_OVERHEAD);
 }

@@ -361,7 +361,8 @@ int tase_gimbal_send(tase_gimbal_t *g, unsigned port, uint8_t group, uint8_t typ
  * absent, a CAMERA_PASS tail NULL with len > 0), TASE_EUNKNOWN (id not
  * in the schema), TASE_ELENGTH (msg NULL for a packet without a
  * zero-length form), TASE_ETOOLONG (CAMERA_PASS tail over 249 bytes),
- * or a port error. Stack: tase_port_send_msg() (port_io.h). O(length). */
+ * or a port error. msg must not change until the call returns, and the
+ * stack is tase_port_send_msg()'s (port_io.h). O(length). */
 int tase_gimbal_send_msg(tase_gimbal_t *g, unsigned port, uint16_t id, const void *msg);
 
 /* Data length of setup packet `type` (0..7), or TASE_EUNKNOWN (type > 7).

@@ -134,7 +134,8 @@ int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *d
  * TASE_EUNKNOWN (id not in the schema), TASE_ELENGTH (msg NULL for a
  * packet without a zero-length form), TASE_ETOOLONG (CAMERA_PASS tail
  * over 249 bytes), all checked before anything is sent, or a port error
- * from tase_port_write_all(). Stack: tase_port_send_msg() (port_io.h).
+ * from tase_port_write_all(). msg must not change until the call returns;
+ * stack: tase_port_send_msg() (port_io.h).
  * O(length). */
 int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg);
 

@@ -24,6 +24,15 @@
  * older than the start counts as no time (see tase_port_elapsed_ms()).
  * A port without now_ms is bounded by calls instead: at most
  * TASE_PORT_WRITE_TRIES calls that take nothing.
+ * tase_port_send_frame() and tase_port_send_msg() write a frame in pieces
+ * of 16 bytes (at most 17), keeping the one deadline and the TRIES count
+ * across them. The deadline is checked while a piece is refused or only
+ * partly taken, so a port that takes every piece whole but blocks W in
+ * each call is called once per piece: up to 17 W for the longest frame
+ * (a POSIX port blocks only while its kernel queue is full; a TX ring
+ * never). A port that refuses every other call uses up the
+ * TASE_PORT_WRITE_TRIES count about one call per piece sooner than
+ * tase_port_write_all() of the same frame.
  */
 #ifndef TASE_PORT_IO_H
 #define TASE_PORT_IO_H
@@ -82,8 +91,11 @@ int tase_port_send_frame(const tase_port_t *port, uint8_t group, uint8_t type, c
  * the bytes tase_packet_encode() gives, produced field by field into the
  * pieces tase_port_send_frame() writes, so no packet or frame buffer is
  * on the stack (CAMERA_PASS's camera bytes are sent from the caller's
- * buffer). msg NULL sends the zero-length form (a query, or
- * GYRO_ZERO_CMD). Returns the frame length, a codec error (checked first,
+ * buffer). msg (and CAMERA_PASS's camera bytes) are read while the frame
+ * is being written, piece by piece: they must not change until the call
+ * returns (a sample an interrupt updates goes in a copy first, or the
+ * frame may mix two samples under a valid checksum). msg NULL sends the
+ * zero-length form (a query, or GYRO_ZERO_CMD). Returns the frame length, a codec error (checked first,
  * nothing sent: TASE_EUNKNOWN id not in the schema; TASE_ELENGTH msg NULL
  * for a packet without a zero-length form; TASE_EARG / TASE_ETOOLONG for
  * a bad CAMERA_PASS tail), TASE_EARG for port NULL, or a
