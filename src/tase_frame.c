@@ -84,8 +84,9 @@ typedef char
 typedef char
     tase_rx_late_check[(RX_WORK_MAX + RX_BUDGET - 1u) / RX_BUDGET <= TASE_RX_LATE_MAX ? 1 : -1];
 
-/* Keeps the general path of tase_rx_push() out of line, so that its fast
- * path (a byte inside a frame) needs no stack frame. GCC and clang only;
+/* Keeps the other paths of tase_rx_push() out of line, so that its fast
+ * path (a byte inside a frame) saves nothing but the return address. GCC
+ * and clang only;
  * another compiler may inline it, which costs speed, not correctness. */
 #if defined(__GNUC__)
 #define RX_NOINLINE __attribute__((noinline))

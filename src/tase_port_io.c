@@ -142,12 +142,14 @@ static int send_stream(const tase_port_t *port, uint8_t group, uint8_t type, tas
             } else if (d < len) {
                 size_t k = STAGE - n;
                 size_t j;
+                if (tail == NULL) {
+                    return TASE_EARG; /* not reached: the callers pass a tail when len > fixed */
+                }
                 if (k > len - d) {
                     k = len - d;
                 }
                 for (j = 0; j < k; j++) {
-                    /* the callers pass a tail whenever len > fixed */
-                    uint8_t b = tail != NULL ? tail[d - fixed + j] : 0u;
+                    uint8_t b = tail[d - fixed + j];
                     st[n + j] = b;
                     sum = (uint16_t)(sum + b);
                 }
