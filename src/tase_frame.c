@@ -55,34 +55,47 @@
 
 #define RX_CAP ((uint16_t)TASE_RX_WINDOW)
 
-/* Work units of the scan per byte taken in, and what a delivery costs
- * (frame.h COST; the unit is about one byte touched). */
-#define RX_BUDGET 96u
-#define RX_COST_STEP 16u
-#define RX_COST_FRAME 16u
+/* Work units of the scan per byte taken in (frame.h COST). A unit is
+ * about one instruction of the scan on a Cortex-M4 (measured: bench/,
+ * docs/TIMING.md), so that the budget bounds the time of a call and not
+ * only its steps: every position the scan examines costs RX_COST_STEP,
+ * every noise byte walked RX_COST_NOISE, a complete candidate judged
+ * RX_COST_JUDGE plus a unit per byte summed, a delivery RX_COST_FRAME. A
+ * step starts only with at least RX_COST_STEP left, or when it only
+ * holds (the scan has caught up: that needs no budget). */
+#define RX_BUDGET 168u
+#define RX_COST_STEP 24u
+#define RX_COST_NOISE 4u
+#define RX_COST_JUDGE 48u
+#define RX_COST_FRAME 48u
 #define RX_UNLIMITED UINT32_MAX
 
-/* Work a window can hold for the scan, in units: every position a step
- * (RX_COST_STEP), every judged candidate (one per sync, so at most every
- * third position) a sum of at most half the window (the shorter of the
- * two ways, which together span at most the window), every frame
- * delivered (at least 8 bytes each) RX_COST_FRAME, noise bytes summed and
- * one compaction (a unit per byte each). A frame the reference decides at
- * byte t lies in the window at t with everything before it, and every
- * byte from t on brings RX_BUDGET units (a byte never waits behind a
- * full window: the byte that finds it full is stored after a step taken
- * on top of the budget). So it is delivered by the call that takes byte
- * t + RX_WORK_MAX / RX_BUDGET at the latest: TASE_RX_LATE_MAX. */
+/* Work a window can hold for the scan, in units: every position a step,
+ * every position a noise byte, every judged candidate (one per sync, so
+ * at most every third position) RX_COST_JUDGE and a sum of at most half
+ * the window (the shorter of the two ways, which together span at most
+ * the window), every frame delivered (at least 8 bytes each)
+ * RX_COST_FRAME, and one compaction (a unit per byte). A frame the
+ * reference decides at byte t lies in the window at t with everything
+ * before it, and every byte from t on brings RX_BUDGET units, of which
+ * the scan spends at least RX_BUDGET - RX_COST_STEP + 1 before it stops
+ * short of its budget (a byte never waits behind a full window: the byte
+ * that finds it full is stored after a step taken on top of the budget).
+ * So the frame is delivered by the call that takes byte
+ * t + RX_WORK_MAX / (RX_BUDGET - RX_COST_STEP + 1) at the latest:
+ * TASE_RX_LATE_MAX. */
 #define RX_WORK_MAX                                                                                \
-    ((uint32_t)RX_CAP * RX_COST_STEP + ((uint32_t)RX_CAP / 3u + 1u) * ((uint32_t)RX_CAP / 2u) +    \
+    ((uint32_t)RX_CAP * (RX_COST_STEP + RX_COST_NOISE) +                                           \
+     ((uint32_t)RX_CAP / 3u + 1u) * (RX_COST_JUDGE + (uint32_t)RX_CAP / 2u) +                      \
      ((uint32_t)RX_CAP / 8u) * RX_COST_FRAME + 2u * (uint32_t)RX_CAP)
-/* A judgement costs a step and at least 2 bytes summed; the last step may
- * overrun the budget, and a byte that finds the window full takes one
- * more. */
+#define RX_SPENT_MIN (RX_BUDGET - RX_COST_STEP + 1u)
+/* A judgement costs at least RX_COST_STEP + RX_COST_JUDGE + 2; the last
+ * one may overrun the budget, and a byte that finds the window full takes
+ * one step more. */
+typedef char tase_rx_judge_check
+    [RX_BUDGET / (RX_COST_STEP + RX_COST_JUDGE + 2u) + 2u <= TASE_RX_JUDGE_MAX ? 1 : -1];
 typedef char
-    tase_rx_judge_check[RX_BUDGET / (RX_COST_STEP + 2u) + 2u <= TASE_RX_JUDGE_MAX ? 1 : -1];
-typedef char
-    tase_rx_late_check[(RX_WORK_MAX + RX_BUDGET - 1u) / RX_BUDGET <= TASE_RX_LATE_MAX ? 1 : -1];
+    tase_rx_late_check[(RX_WORK_MAX + RX_SPENT_MIN - 1u) / RX_SPENT_MIN <= TASE_RX_LATE_MAX ? 1 : -1];
 
 /* Keeps the other paths of tase_rx_push() out of line, so that its fast
  * path (a byte inside a frame) saves nothing but the return address. GCC
@@ -171,6 +184,13 @@ uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n)
         (void)memcpy(&w1, &p[i + 4u], 4u);
         sum = __usada8(w0, 0u, sum);
         sum = __usada8(w1, 0u, sum);
+    }
+    if (n - i >= 4u) {
+        uint32_t w;
+        /* cppcheck-suppress misra-c2012-21.15 */
+        (void)memcpy(&w, &p[i], 4u);
+        sum = __usada8(w, 0u, sum);
+        i += 4u;
     }
 #elif RX_WORDS
     while (n - i >= sizeof(sum_word_t)) {
@@ -289,12 +309,6 @@ static void compact(tase_rx_t *rx)
     rx->scan = 0u;
 }
 
-/* Take `units` from the budget, down to zero. */
-static uint32_t spend(uint32_t budget, size_t units)
-{
-    return (budget > units) ? budget - (uint32_t)units : 0u;
-}
-
 /* The scan has caught up with something to hold at buf[s]: a partial
  * sync, or a candidate of flen bytes still incomplete. A partial sync
  * moves to the front (at most 3 bytes), a candidate only if the window
@@ -307,95 +321,137 @@ static void hold(tase_rx_t *rx, size_t s, size_t flen)
     }
 }
 
+/* Whether the scan, at p with avail bytes, has caught up: a partial sync
+ * or a candidate whose last byte is still to come (what advance() holds;
+ * O(1), so it needs no budget). */
+RX_INLINE static bool holds(const uint8_t *p, size_t avail)
+{
+    if (p[0] != TASE_SYNC1) {
+        return false;
+    }
+    if (avail < 4u) {
+        return avail == 1u || (p[1] == TASE_SYNC2 && (avail == 2u || p[2] == TASE_SYNC3));
+    }
+    return p[1] == TASE_SYNC2 && p[2] == TASE_SYNC3 && p[3] >= 2u && (size_t)p[3] + 6u > avail;
+}
+
 /* The greedy scan from buf[scan] on, until it has caught up (lag 0) or
  * spent `budget` units (lag 1). `final`: end of input, so an incomplete
  * candidate or partial sync fails like a bad one. Returns false when a
  * callback re-initialised the receiver. */
 static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
 {
-    uint32_t budget = allowance;
-    while (rx->stop == 0u) { /* tase_rx_stop() ends the call (and sets lag) */
-        size_t s = rx->scan;
-        size_t len = rx->len;
+    /* signed: a step may overrun what is left (bounded, see above) */
+    int32_t budget = (allowance > (uint32_t)INT32_MAX) ? INT32_MAX : (int32_t)allowance;
+    const uint8_t *b = rx->buf;
+    size_t s = rx->scan;
+    size_t len = rx->len;
+    uint32_t sum = rx->sum_scan; /* the running sum up to buf[s] (mod 2^16) */
+    uint32_t dropped = 0;        /* bytes discarded, not yet counted */
+    bool live = true;
+    for (;;) {
         size_t avail = len - s;
-        const uint8_t *p = &rx->buf[s];
+        const uint8_t *p = &b[s];
         size_t k = 1;
         if (avail == 0u) {
             /* all decided: start the window over */
-            rx->len = 0u;
-            rx->scan = 0u;
+            len = 0u;
+            s = 0u;
             rx->lag = 0u;
-            return true;
+            break;
         }
-        if (budget == 0u) {
-            rx->lag = 1u;
-            return true;
+        if (budget < (int32_t)RX_COST_STEP && !holds(p, avail)) {
+            rx->lag = 1u; /* the budget is spent: the next call goes on */
+            break;
         }
-        budget = spend(budget, RX_COST_STEP);
+        budget -= (int32_t)RX_COST_STEP;
         if (p[0] != TASE_SYNC1) {
             /* noise up to the next 00 (summed on the way) */
-            uint16_t sum = (uint16_t)(rx->sum_scan + p[0]);
+            sum += p[0];
             while (k < avail && p[k] != TASE_SYNC1) {
-                sum = (uint16_t)(sum + p[k]);
+                sum += p[k];
                 k++;
             }
-            rx->sum_scan = sum;
-            rx->stats.bytes_discarded += (uint32_t)k;
-            rx->scan = (uint16_t)(s + k);
-            budget = spend(budget, k);
+            dropped += (uint32_t)k;
+            s += k;
+            budget -= (int32_t)(k * RX_COST_NOISE);
             continue;
         }
-        while (k < 3u && k < avail && p[k] == sync[k]) {
-            k++;
-        }
-        if (k == avail && !final) {
-            hold(rx, s, RX_CAP); /* a sync still arriving: to the front */
-            return true;
-        }
-        if (k == 3u && avail > 3u) {
+        if (avail < 4u) {
+            while (k < avail && p[k] == sync[k]) {
+                k++;
+            }
+            if (k == avail && !final) {
+                /* a sync still arriving: to the front */
+                rx->scan = (uint16_t)s;
+                hold(rx, s, RX_CAP);
+                s = rx->scan;
+                len = rx->len;
+                break;
+            }
+        } else if (p[1] == TASE_SYNC2 && p[2] == TASE_SYNC3) {
             size_t flen = (size_t)p[3] + 6u;
             if (p[3] < 2u) {
                 rx->stats.bad_size++;
             } else if (flen <= avail) {
-                /* complete: judge it (see the file comment for the sums) */
-                size_t be = s + flen - 2u;
+                /* complete: judge it, if what is left pays for it (see
+                 * the file comment for the sums: the shorter way to its
+                 * Check_0 byte) */
                 size_t fwd = flen - 2u;
-                size_t bwd = len - be;
-                uint16_t at_be =
-                    (bwd < fwd) ? (uint16_t)(rx->sum_len - tase_checksum(0u, &rx->buf[be], bwd))
-                                : tase_checksum(rx->sum_scan, p, fwd);
-                uint16_t want = (uint16_t)(((uint16_t)p[flen - 2u] << 8) | p[flen - 1u]);
-                budget = spend(budget, (bwd < fwd) ? bwd : fwd);
-                if ((uint16_t)(at_be - rx->sum_scan) == want) {
-                    rx->sum_scan = (uint16_t)(at_be + p[flen - 2u] + p[flen - 1u]);
-                    rx->scan = (uint16_t)(s + flen);
-                    budget = spend(budget, RX_COST_FRAME);
+                size_t bwd = avail - fwd;
+                bool back = bwd < fwd;
+                uint16_t part;
+                if (budget < (int32_t)RX_COST_JUDGE) {
+                    rx->lag = 1u; /* the next call judges it */
+                    break;
+                }
+                part = back ? tase_checksum(0u, &p[fwd], bwd) : tase_checksum(0u, p, fwd);
+                uint32_t at_be = back ? (uint32_t)rx->sum_len - part : sum + part;
+                uint16_t want = (uint16_t)(((uint16_t)p[fwd] << 8) | p[fwd + 1u]);
+                budget -= (int32_t)(RX_COST_JUDGE + (back ? bwd : fwd));
+                if ((uint16_t)(at_be - sum) == want) {
+                    sum = at_be + p[fwd] + p[fwd + 1u];
+                    s += flen;
+                    budget -= (int32_t)RX_COST_FRAME;
                     c->count++;
-                    if (!deliver(rx, p, rx->stats.bytes_in - (uint32_t)avail, c->on_frame,
-                                 c->user)) {
-                        return false;
+                    /* the state as the callback may see it */
+                    rx->scan = (uint16_t)s;
+                    rx->sum_scan = (uint16_t)sum;
+                    rx->stats.bytes_discarded += dropped;
+                    dropped = 0u;
+                    live = deliver(rx, p, rx->stats.bytes_in - (uint32_t)avail, c->on_frame,
+                                   c->user);
+                    if (!live) {
+                        return false; /* re-initialised: leave rx alone */
                     }
                     if (rx->stop != 0u) {
-                        rx->lag = 1u; /* the next call goes on from here */
+                        rx->lag = 1u; /* stopped: the next call goes on from here */
+                        break;
                     }
                     continue;
                 }
                 rx->stats.checksum_errors++;
             } else if (!final) {
                 /* a candidate whose last byte is still to come */
+                rx->scan = (uint16_t)s;
                 hold(rx, s, flen);
-                return true;
+                s = rx->scan;
+                len = rx->len;
+                break;
             } else {
                 /* end of input: it can no longer complete */
             }
         }
         /* no frame here: the scan moves on one byte (a first sync byte is
          * 00: the sum does not change) */
-        rx->sum_scan = (uint16_t)(rx->sum_scan + p[0]);
-        rx->stats.bytes_discarded++;
-        rx->scan = (uint16_t)(s + 1u);
+        dropped++;
+        s++;
     }
-    return true;
+    rx->scan = (uint16_t)s;
+    rx->len = (uint16_t)len;
+    rx->sum_scan = (uint16_t)sum;
+    rx->stats.bytes_discarded += dropped;
+    return live;
 }
 
 /* Store one byte, making room first if the window is full: one step of
@@ -405,7 +461,7 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
 RX_INLINE static bool put(tase_rx_t *rx, rx_call_t *c, uint8_t b)
 {
     if (rx->len == RX_CAP) {
-        if (rx->scan == 0u && !advance(rx, c, 1u, false)) {
+        if (rx->scan == 0u && !advance(rx, c, RX_COST_STEP + RX_COST_JUDGE, false)) {
             return false;
         }
         if (rx->stop != 0u) {
@@ -613,7 +669,7 @@ RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t o
     rx->stats.bytes_in++;
     rx->stats.bytes_discarded++;
     rx->scan = (uint16_t)(rx->scan + 1u);
-    return finish(rx, &c, advance(rx, &c, RX_BUDGET - RX_COST_STEP - 2u, false));
+    return finish(rx, &c, advance(rx, &c, RX_BUDGET - RX_COST_STEP - RX_COST_JUDGE - 2u, false));
 }
 
 /* tase_rx_push() for the last byte of the candidate held at buf[scan]
