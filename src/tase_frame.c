@@ -63,39 +63,42 @@
  * RX_COST_JUDGE plus a unit per byte summed, a delivery RX_COST_FRAME. A
  * step starts only with at least RX_COST_STEP left, or when it only
  * holds (the scan has caught up: that needs no budget). */
-#define RX_BUDGET 168u
+#define RX_BUDGET 128u
+#define RX_BANK_MAX 384u
 #define RX_COST_STEP 24u
 #define RX_COST_NOISE 4u
 #define RX_COST_JUDGE 48u
 #define RX_COST_FRAME 48u
-#define RX_UNLIMITED UINT32_MAX
+#define RX_SUM_PER_UNIT 1u
+#define RX_UNLIMITED INT32_MAX
 
-/* Work a window can hold for the scan, in units: every position a step,
- * every position a noise byte, every judged candidate (one per sync, so
- * at most every third position) RX_COST_JUDGE and a sum of at most half
- * the window (the shorter of the two ways, which together span at most
- * the window), every frame delivered (at least 8 bytes each)
- * RX_COST_FRAME, and one compaction (a unit per byte). A frame the
- * reference decides at byte t lies in the window at t with everything
- * before it, and every byte from t on brings RX_BUDGET units, of which
- * the scan spends at least RX_BUDGET - RX_COST_STEP + 1 before it stops
- * short of its budget (a byte never waits behind a full window: the byte
- * that finds it full is stored after a step taken on top of the budget).
- * So the frame is delivered by the call that takes byte
- * t + RX_WORK_MAX / (RX_BUDGET - RX_COST_STEP + 1) at the latest:
- * TASE_RX_LATE_MAX. */
+/* Work a window can hold for the scan, in units: every position a step
+ * and a noise byte; every judged candidate (00 FF 5A Size with Size >= 2:
+ * the next one starts 4 bytes later at the earliest) RX_COST_JUDGE and a
+ * sum of at most half the window (the shorter of the two ways, which
+ * together span at most the window); every frame delivered (at least 8
+ * bytes each) RX_COST_FRAME; and one compaction (a unit per byte). A frame
+ * the reference decides at byte t lies in the window at t with everything
+ * before it, and every byte from t on brings RX_BUDGET units (a byte never
+ * waits behind a full window: the byte that finds it full is stored after
+ * a step taken on top of the budget). So the frame is delivered by the
+ * call that takes byte t + RX_WORK_MAX / RX_BUDGET (rounded up, see the
+ * check below) at the latest: TASE_RX_LATE_MAX. */
 #define RX_WORK_MAX                                                                                \
     ((uint32_t)RX_CAP * (RX_COST_STEP + RX_COST_NOISE) +                                           \
-     ((uint32_t)RX_CAP / 3u + 1u) * (RX_COST_JUDGE + (uint32_t)RX_CAP / 2u) +                      \
+     ((uint32_t)RX_CAP / 4u + 1u) * (RX_COST_JUDGE + (uint32_t)RX_CAP / 2u / RX_SUM_PER_UNIT) +                      \
      ((uint32_t)RX_CAP / 8u) * RX_COST_FRAME + 2u * (uint32_t)RX_CAP)
-#define RX_SPENT_MIN (RX_BUDGET - RX_COST_STEP + 1u)
 /* A judgement costs at least RX_COST_STEP + RX_COST_JUDGE + 2; the last
- * one may overrun the budget, and a byte that finds the window full takes
+ * one may overrun the credit, and a byte that finds the window full takes
  * one step more. */
 typedef char tase_rx_judge_check
-    [RX_BUDGET / (RX_COST_STEP + RX_COST_JUDGE + 2u) + 2u <= TASE_RX_JUDGE_MAX ? 1 : -1];
-typedef char
-    tase_rx_late_check[(RX_WORK_MAX + RX_SPENT_MIN - 1u) / RX_SPENT_MIN <= TASE_RX_LATE_MAX ? 1 : -1];
+    [RX_BANK_MAX / (RX_COST_STEP + RX_COST_JUDGE + 2u) + 2u <= TASE_RX_JUDGE_MAX ? 1 : -1];
+/* A lagging scan stops with less than RX_COST_JUDGE left, and what it
+ * leaves plus a byte's RX_BUDGET never exceeds RX_BANK_MAX: so over m
+ * bytes it spends at least m * RX_BUDGET - RX_COST_JUDGE + 1 units. */
+typedef char tase_rx_bank_check[RX_COST_JUDGE + RX_BUDGET <= RX_BANK_MAX ? 1 : -1];
+typedef char tase_rx_late_check
+    [(RX_WORK_MAX + RX_COST_JUDGE + RX_BUDGET - 1u) / RX_BUDGET <= TASE_RX_LATE_MAX ? 1 : -1];
 
 /* Keeps the other paths of tase_rx_push() out of line, so that its fast
  * path (a byte inside a frame) saves nothing but the return address. GCC
@@ -254,6 +257,12 @@ typedef struct {
     tase_rx_handler_t on_frame;
     void *user;
     uint32_t count;
+    int32_t left; /* units advance() left unspent */
+    /* tase_rx_feed()'s input from in[in_i] to in[in_n]: bytes advance()
+     * takes in itself while the scan lags (see take()) */
+    const uint8_t *in;
+    size_t in_i;
+    size_t in_n;
 } rx_call_t;
 
 /* Count and hand on the valid frame f[0..Size+6) at stream offset
@@ -335,20 +344,45 @@ RX_INLINE static bool holds(const uint8_t *p, size_t avail)
     return p[1] == TASE_SYNC2 && p[2] == TASE_SYNC3 && p[3] >= 2u && (size_t)p[3] + 6u > avail;
 }
 
+/* A scan that has spent its credit while tase_rx_feed() has more input
+ * takes the next byte in itself, exactly as the call would (put(), then
+ * scan_on() with the credit that byte brings), without leaving the scan:
+ * returns the new credit, or -1 when there is no byte to take or the
+ * window is full (the caller's put() makes room first). */
+RX_INLINE static int32_t take(tase_rx_t *rx, rx_call_t *c, size_t len, int32_t budget)
+{
+    uint8_t byte;
+    uint32_t units;
+    if (c->in_i >= c->in_n || len >= RX_CAP) {
+        return -1;
+    }
+    byte = c->in[c->in_i];
+    c->in_i++;
+    rx->buf[len] = byte;
+    rx->len = (uint16_t)(len + 1u);
+    rx->sum_len = (uint16_t)(rx->sum_len + byte);
+    rx->stats.bytes_in++;
+    units = ((budget > 0) ? (uint32_t)budget : 0u) + RX_BUDGET;
+    return (int32_t)((units < RX_BANK_MAX) ? units : RX_BANK_MAX);
+}
+
 /* The greedy scan from buf[scan] on, until it has caught up (lag 0) or
  * spent `budget` units (lag 1). `final`: end of input, so an incomplete
  * candidate or partial sync fails like a bad one. Returns false when a
  * callback re-initialised the receiver. */
-static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
+static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
 {
-    /* signed: a step may overrun what is left (bounded, see above) */
-    int32_t budget = (allowance > (uint32_t)INT32_MAX) ? INT32_MAX : (int32_t)allowance;
+    int32_t budget = allowance; /* signed: a step may overrun what is left */
     const uint8_t *b = rx->buf;
     size_t s = rx->scan;
     size_t len = rx->len;
     uint32_t sum = rx->sum_scan; /* the running sum up to buf[s] (mod 2^16) */
     uint32_t dropped = 0;        /* bytes discarded, not yet counted */
     bool live = true;
+    c->left = allowance;
+    if (rx->stop != 0u) {
+        return true; /* stopped by a callback of this call */
+    }
     for (;;) {
         size_t avail = len - s;
         const uint8_t *p = &b[s];
@@ -361,14 +395,26 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
             break;
         }
         if (budget < (int32_t)RX_COST_STEP && !holds(p, avail)) {
-            rx->lag = 1u; /* the budget is spent: the next call goes on */
-            break;
+            /* the credit is spent: the next byte brings more */
+            int32_t more = take(rx, c, len, budget);
+            if (more < 0) {
+                rx->lag = 1u; /* the next call goes on */
+                break;
+            }
+            budget = more;
+            len++;
+            continue;
         }
         budget -= (int32_t)RX_COST_STEP;
         if (p[0] != TASE_SYNC1) {
-            /* noise up to the next 00 (summed on the way) */
+            /* noise up to the next 00 (summed on the way), as far as what
+             * is left pays for */
+            size_t lim = (budget > 0) ? (size_t)budget / RX_COST_NOISE + 1u : 1u;
+            if (lim > avail) {
+                lim = avail;
+            }
             sum += p[0];
-            while (k < avail && p[k] != TASE_SYNC1) {
+            while (k < lim && p[k] != TASE_SYNC1) {
                 sum += p[k];
                 k++;
             }
@@ -399,16 +445,32 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
                  * Check_0 byte) */
                 size_t fwd = flen - 2u;
                 size_t bwd = avail - fwd;
-                bool back = bwd < fwd;
-                uint16_t part;
+                size_t cost = RX_COST_JUDGE;
+                uint32_t at_be;
+                uint16_t want;
                 if (budget < (int32_t)RX_COST_JUDGE) {
-                    rx->lag = 1u; /* the next call judges it */
-                    break;
+                    int32_t more = take(rx, c, len, budget);
+                    if (more < 0) {
+                        rx->lag = 1u; /* the next call judges it */
+                        break;
+                    }
+                    budget = more;
+                    len++;
+                    continue;
                 }
-                part = back ? tase_checksum(0u, &p[fwd], bwd) : tase_checksum(0u, p, fwd);
-                uint32_t at_be = back ? (uint32_t)rx->sum_len - part : sum + part;
-                uint16_t want = (uint16_t)(((uint16_t)p[fwd] << 8) | p[fwd + 1u]);
-                budget -= (int32_t)(RX_COST_JUDGE + (back ? bwd : fwd));
+                if (bwd == 2u) {
+                    /* its last byte just came: the sum is 2 bytes back */
+                    at_be = (uint32_t)rx->sum_len - p[fwd] - p[fwd + 1u];
+                    cost += 2u;
+                } else if (bwd < fwd) {
+                    at_be = (uint32_t)rx->sum_len - tase_checksum(0u, &p[fwd], bwd);
+                    cost += bwd / RX_SUM_PER_UNIT;
+                } else {
+                    at_be = sum + tase_checksum(0u, p, fwd);
+                    cost += fwd / RX_SUM_PER_UNIT;
+                }
+                want = (uint16_t)(((uint16_t)p[fwd] << 8) | p[fwd + 1u]);
+                budget -= (int32_t)cost;
                 if ((uint16_t)(at_be - sum) == want) {
                     sum = at_be + p[fwd] + p[fwd + 1u];
                     s += flen;
@@ -451,7 +513,36 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
     rx->len = (uint16_t)len;
     rx->sum_scan = (uint16_t)sum;
     rx->stats.bytes_discarded += dropped;
+    c->left = budget;
     return live;
+}
+
+/* The scan's credit for this byte (or tick, or 0-byte feed): what the
+ * last budgeted scan left, plus RX_BUDGET for every byte taken in since
+ * (at least one), up to RX_BANK_MAX. It depends on the stream only (the
+ * count of bytes), never on how it was split into calls. */
+RX_INLINE static int32_t credit(const tase_rx_t *rx)
+{
+    uint32_t since = (uint16_t)(rx->stats.bytes_in - rx->bank_at);
+    uint32_t units = rx->bank + ((since != 0u) ? since : 1u) * RX_BUDGET;
+    return (int32_t)((units < RX_BANK_MAX) ? units : RX_BANK_MAX);
+}
+
+/* Scan on with this byte's credit, less `spent` units already used on
+ * it, and keep what is left. A scan that ends with nothing left to
+ * decide keeps the credit it had (tase_rx_push() delivers a frame whose
+ * last byte came without scanning, so the credit must not depend on
+ * it). Returns false when a callback re-initialised the receiver. */
+RX_INLINE static bool scan_on(tase_rx_t *rx, rx_call_t *c, uint32_t spent)
+{
+    if (!advance(rx, c, credit(rx) - (int32_t)spent, false)) {
+        return false;
+    }
+    if (rx->len != rx->scan) {
+        rx->bank = (uint16_t)((c->left > 0) ? c->left : 0);
+        rx->bank_at = (uint16_t)rx->stats.bytes_in;
+    }
+    return true;
 }
 
 /* Store one byte, making room first if the window is full: one step of
@@ -461,7 +552,7 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
 RX_INLINE static bool put(tase_rx_t *rx, rx_call_t *c, uint8_t b)
 {
     if (rx->len == RX_CAP) {
-        if (rx->scan == 0u && !advance(rx, c, RX_COST_STEP + RX_COST_JUDGE, false)) {
+        if (rx->scan == 0u && !advance(rx, c, (int32_t)(RX_COST_STEP + RX_COST_JUDGE), false)) {
             return false;
         }
         if (rx->stop != 0u) {
@@ -552,12 +643,12 @@ static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
 static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx_handler_t on_frame,
                void *user)
 {
-    rx_call_t c = {on_frame, user, 0u};
+    rx_call_t c = {on_frame, user, 0u, 0, NULL, 0u, 0u};
     size_t i = 0;
     bool live = true;
     begin(rx);
     if (n == 0u && rx->lag != 0u) {
-        live = advance(rx, &c, RX_BUDGET, false);
+        live = scan_on(rx, &c, 0u);
     }
     while (live && i < n && rx->stop == 0u) {
         if (rx->lag == 0u) {
@@ -577,8 +668,20 @@ static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx
                     k = n - i;
                 }
                 if (k > 0u) {
-                    (void)memcpy(&rx->buf[rx->len], &data[i], k);
-                    rx->sum_len = tase_checksum(rx->sum_len, &data[i], k);
+                    uint8_t *to = &rx->buf[rx->len];
+                    if (k < 8u) {
+                        /* a few bytes: a loop costs less than the calls */
+                        uint32_t sum = rx->sum_len;
+                        size_t j;
+                        for (j = 0; j < k; j++) {
+                            to[j] = data[i + j];
+                            sum += data[i + j];
+                        }
+                        rx->sum_len = (uint16_t)sum;
+                    } else {
+                        (void)memcpy(to, &data[i], k);
+                        rx->sum_len = tase_checksum(rx->sum_len, &data[i], k);
+                    }
                     rx->len = (uint16_t)(rx->len + k);
                     rx->stats.bytes_in += (uint32_t)k;
                 }
@@ -592,8 +695,18 @@ static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx
                 continue;
             }
         }
-        live = put(rx, &c, data[i]) && advance(rx, &c, RX_BUDGET, false);
+        /* the byte, then the scan, which takes the bytes after it itself
+         * while it lags */
+        live = put(rx, &c, data[i]);
         i++;
+        if (live && rx->stop == 0u) {
+            c.in = data;
+            c.in_i = i;
+            c.in_n = n;
+            live = scan_on(rx, &c, 0u);
+            i = c.in_i;
+            c.in_n = 0u;
+        }
     }
     if (live && final) {
         live = advance(rx, &c, RX_UNLIMITED, true);
@@ -643,13 +756,27 @@ static int rx_check(const tase_rx_t *rx)
  * does for each byte), a call from a callback, or a corrupted instance. */
 RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c = {on_frame, user, 0u}; /* before the check: fewer registers kept */
+    rx_call_t c = {on_frame, user, 0u, 0, NULL, 0u, 0u}; /* before the check: fewer registers kept */
     int r = rx_check(rx);
     if (r != TASE_OK) {
         return r;
     }
     begin(rx);
-    return finish(rx, &c, put(rx, &c, b) && advance(rx, &c, RX_BUDGET, false));
+    return finish(rx, &c, put(rx, &c, b) && scan_on(rx, &c, 0u));
+}
+
+/* tase_rx_push() for a byte while the scan lags (`end` RX_BLOCKED outside
+ * a call): what push_slow() does, with only the checks rx_sane() makes of
+ * that state (anything else goes to push_slow(), which reports it). */
+RX_NOINLINE static int push_lag(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+{
+    rx_call_t c = {on_frame, user, 0u, 0, NULL, 0u, 0u};
+    if (rx->busy != 0u || rx->lag != 1u || rx->stop != 0u || rx->len > RX_CAP ||
+        rx->scan > rx->len) {
+        return push_slow(rx, b, on_frame, user);
+    }
+    begin(rx);
+    return finish(rx, &c, put(rx, &c, b) && scan_on(rx, &c, 0u));
 }
 
 /* tase_rx_push() for the last byte of a held candidate that failed: the
@@ -659,7 +786,7 @@ RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
  * that any split of the stream gives the same result. */
 RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c = {on_frame, user, 0u};
+    rx_call_t c = {on_frame, user, 0u, 0, NULL, 0u, 0u};
     size_t len = rx->len;
     begin(rx);
     rx->stats.checksum_errors++;
@@ -669,7 +796,7 @@ RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t o
     rx->stats.bytes_in++;
     rx->stats.bytes_discarded++;
     rx->scan = (uint16_t)(rx->scan + 1u);
-    return finish(rx, &c, advance(rx, &c, RX_BUDGET - RX_COST_STEP - RX_COST_JUDGE - 2u, false));
+    return finish(rx, &c, scan_on(rx, &c, RX_COST_STEP + RX_COST_JUDGE + 2u));
 }
 
 /* tase_rx_push() for the last byte of the candidate held at buf[scan]
@@ -712,6 +839,9 @@ RX_NOINLINE static int push_event(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t
     uint16_t end = rx->end;
     if (len == end && end != 0u && end < RX_CAP) {
         return push_last(rx, byte, on_frame, user);
+    }
+    if (end == RX_BLOCKED) {
+        return push_lag(rx, byte, on_frame, user);
     }
     return push_slow(rx, byte, on_frame, user);
 }

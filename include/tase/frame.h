@@ -237,6 +237,10 @@ typedef struct {
     uint16_t scan;
     uint16_t sum_len;
     uint16_t sum_scan;
+    /* The scan's credit (src/tase_frame.c): units left at the last
+     * budgeted scan, and the low 16 bits of stats.bytes_in then. */
+    uint16_t bank;
+    uint16_t bank_at;
     uint8_t buf[TASE_RX_WINDOW];
 } tase_rx_t;
 
