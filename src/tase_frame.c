@@ -257,13 +257,16 @@ typedef struct {
     tase_rx_handler_t on_frame;
     void *user;
     uint32_t count;
-    int32_t left; /* units advance() left unspent */
-    /* tase_rx_feed()'s input from in[in_i] to in[in_n]: bytes advance()
-     * takes in itself while the scan lags (see take()) */
-    const uint8_t *in;
-    size_t in_i;
-    size_t in_n;
+    /* tase_rx_feed()'s input not taken in yet: bytes advance() takes in
+     * itself while the scan lags (see take()); NULL for the others */
+    struct rx_input *in;
 } rx_call_t;
+
+/* The input of a tase_rx_feed() call from `next` to `end`. */
+struct rx_input {
+    const uint8_t *next;
+    const uint8_t *end;
+};
 
 /* Count and hand on the valid frame f[0..Size+6) at stream offset
  * `offset`. Returns false when the callback re-initialised the receiver:
@@ -282,6 +285,15 @@ static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, tase_rx_ha
         on_frame(user, &fr);
     }
     return rx->busy != 0u;
+}
+
+/* deliver() out of line, for the scan: its tase_frame_t then lives only
+ * while the callback runs, not in advance()'s frame for the whole scan
+ * (the push path's stack, docs/FOOTPRINT.md). */
+RX_NOINLINE static bool deliver_from_scan(tase_rx_t *rx, const uint8_t *f, uint32_t offset,
+                                          const rx_call_t *c)
+{
+    return deliver(rx, f, offset, c->on_frame, c->user);
 }
 
 /* Drop the decided bytes buf[0..scan): the rest moves to the front. The
@@ -353,11 +365,11 @@ RX_INLINE static int32_t take(tase_rx_t *rx, rx_call_t *c, size_t len, int32_t b
 {
     uint8_t byte;
     uint32_t units;
-    if (c->in_i >= c->in_n || len >= RX_CAP) {
+    if (c->in == NULL || c->in->next == c->in->end || len >= RX_CAP) {
         return -1;
     }
-    byte = c->in[c->in_i];
-    c->in_i++;
+    byte = *c->in->next;
+    c->in->next++;
     rx->buf[len] = byte;
     rx->len = (uint16_t)(len + 1u);
     rx->sum_len = (uint16_t)(rx->sum_len + byte);
@@ -379,7 +391,6 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
     uint32_t sum = rx->sum_scan; /* the running sum up to buf[s] (mod 2^16) */
     uint32_t dropped = 0;        /* bytes discarded, not yet counted */
     bool live = true;
-    c->left = allowance;
     if (rx->stop != 0u) {
         return true; /* stopped by a callback of this call */
     }
@@ -481,8 +492,7 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
                     rx->sum_scan = (uint16_t)sum;
                     rx->stats.bytes_discarded += dropped;
                     dropped = 0u;
-                    live = deliver(rx, p, rx->stats.bytes_in - (uint32_t)avail, c->on_frame,
-                                   c->user);
+                    live = deliver_from_scan(rx, p, rx->stats.bytes_in - (uint32_t)avail, c);
                     if (!live) {
                         return false; /* re-initialised: leave rx alone */
                     }
@@ -513,7 +523,12 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
     rx->len = (uint16_t)len;
     rx->sum_scan = (uint16_t)sum;
     rx->stats.bytes_discarded += dropped;
-    c->left = budget;
+    if (!final && len != s) {
+        /* something is left to decide: keep what is left of the credit
+         * (scan_on()) */
+        rx->bank = (uint16_t)((budget > 0) ? budget : 0);
+        rx->bank_at = (uint16_t)rx->stats.bytes_in;
+    }
     return live;
 }
 
@@ -529,20 +544,14 @@ RX_INLINE static int32_t credit(const tase_rx_t *rx)
 }
 
 /* Scan on with this byte's credit, less `spent` units already used on
- * it, and keep what is left. A scan that ends with nothing left to
- * decide keeps the credit it had (tase_rx_push() delivers a frame whose
- * last byte came without scanning, so the credit must not depend on
- * it). Returns false when a callback re-initialised the receiver. */
+ * it; advance() keeps what is left in the bank. A scan that ends with
+ * nothing left to decide keeps the credit it had (tase_rx_push() delivers
+ * a frame whose last byte came without scanning, so the credit must not
+ * depend on it). Returns false when a callback re-initialised the
+ * receiver. */
 RX_INLINE static bool scan_on(tase_rx_t *rx, rx_call_t *c, uint32_t spent)
 {
-    if (!advance(rx, c, credit(rx) - (int32_t)spent, false)) {
-        return false;
-    }
-    if (rx->len != rx->scan) {
-        rx->bank = (uint16_t)((c->left > 0) ? c->left : 0);
-        rx->bank_at = (uint16_t)rx->stats.bytes_in;
-    }
-    return true;
+    return advance(rx, c, credit(rx) - (int32_t)spent, false);
 }
 
 /* Store one byte, making room first if the window is full: one step of
@@ -552,8 +561,15 @@ RX_INLINE static bool scan_on(tase_rx_t *rx, rx_call_t *c, uint32_t spent)
 RX_INLINE static bool put(tase_rx_t *rx, rx_call_t *c, uint8_t b)
 {
     if (rx->len == RX_CAP) {
-        if (rx->scan == 0u && !advance(rx, c, (int32_t)(RX_COST_STEP + RX_COST_JUDGE), false)) {
-            return false;
+        if (rx->scan == 0u) {
+            /* a step on top of the credit, which it leaves as it was */
+            uint16_t bank = rx->bank;
+            uint16_t at = rx->bank_at;
+            if (!advance(rx, c, (int32_t)(RX_COST_STEP + RX_COST_JUDGE), false)) {
+                return false;
+            }
+            rx->bank = bank;
+            rx->bank_at = at;
         }
         if (rx->stop != 0u) {
             return true; /* stopped: not taken (compact() would move the frame) */
@@ -643,7 +659,7 @@ static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
 static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx_handler_t on_frame,
                void *user)
 {
-    rx_call_t c = {on_frame, user, 0u, 0, NULL, 0u, 0u};
+    rx_call_t c = {on_frame, user, 0u, NULL};
     size_t i = 0;
     bool live = true;
     begin(rx);
@@ -700,12 +716,13 @@ static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx
         live = put(rx, &c, data[i]);
         i++;
         if (live && rx->stop == 0u) {
-            c.in = data;
-            c.in_i = i;
-            c.in_n = n;
+            struct rx_input in;
+            in.next = &data[i];
+            in.end = &data[n];
+            c.in = &in;
             live = scan_on(rx, &c, 0u);
-            i = c.in_i;
-            c.in_n = 0u;
+            c.in = NULL;
+            i = (size_t)(in.next - data);
         }
     }
     if (live && final) {
@@ -751,32 +768,37 @@ static int rx_check(const tase_rx_t *rx)
     return rx_sane(rx) ? TASE_OK : TASE_EARG;
 }
 
-/* tase_rx_push() for every byte its fast paths do not take: a lagging
- * scan (the byte is stored and the scan goes on with a budget, as run()
- * does for each byte), a call from a callback, or a corrupted instance. */
-RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+/* tase_rx_push() for a byte the fast paths do not take, once rx has
+ * passed its checks: the byte is stored and the scan goes on with its
+ * credit, as run() does for each byte. */
+RX_NOINLINE static int push_body(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c = {on_frame, user, 0u, 0, NULL, 0u, 0u}; /* before the check: fewer registers kept */
-    int r = rx_check(rx);
-    if (r != TASE_OK) {
-        return r;
-    }
+    rx_call_t c = {on_frame, user, 0u, NULL};
     begin(rx);
     return finish(rx, &c, put(rx, &c, b) && scan_on(rx, &c, 0u));
 }
 
+/* tase_rx_push() for every byte its fast paths do not take: a call from
+ * a callback or a corrupted instance (the error), or the general path. */
+RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+{
+    int r = rx_check(rx);
+    if (r != TASE_OK) {
+        return r;
+    }
+    return push_body(rx, b, on_frame, user);
+}
+
 /* tase_rx_push() for a byte while the scan lags (`end` RX_BLOCKED outside
- * a call): what push_slow() does, with only the checks rx_sane() makes of
- * that state (anything else goes to push_slow(), which reports it). */
+ * a call): push_slow() with only the checks rx_sane() makes of that state
+ * (anything else goes to push_slow(), which reports it). */
 RX_NOINLINE static int push_lag(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c = {on_frame, user, 0u, 0, NULL, 0u, 0u};
     if (rx->busy != 0u || rx->lag != 1u || rx->stop != 0u || rx->len > RX_CAP ||
         rx->scan > rx->len) {
         return push_slow(rx, b, on_frame, user);
     }
-    begin(rx);
-    return finish(rx, &c, put(rx, &c, b) && scan_on(rx, &c, 0u));
+    return push_body(rx, b, on_frame, user);
 }
 
 /* tase_rx_push() for the last byte of a held candidate that failed: the
@@ -786,7 +808,7 @@ RX_NOINLINE static int push_lag(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_f
  * that any split of the stream gives the same result. */
 RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c = {on_frame, user, 0u, 0, NULL, 0u, 0u};
+    rx_call_t c = {on_frame, user, 0u, NULL};
     size_t len = rx->len;
     begin(rx);
     rx->stats.checksum_errors++;
