@@ -69,7 +69,6 @@
 #define RX_COST_NOISE 4u
 #define RX_COST_JUDGE 48u
 #define RX_COST_FRAME 48u
-#define RX_SUM_PER_UNIT 1u
 #define RX_UNLIMITED INT32_MAX
 
 /* Work a window can hold for the scan, in units: every position a step
@@ -86,7 +85,7 @@
  * check below) at the latest: TASE_RX_LATE_MAX. */
 #define RX_WORK_MAX                                                                                \
     ((uint32_t)RX_CAP * (RX_COST_STEP + RX_COST_NOISE) +                                           \
-     ((uint32_t)RX_CAP / 4u + 1u) * (RX_COST_JUDGE + (uint32_t)RX_CAP / 2u / RX_SUM_PER_UNIT) +                      \
+     ((uint32_t)RX_CAP / 4u + 1u) * (RX_COST_JUDGE + (uint32_t)RX_CAP / 2u) +                      \
      ((uint32_t)RX_CAP / 8u) * RX_COST_FRAME + 2u * (uint32_t)RX_CAP)
 /* A judgement costs at least RX_COST_STEP + RX_COST_JUDGE + 2; the last
  * one may overrun the credit, and a byte that finds the window full takes
@@ -475,10 +474,10 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
                     cost += 2u;
                 } else if (bwd < fwd) {
                     at_be = (uint32_t)rx->sum_len - tase_checksum(0u, &p[fwd], bwd);
-                    cost += bwd / RX_SUM_PER_UNIT;
+                    cost += bwd;
                 } else {
                     at_be = sum + tase_checksum(0u, p, fwd);
-                    cost += fwd / RX_SUM_PER_UNIT;
+                    cost += fwd;
                 }
                 want = (uint16_t)(((uint16_t)p[fwd] << 8) | p[fwd + 1u]);
                 budget -= (int32_t)cost;

@@ -1414,6 +1414,97 @@ static void one_byte_never_decides_the_whole_window_at_once(void **state)
     free(want);
 }
 
+/* Issue 21, second pass: a false candidate held over 200 noise bytes
+ * (no 00 among them) and a valid frame behind them, then noise, repeated:
+ * when the candidate fails, the scan walks the noise in pieces its credit
+ * pays for (a walk in one piece took 2,254 instructions in one
+ * tase_rx_push() on a Cortex-M4) and still finds the frame. Between
+ * them, streams whose scan lags for long (held255, burst): a
+ * tase_rx_feed() takes the bytes of a lagging scan in itself, and every
+ * split gives what pushing byte by byte gives, moments of delivery
+ * included. */
+static void a_lagging_scan_gives_the_same_frames_for_any_split(void **state)
+{
+    static uint8_t buf[6 * 261 + 4 * 256 + 4 * 261];
+    tase_rx_t rx;
+    tase_rx_t one;
+    recorder_t *got = new_recorder(&rx);
+    recorder_t *want = new_recorder(&rx);
+    recorder_t *ref = new_recorder(&one);
+    size_t n = 0, i, k, rep, chunk;
+    int mode;
+    (void)state;
+    for (rep = 0; rep < 6; rep++) {
+        size_t start = n;
+        buf[n++] = 0x00;
+        buf[n++] = 0xFF;
+        buf[n++] = 0x5A;
+        buf[n++] = 0xFF;
+        for (k = 0; k < 200; k++) {
+            buf[n++] = (uint8_t)(0x11 + (k + rep) % 0xE0);
+        }
+        n +=
+            (size_t)tase_frame_build(0x10, (uint8_t)rep, (const uint8_t *)"noise!", 6, buf + n, 14);
+        while (n < start + 261) {
+            buf[n++] = 0x42;
+        }
+    }
+    for (rep = 0; rep < 4; rep++) {
+        for (k = 0; k < 64; k++) {
+            buf[n++] = 0x00;
+            buf[n++] = 0xFF;
+            buf[n++] = 0x5A;
+            buf[n++] = (uint8_t)(255 - 4 * k);
+        }
+    }
+    for (rep = 0; rep < 4; rep++) {
+        size_t start = n;
+        buf[n++] = 0x00;
+        buf[n++] = 0xFF;
+        buf[n++] = 0x5A;
+        buf[n++] = 0xFF;
+        for (k = 0; k < 31; k++) {
+            n += (size_t)tase_frame_build(0x00, (uint8_t)k, NULL, 0, buf + n, 8);
+        }
+        while (n < start + 261) {
+            buf[n] = (uint8_t)(0x11 + n % 7);
+            n++;
+        }
+    }
+    assert_int_equal(n, sizeof(buf));
+    for (mode = FEED_BYTES; mode <= FEED_STOP; mode++) {
+        differential(&rx, got, want, buf, n, mode);
+    }
+    assert_int_equal(got->n, 6 + 4 * 31);
+    /* byte by byte with tase_rx_push() against feeds of 16 and 64 bytes
+     * (the longest calls of docs/TIMING.md) and of odd sizes */
+    assert_int_equal(tase_rx_init(&one), TASE_OK);
+    ref->n = 0;
+    for (i = 0; i < n; i++) {
+        assert_true(tase_rx_push(&one, buf[i], record, ref) >= 0);
+    }
+    for (chunk = 3; chunk <= 64; chunk = chunk * 2 + 1) {
+        for (k = 0; k < 2; k++) {
+            size_t size = k == 0 ? chunk : 16u * (chunk / 16u + 1u);
+            assert_int_equal(tase_rx_init(&rx), TASE_OK);
+            got->n = 0;
+            for (i = 0; i < n; i += size) {
+                assert_true(tase_rx_feed(&rx, buf + i, n - i < size ? n - i : size, record, got) >=
+                            0);
+            }
+            assert_int_equal(got->n, ref->n);
+            for (i = 0; i < got->n; i++) {
+                assert_int_equal(got->f[i].offset, ref->f[i].offset);
+                assert_int_equal(got->f[i].seen_at, ref->f[i].seen_at);
+            }
+            assert_memory_equal(&rx.stats, &one.stats, sizeof(rx.stats));
+        }
+    }
+    free(got);
+    free(want);
+    free(ref);
+}
+
 static void sync_inside_a_delivered_frame_starts_nothing(void **state)
 {
     tase_rx_t rx;
@@ -1787,6 +1878,7 @@ int main(void)
         cmocka_unit_test(an_empty_read_after_the_limit_settles_stale_candidates),
         cmocka_unit_test(receiver_matches_the_reference_with_quiet_times),
         cmocka_unit_test(one_byte_never_decides_the_whole_window_at_once),
+        cmocka_unit_test(a_lagging_scan_gives_the_same_frames_for_any_split),
         cmocka_unit_test(sync_inside_a_delivered_frame_starts_nothing),
         cmocka_unit_test(counters_only_reset_on_request),
         cmocka_unit_test(every_call_from_inside_the_callback_is_refused_or_safe),
