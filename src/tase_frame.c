@@ -15,8 +15,8 @@
  *     candidate whose last byte has not come (Size >= 2 known, `end` the
  *     index of its last byte): the scan has caught up (lag 0); or
  *   - bytes not yet examined (lag 1): a call stopped scanning because it
- *     had spent its budget. Each later call, even one that brings no byte,
- *     continues the scan before anything else, with a new budget.
+ *     had spent its credit. Each later call, even one that brings no byte,
+ *     continues the scan before anything else, with the credit it brings.
  * The scan position never moves back: each position is examined once and
  * each candidate judged once.
  *
@@ -29,22 +29,27 @@
  * just came, that is 2 bytes back. (compact() moves the constant, not the
  * sums: the differences stay right.)
  *
- * BUDGET. A call spends at most RX_BUDGET work units on the scan per byte
- * it takes in (a unit is about one byte examined, summed or moved; a
- * delivery counts RX_COST_FRAME), and then stops with lag 1. Whatever
- * work the window holds is bounded (RX_WORK_MAX below), so a frame comes
- * out at most RX_WORK_MAX / RX_BUDGET + 1 bytes after the byte that
- * decides it (frame.h, LATENCY). A byte that finds the window full first
- * makes room: one step of the scan if the scan is at buf[0], then
+ * CREDIT. Every byte taken in brings RX_BUDGET units of scan work (a
+ * unit is about an instruction on a Cortex-M4; see the costs below); the
+ * scan spends them and stops with lag 1 when they run out. What a byte
+ * leaves is kept in `bank` (with `bank_at`, the byte count then) up to
+ * RX_BANK_MAX, so the credit of a byte depends on the byte count only and
+ * a quiet receiver settles an isolated failure at once. While tase_rx_feed()
+ * has input left, a scan that runs out takes the next byte in itself
+ * (take()) instead of returning to run() for it. Whatever work the window
+ * holds is bounded (RX_WORK_MAX below), so a frame comes out at most
+ * TASE_RX_LATE_MAX bytes after the byte that decides it (frame.h,
+ * LATENCY). A byte that finds the window full first makes room: one step
+ * of the scan if the scan is at buf[0] (on top of the credit), then
  * compact().
  *
  * tase_rx_push() stores a byte inside a held candidate with one test
  * (len < end) and nothing saved but the return address; the sync and Size
  * bytes of a frame (push_other()), the last byte of a candidate
  * (push_last()) and every other byte (the general path, run()) are out of
- * line. Every other path runs
- * with `busy` set and `end` zero, so that test fails while a callback runs
- * and a re-entrant call lands on the busy check.
+ * line, and so are the bytes of a lagging scan (push_lag()). Every other
+ * path runs with `busy` set and `end` RX_BLOCKED, so that test fails while
+ * a callback runs and a re-entrant call lands on the busy check.
  */
 #include "tase/frame.h"
 
@@ -55,14 +60,16 @@
 
 #define RX_CAP ((uint16_t)TASE_RX_WINDOW)
 
-/* Work units of the scan per byte taken in (frame.h COST). A unit is
- * about one instruction of the scan on a Cortex-M4 (measured: bench/,
- * docs/TIMING.md), so that the budget bounds the time of a call and not
- * only its steps: every position the scan examines costs RX_COST_STEP,
- * every noise byte walked RX_COST_NOISE, a complete candidate judged
- * RX_COST_JUDGE plus a unit per byte summed, a delivery RX_COST_FRAME. A
- * step starts only with at least RX_COST_STEP left, or when it only
- * holds (the scan has caught up: that needs no budget). */
+/* The scan's credit per byte taken in and its cap (frame.h COST, CREDIT
+ * above), in units of about one instruction of the scan on a Cortex-M4
+ * (measured: bench/, docs/TIMING.md), so that the credit bounds the time
+ * of a call and not only its steps: every position the scan examines
+ * costs RX_COST_STEP, every noise byte walked RX_COST_NOISE, a complete
+ * candidate judged RX_COST_JUDGE plus a unit per byte summed, a delivery
+ * RX_COST_FRAME. A step starts only with at least RX_COST_STEP left (or
+ * when it only holds: the scan has caught up, which needs no credit), a
+ * judgement only with RX_COST_JUDGE left, and a noise walk goes only as
+ * far as what is left pays for. */
 #define RX_BUDGET 128u
 #define RX_BANK_MAX 384u
 #define RX_COST_STEP 24u
@@ -80,9 +87,9 @@
  * the reference decides at byte t lies in the window at t with everything
  * before it, and every byte from t on brings RX_BUDGET units (a byte never
  * waits behind a full window: the byte that finds it full is stored after
- * a step taken on top of the budget). So the frame is delivered by the
- * call that takes byte t + RX_WORK_MAX / RX_BUDGET (rounded up, see the
- * check below) at the latest: TASE_RX_LATE_MAX. */
+ * a step taken on top of the credit). So the frame is delivered by the
+ * call that takes byte t + (RX_WORK_MAX + RX_COST_JUDGE) / RX_BUDGET
+ * (rounded up, see the checks below) at the latest: TASE_RX_LATE_MAX. */
 #define RX_WORK_MAX                                                                                \
     ((uint32_t)RX_CAP * (RX_COST_STEP + RX_COST_NOISE) +                                           \
      ((uint32_t)RX_CAP / 4u + 1u) * (RX_COST_JUDGE + (uint32_t)RX_CAP / 2u) +                      \
@@ -343,7 +350,7 @@ static void hold(tase_rx_t *rx, size_t s, size_t flen)
 
 /* Whether the scan, at p with avail bytes, has caught up: a partial sync
  * or a candidate whose last byte is still to come (what advance() holds;
- * O(1), so it needs no budget). */
+ * O(1), so it needs no credit). */
 RX_INLINE static bool holds(const uint8_t *p, size_t avail)
 {
     if (p[0] != TASE_SYNC1) {
@@ -378,7 +385,9 @@ RX_INLINE static int32_t take(tase_rx_t *rx, rx_call_t *c, size_t len, int32_t b
 }
 
 /* The greedy scan from buf[scan] on, until it has caught up (lag 0) or
- * spent `budget` units (lag 1). `final`: end of input, so an incomplete
+ * spent `allowance` units and, in a tase_rx_feed(), the credit of every
+ * byte it took in itself (lag 1); what is left goes to the bank unless
+ * nothing is left to decide. `final`: end of input, so an incomplete
  * candidate or partial sync fails like a bad one. Returns false when a
  * callback re-initialised the receiver. */
 static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
@@ -653,8 +662,9 @@ static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
  * settle everything. Bytes that cannot decide anything are taken in bulk:
  * noise while nothing is held, the sync and Size bytes of a frame, and
  * the bytes of a held candidate before its last one. Every other byte is
- * stored and the scan runs on with a budget of RX_BUDGET: the result is
- * the same for any split of the stream into calls. */
+ * stored and the scan runs on with its credit, taking the bytes after it
+ * in itself while it lags: the result is the same for any split of the
+ * stream into calls. */
 static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx_handler_t on_frame,
                void *user)
 {
@@ -802,8 +812,9 @@ RX_NOINLINE static int push_lag(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_f
 
 /* tase_rx_push() for the last byte of a held candidate that failed: the
  * byte is stored, the scan moves past the candidate's first byte (00) and
- * goes on with what is left of the budget after this judgement, exactly
- * as in run() (where advance() judges it: a step and 2 bytes summed), so
+ * goes on with what is left of the credit after this judgement, exactly
+ * as in run() (where advance() judges it: a step, a judgement and 2 bytes
+ * summed), so
  * that any split of the stream gives the same result. */
 RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
