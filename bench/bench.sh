@@ -427,9 +427,9 @@ echo "wrote $out"
     done
     echo
     echo "\`tase_rx_flush\` and a settling \`tase_rx_tick\` decide the whole window at once (end of"
-    echo "input); every other receiver call spends at most a fixed budget of scan work per byte it"
-    echo "takes in (include/tase/frame.h, COST), so a \`tase_rx_feed\` of n bytes costs at most n times"
-    echo "the longest \`tase_rx_push\` plus its copying."
+    echo "input); every other receiver call spends at most the scan's credit: a capped bank and a"
+    echo "fixed amount per byte it takes in (include/tase/frame.h, COST), so a \`tase_rx_feed\` of n"
+    echo "bytes costs at most the longest \`tase_rx_push\` plus n - 1 bytes' credit and its copying."
     echo
     echo "How the inputs are built (\`bench/cm/timing*.c\`):"
     echo

@@ -293,13 +293,21 @@ static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, tase_rx_ha
     return rx->busy != 0u;
 }
 
-/* deliver() out of line, for the scan: its tase_frame_t then lives only
- * while the callback runs, not in advance()'s frame for the whole scan
- * (the push path's stack, docs/FOOTPRINT.md). */
-RX_NOINLINE static bool deliver_from_scan(tase_rx_t *rx, const uint8_t *f, uint32_t offset,
-                                          const rx_call_t *c)
+/* The scan's delivery, out of line: the frame f[0..Size+6) at stream
+ * offset `offset` handed to c's callback (not NULL; the caller counts the
+ * frame and looks at `busy` afterwards). The tase_frame_t then lives only
+ * while the callback runs, not in advance()'s frame for the whole scan,
+ * and this frame holds nothing else (the push path's stack,
+ * docs/FOOTPRINT.md). */
+RX_NOINLINE static void hand_on(const uint8_t *f, uint32_t offset, const rx_call_t *c)
 {
-    return deliver(rx, f, offset, c->on_frame, c->user);
+    tase_frame_t fr;
+    fr.offset = offset;
+    fr.group = f[4];
+    fr.type = f[5];
+    fr.len = (uint8_t)(f[3] - 2u);
+    fr.data = &f[TASE_FRAME_HEADER];
+    c->on_frame(c->user, &fr);
 }
 
 /* Drop the decided bytes buf[0..scan): the rest moves to the front. The
@@ -500,7 +508,11 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
                     rx->sum_scan = (uint16_t)sum;
                     rx->stats.bytes_discarded += dropped;
                     dropped = 0u;
-                    live = deliver_from_scan(rx, p, rx->stats.bytes_in - (uint32_t)avail, c);
+                    rx->stats.frames_ok++;
+                    if (c->on_frame != NULL) {
+                        hand_on(p, rx->stats.bytes_in - (uint32_t)avail, c);
+                    }
+                    live = rx->busy != 0u;
                     if (!live) {
                         return false; /* re-initialised: leave rx alone */
                     }
@@ -657,24 +669,36 @@ static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
     return (c->count > (uint32_t)INT_MAX) ? INT_MAX : (int)c->count;
 }
 
-/* The general path: feed data[0..n) (data not NULL; n may be 0: only continue a
- * lagging scan), then, if `final` (tase_rx_flush(), a settling tick),
- * settle everything. Bytes that cannot decide anything are taken in bulk:
- * noise while nothing is held, the sync and Size bytes of a frame, and
- * the bytes of a held candidate before its last one. Every other byte is
- * stored and the scan runs on with its credit, taking the bytes after it
- * in itself while it lags: the result is the same for any split of the
- * stream into calls. */
-static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx_handler_t on_frame,
-               void *user)
+/* A call that brings no byte (a 0-byte tase_rx_feed(), tase_rx_flush(),
+ * a tick): a lagging scan goes on with one byte's credit, then, if
+ * `final` (tase_rx_flush(), a settling tick), everything is settled. Four
+ * arguments, so that the wrappers reach it by a tail call. */
+static int scan_only(tase_rx_t *rx, bool final, tase_rx_handler_t on_frame, void *user)
+{
+    rx_call_t c = {on_frame, user, 0u, NULL};
+    bool live = true;
+    begin(rx);
+    if (rx->lag != 0u) {
+        live = scan_on(rx, &c, 0u);
+    }
+    if (live && final) {
+        live = advance(rx, &c, RX_UNLIMITED, true);
+    }
+    return finish(rx, &c, live);
+}
+
+/* The general path: feed data[0..n) (data not NULL, n > 0). Bytes that
+ * cannot decide anything are taken in bulk: noise while nothing is held,
+ * the sync and Size bytes of a frame, and the bytes of a held candidate
+ * before its last one. Every other byte is stored and the scan runs on
+ * with its credit, taking the bytes after it in itself while it lags: the
+ * result is the same for any split of the stream into calls. */
+static int run(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame, void *user)
 {
     rx_call_t c = {on_frame, user, 0u, NULL};
     size_t i = 0;
     bool live = true;
     begin(rx);
-    if (n == 0u && rx->lag != 0u) {
-        live = scan_on(rx, &c, 0u);
-    }
     while (live && i < n && rx->stop == 0u) {
         if (rx->lag == 0u) {
             size_t k = 0;
@@ -733,9 +757,6 @@ static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx
             c.in = NULL;
             i = (size_t)(in.next - data);
         }
-    }
-    if (live && final) {
-        live = advance(rx, &c, RX_UNLIMITED, true);
     }
     return finish(rx, &c, live);
 }
@@ -928,18 +949,18 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
     if (r != TASE_OK) {
         return r;
     }
-    return run(rx, (data != NULL) ? data : rx->buf, n, false, on_frame, user); /* n 0 if NULL */
+    return (n == 0u) ? scan_only(rx, false, on_frame, user) : run(rx, data, n, on_frame, user);
 }
 
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
 {
     int r = rx_check(rx);
-    return (r != TASE_OK) ? r : run(rx, rx->buf, 0u, true, on_frame, user);
+    return (r != TASE_OK) ? r : scan_only(rx, true, on_frame, user);
 }
 
 /* The time bound's two ways into the scan (tase_frame_private.h): thin
- * wrappers, so that the static rx_check() and run() keep the callers gcc
- * compiled them for. */
+ * wrappers, so that the static rx_check() and scan_only() keep the
+ * callers gcc compiled them for. */
 int tase_rx_state_check(const tase_rx_t *rx)
 {
     return rx_check(rx);
@@ -947,5 +968,5 @@ int tase_rx_state_check(const tase_rx_t *rx)
 
 int tase_rx_continue(tase_rx_t *rx, bool settle, tase_rx_handler_t on_frame, void *user)
 {
-    return run(rx, rx->buf, 0u, settle, on_frame, user);
+    return scan_only(rx, settle, on_frame, user);
 }
