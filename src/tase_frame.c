@@ -533,6 +533,8 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
             } else {
                 /* end of input: it can no longer complete */
             }
+        } else {
+            /* 00 not followed by FF 5A */
         }
         /* no frame here: the scan moves on one byte (a first sync byte is
          * 00: the sum does not change) */
