@@ -382,6 +382,9 @@ RX_INLINE static int32_t take(tase_rx_t *rx, rx_call_t *c, size_t len, int32_t b
     if (c->in == NULL || c->in->next == c->in->end || len >= RX_CAP) {
         return -1;
     }
+    /* what the scan of the byte before would have kept (scan_on()) */
+    rx->bank = (uint16_t)((budget > 0) ? budget : 0);
+    rx->bank_at = (uint16_t)rx->stats.bytes_in;
     byte = *c->in->next;
     c->in->next++;
     rx->buf[len] = byte;
@@ -706,7 +709,7 @@ static int run(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t o
             size_t k = 0;
             size_t s = rx->scan;
             size_t held = (size_t)rx->len - s;
-            if (held == 0u) {
+            if (held == 0u && data[i] != TASE_SYNC1) {
                 /* nothing held: noise up to the next 00 is decided now */
                 const uint8_t *z = memchr(&data[i], TASE_SYNC1, n - i);
                 k = (z != NULL) ? (size_t)(z - &data[i]) : n - i;
@@ -737,7 +740,9 @@ static int run(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t o
                     rx->stats.bytes_in += (uint32_t)k;
                 }
             } else {
-                /* the sync and Size bytes */
+                /* the sync and Size bytes (a 00 while nothing is held too,
+                 * exactly as tase_rx_push() takes them: no scan, so the
+                 * scan's credit is the same for any split) */
                 (void)hunt(rx, data[i]);
                 k = 1u;
             }
@@ -877,7 +882,9 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     rx->busy = 1u;
     rx->end = RX_BLOCKED;
     (void)deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), on_frame, user);
-    /* hunting from here; also right when the callback re-initialised or stopped rx */
+    /* hunting from here; also right when the callback re-initialised or
+     * stopped rx (frame.h, RE-ENTRANCY: nothing else may be called on rx
+     * after a re-initialisation until the callback returns) */
     rx->end = 0u;
     rx->stop = 0u;
     rx->busy = 0u;

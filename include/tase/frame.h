@@ -55,7 +55,10 @@
  * greedy scan exactly; only that moment moves. In the callback,
  * stats.bytes_in counts the bytes fed up to the delivering byte, and the
  * other counters the candidates judged so far. The result is the same for
- * any split of the stream into calls (seen_at included).
+ * any split of the stream into calls that take bytes (seen_at included);
+ * a call with no byte (a 0-byte tase_rx_feed(), a tick) continues a
+ * lagging scan with a byte's worth of work, so frames may come out
+ * earlier with such calls between, never later.
  * tase_rx_flush() settles whatever is pending at end of input: the scan
  * catches up, pending candidates can no longer complete, so they fail and
  * what they were hiding is scanned.
@@ -143,7 +146,11 @@
  *   - tase_rx_init() is allowed: the receiver is reset, and the call that
  *     made the callback returns as soon as the callback does, with the
  *     number of frames it delivered; the rest of its input is not consumed
- *     (nor counted in bytes_in);
+ *     (nor counted in bytes_in). Call nothing else on the receiver after
+ *     it until the callback returns: it is no longer guarded as busy, and
+ *     a call that took a frame's last byte resets it to hunting when the
+ *     callback returns (whatever was fed in between is lost and later
+ *     calls may find it visibly corrupted: TASE_EARG);
  *   - tase_rx_stop() is allowed: the call returns after this frame (see
  *     there), so the frame can be handled with the receiver's stack
  *     unwound.
@@ -220,7 +227,8 @@ typedef struct {
     /* The time bound (TIME BOUND above): the link's byte rate and margin
      * (tase_rx_set_timing()), stats.bytes_in at the last tase_rx_tick()
      * and the now_ms of the last tick that saw new bytes (`ticked` says
-     * whether those two are set yet). */
+     * whether those two are set yet, and that a settling tick a callback
+     * stopped is to go on). */
     uint32_t rate;
     uint32_t tick_bytes;
     uint32_t quiet_since;
