@@ -125,6 +125,24 @@ static size_t gen_burst(uint8_t *buf, size_t cap)
     return n;
 }
 
+/* 00 FF 5A FF, then 257 noise bytes without a 00: the false candidate
+ * fails on its 261st byte and the scan walks the 257 noise bytes it was
+ * holding. Repeated. */
+static size_t gen_heldnoise(uint8_t *buf, size_t cap)
+{
+    size_t n = 0, k;
+    while (n + 261u <= cap) {
+        buf[n++] = 0x00;
+        buf[n++] = 0xFF;
+        buf[n++] = 0x5A;
+        buf[n++] = 0xFF;
+        for (k = 0; k < 257u; k++) {
+            buf[n++] = (uint8_t)(0x11u + k % 0xEEu);
+        }
+    }
+    return n;
+}
+
 size_t bench_stream(const char *name, uint8_t *buf, size_t cap)
 {
     size_t i;
@@ -133,6 +151,9 @@ size_t bench_stream(const char *name, uint8_t *buf, size_t cap)
     }
     if (strcmp(name, "burst") == 0) {
         return gen_burst(buf, cap);
+    }
+    if (strcmp(name, "heldnoise") == 0) {
+        return gen_heldnoise(buf, cap);
     }
     if (strcmp(name, "telemetry") == 0) {
         return gen_telemetry(buf, cap, 0);

@@ -13,6 +13,8 @@
  *              complete false candidates decided by one byte (issue 21)
  *   burst      00 FF 5A FF + 31 valid empty frames + 9 noise bytes,
  *              repeated: one byte releases 31 frames
+ *   heldnoise  00 FF 5A FF + 257 noise bytes without a 00, repeated: the
+ *              scan walks what the failed candidate was holding
  */
 #ifndef BENCH_STREAMS_H
 #define BENCH_STREAMS_H

@@ -15,8 +15,8 @@
  *     candidate whose last byte has not come (Size >= 2 known, `end` the
  *     index of its last byte): the scan has caught up (lag 0); or
  *   - bytes not yet examined (lag 1): a call stopped scanning because it
- *     had spent its budget. Each later call, even one that brings no byte,
- *     continues the scan before anything else, with a new budget.
+ *     had spent its credit. Each later call, even one that brings no byte,
+ *     continues the scan before anything else, with the credit it brings.
  * The scan position never moves back: each position is examined once and
  * each candidate judged once.
  *
@@ -29,22 +29,27 @@
  * just came, that is 2 bytes back. (compact() moves the constant, not the
  * sums: the differences stay right.)
  *
- * BUDGET. A call spends at most RX_BUDGET work units on the scan per byte
- * it takes in (a unit is about one byte examined, summed or moved; a
- * delivery counts RX_COST_FRAME), and then stops with lag 1. Whatever
- * work the window holds is bounded (RX_WORK_MAX below), so a frame comes
- * out at most RX_WORK_MAX / RX_BUDGET + 1 bytes after the byte that
- * decides it (frame.h, LATENCY). A byte that finds the window full first
- * makes room: one step of the scan if the scan is at buf[0], then
+ * CREDIT. Every byte taken in brings RX_BUDGET units of scan work (a
+ * unit is about an instruction on a Cortex-M4; see the costs below); the
+ * scan spends them and stops with lag 1 when they run out. What a byte
+ * leaves is kept in `bank` (with `bank_at`, the byte count then) up to
+ * RX_BANK_MAX, so the credit of a byte depends on the byte count only and
+ * a quiet receiver settles an isolated failure at once. While tase_rx_feed()
+ * has input left, a scan that runs out takes the next byte in itself
+ * (take()) instead of returning to run() for it. Whatever work the window
+ * holds is bounded (RX_WORK_MAX below), so a frame comes out at most
+ * TASE_RX_LATE_MAX bytes after the byte that decides it (frame.h,
+ * LATENCY). A byte that finds the window full first makes room: one step
+ * of the scan if the scan is at buf[0] (on top of the credit), then
  * compact().
  *
  * tase_rx_push() stores a byte inside a held candidate with one test
  * (len < end) and nothing saved but the return address; the sync and Size
  * bytes of a frame (push_other()), the last byte of a candidate
  * (push_last()) and every other byte (the general path, run()) are out of
- * line. Every other path runs
- * with `busy` set and `end` zero, so that test fails while a callback runs
- * and a re-entrant call lands on the busy check.
+ * line, and so are the bytes of a lagging scan (push_lag()). Every other
+ * path runs with `busy` set and `end` RX_BLOCKED, so that test fails while
+ * a callback runs and a re-entrant call lands on the busy check.
  */
 #include "tase/frame.h"
 
@@ -55,34 +60,51 @@
 
 #define RX_CAP ((uint16_t)TASE_RX_WINDOW)
 
-/* Work units of the scan per byte taken in, and what a delivery costs
- * (frame.h COST; the unit is about one byte touched). */
-#define RX_BUDGET 96u
-#define RX_COST_STEP 16u
-#define RX_COST_FRAME 16u
-#define RX_UNLIMITED UINT32_MAX
+/* The scan's credit per byte taken in and its cap (frame.h COST, CREDIT
+ * above), in units of about one instruction of the scan on a Cortex-M4
+ * (measured: bench/, docs/TIMING.md), so that the credit bounds the time
+ * of a call and not only its steps: every position the scan examines
+ * costs RX_COST_STEP, every noise byte walked RX_COST_NOISE, a complete
+ * candidate judged RX_COST_JUDGE plus a unit per byte summed, a delivery
+ * RX_COST_FRAME. A step starts only with at least RX_COST_STEP left (or
+ * when it only holds: the scan has caught up, which needs no credit), a
+ * judgement only with RX_COST_JUDGE left, and a noise walk goes only as
+ * far as what is left pays for. */
+#define RX_BUDGET 128u
+#define RX_BANK_MAX 384u
+#define RX_COST_STEP 24u
+#define RX_COST_NOISE 4u
+#define RX_COST_JUDGE 48u
+#define RX_COST_FRAME 48u
+#define RX_UNLIMITED INT32_MAX
 
 /* Work a window can hold for the scan, in units: every position a step
- * (RX_COST_STEP), every judged candidate (one per sync, so at most every
- * third position) a sum of at most half the window (the shorter of the
- * two ways, which together span at most the window), every frame
- * delivered (at least 8 bytes each) RX_COST_FRAME, noise bytes summed and
- * one compaction (a unit per byte each). A frame the reference decides at
- * byte t lies in the window at t with everything before it, and every
- * byte from t on brings RX_BUDGET units (a byte never waits behind a
- * full window: the byte that finds it full is stored after a step taken
- * on top of the budget). So it is delivered by the call that takes byte
- * t + RX_WORK_MAX / RX_BUDGET at the latest: TASE_RX_LATE_MAX. */
+ * and a noise byte; every judged candidate (00 FF 5A Size with Size >= 2:
+ * the next one starts 4 bytes later at the earliest) RX_COST_JUDGE and a
+ * sum of at most half the window (the shorter of the two ways, which
+ * together span at most the window); every frame delivered (at least 8
+ * bytes each) RX_COST_FRAME; and one compaction (a unit per byte). A frame
+ * the reference decides at byte t lies in the window at t with everything
+ * before it, and every byte from t on brings RX_BUDGET units (a byte never
+ * waits behind a full window: the byte that finds it full is stored after
+ * a step taken on top of the credit). So the frame is delivered by the
+ * call that takes byte t + (RX_WORK_MAX + RX_COST_JUDGE) / RX_BUDGET
+ * (rounded up, see the checks below) at the latest: TASE_RX_LATE_MAX. */
 #define RX_WORK_MAX                                                                                \
-    ((uint32_t)RX_CAP * RX_COST_STEP + ((uint32_t)RX_CAP / 3u + 1u) * ((uint32_t)RX_CAP / 2u) +    \
+    ((uint32_t)RX_CAP * (RX_COST_STEP + RX_COST_NOISE) +                                           \
+     ((uint32_t)RX_CAP / 4u + 1u) * (RX_COST_JUDGE + (uint32_t)RX_CAP / 2u) +                      \
      ((uint32_t)RX_CAP / 8u) * RX_COST_FRAME + 2u * (uint32_t)RX_CAP)
-/* A judgement costs a step and at least 2 bytes summed; the last step may
- * overrun the budget, and a byte that finds the window full takes one
- * more. */
-typedef char
-    tase_rx_judge_check[RX_BUDGET / (RX_COST_STEP + 2u) + 2u <= TASE_RX_JUDGE_MAX ? 1 : -1];
-typedef char
-    tase_rx_late_check[(RX_WORK_MAX + RX_BUDGET - 1u) / RX_BUDGET <= TASE_RX_LATE_MAX ? 1 : -1];
+/* A judgement costs at least RX_COST_STEP + RX_COST_JUDGE + 2; the last
+ * one may overrun the credit, and a byte that finds the window full takes
+ * one step more. */
+typedef char tase_rx_judge_check
+    [RX_BANK_MAX / (RX_COST_STEP + RX_COST_JUDGE + 2u) + 2u <= TASE_RX_JUDGE_MAX ? 1 : -1];
+/* A lagging scan stops with less than RX_COST_JUDGE left, and what it
+ * leaves plus a byte's RX_BUDGET never exceeds RX_BANK_MAX: so over m
+ * bytes it spends at least m * RX_BUDGET - RX_COST_JUDGE + 1 units. */
+typedef char tase_rx_bank_check[RX_COST_JUDGE + RX_BUDGET <= RX_BANK_MAX ? 1 : -1];
+typedef char tase_rx_late_check
+    [(RX_WORK_MAX + RX_COST_JUDGE + RX_BUDGET - 1u) / RX_BUDGET <= TASE_RX_LATE_MAX ? 1 : -1];
 
 /* Keeps the other paths of tase_rx_push() out of line, so that its fast
  * path (a byte inside a frame) saves nothing but the return address. GCC
@@ -172,6 +194,13 @@ uint16_t tase_checksum(uint16_t seed, const uint8_t *p, size_t n)
         sum = __usada8(w0, 0u, sum);
         sum = __usada8(w1, 0u, sum);
     }
+    if (n - i >= 4u) {
+        uint32_t w;
+        /* cppcheck-suppress misra-c2012-21.15 */
+        (void)memcpy(&w, &p[i], 4u);
+        sum = __usada8(w, 0u, sum);
+        i += 4u;
+    }
 #elif RX_WORDS
     while (n - i >= sizeof(sum_word_t)) {
         sum_word_t lanes = 0u;
@@ -234,7 +263,16 @@ typedef struct {
     tase_rx_handler_t on_frame;
     void *user;
     uint32_t count;
+    /* tase_rx_feed()'s input not taken in yet: bytes advance() takes in
+     * itself while the scan lags (see take()); NULL for the others */
+    struct rx_input *in;
 } rx_call_t;
+
+/* The input of a tase_rx_feed() call from `next` to `end`. */
+struct rx_input {
+    const uint8_t *next;
+    const uint8_t *end;
+};
 
 /* Count and hand on the valid frame f[0..Size+6) at stream offset
  * `offset`. Returns false when the callback re-initialised the receiver:
@@ -253,6 +291,23 @@ static bool deliver(tase_rx_t *rx, const uint8_t *f, uint32_t offset, tase_rx_ha
         on_frame(user, &fr);
     }
     return rx->busy != 0u;
+}
+
+/* The scan's delivery, out of line: the frame f[0..Size+6) at stream
+ * offset `offset` handed to c's callback (not NULL; the caller counts the
+ * frame and looks at `busy` afterwards). The tase_frame_t then lives only
+ * while the callback runs, not in advance()'s frame for the whole scan,
+ * and this frame holds nothing else (the push path's stack,
+ * docs/FOOTPRINT.md). */
+RX_NOINLINE static void hand_on(const uint8_t *f, uint32_t offset, const rx_call_t *c)
+{
+    tase_frame_t fr;
+    fr.offset = offset;
+    fr.group = f[4];
+    fr.type = f[5];
+    fr.len = (uint8_t)(f[3] - 2u);
+    fr.data = &f[TASE_FRAME_HEADER];
+    c->on_frame(c->user, &fr);
 }
 
 /* Drop the decided bytes buf[0..scan): the rest moves to the front. The
@@ -289,12 +344,6 @@ static void compact(tase_rx_t *rx)
     rx->scan = 0u;
 }
 
-/* Take `units` from the budget, down to zero. */
-static uint32_t spend(uint32_t budget, size_t units)
-{
-    return (budget > units) ? budget - (uint32_t)units : 0u;
-}
-
 /* The scan has caught up with something to hold at buf[s]: a partial
  * sync, or a candidate of flen bytes still incomplete. A partial sync
  * moves to the front (at most 3 bytes), a candidate only if the window
@@ -307,95 +356,227 @@ static void hold(tase_rx_t *rx, size_t s, size_t flen)
     }
 }
 
+/* Whether the scan, at p with avail bytes, has caught up: a partial sync
+ * or a candidate whose last byte is still to come (what advance() holds;
+ * O(1), so it needs no credit). */
+RX_INLINE static bool holds(const uint8_t *p, size_t avail)
+{
+    if (p[0] != TASE_SYNC1) {
+        return false;
+    }
+    if (avail < 4u) {
+        return avail == 1u || (p[1] == TASE_SYNC2 && (avail == 2u || p[2] == TASE_SYNC3));
+    }
+    return p[1] == TASE_SYNC2 && p[2] == TASE_SYNC3 && p[3] >= 2u && (size_t)p[3] + 6u > avail;
+}
+
+/* A scan that has spent its credit while tase_rx_feed() has more input
+ * takes the next byte in itself, exactly as the call would (put(), then
+ * scan_on() with the credit that byte brings), without leaving the scan:
+ * returns the new credit, or -1 when there is no byte to take or the
+ * window is full (the caller's put() makes room first). */
+RX_INLINE static int32_t take(tase_rx_t *rx, rx_call_t *c, size_t len, int32_t budget)
+{
+    uint8_t byte;
+    uint32_t units;
+    if (c->in == NULL || c->in->next == c->in->end || len >= RX_CAP) {
+        return -1;
+    }
+    /* what the scan of the byte before would have kept (scan_on()) */
+    rx->bank = (uint16_t)((budget > 0) ? budget : 0);
+    rx->bank_at = (uint16_t)rx->stats.bytes_in;
+    byte = *c->in->next;
+    c->in->next++;
+    rx->buf[len] = byte;
+    rx->len = (uint16_t)(len + 1u);
+    rx->sum_len = (uint16_t)(rx->sum_len + byte);
+    rx->stats.bytes_in++;
+    units = ((budget > 0) ? (uint32_t)budget : 0u) + RX_BUDGET;
+    return (int32_t)((units < RX_BANK_MAX) ? units : RX_BANK_MAX);
+}
+
 /* The greedy scan from buf[scan] on, until it has caught up (lag 0) or
- * spent `budget` units (lag 1). `final`: end of input, so an incomplete
+ * spent `allowance` units and, in a tase_rx_feed(), the credit of every
+ * byte it took in itself (lag 1); what is left goes to the bank unless
+ * nothing is left to decide. `final`: end of input, so an incomplete
  * candidate or partial sync fails like a bad one. Returns false when a
  * callback re-initialised the receiver. */
-static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
+static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
 {
-    uint32_t budget = allowance;
-    while (rx->stop == 0u) { /* tase_rx_stop() ends the call (and sets lag) */
-        size_t s = rx->scan;
-        size_t len = rx->len;
+    int32_t budget = allowance; /* signed: a step may overrun what is left */
+    const uint8_t *b = rx->buf;
+    size_t s = rx->scan;
+    size_t len = rx->len;
+    uint32_t sum = rx->sum_scan; /* the running sum up to buf[s] (mod 2^16) */
+    uint32_t dropped = 0;        /* bytes discarded, not yet counted */
+    bool live = true;
+    if (rx->stop != 0u) {
+        return true; /* stopped by a callback of this call */
+    }
+    for (;;) {
         size_t avail = len - s;
-        const uint8_t *p = &rx->buf[s];
+        const uint8_t *p = &b[s];
         size_t k = 1;
         if (avail == 0u) {
             /* all decided: start the window over */
-            rx->len = 0u;
-            rx->scan = 0u;
+            len = 0u;
+            s = 0u;
             rx->lag = 0u;
-            return true;
+            break;
         }
-        if (budget == 0u) {
-            rx->lag = 1u;
-            return true;
-        }
-        budget = spend(budget, RX_COST_STEP);
-        if (p[0] != TASE_SYNC1) {
-            /* noise up to the next 00 (summed on the way) */
-            uint16_t sum = (uint16_t)(rx->sum_scan + p[0]);
-            while (k < avail && p[k] != TASE_SYNC1) {
-                sum = (uint16_t)(sum + p[k]);
-                k++;
+        if (budget < (int32_t)RX_COST_STEP && !holds(p, avail)) {
+            /* the credit is spent: the next byte brings more */
+            int32_t more = take(rx, c, len, budget);
+            if (more < 0) {
+                rx->lag = 1u; /* the next call goes on */
+                break;
             }
-            rx->sum_scan = sum;
-            rx->stats.bytes_discarded += (uint32_t)k;
-            rx->scan = (uint16_t)(s + k);
-            budget = spend(budget, k);
+            budget = more;
+            len++;
             continue;
         }
-        while (k < 3u && k < avail && p[k] == sync[k]) {
-            k++;
+        budget -= (int32_t)RX_COST_STEP;
+        if (p[0] != TASE_SYNC1) {
+            /* noise up to the next 00 (summed on the way), as far as what
+             * is left pays for */
+            size_t lim = (budget > 0) ? (size_t)budget / RX_COST_NOISE + 1u : 1u;
+            if (lim > avail) {
+                lim = avail;
+            }
+            sum += p[0];
+            while (k < lim && p[k] != TASE_SYNC1) {
+                sum += p[k];
+                k++;
+            }
+            dropped += (uint32_t)k;
+            s += k;
+            budget -= (int32_t)(k * RX_COST_NOISE);
+            continue;
         }
-        if (k == avail && !final) {
-            hold(rx, s, RX_CAP); /* a sync still arriving: to the front */
-            return true;
-        }
-        if (k == 3u && avail > 3u) {
+        if (avail < 4u) {
+            while (k < avail && p[k] == sync[k]) {
+                k++;
+            }
+            if (k == avail && !final) {
+                /* a sync still arriving: to the front */
+                rx->scan = (uint16_t)s;
+                hold(rx, s, RX_CAP);
+                s = rx->scan;
+                len = rx->len;
+                break;
+            }
+        } else if (p[1] == TASE_SYNC2 && p[2] == TASE_SYNC3) {
             size_t flen = (size_t)p[3] + 6u;
             if (p[3] < 2u) {
                 rx->stats.bad_size++;
             } else if (flen <= avail) {
-                /* complete: judge it (see the file comment for the sums) */
-                size_t be = s + flen - 2u;
+                /* complete: judge it, if what is left pays for it (see
+                 * the file comment for the sums: the shorter way to its
+                 * Check_0 byte) */
                 size_t fwd = flen - 2u;
-                size_t bwd = len - be;
-                uint16_t at_be =
-                    (bwd < fwd) ? (uint16_t)(rx->sum_len - tase_checksum(0u, &rx->buf[be], bwd))
-                                : tase_checksum(rx->sum_scan, p, fwd);
-                uint16_t want = (uint16_t)(((uint16_t)p[flen - 2u] << 8) | p[flen - 1u]);
-                budget = spend(budget, (bwd < fwd) ? bwd : fwd);
-                if ((uint16_t)(at_be - rx->sum_scan) == want) {
-                    rx->sum_scan = (uint16_t)(at_be + p[flen - 2u] + p[flen - 1u]);
-                    rx->scan = (uint16_t)(s + flen);
-                    budget = spend(budget, RX_COST_FRAME);
+                size_t bwd = avail - fwd;
+                size_t cost = RX_COST_JUDGE;
+                uint32_t at_be;
+                uint16_t want;
+                if (budget < (int32_t)RX_COST_JUDGE) {
+                    int32_t more = take(rx, c, len, budget);
+                    if (more < 0) {
+                        rx->lag = 1u; /* the next call judges it */
+                        break;
+                    }
+                    budget = more;
+                    len++;
+                    continue;
+                }
+                if (bwd == 2u) {
+                    /* its last byte just came: the sum is 2 bytes back */
+                    at_be = (uint32_t)rx->sum_len - p[fwd] - p[fwd + 1u];
+                    cost += 2u;
+                } else if (bwd < fwd) {
+                    at_be = (uint32_t)rx->sum_len - tase_checksum(0u, &p[fwd], bwd);
+                    cost += bwd;
+                } else {
+                    at_be = sum + tase_checksum(0u, p, fwd);
+                    cost += fwd;
+                }
+                want = (uint16_t)(((uint16_t)p[fwd] << 8) | p[fwd + 1u]);
+                budget -= (int32_t)cost;
+                if ((uint16_t)(at_be - sum) == want) {
+                    sum = at_be + p[fwd] + p[fwd + 1u];
+                    s += flen;
+                    budget -= (int32_t)RX_COST_FRAME;
                     c->count++;
-                    if (!deliver(rx, p, rx->stats.bytes_in - (uint32_t)avail, c->on_frame,
-                                 c->user)) {
-                        return false;
+                    /* the state as the callback may see it */
+                    rx->scan = (uint16_t)s;
+                    rx->sum_scan = (uint16_t)sum;
+                    rx->stats.bytes_discarded += dropped;
+                    dropped = 0u;
+                    rx->stats.frames_ok++;
+                    if (c->on_frame != NULL) {
+                        hand_on(p, rx->stats.bytes_in - (uint32_t)avail, c);
+                    }
+                    live = rx->busy != 0u;
+                    if (!live) {
+                        return false; /* re-initialised: leave rx alone */
                     }
                     if (rx->stop != 0u) {
-                        rx->lag = 1u; /* the next call goes on from here */
+                        rx->lag = 1u; /* stopped: the next call goes on from here */
+                        break;
                     }
                     continue;
                 }
                 rx->stats.checksum_errors++;
             } else if (!final) {
                 /* a candidate whose last byte is still to come */
+                rx->scan = (uint16_t)s;
                 hold(rx, s, flen);
-                return true;
+                s = rx->scan;
+                len = rx->len;
+                break;
             } else {
                 /* end of input: it can no longer complete */
             }
+        } else {
+            /* 00 not followed by FF 5A */
         }
         /* no frame here: the scan moves on one byte (a first sync byte is
          * 00: the sum does not change) */
-        rx->sum_scan = (uint16_t)(rx->sum_scan + p[0]);
-        rx->stats.bytes_discarded++;
-        rx->scan = (uint16_t)(s + 1u);
+        dropped++;
+        s++;
     }
-    return true;
+    rx->scan = (uint16_t)s;
+    rx->len = (uint16_t)len;
+    rx->sum_scan = (uint16_t)sum;
+    rx->stats.bytes_discarded += dropped;
+    if (!final && len != s) {
+        /* something is left to decide: keep what is left of the credit
+         * (scan_on()) */
+        rx->bank = (uint16_t)((budget > 0) ? budget : 0);
+        rx->bank_at = (uint16_t)rx->stats.bytes_in;
+    }
+    return live;
+}
+
+/* The scan's credit for this byte (or tick, or 0-byte feed): what the
+ * last budgeted scan left, plus RX_BUDGET for every byte taken in since
+ * (at least one), up to RX_BANK_MAX. It depends on the stream only (the
+ * count of bytes), never on how it was split into calls. */
+RX_INLINE static int32_t credit(const tase_rx_t *rx)
+{
+    uint32_t since = (uint16_t)(rx->stats.bytes_in - rx->bank_at);
+    uint32_t units = rx->bank + ((since != 0u) ? since : 1u) * RX_BUDGET;
+    return (int32_t)((units < RX_BANK_MAX) ? units : RX_BANK_MAX);
+}
+
+/* Scan on with this byte's credit, less `spent` units already used on
+ * it; advance() keeps what is left in the bank. A scan that ends with
+ * nothing left to decide keeps the credit it had (tase_rx_push() delivers
+ * a frame whose last byte came without scanning, so the credit must not
+ * depend on it). Returns false when a callback re-initialised the
+ * receiver. */
+RX_INLINE static bool scan_on(tase_rx_t *rx, rx_call_t *c, uint32_t spent)
+{
+    return advance(rx, c, credit(rx) - (int32_t)spent, false);
 }
 
 /* Store one byte, making room first if the window is full: one step of
@@ -405,8 +586,15 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, uint32_t allowance, bool final)
 RX_INLINE static bool put(tase_rx_t *rx, rx_call_t *c, uint8_t b)
 {
     if (rx->len == RX_CAP) {
-        if (rx->scan == 0u && !advance(rx, c, 1u, false)) {
-            return false;
+        if (rx->scan == 0u) {
+            /* a step on top of the credit, which it leaves as it was */
+            uint16_t bank = rx->bank;
+            uint16_t at = rx->bank_at;
+            if (!advance(rx, c, (int32_t)(RX_COST_STEP + RX_COST_JUDGE), false)) {
+                return false;
+            }
+            rx->bank = bank;
+            rx->bank_at = at;
         }
         if (rx->stop != 0u) {
             return true; /* stopped: not taken (compact() would move the frame) */
@@ -486,29 +674,42 @@ static int finish(tase_rx_t *rx, const rx_call_t *c, bool live)
     return (c->count > (uint32_t)INT_MAX) ? INT_MAX : (int)c->count;
 }
 
-/* The general path: feed data[0..n) (data not NULL; n may be 0: only continue a
- * lagging scan), then, if `final` (tase_rx_flush(), a settling tick),
- * settle everything. Bytes that cannot decide anything are taken in bulk:
- * noise while nothing is held, the sync and Size bytes of a frame, and
- * the bytes of a held candidate before its last one. Every other byte is
- * stored and the scan runs on with a budget of RX_BUDGET: the result is
- * the same for any split of the stream into calls. */
-static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx_handler_t on_frame,
-               void *user)
+/* A call that brings no byte (a 0-byte tase_rx_feed(), tase_rx_flush(),
+ * a tick): a lagging scan goes on with one byte's credit, then, if
+ * `final` (tase_rx_flush(), a settling tick), everything is settled. Four
+ * arguments, so that the wrappers reach it by a tail call. */
+static int scan_only(tase_rx_t *rx, bool final, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c = {on_frame, user, 0u};
+    rx_call_t c = {on_frame, user, 0u, NULL};
+    bool live = true;
+    begin(rx);
+    if (rx->lag != 0u) {
+        live = scan_on(rx, &c, 0u);
+    }
+    if (live && final) {
+        live = advance(rx, &c, RX_UNLIMITED, true);
+    }
+    return finish(rx, &c, live);
+}
+
+/* The general path: feed data[0..n) (data not NULL, n > 0). Bytes that
+ * cannot decide anything are taken in bulk: noise while nothing is held,
+ * the sync and Size bytes of a frame, and the bytes of a held candidate
+ * before its last one. Every other byte is stored and the scan runs on
+ * with its credit, taking the bytes after it in itself while it lags: the
+ * result is the same for any split of the stream into calls. */
+static int run(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame, void *user)
+{
+    rx_call_t c = {on_frame, user, 0u, NULL};
     size_t i = 0;
     bool live = true;
     begin(rx);
-    if (n == 0u && rx->lag != 0u) {
-        live = advance(rx, &c, RX_BUDGET, false);
-    }
     while (live && i < n && rx->stop == 0u) {
         if (rx->lag == 0u) {
             size_t k = 0;
             size_t s = rx->scan;
             size_t held = (size_t)rx->len - s;
-            if (held == 0u) {
+            if (held == 0u && data[i] != TASE_SYNC1) {
                 /* nothing held: noise up to the next 00 is decided now */
                 const uint8_t *z = memchr(&data[i], TASE_SYNC1, n - i);
                 k = (z != NULL) ? (size_t)(z - &data[i]) : n - i;
@@ -521,13 +722,27 @@ static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx
                     k = n - i;
                 }
                 if (k > 0u) {
-                    (void)memcpy(&rx->buf[rx->len], &data[i], k);
-                    rx->sum_len = tase_checksum(rx->sum_len, &data[i], k);
+                    uint8_t *to = &rx->buf[rx->len];
+                    if (k < 8u) {
+                        /* a few bytes: a loop costs less than the calls */
+                        uint32_t sum = rx->sum_len;
+                        size_t j;
+                        for (j = 0; j < k; j++) {
+                            to[j] = data[i + j];
+                            sum += data[i + j];
+                        }
+                        rx->sum_len = (uint16_t)sum;
+                    } else {
+                        (void)memcpy(to, &data[i], k);
+                        rx->sum_len = tase_checksum(rx->sum_len, &data[i], k);
+                    }
                     rx->len = (uint16_t)(rx->len + k);
                     rx->stats.bytes_in += (uint32_t)k;
                 }
             } else {
-                /* the sync and Size bytes */
+                /* the sync and Size bytes (a 00 while nothing is held too,
+                 * exactly as tase_rx_push() takes them: no scan, so the
+                 * scan's credit is the same for any split) */
                 (void)hunt(rx, data[i]);
                 k = 1u;
             }
@@ -536,11 +751,19 @@ static int run(tase_rx_t *rx, const uint8_t *data, size_t n, bool final, tase_rx
                 continue;
             }
         }
-        live = put(rx, &c, data[i]) && advance(rx, &c, RX_BUDGET, false);
+        /* the byte, then the scan, which takes the bytes after it itself
+         * while it lags */
+        live = put(rx, &c, data[i]);
         i++;
-    }
-    if (live && final) {
-        live = advance(rx, &c, RX_UNLIMITED, true);
+        if (live && rx->stop == 0u) {
+            struct rx_input in;
+            in.next = &data[i];
+            in.end = &data[n];
+            c.in = &in;
+            live = scan_on(rx, &c, 0u);
+            c.in = NULL;
+            i = (size_t)(in.next - data);
+        }
     }
     return finish(rx, &c, live);
 }
@@ -582,28 +805,48 @@ static int rx_check(const tase_rx_t *rx)
     return rx_sane(rx) ? TASE_OK : TASE_EARG;
 }
 
-/* tase_rx_push() for every byte its fast paths do not take: a lagging
- * scan (the byte is stored and the scan goes on with a budget, as run()
- * does for each byte), a call from a callback, or a corrupted instance. */
+/* tase_rx_push() for a byte the fast paths do not take, once rx has
+ * passed its checks: the byte is stored and the scan goes on with its
+ * credit, as run() does for each byte. */
+RX_NOINLINE static int push_body(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+{
+    rx_call_t c = {on_frame, user, 0u, NULL};
+    begin(rx);
+    return finish(rx, &c, put(rx, &c, b) && scan_on(rx, &c, 0u));
+}
+
+/* tase_rx_push() for every byte its fast paths do not take: a call from
+ * a callback or a corrupted instance (the error), or the general path. */
 RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c = {on_frame, user, 0u}; /* before the check: fewer registers kept */
     int r = rx_check(rx);
     if (r != TASE_OK) {
         return r;
     }
-    begin(rx);
-    return finish(rx, &c, put(rx, &c, b) && advance(rx, &c, RX_BUDGET, false));
+    return push_body(rx, b, on_frame, user);
+}
+
+/* tase_rx_push() for a byte while the scan lags (`end` RX_BLOCKED outside
+ * a call): push_slow() with only the checks rx_sane() makes of that state
+ * (anything else goes to push_slow(), which reports it). */
+RX_NOINLINE static int push_lag(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+{
+    if (rx->busy != 0u || rx->lag != 1u || rx->stop != 0u || rx->len > RX_CAP ||
+        rx->scan > rx->len) {
+        return push_slow(rx, b, on_frame, user);
+    }
+    return push_body(rx, b, on_frame, user);
 }
 
 /* tase_rx_push() for the last byte of a held candidate that failed: the
  * byte is stored, the scan moves past the candidate's first byte (00) and
- * goes on with what is left of the budget after this judgement, exactly
- * as in run() (where advance() judges it: a step and 2 bytes summed), so
+ * goes on with what is left of the credit after this judgement, exactly
+ * as in run() (where advance() judges it: a step, a judgement and 2 bytes
+ * summed), so
  * that any split of the stream gives the same result. */
 RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c = {on_frame, user, 0u};
+    rx_call_t c = {on_frame, user, 0u, NULL};
     size_t len = rx->len;
     begin(rx);
     rx->stats.checksum_errors++;
@@ -613,7 +856,7 @@ RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t o
     rx->stats.bytes_in++;
     rx->stats.bytes_discarded++;
     rx->scan = (uint16_t)(rx->scan + 1u);
-    return finish(rx, &c, advance(rx, &c, RX_BUDGET - RX_COST_STEP - 2u, false));
+    return finish(rx, &c, scan_on(rx, &c, RX_COST_STEP + RX_COST_JUDGE + 2u));
 }
 
 /* tase_rx_push() for the last byte of the candidate held at buf[scan]
@@ -639,7 +882,9 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     rx->busy = 1u;
     rx->end = RX_BLOCKED;
     (void)deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), on_frame, user);
-    /* hunting from here; also right when the callback re-initialised or stopped rx */
+    /* hunting from here; also right when the callback re-initialised or
+     * stopped rx (frame.h, RE-ENTRANCY: nothing else may be called on rx
+     * after a re-initialisation until the callback returns) */
     rx->end = 0u;
     rx->stop = 0u;
     rx->busy = 0u;
@@ -656,6 +901,9 @@ RX_NOINLINE static int push_event(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t
     uint16_t end = rx->end;
     if (len == end && end != 0u && end < RX_CAP) {
         return push_last(rx, byte, on_frame, user);
+    }
+    if (end == RX_BLOCKED) {
+        return push_lag(rx, byte, on_frame, user);
     }
     return push_slow(rx, byte, on_frame, user);
 }
@@ -710,18 +958,18 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
     if (r != TASE_OK) {
         return r;
     }
-    return run(rx, (data != NULL) ? data : rx->buf, n, false, on_frame, user); /* n 0 if NULL */
+    return (n == 0u) ? scan_only(rx, false, on_frame, user) : run(rx, data, n, on_frame, user);
 }
 
 int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user)
 {
     int r = rx_check(rx);
-    return (r != TASE_OK) ? r : run(rx, rx->buf, 0u, true, on_frame, user);
+    return (r != TASE_OK) ? r : scan_only(rx, true, on_frame, user);
 }
 
 /* The time bound's two ways into the scan (tase_frame_private.h): thin
- * wrappers, so that the static rx_check() and run() keep the callers gcc
- * compiled them for. */
+ * wrappers, so that the static rx_check() and scan_only() keep the
+ * callers gcc compiled them for. */
 int tase_rx_state_check(const tase_rx_t *rx)
 {
     return rx_check(rx);
@@ -729,5 +977,5 @@ int tase_rx_state_check(const tase_rx_t *rx)
 
 int tase_rx_continue(tase_rx_t *rx, bool settle, tase_rx_handler_t on_frame, void *user)
 {
-    return run(rx, rx->buf, 0u, settle, on_frame, user);
+    return scan_only(rx, settle, on_frame, user);
 }

@@ -16,7 +16,7 @@
  * visibly corrupted), TASE_EBUSY (a call in progress). */
 int tase_rx_state_check(const tase_rx_t *rx);
 
-/* Continue a lagging scan with one byte's budget, or with `settle` run it
+/* Continue a lagging scan with one byte's credit, or with `settle` run it
  * to the end of input as tase_rx_flush() does. rx has passed
  * tase_rx_state_check(). Returns the frames delivered. */
 int tase_rx_continue(tase_rx_t *rx, bool settle, tase_rx_handler_t on_frame, void *user);

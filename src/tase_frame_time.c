@@ -11,6 +11,10 @@
 
 #include "tase_frame_private.h"
 
+/* `ticked` while a settling tick stopped by its callback (tase_rx_stop())
+ * has not finished: the next tick settles the rest. */
+#define RX_SETTLING 2u
+
 int tase_rx_init(tase_rx_t *rx)
 {
     if (rx == NULL) {
@@ -24,8 +28,7 @@ int tase_rx_init(tase_rx_t *rx)
 }
 
 /* The call in progress ends after the frame its callback is handling:
- * advance() and run() in src/tase_frame.c look at `stop`, finish() clears
- * it. */
+ * advance() in src/tase_frame.c looks at `stop`, finish() clears it. */
 int tase_rx_stop(tase_rx_t *rx)
 {
     if (rx == NULL) {
@@ -92,6 +95,8 @@ int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, voi
         rx->ticked = 1u;
         rx->tick_bytes = rx->stats.bytes_in;
         rx->quiet_since = now_ms;
+    } else if (rx->ticked == RX_SETTLING) {
+        settle = true; /* a settle a callback stopped goes on (tase_rx_stop()) */
     } else {
         settle = rx->len != 0u && quiet_for(now_ms, rx->quiet_since) > quiet_limit(rx);
     }
@@ -99,7 +104,16 @@ int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, voi
         return 0;
     }
     /* a lagging scan goes on; past the quiet limit, as at end of input */
-    return tase_rx_continue(rx, settle, on_frame, user);
+    r = tase_rx_continue(rx, settle, on_frame, user);
+    if (settle && r >= 0 && rx->lag != 0u && rx->ticked != 0u) {
+        /* stopped by a callback before it was done (not re-initialised:
+         * that clears `ticked`): the next tick settles the rest, whatever
+         * the scan's position does to the quiet limit meanwhile */
+        rx->ticked = RX_SETTLING;
+    } else if (rx->ticked == RX_SETTLING) {
+        rx->ticked = 1u;
+    }
+    return r;
 }
 
 uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms)

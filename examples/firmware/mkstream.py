@@ -36,7 +36,7 @@ def model(stream, arrive, pause_at, settle_after):
     than its quiet limit: settle_after(bytes it still needs) ticks after
     the tick of its last byte that came, if that is before the line speaks
     again. `arrive(i)` is the tick that feeds byte i. Returns the frames
-    (start, group, type, data length, tick delivering it), the checksum
+    (start, group, type, data length, tick deciding it), the checksum
     and Size errors, and the bytes not in a delivered frame."""
     out, csum_err, bad_size = [], 0, 0
     pos, decided, n = 0, 0, len(stream)
@@ -267,7 +267,7 @@ def main():
             v = fields(fmt, data) if n > 0 else [0] * len(fmt.replace("x", ""))
         rows.append((s, g, t, n, r, len(values), len(v), decided))
         values.extend(v)
-        tick = decided  # the tick that delivers it
+        tick = decided  # the tick whose bytes decide it
         if r == ROUTE_TYPED and (g, t) == (0x00, 0x80):
             events.setdefault(tick, []).append(("cmd", v))
         if r == ROUTE_TYPED and (g, t) == (0x48, 0x00) and n > 0:
@@ -302,7 +302,7 @@ def main():
     w("    uint32_t offset;")
     w("    uint8_t group, type, len, route;")
     w("    uint8_t first, nfields; /* decoded fields: expect_values[first..] */")
-    w("    uint16_t tick;          /* the main loop tick that delivers it */")
+    w("    uint16_t tick;          /* the main loop tick whose bytes decide it */")
     w("} expect_frame_t;")
     w("")
     w("/* Every clean frame, in delivery order. */")

@@ -79,7 +79,7 @@ typedef struct {
     uint32_t offset;
     uint8_t group, type, len, route;
     uint8_t first, nfields; /* decoded fields: expect_values[first..] */
-    uint16_t tick;          /* the main loop tick that delivers it */
+    uint16_t tick;          /* the main loop tick whose bytes decide it */
 } expect_frame_t;
 
 /* Every clean frame, in delivery order. */

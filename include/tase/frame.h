@@ -55,7 +55,10 @@
  * greedy scan exactly; only that moment moves. In the callback,
  * stats.bytes_in counts the bytes fed up to the delivering byte, and the
  * other counters the candidates judged so far. The result is the same for
- * any split of the stream into calls (seen_at included).
+ * any split of the stream into calls that take bytes (seen_at included);
+ * a call with no byte (a 0-byte tase_rx_feed(), a tick) continues a
+ * lagging scan with a byte's worth of work, so frames may come out
+ * earlier with such calls between, never later.
  * tase_rx_flush() settles whatever is pending at end of input: the scan
  * catches up, pending candidates can no longer complete, so they fail and
  * what they were hiding is scanned.
@@ -64,26 +67,31 @@
  * each candidate judged once, and a candidate's checksum is read off
  * running sums plus the shorter of the two stretches between them and its
  * checksum bytes (at most half the window, 2 bytes for a candidate whose
- * last byte just came). Every call spends at most a fixed budget of work
- * on the scan per byte it takes in (and a call with no byte, or a tick,
- * one byte's worth), then stops; the scan goes on in the next call. So
- * every call has a worst case that does not depend on the stream:
+ * last byte just came). The scan runs on credit: every byte taken in (and
+ * a call with no byte, or a tick) brings a fixed amount of scan work,
+ * what a byte leaves unused is kept up to a cap, and the scan stops when
+ * the credit is spent; it goes on in the next call. So every call has a
+ * worst case that does not depend on the stream, and a call taking n
+ * bytes at most the cap plus n bytes' worth (plus its callbacks):
  * docs/TIMING.md lists it per function, measured on Cortex-M4 and M0+ on
- * the adversarial streams of bench/. tase_rx_push() stores a byte inside
- * a frame with one test, a store and an add; the sync bytes, the Size
- * byte and the last byte of a valid frame (its checksum is two bytes off
- * the running sum) are handled beside it without the general path. A
- * buffer fed with tase_rx_feed() takes noise and the bytes of a held
- * candidate in bulk (memchr, memcpy, one checksum pass). On telemetry a
- * byte costs about as much as in a classic single-state parser; the worst
- * streams measured, false syncs every 4 bytes (each failing after its
- * 261st byte), cost about 110 Thumb instructions per byte on a Cortex-M4
- * (-O2) and 160 on an M0+ (-Os). docs/PERFORMANCE.md has the numbers.
+ * the adversarial streams of bench/ (on a Cortex-M4 -O2: about 850
+ * instructions for one tase_rx_push(), 3,700 for a 16-byte
+ * tase_rx_feed(), 12,000 for a 64-byte one). tase_rx_push() stores a
+ * byte inside a frame with one test, a store and an add; the sync bytes,
+ * the Size byte and the last byte of a valid frame (its checksum is two
+ * bytes off the running sum) are handled beside it without the general
+ * path. A buffer fed with tase_rx_feed() takes noise and the bytes of a
+ * held candidate in bulk (memchr, memcpy, one checksum pass). On telemetry
+ * a byte costs about as much as in a classic single-state parser; the
+ * worst streams measured (false syncs with random Sizes every 4 bytes)
+ * cost about 95 Thumb instructions per byte through tase_rx_push() on a
+ * Cortex-M4 (-O2) and 175 on an M0+ (-Os). docs/PERFORMANCE.md has the
+ * numbers.
  *
- * RAM. sizeof(tase_rx_t) is 356: the TASE_RX_WINDOW (300) window bytes (a
+ * RAM. sizeof(tase_rx_t) is 360: the TASE_RX_WINDOW (300) window bytes (a
  * frame and the room a lagging scan needs), 28 of counters, 15 of the time
- * bound and 13 of scan state; checked against TASE_RX_SIZE_BUDGET at
- * compile time. Stack: see docs/FOOTPRINT.md.
+ * bound, 13 of scan state and 4 of the scan's credit; checked against
+ * TASE_RX_SIZE_BUDGET at compile time. Stack: see docs/FOOTPRINT.md.
  *
  * TIME BOUND. A held candidate waits for its last byte, and with it every
  * frame inside it. On a link that goes quiet (a command link: a few
@@ -138,7 +146,11 @@
  *   - tase_rx_init() is allowed: the receiver is reset, and the call that
  *     made the callback returns as soon as the callback does, with the
  *     number of frames it delivered; the rest of its input is not consumed
- *     (nor counted in bytes_in);
+ *     (nor counted in bytes_in). Call nothing else on the receiver after
+ *     it until the callback returns: it is no longer guarded as busy, and
+ *     a call that took a frame's last byte resets it to hunting when the
+ *     callback returns (whatever was fed in between is lost and later
+ *     calls may find it visibly corrupted: TASE_EARG);
  *   - tase_rx_stop() is allowed: the call returns after this frame (see
  *     there), so the frame can be handled with the receiver's stack
  *     unwound.
@@ -215,7 +227,8 @@ typedef struct {
     /* The time bound (TIME BOUND above): the link's byte rate and margin
      * (tase_rx_set_timing()), stats.bytes_in at the last tase_rx_tick()
      * and the now_ms of the last tick that saw new bytes (`ticked` says
-     * whether those two are set yet). */
+     * whether those two are set yet, and that a settling tick a callback
+     * stopped is to go on). */
     uint32_t rate;
     uint32_t tick_bytes;
     uint32_t quiet_since;
@@ -237,6 +250,10 @@ typedef struct {
     uint16_t scan;
     uint16_t sum_len;
     uint16_t sum_scan;
+    /* The scan's credit (src/tase_frame.c): units left at the last
+     * budgeted scan, and the low 16 bits of stats.bytes_in then. */
+    uint16_t bank;
+    uint16_t bank_at;
     uint8_t buf[TASE_RX_WINDOW];
 } tase_rx_t;
 
@@ -300,9 +317,10 @@ int tase_rx_init(tase_rx_t *rx);
  * many were.
  * Feeding a stream one byte at a time or in any split gives the same
  * frames, offsets, counters and moments of delivery. Feeding 0 bytes
- * continues a lagging scan. Cost O(n): per byte taken in, at most a fixed
- * budget of scan work (COST), plus the callbacks; worst case per call on
- * Cortex-M in docs/TIMING.md. */
+ * continues a lagging scan. Cost O(n): the scan work of the credit kept
+ * from earlier bytes (at most a fixed cap) and of a fixed amount per byte
+ * taken in (COST), plus the callbacks; worst case per call on Cortex-M in
+ * docs/TIMING.md. */
 int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t on_frame,
                  void *user);
 
@@ -315,10 +333,12 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
  * in if a callback stopped the call before room was made for it:
  * stats.bytes_in says), or TASE_EARG (rx NULL
  * or visibly corrupted) / TASE_EBUSY (inside a callback of this
- * receiver), receiver unchanged. Longest block: one byte's budget of scan
- * work plus one compaction of the window and the callbacks of the frames
- * that work releases: bounded whatever the stream (docs/TIMING.md: the
- * measured worst case on Cortex-M4 and M0+ and the stream that gives it). */
+ * receiver), receiver unchanged. Longest block: the scan work the byte's
+ * credit pays for (COST: the byte's own and what earlier bytes left, up
+ * to a cap) plus one compaction of the window and the callbacks of the
+ * frames that work releases: bounded whatever the stream (docs/TIMING.md:
+ * the measured worst case on Cortex-M4 and M0+ and the stream that gives
+ * it). */
 int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user);
 
 /* End of input (end of a capture file, link closed): settle what is
@@ -356,7 +376,7 @@ int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms);
  * now_ms earlier than the noted time (a stale sample: a difference of
  * 2^31 or more) counts as no time passed. Returns TASE_EARG / TASE_EBUSY
  * as tase_rx_flush() (receiver unchanged). A tick also continues a
- * lagging scan (one byte's budget, and its frames are counted in the
+ * lagging scan (one byte's credit, and its frames are counted in the
  * return value). Longest block: as tase_rx_flush() when it settles, as
  * tase_rx_push() otherwise. */
 int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, void *user);
@@ -398,7 +418,7 @@ uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms);
  *     } while (stopped || n > 0u);
  * (tase_gimbal_feed() in src/tase_gimbal.c is this loop.) TASE_RX_LATE_MAX holds when every stop is followed by a
  * 0-byte tase_rx_feed() before more bytes are fed (each such call brings
- * a byte's budget, more than a stop forfeits).
+ * a byte's credit; a stop forfeits none).
  * Returns TASE_OK; TASE_ESTATE when no call of rx is running (outside its
  * callback); TASE_EARG for rx NULL. O(1). */
 int tase_rx_stop(tase_rx_t *rx);

@@ -45,7 +45,7 @@
  *      names, tase_rx_init; sizeof(tase_rx_t) 328 on x86-64).
  *   2  0.2.0: the greedy receiver (sizeof(tase_rx_t) 296 on x86-64)
  *      and the other changes CHANGELOG.md lists under 0.2.0.
- *   3  0.3.0: the receiver's time bound and bounded calls (sizeof(tase_rx_t) 356),
+ *   3  0.3.0: the receiver's time bound and bounded calls (sizeof(tase_rx_t) 360),
  *      tase_port_t's bytes_per_s and the other changes under 0.3.0.
  * Keep it a plain decimal number: it is pasted into link names. */
 #define TASE_ABI_LEVEL 3
