@@ -112,6 +112,8 @@ int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, voi
         rx->ticked = RX_SETTLING;
     } else if (rx->ticked == RX_SETTLING) {
         rx->ticked = 1u;
+    } else {
+        /* nothing stopped */
     }
     return r;
 }
