@@ -113,9 +113,11 @@ typedef char tase_rx_late_check
 #if defined(__GNUC__)
 #define RX_NOINLINE __attribute__((noinline))
 #define RX_INLINE __inline__ __attribute__((always_inline))
+#define RX_LIKELY(x) __builtin_expect(!!(x), 1)
 #else
 #define RX_NOINLINE
 #define RX_INLINE
+#define RX_LIKELY(x) (x)
 #endif
 
 /* C99 has no _Static_assert: a negative array size fails the build. */
@@ -866,10 +868,11 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
 {
     size_t s = rx->scan;
     size_t len = rx->len;
-    /* the checks of rx_sane() that make the frame lie inside buf; else
-     * push_slow() gives the error */
-    if (s + 4u > len || rx->buf[s + 3u] < 2u || rx->end != s + rx->buf[s + 3u] + 5u) {
-        return push_slow(rx, b, on_frame, user);
+    /* the checks of rx_sane() that make the frame lie inside buf (len is
+     * end here); an instance that fails them fails rx_check() too: its
+     * error */
+    if (s + 4u > len || rx->buf[s + 3u] < 2u || len != s + rx->buf[s + 3u] + 5u) {
+        return (rx->busy == 1u) ? TASE_EBUSY : TASE_EARG;
     }
     if ((uint16_t)(rx->sum_len - rx->buf[len - 1u] - rx->sum_scan) !=
         (uint16_t)(((uint16_t)rx->buf[len - 1u] << 8) | b)) {
@@ -881,13 +884,15 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     rx->sum_len = rx->sum_scan;
     rx->busy = 1u;
     rx->end = RX_BLOCKED;
-    (void)deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), on_frame, user);
-    /* hunting from here; also right when the callback re-initialised or
-     * stopped rx (frame.h, RE-ENTRANCY: nothing else may be called on rx
-     * after a re-initialisation until the callback returns) */
-    rx->end = 0u;
-    rx->stop = 0u;
-    rx->busy = 0u;
+    if (RX_LIKELY(deliver(rx, &rx->buf[s], rx->stats.bytes_in - (uint32_t)(len + 1u - s), on_frame,
+                          user))) {
+        /* hunting from here (also right when the callback stopped rx); a
+         * callback that re-initialised rx may have fed it since: left as
+         * it is */
+        rx->end = 0u;
+        rx->stop = 0u;
+        rx->busy = 0u;
+    }
     return 1;
 }
 

@@ -1679,6 +1679,65 @@ static void a_stopped_settling_tick_settles_when_repeated(void **state)
     assert_int_equal(t[0].n, 1);
 }
 
+/* Found in review (also before the credit): a callback that re-initialises
+ * the receiver may use it again at once (frame.h, RE-ENTRANCY: it is no
+ * longer busy). tase_rx_push() reset it to hunting when a frame's last
+ * byte's callback returned, whatever that callback had fed it since: the
+ * held candidate's end was lost and every later call returned TASE_EARG. */
+typedef struct {
+    tase_rx_t *rx;
+    const uint8_t *more; /* fed from the first callback, after tase_rx_init() */
+    size_t n;
+    size_t frames;
+    uint8_t last_type;
+} reinit_t;
+
+static void reinit_and_feed(void *user, const tase_frame_t *f)
+{
+    reinit_t *t = user;
+    t->frames++;
+    t->last_type = f->type;
+    if (t->frames == 1u) {
+        assert_int_equal(tase_rx_init(t->rx), TASE_OK);
+        assert_int_equal(tase_rx_feed(t->rx, t->more, t->n, reinit_and_feed, t), 0);
+    }
+}
+
+static void a_receiver_re_initialised_in_its_callback_can_be_fed_there(void **state)
+{
+    uint8_t a[16], b[32], d[10];
+    size_t na, nb, k;
+    int mode;
+    tase_rx_t rx;
+    reinit_t t;
+    (void)state;
+    memset(d, 0x33, sizeof(d));
+    na = (size_t)tase_frame_build(0x00, 0x01, NULL, 0, a, sizeof(a));
+    nb = (size_t)tase_frame_build(0x00, 0x02, d, sizeof(d), b, sizeof(b));
+    for (mode = 0; mode < 2; mode++) { /* A's bytes pushed, or fed in one call */
+        memset(&t, 0, sizeof(t));
+        t.rx = &rx;
+        t.more = b;
+        t.n = 5; /* B's sync, Size and Group: a held candidate */
+        assert_int_equal(tase_rx_init(&rx), TASE_OK);
+        if (mode == 0) {
+            for (k = 0; k < na; k++) {
+                assert_true(tase_rx_push(&rx, a[k], reinit_and_feed, &t) >= 0);
+            }
+        } else {
+            assert_int_equal(tase_rx_feed(&rx, a, na, reinit_and_feed, &t), 1);
+        }
+        assert_int_equal(t.frames, 1);
+        assert_int_equal(rx.stats.bytes_in, 5); /* counted from the re-initialisation */
+        for (k = 5; k < nb; k++) {
+            assert_true(tase_rx_push(&rx, b[k], reinit_and_feed, &t) >= 0);
+        }
+        assert_int_equal(t.frames, 2);
+        assert_int_equal(t.last_type, 0x02);
+        assert_int_equal(rx.stats.frames_ok, 1);
+    }
+}
+
 static void sync_inside_a_delivered_frame_starts_nothing(void **state)
 {
     tase_rx_t rx;
@@ -2055,6 +2114,7 @@ int main(void)
         cmocka_unit_test(a_lagging_scan_gives_the_same_frames_for_any_split),
         cmocka_unit_test(the_scans_credit_does_not_depend_on_the_split),
         cmocka_unit_test(a_stopped_settling_tick_settles_when_repeated),
+        cmocka_unit_test(a_receiver_re_initialised_in_its_callback_can_be_fed_there),
         cmocka_unit_test(sync_inside_a_delivered_frame_starts_nothing),
         cmocka_unit_test(counters_only_reset_on_request),
         cmocka_unit_test(every_call_from_inside_the_callback_is_refused_or_safe),

@@ -146,11 +146,9 @@
  *   - tase_rx_init() is allowed: the receiver is reset, and the call that
  *     made the callback returns as soon as the callback does, with the
  *     number of frames it delivered; the rest of its input is not consumed
- *     (nor counted in bytes_in). Call nothing else on the receiver after
- *     it until the callback returns: it is no longer guarded as busy, and
- *     a call that took a frame's last byte resets it to hunting when the
- *     callback returns (whatever was fed in between is lost and later
- *     calls may find it visibly corrupted: TASE_EARG);
+ *     (nor counted in bytes_in). The receiver is no longer busy: the
+ *     callback may feed it at once, and the interrupted call leaves what
+ *     that did alone;
  *   - tase_rx_stop() is allowed: the call returns after this frame (see
  *     there), so the frame can be handled with the receiver's stack
  *     unwound.
