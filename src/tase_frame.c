@@ -375,26 +375,31 @@ RX_INLINE static bool holds(const uint8_t *p, size_t avail)
 /* A scan that has spent its credit while tase_rx_feed() has more input
  * takes the next byte in itself, exactly as the call would (put(), then
  * scan_on() with the credit that byte brings), without leaving the scan:
- * returns the new credit, or -1 when there is no byte to take or the
+ * the byte is stored (*len one more) and *budget becomes its credit.
+ * Returns false, changing nothing, when there is no byte to take or the
  * window is full (the caller's put() makes room first). */
-RX_INLINE static int32_t take(tase_rx_t *rx, rx_call_t *c, size_t len, int32_t budget)
+RX_INLINE static bool take(tase_rx_t *rx, rx_call_t *c, size_t *len, int32_t *budget)
 {
     uint8_t byte;
+    uint32_t left;
     uint32_t units;
-    if (c->in == NULL || c->in->next == c->in->end || len >= RX_CAP) {
-        return -1;
+    if (c->in == NULL || c->in->next == c->in->end || *len >= RX_CAP) {
+        return false;
     }
     /* what the scan of the byte before would have kept (scan_on()) */
-    rx->bank = (uint16_t)((budget > 0) ? budget : 0);
+    left = (*budget > 0) ? (uint32_t)*budget : 0u;
+    rx->bank = (uint16_t)left;
     rx->bank_at = (uint16_t)rx->stats.bytes_in;
     byte = *c->in->next;
     c->in->next++;
-    rx->buf[len] = byte;
-    rx->len = (uint16_t)(len + 1u);
+    rx->buf[*len] = byte;
+    *len += 1u;
+    rx->len = (uint16_t)*len;
     rx->sum_len = (uint16_t)(rx->sum_len + byte);
     rx->stats.bytes_in++;
-    units = ((budget > 0) ? (uint32_t)budget : 0u) + RX_BUDGET;
-    return (int32_t)((units < RX_BANK_MAX) ? units : RX_BANK_MAX);
+    units = left + RX_BUDGET;
+    *budget = (int32_t)((units < RX_BANK_MAX) ? units : RX_BANK_MAX);
+    return true;
 }
 
 /* The greedy scan from buf[scan] on, until it has caught up (lag 0) or
@@ -428,13 +433,10 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
         }
         if (budget < (int32_t)RX_COST_STEP && !holds(p, avail)) {
             /* the credit is spent: the next byte brings more */
-            int32_t more = take(rx, c, len, budget);
-            if (more < 0) {
+            if (!take(rx, c, &len, &budget)) {
                 rx->lag = 1u; /* the next call goes on */
                 break;
             }
-            budget = more;
-            len++;
             continue;
         }
         budget -= (int32_t)RX_COST_STEP;
@@ -481,13 +483,11 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
                 uint32_t at_be;
                 uint16_t want;
                 if (budget < (int32_t)RX_COST_JUDGE) {
-                    int32_t more = take(rx, c, len, budget);
-                    if (more < 0) {
+                    /* judged with the next byte's credit */
+                    if (!take(rx, c, &len, &budget)) {
                         rx->lag = 1u; /* the next call judges it */
                         break;
                     }
-                    budget = more;
-                    len++;
                     continue;
                 }
                 if (bwd == 2u) {
