@@ -86,6 +86,17 @@ static size_t gen_telemetry(uint8_t *buf, size_t cap, int corrupt_size)
     }
 }
 
+/* 00 FF 5A and a Size byte at buf[n] (a sync; a candidate claiming
+ * size - 2 data bytes). Returns n + 4. */
+static size_t put_sync(uint8_t *buf, size_t n, uint8_t size)
+{
+    buf[n] = 0x00;
+    buf[n + 1u] = 0xFF;
+    buf[n + 2u] = 0x5A;
+    buf[n + 3u] = size;
+    return n + 4u;
+}
+
 /* 00 FF 5A FF (a false sync claiming 253 data bytes), then 63 groups
  * 00 FF 5A (255 - 4k), k = 1..63: every group is a complete false
  * candidate ending where the first one ends, so all 64 are decided by the
@@ -95,10 +106,7 @@ static size_t gen_held255(uint8_t *buf, size_t cap)
     size_t n = 0, k;
     while (n + 256u <= cap) {
         for (k = 0; k < 64u; k++) {
-            buf[n++] = 0x00;
-            buf[n++] = 0xFF;
-            buf[n++] = 0x5A;
-            buf[n++] = (uint8_t)(255u - 4u * k);
+            n = put_sync(buf, n, (uint8_t)(255u - 4u * k));
         }
     }
     return n;
@@ -111,10 +119,7 @@ static size_t gen_burst(uint8_t *buf, size_t cap)
 {
     size_t n = 0, k;
     while (n + 261u <= cap) {
-        buf[n++] = 0x00;
-        buf[n++] = 0xFF;
-        buf[n++] = 0x5A;
-        buf[n++] = 0xFF;
+        n = put_sync(buf, n, 0xFF);
         for (k = 0; k < 31u; k++) {
             n += (size_t)tase_frame_build(0x00, (uint8_t)k, NULL, 0u, &buf[n], cap - n);
         }
@@ -132,10 +137,7 @@ static size_t gen_heldnoise(uint8_t *buf, size_t cap)
 {
     size_t n = 0, k;
     while (n + 261u <= cap) {
-        buf[n++] = 0x00;
-        buf[n++] = 0xFF;
-        buf[n++] = 0x5A;
-        buf[n++] = 0xFF;
+        n = put_sync(buf, n, 0xFF);
         for (k = 0; k < 257u; k++) {
             buf[n++] = (uint8_t)(0x11u + k % 0xEEu);
         }
@@ -163,11 +165,8 @@ size_t bench_stream(const char *name, uint8_t *buf, size_t cap)
     }
     if (strcmp(name, "sync4") == 0 || strcmp(name, "syncrand") == 0) {
         int r = strcmp(name, "syncrand") == 0;
-        for (i = 0; i + 4u <= cap; i += 4u) {
-            buf[i] = 0x00;
-            buf[i + 1] = 0xFF;
-            buf[i + 2] = 0x5A;
-            buf[i + 3] = r ? rnd8() : 0xFF;
+        for (i = 0; i + 4u <= cap;) {
+            i = put_sync(buf, i, r ? rnd8() : 0xFF);
         }
         return i;
     }

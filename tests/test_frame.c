@@ -90,6 +90,42 @@ static size_t make_frame(uint8_t *out, uint8_t group, uint8_t type, size_t len)
     return (size_t)n;
 }
 
+/* 00 FF 5A and a Size byte at buf[n]: a sync, a candidate claiming
+ * size - 2 data bytes. Returns n + 4. */
+static size_t put_sync(uint8_t *buf, size_t n, uint8_t size)
+{
+    buf[n] = 0x00;
+    buf[n + 1] = 0xFF;
+    buf[n + 2] = 0x5A;
+    buf[n + 3] = size;
+    return n + 4;
+}
+
+/* A false candidate claiming 253 data bytes with 31 valid empty frames
+ * inside (issue 21's burst: its failure releases them all). Returns the
+ * index after the frames (n + 252); the caller fills the candidate's
+ * last 9 bytes. */
+static size_t put_burst(uint8_t *buf, size_t n)
+{
+    size_t k;
+    n = put_sync(buf, n, 0xFF);
+    for (k = 0; k < 31; k++) {
+        n += (size_t)tase_frame_build(0x00, (uint8_t)k, NULL, 0, buf + n, 8);
+    }
+    return n;
+}
+
+/* 00 FF 5A FF, then 63 groups 00 FF 5A (255 - 4k): 64 complete false
+ * candidates all decided by one byte (issue 21). Returns n + 256. */
+static size_t put_held255(uint8_t *buf, size_t n)
+{
+    size_t k;
+    for (k = 0; k < 64; k++) {
+        n = put_sync(buf, n, (uint8_t)(255 - 4 * k));
+    }
+    return n;
+}
+
 /* Byte at a time, alternating the two one-byte entry points so both are
  * held to every expectation of the tests that use this. */
 static void feed_bytes_one_by_one(tase_rx_t *rx, const uint8_t *p, size_t n, recorder_t *r)
@@ -1374,24 +1410,13 @@ static void one_byte_never_decides_the_whole_window_at_once(void **state)
     size_t n = 0, i, k, rep, most_frames = 0, most_judged = 0;
     (void)state;
     for (rep = 0; rep < 4; rep++) {
-        buf[n++] = 0x00;
-        buf[n++] = 0xFF;
-        buf[n++] = 0x5A;
-        buf[n++] = 0xFF;
-        for (k = 0; k < 31; k++) {
-            n += (size_t)tase_frame_build(0x00, (uint8_t)k, NULL, 0, buf + n, 8);
-        }
+        n = put_burst(buf, n);
         for (k = 0; k < 9; k++) {
             buf[n++] = (uint8_t)(0x11 + k);
         }
     }
     for (rep = 0; rep < 4; rep++) {
-        for (k = 0; k < 64; k++) {
-            buf[n++] = 0x00;
-            buf[n++] = 0xFF;
-            buf[n++] = 0x5A;
-            buf[n++] = (uint8_t)(255 - 4 * k);
-        }
+        n = put_held255(buf, n);
     }
     assert_int_equal(n, sizeof(buf));
     assert_int_equal(tase_rx_init(&rx), TASE_OK);
@@ -1436,10 +1461,7 @@ static void a_lagging_scan_gives_the_same_frames_for_any_split(void **state)
     (void)state;
     for (rep = 0; rep < 6; rep++) {
         size_t start = n;
-        buf[n++] = 0x00;
-        buf[n++] = 0xFF;
-        buf[n++] = 0x5A;
-        buf[n++] = 0xFF;
+        n = put_sync(buf, n, 0xFF);
         for (k = 0; k < 200; k++) {
             buf[n++] = (uint8_t)(0x11 + (k + rep) % 0xE0);
         }
@@ -1450,22 +1472,11 @@ static void a_lagging_scan_gives_the_same_frames_for_any_split(void **state)
         }
     }
     for (rep = 0; rep < 4; rep++) {
-        for (k = 0; k < 64; k++) {
-            buf[n++] = 0x00;
-            buf[n++] = 0xFF;
-            buf[n++] = 0x5A;
-            buf[n++] = (uint8_t)(255 - 4 * k);
-        }
+        n = put_held255(buf, n);
     }
     for (rep = 0; rep < 4; rep++) {
         size_t start = n;
-        buf[n++] = 0x00;
-        buf[n++] = 0xFF;
-        buf[n++] = 0x5A;
-        buf[n++] = 0xFF;
-        for (k = 0; k < 31; k++) {
-            n += (size_t)tase_frame_build(0x00, (uint8_t)k, NULL, 0, buf + n, 8);
-        }
+        n = put_burst(buf, n);
         while (n < start + 261) {
             buf[n] = (uint8_t)(0x11 + n % 7);
             n++;
@@ -1539,13 +1550,7 @@ static void the_scans_credit_does_not_depend_on_the_split(void **state)
     (void)state;
     /* 31 frames behind a false candidate: the 32nd callback (frame F)
      * resets the counters */
-    buf[n++] = 0x00;
-    buf[n++] = 0xFF;
-    buf[n++] = 0x5A;
-    buf[n++] = 0xFF;
-    for (k = 0; k < 31; k++) {
-        n += (size_t)tase_frame_build(0x00, (uint8_t)k, NULL, 0, buf + n, 8);
-    }
+    n = put_burst(buf, n);
     while (n < 361) {
         buf[n++] = 0x11;
     }
@@ -1555,10 +1560,7 @@ static void the_scans_credit_does_not_depend_on_the_split(void **state)
     }
     /* a 60-byte false candidate with a frame inside, after noise */
     start = n;
-    buf[n++] = 0x00;
-    buf[n++] = 0xFF;
-    buf[n++] = 0x5A;
-    buf[n++] = 54;
+    n = put_sync(buf, n, 54);
     while (n < start + 29) {
         buf[n++] = 0x11;
     }
@@ -1636,10 +1638,7 @@ static void a_stopped_settling_tick_settles_when_repeated(void **state)
     int mode, r;
     (void)state;
     memset(d, 0x11, sizeof(d));
-    s[n++] = 0x00; /* a false candidate claiming 70 bytes */
-    s[n++] = 0xFF;
-    s[n++] = 0x5A;
-    s[n++] = 0x40;
+    n = put_sync(s, n, 0x40); /* a false candidate claiming 70 bytes */
     n += (size_t)tase_frame_build(0x01, 0x02, NULL, 0, s + n, 8);          /* F1, inside it */
     hl = (size_t)tase_frame_build(0x03, 0x04, d, sizeof(d), h, sizeof(h)); /* H, 54 bytes */
     memcpy(s + n, h, 9); /* of which 9 come before the line goes quiet */
