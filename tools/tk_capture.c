@@ -92,6 +92,7 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
     pcap_t *p = pcap_open_dead_with_tstamp_precision(linktype, snaplen, PCAP_TSTAMP_PRECISION_NANO);
     pcap_dumper_t *d;
     struct stat st;
+    bool existed = stat(path, &st) == 0;
     if (p == NULL) {
         tk_die("cannot start a capture: out of memory");
     }
@@ -104,17 +105,30 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
     /* a temporary file and a rename only for a regular file (or a new
      * one): a device, a FIFO or /dev/stdout is written in place, never
      * replaced by a rename */
-    if (!append && (stat(path, &st) != 0 ? errno == ENOENT : S_ISREG(st.st_mode))) {
+    if (!append && (existed ? S_ISREG(st.st_mode) : errno == ENOENT)) {
         int k = snprintf(w->tmp, sizeof(w->tmp), "%s.partial-%ld", path, (long)getpid());
         if (k < 0 || (size_t)k >= sizeof(w->tmp)) {
             tk_die("cannot write capture %s: the path is too long", path);
         }
     }
+    errno = 0;
     d = append ? pcap_dump_open_append(p, path)
                : pcap_dump_open(p, w->tmp[0] != '\0' ? w->tmp : path);
     if (d == NULL) {
-        /* libpcap's message names the file and the reason */
-        tk_die("cannot write capture: %s", pcap_geterr(p));
+        int e = errno;
+        /* nothing recorded: a file this call created goes again (a full
+         * disk leaves it empty or cut inside the file header) */
+        if (w->tmp[0] != '\0') {
+            (void)unlink(w->tmp);
+        } else if (append && !existed) {
+            (void)unlink(path);
+        }
+        /* the reason: errno where libpcap's own message is of a step
+         * ("Can't seek to the end of ..." for a full disk) */
+        if (e != 0) {
+            tk_die("cannot write capture %s: %s", path, strerror(e));
+        }
+        tk_die("cannot write capture %s: %s", path, pcap_geterr(p));
     }
     w->pcap = p;
     w->dumper = d;
@@ -166,18 +180,25 @@ void tk_cap_put_can(tk_cap_writer_t *w, const struct timespec *t, const uint8_t 
     put_record(w, t, out, n);
 }
 
-void tk_cap_flush(tk_cap_writer_t *w)
+bool tk_cap_flush(tk_cap_writer_t *w)
 {
-    if (pcap_dump_flush(w->dumper) != 0) {
-        tk_die("cannot write capture %s: %s", w->path, strerror(errno));
+    if (w->err != 0) {
+        return false;
     }
+    errno = 0;
+    if (pcap_dump_flush(w->dumper) != 0) {
+        w->err = errno != 0 ? errno : EIO;
+        return false;
+    }
+    w->good = ftell(pcap_dump_file(w->dumper)); /* a record boundary */
+    return true;
 }
 
 int tk_cap_finish(tk_cap_writer_t *w)
 {
     FILE *f = pcap_dump_file(w->dumper);
-    int e = 0;
-    if (fflush(f) != 0 || ferror(f)) {
+    int e = w->err; /* the first failure, not the close's */
+    if (e == 0 && (fflush(f) != 0 || ferror(f))) {
         e = errno != 0 ? errno : EIO;
     }
     if (fsync(fileno(f)) != 0 && errno != EINVAL && e == 0) {
@@ -187,14 +208,26 @@ int tk_cap_finish(tk_cap_writer_t *w)
     pcap_close(w->pcap);
     w->dumper = NULL;
     w->pcap = NULL;
+    if (e != 0 && w->good > 0) {
+        /* end the file at its last whole record: readable, and what a
+         * later --record appends to follows it */
+        (void)truncate(w->tmp[0] != '\0' ? w->tmp : w->path, (off_t)w->good);
+    }
     if (w->tmp[0] != '\0') {
         if (e == 0 && rename(w->tmp, w->path) != 0) {
             e = errno;
         }
-        if (e != 0) {
+        if (e != 0 && w->good >= 0 && w->good <= 24) {
+            /* no record reached the disk (24: the file header) */
+            (void)unlink(w->tmp);
+            fflush(stdout);
+            fprintf(stderr, "%s: nothing was recorded; %s is unchanged\n", tk_prog, w->path);
+        } else if (e != 0) {
             fflush(stdout);
             fprintf(stderr, "%s: the capture so far is kept in %s; %s is unchanged\n", tk_prog,
                     w->tmp, w->path);
+        } else {
+            /* renamed */
         }
     }
     return e;
@@ -220,13 +253,8 @@ static void tap_record(tk_cap_tap_t *tap, unsigned dir, const uint8_t *data, siz
         return;
     }
     clock_gettime(CLOCK_REALTIME, &t);
-    errno = 0;
     tk_cap_put_serial(tap->w, &t, dir, data, n);
-    if (pcap_dump_flush(tap->w->dumper) != 0) {
-        tap->w->err = errno != 0 ? errno : EIO;
-    } else {
-        tap->w->good = ftell(pcap_dump_file(tap->w->dumper)); /* a record boundary */
-    }
+    (void)tk_cap_flush(tap->w); /* a failure stays in w->err */
 }
 
 static int tap_write(void *ctx, const uint8_t *data, size_t n)
@@ -280,13 +308,6 @@ static void close_session_capture(void)
         return;
     }
     e = tk_cap_finish(&session_capture);
-    if (session_capture.err != 0) {
-        e = session_capture.err; /* the first failure, not the close's */
-        if (session_capture.good > 0) {
-            /* end the file at its last whole record */
-            (void)truncate(session_capture.path, (off_t)session_capture.good);
-        }
-    }
     if (e != 0) {
         const char *sent = tk_sent();
         fflush(stdout);

@@ -66,8 +66,8 @@ typedef struct {
      * path when it is complete: an existing file at path is never touched
      * by a recording that fails or is killed (the partial file stays) */
     char tmp[4096];
-    int err;   /* --record: the errno that stopped recording, 0 none */
-    long good; /* --record: file length after the last whole record, -1 unknown */
+    int err;   /* the errno of the first failed write (recording stopped), 0 none */
+    long good; /* file length after the last whole record flushed, -1 unknown */
 } tk_cap_writer_t;
 
 /* Start a new capture for `path`: a new or regular file is written to
@@ -85,11 +85,17 @@ void tk_cap_put_serial(tk_cap_writer_t *w, const struct timespec *t, unsigned di
  * canfd_frame (72 bytes) exactly as read from a raw socket, identifier in
  * host byte order (it is written big-endian). */
 void tk_cap_put_can(tk_cap_writer_t *w, const struct timespec *t, const uint8_t *rec, size_t n);
-/* Push buffered records to the file; dies on a write error. */
-void tk_cap_flush(tk_cap_writer_t *w);
-/* Flush and close; dies on a write error. */
+/* Push buffered records to the file. Returns false on a write error (a
+ * full disk): w->err says which; stop recording and close, which reports
+ * it. */
+bool tk_cap_flush(tk_cap_writer_t *w);
+/* Flush and close; dies on a write error, or one tk_cap_flush() met,
+ * after tk_cap_finish() has kept what it could. */
 void tk_cap_close(tk_cap_writer_t *w);
-/* The same without dying (for exit handlers): returns 0 or an errno. */
+/* The same without dying (for exit handlers): returns 0 or an errno (the
+ * first write error). After an error the file written ends at its last
+ * whole record, and a new capture's partial file is kept and named on
+ * stderr. */
 int tk_cap_finish(tk_cap_writer_t *w);
 
 /* A port that records what passes through `inner` into `w` (reads as

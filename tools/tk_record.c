@@ -102,7 +102,9 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *path, const char *dev,
                 bytes += (unsigned long)got;
             }
         }
-        tk_cap_flush(w);
+        if (!tk_cap_flush(w)) {
+            break; /* a full disk: tk_cap_close() keeps what it can and says so */
+        }
     }
     for (i = 0; i < n; i++) {
         tk_link_close(&links[i]);
@@ -198,7 +200,9 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *path, const char *iface, 
             tk_cap_put_can(w, &t, (const uint8_t *)&frame, (size_t)got);
             frames++;
         }
-        tk_cap_flush(w);
+        if (!tk_cap_flush(w)) {
+            break; /* as in the serial loop */
+        }
     }
     close(fd);
     tk_cap_close(w);

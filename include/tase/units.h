@@ -16,7 +16,10 @@
  * beyond it gives the nearest representable one); NaN gives 0. Mind
  * reserved values at the ends of a range: e.g. HFOV -1 and TAS 0xFFFF
  * mean "no change"/"unavailable", so clamp before converting if a real
- * value could land there. From-wire conversions are exact within double.
+ * value could land there. The rounding is of the double given: 1.005 is
+ * stored just below 1.005, so tase_units_deg_to_cdeg(1.005) is 100 (the
+ * `tase` tool and the Python package round the decimal as written, 101).
+ * From-wire conversions are exact within double.
  *
  * Header only (static inline, no libm): unused helpers cost nothing.
  * Clean as C and as C++ under the strictest cast warnings (gcc

@@ -7,6 +7,7 @@ scanned by the greedy receiver (tase/frame.h) and JSON is formatted by the
 bench tools' own formatter, so it is exactly what `tase --json` prints.
 """
 
+import decimal
 import gc
 import itertools
 import math
@@ -14,6 +15,23 @@ import operator
 import threading
 
 from ._tase import ffi, lib
+
+# Exact enough for any wire value (10 digits) of any float's repr (17
+# significant digits) times a scale; ROUND_HALF_UP is "halves away from zero".
+_DEC = decimal.Context(prec=60, rounding=decimal.ROUND_HALF_UP)
+
+
+def _decimal(x):
+    """The decimal a number was written as: an int exactly, a float as its
+    shortest repr (1.005, though the double is just below it)."""
+    return decimal.Decimal(float.__repr__(float(x)) if isinstance(x, float) else int(x))
+
+
+def _scaled(value, mul, div=1):
+    """value * mul / div (a finite int or float) as an int, rounded half away
+    from zero on the decimal written: 1.005 deg * 100 is 101 cdeg."""
+    x = _DEC.divide(_DEC.multiply(_decimal(value), _decimal(mul)), _decimal(div))
+    return int(x.to_integral_value(rounding=decimal.ROUND_HALF_UP, context=_DEC))
 
 __all__ = [
     "Error",
@@ -144,9 +162,7 @@ class Field:
             return self._check(value, pkt)
         if not math.isfinite(value):
             raise FieldError("%s %s: %r is not a finite number" % (pkt, self.name, value))
-        x = value * self._div if self._div else value / self.scale
-        r = math.floor(abs(x) + 0.5)
-        r = -r if x < 0 else r
+        r = _scaled(value, self._div) if self._div else _scaled(value, 1, self.scale)
         if not self.min <= r <= self.max:
             raise FieldError(
                 "%s %s: %s %s out of range %s..%s %s"
@@ -323,9 +339,11 @@ class Packet(tuple):
     has one, `temporary` (PACKET_RATE, AXIS_SETTING) takes 1 (not stored by
     the gimbal, as `tase send`); any other missing field is a FieldError.
     Values out of range, unknown names and non-numbers are FieldError: a
-    packet that exists is valid. `length` selects a shorter accepted form
-    (CAMERA_CMD 1: camera only; AXIS_SETTING 22: the short layout).
-    CAMERA_PASS takes its camera bytes as data=b"...".
+    packet that exists is valid. Engineering values round half away from
+    zero on the decimal written (pan=1.005 is 101). `length` selects a
+    shorter accepted form (CAMERA_CMD 1: camera only; AXIS_SETTING 22: the
+    short layout). CAMERA_PASS takes camera= (baud left out: 0, no change)
+    and its camera bytes as data=b"...".
 
     Read: .name .group .type .id .size .fields (engineering values)
     .raw (wire integers) .units (the `--units` JSON values) .data

@@ -26,6 +26,7 @@ from ._core import (
     TimeoutError_,
     _check,
     _from_data,
+    _scaled,
     _Sink,
     _with_meta,
     error,
@@ -617,27 +618,20 @@ class Link:
         if cam is not None:
             raw["camera"] = cam
         if hfov is not None:
-            raw["hfov"] = _round(hfov * 100)
+            raw["hfov"] = _scaled(hfov, 100)
         if zoom is not None:
-            raw["hfov"] = -_round(zoom * 100)
+            raw["hfov"] = -_scaled(zoom, 100)
         if hfov is None and zoom is None:
             return self.send(Packet("CAMERA_CMD", raw=raw, length=1))
         return self.send(Packet("CAMERA_CMD", raw=raw))
-
-
-def _round(x):
-    import math
-
-    r = math.floor(abs(x) + 0.5)
-    return -r if x < 0 else r
 
 
 def _gimbal_cmd(pan, tilt, flags):
     return Packet(
         "GIMBAL_CMD",
         raw={
-            "pan": _round(pan * 100),
-            "tilt": _round(tilt * 100),
+            "pan": _scaled(pan, 100),
+            "tilt": _scaled(tilt, 100),
             "roll": 0,
             "flags": flags,
             "impulse_time": 0,

@@ -60,6 +60,24 @@ def _drain(fd, wait=0.2):
     return out
 
 
+def test_verbs_round_the_decimal_written(silent_pty):
+    # 1.005 deg is 100.49999999999999 cdeg as doubles: halves away from
+    # zero on the decimal written, as the packets' fields do
+    url, master = silent_pty
+    with tase.connect(url) as link:
+        link.point(1.005, -1.005)
+        link.rate(8.345, -0.285)
+        link.camera(hfov=0.015)
+        link.camera(zoom=4.015)
+        got = tase.decode(_drain(master))
+    assert [(p.name, p.raw.get("pan"), p.raw.get("tilt"), p.raw.get("hfov")) for p in got] == [
+        ("GIMBAL_CMD", 101, -101, None),
+        ("GIMBAL_CMD", 835, -29, None),
+        ("CAMERA_CMD", None, None, 2),
+        ("CAMERA_CMD", None, None, -402),
+    ]
+
+
 def test_timeout_is_timeouterror_after_retries(silent_pty):
     url, master = silent_pty
     with tase.connect(url) as link:

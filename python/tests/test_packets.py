@@ -71,6 +71,25 @@ def test_engineering_values_and_repr():
     assert g.fields["lat"] == 45.0
 
 
+def test_conversions_round_the_decimal_written():
+    # 1.005 is just below 1.005 as a double (100.49999999999999 cdeg):
+    # halves away from zero on the decimal written, as docs/PYTHON.md says
+    p = tase.Packet("GIMBAL_ANGLE", pan=1.005, tilt=-1.005, roll=2.675)
+    assert p.raw == {"pan": 101, "tilt": -101, "roll": 268}
+    for deg, cdeg in [(1.115, 112), (4.015, 402), (8.345, 835), (0.285, 29), (-0.285, -29),
+                      (0.004999, 0), (-0.0049999, 0), (179.995, 18000)]:
+        assert tase.Packet("GIMBAL_ANGLE", pan=deg, tilt=0, roll=0).raw["pan"] == cdeg, deg
+    # milli-arcseconds and centimetres the same way; integers stay exact
+    g = tase.Packet("SPOI_CMD", lat=45.0000001389, lon=-0.00000013888, height=1.005, vnorth=0,
+                    veast=0, vdown=0, flags=0)
+    assert (g.raw["lat"], g.raw["lon"], g.raw["height"]) == (162000001, 0, 101)
+    assert tase.Packet("SPOI_CMD", lat=90, lon=-180, height=0, vnorth=0, veast=0, vdown=0,
+                       flags=0).raw["lon"] == -648000000
+    # a value that rounds past the range is still refused
+    with pytest.raises(tase.FieldError):
+        tase.Packet("GIMBAL_ANGLE", pan=327.675, tilt=0, roll=0)
+
+
 def test_replace_and_pickle():
     import pickle
 

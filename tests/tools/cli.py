@@ -575,6 +575,21 @@ rc, out, err = run(["send", "AXIS_SETTING", "pan_pos_gain=41", "--serial", fg.pa
 ok("... the text output says which layout was used",
    rc == 0 and "22-byte layout the gimbal answered" in out and fg.settings[18] == 41,
    "exit %d %r %r" % (rc, err, out))
+# Decimal degrees and metres round half away from zero on the decimal as
+# typed: 1.005 deg is 100.49999999999999 cdeg as a double (it gave 100).
+fg.got.clear()
+for args in (["point", "1.005", "-1.005"], ["rate", "8.345", "-0.285"],
+             ["camera", "--hfov", "0.015"], ["camera", "--zoom", "4.015"],
+             ["spoi", "45.0000001389", "-0.00000013888", "1.005", "--no-wait"]):
+    run(args + ["--serial", fg.path])
+deadline = time.monotonic() + 2.0
+while len(fg.got) < 5 and time.monotonic() < deadline:
+    time.sleep(0.01)
+keys = ("pan", "tilt", "hfov", "lat", "lon", "height")
+got = [tuple(v for k, v in tase.Packet.from_data(g, t, d).raw.items() if k in keys)
+       for g, t, d in fg.got]
+ok("decimal arguments round half away from zero on the decimal typed",
+   got == [(101, -101), (835, -29), (2,), (-402,), (162000001, 0, 101)], repr(got))
 fg.close()
 
 # ---- 64-bit offsets (4 GiB through a pipe: about 1.5 s of CPU; not under memcheck) ----

@@ -170,3 +170,36 @@ double cli_real_arg(const char *what, const char *v, double lo, double hi, const
     }
     return x;
 }
+
+long long cli_scaled_arg(const char *what, const char *v, double lo, double hi, const char *unit,
+                         unsigned long mul)
+{
+    const char *p = v;
+    unsigned long long whole = 0, carry = 0;
+    const char *dot, *end;
+    bool neg = *p == '-';
+    bool up = false;
+    (void)cli_real_arg(what, v, lo, hi, unit); /* syntax and range */
+    if (*p == '+' || *p == '-') {
+        p++;
+    }
+    for (; *p >= '0' && *p <= '9'; p++) {
+        whole = whole * 10u + (unsigned)(*p - '0'); /* in range: a few digits */
+    }
+    dot = p;
+    end = dot + strlen(dot);
+    /* The fraction times mul, exactly: a digit at a time from the last,
+     * as on paper; carry ends as its whole part, and the last digit
+     * written (the first after the point) says whether what is left is
+     * at least one half. */
+    if (*dot == '.') {
+        const char *q;
+        for (q = end - 1; q > dot; q--) {
+            unsigned long long t = (unsigned long long)(*q - '0') * mul + carry;
+            up = t % 10u >= 5u;
+            carry = t / 10u;
+        }
+    }
+    whole = whole * mul + carry + (up ? 1u : 0u);
+    return neg ? -(long long)whole : (long long)whole;
+}

@@ -81,6 +81,11 @@ bool cli_req_opt(cli_args_t *a, cli_req_opts_t *r);
 long long cli_int_opt_value(const char *name, const char *v, long long min, long long max);
 /* A decimal number argument in [lo, hi]; `what` names it in messages. */
 double cli_real_arg(const char *what, const char *v, double lo, double hi, const char *unit);
+/* The same argument times mul (100: degrees -> 1/100 degree, metres -> cm;
+ * 3600000: degrees -> milli-arcseconds), rounded half away from zero on
+ * the decimal as typed (1.005 deg -> 101), not on its binary double. */
+long long cli_scaled_arg(const char *what, const char *v, double lo, double hi, const char *unit,
+                         unsigned long mul);
 /* Usage error naming argv[i]: an unknown option or an unexpected argument. */
 void cli_bad_arg(const cli_args_t *a);
 

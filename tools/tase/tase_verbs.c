@@ -154,9 +154,9 @@ static int gimbal_verb(cli_args_t *a, const gimbal_verb_t *gv)
     verb_parse(a, &v, 2, "stab");
     need_args(&v, 2, gv->args);
     snprintf(what, sizeof(what), "pan%s", gv->what);
-    pan = tase_units_deg_to_cdeg(cli_real_arg(what, v.pos[0], gv->pan_lo, gv->pan_hi, gv->unit));
+    pan = cli_scaled_arg(what, v.pos[0], gv->pan_lo, gv->pan_hi, gv->unit, 100u);
     snprintf(what, sizeof(what), "tilt%s", gv->what);
-    tilt = tase_units_deg_to_cdeg(cli_real_arg(what, v.pos[1], gv->tilt_lo, gv->tilt_hi, gv->unit));
+    tilt = cli_scaled_arg(what, v.pos[1], gv->tilt_lo, gv->tilt_hi, gv->unit, 100u);
     flags = TASE_GIMBAL_FLAGS(gv->kind, v.stab == NULL || strcmp(v.stab, "on") == 0);
     cli_fields_init(&fs, p, p->len);
     cli_fields_set(&fs, "pan", pan);
@@ -247,14 +247,12 @@ int cli_cmd_camera(cli_args_t *a)
         tk_usage_error("expected a camera (A, B, C), --hfov DEG or --zoom X (see --help)");
     }
     if (v.hfov != NULL) {
-        double d = cli_real_arg("--hfov", v.hfov, 0.01, 327.67, "deg");
-        hfov = tase_units_deg_to_cdeg(d);
+        hfov = cli_scaled_arg("--hfov", v.hfov, 0.01, 327.67, "deg", 100u);
         snprintf(what, sizeof(what), ", HFOV %.2f deg", (double)hfov / 100.0);
     } else if (v.zoom != NULL) {
         /* a negative HFOV is a zoom ratio in -1/100 (-1 itself means "no
          * change", which a ratio of at least 1 never reaches) */
-        double z = cli_real_arg("--zoom", v.zoom, 1.0, 327.68, "x");
-        hfov = -(long long)tase_units_round_clamp(z * 100.0, 100.0, 32768.0);
+        hfov = -cli_scaled_arg("--zoom", v.zoom, 1.0, 327.68, "x", 100u);
         snprintf(what, sizeof(what), ", zoom %.2fx", (double)-hfov / 100.0);
     } else {
         what[0] = '\0';
@@ -369,16 +367,16 @@ int cli_cmd_spoi(cli_args_t *a)
     cli_send_opts_t o;
     cli_fields_t fs;
     cli_session_t s;
-    double lat, lon, height;
+    long long lat, lon, height;
     verb_parse(a, &v, 3, "no-wait");
     need_args(&v, 3, "LAT LON HEIGHT (degrees, degrees, metres)");
-    lat = cli_real_arg("latitude", v.pos[0], -90.0, 90.0, "deg");
-    lon = cli_real_arg("longitude", v.pos[1], -180.0, 180.0, "deg");
-    height = cli_real_arg("height", v.pos[2], -21474836.48, 21474836.47, "m");
+    lat = cli_scaled_arg("latitude", v.pos[0], -90.0, 90.0, "deg", 3600000u);
+    lon = cli_scaled_arg("longitude", v.pos[1], -180.0, 180.0, "deg", 3600000u);
+    height = cli_scaled_arg("height", v.pos[2], -21474836.48, 21474836.47, "m", 100u);
     cli_fields_init(&fs, p, p->len);
-    cli_fields_set(&fs, "lat", tase_units_deg_to_mas(lat));
-    cli_fields_set(&fs, "lon", tase_units_deg_to_mas(lon));
-    cli_fields_set(&fs, "height", tase_units_m_to_cm(height));
+    cli_fields_set(&fs, "lat", lat);
+    cli_fields_set(&fs, "lon", lon);
+    cli_fields_set(&fs, "height", height);
     cli_fields_set(&fs, "vnorth", 0);
     cli_fields_set(&fs, "veast", 0);
     cli_fields_set(&fs, "vdown", 0);
