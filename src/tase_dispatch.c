@@ -48,7 +48,8 @@ TASE_NOINLINE_ static tase_packet_handler_t route(tase_dispatch_t *d, const tase
         /* no handler table: everything goes to on_default */
     }
     if (h != NULL) {
-        /* Cannot fail: the packet is known and its length accepted. */
+        /* Cannot fail: the packet is known, its length accepted and its
+         * data there (tase_dispatch_frame() checked). */
         *msg = p->size != 0u ? &d->msg : NULL;
         (void)tase_packet_decode_iter(&it, frame->data, *msg);
     }
@@ -61,8 +62,8 @@ void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame)
     tase_packet_handler_t h;
     void *msg = NULL;
     bool refused;
-    if (d == NULL || frame == NULL) {
-        return;
+    if (d == NULL || frame == NULL || (frame->data == NULL && frame->len > 0u)) {
+        return; /* no frame the receiver delivers: nothing to decode */
     }
     h = route(d, frame, &msg, &refused);
     if (refused) {

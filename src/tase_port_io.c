@@ -22,7 +22,8 @@ typedef struct {
     const tase_port_t *port;
     uint32_t start;  /* now_ms() at the first write */
     uint32_t waited; /* the longest wait seen, ms */
-    uint8_t idle;    /* write() calls that took nothing (< TASE_PORT_WRITE_TRIES) */
+    uint32_t idle;   /* write() calls that took nothing (without a clock: in
+                      * all; with one: since the clock last moved on) */
     bool done;       /* the port took some of the frame */
     bool clock;
 } wr_t;
@@ -60,12 +61,19 @@ static TASE_INLINE_ int wr_put(wr_t *w, const uint8_t *data, size_t n)
             w->idle++;
         }
         if (w->clock && off < n) {
-            /* The longest wait seen so far: a stale sample cannot undo it. */
+            /* The longest wait seen so far: a stale sample cannot undo it.
+             * While it grows, time passes and the deadline bounds the
+             * retries (a TX ring that refuses until it drains is retried
+             * until then, however fast it refuses); only a clock that
+             * stands still (or goes back) counts calls. */
             uint32_t e = tase_port_elapsed_ms(port->ops->now_ms(port->ctx), w->start);
-            w->waited = e > w->waited ? e : w->waited;
+            if (e > w->waited) {
+                w->waited = e;
+                w->idle = 0;
+            }
         }
-        if (off < n &&
-            (w->waited >= TASE_PORT_WRITE_TIMEOUT_MS || w->idle >= TASE_PORT_WRITE_TRIES)) {
+        if (off < n && (w->waited >= TASE_PORT_WRITE_TIMEOUT_MS ||
+                        w->idle >= (w->clock ? TASE_PORT_WRITE_SPINS : TASE_PORT_WRITE_TRIES))) {
             /* The port kept refusing until the deadline: its queue is full.
              * Nothing went out, or part of the frame did (the receiver drops
              * a cut frame by its checksum and finds the next one). */

@@ -277,10 +277,42 @@ static void dispatch_api_rejects_bad_arguments(void **state)
     assert_memory_equal(&stats, &scopy, sizeof stats);
 }
 
+/* A frame with its data NULL and len > 0 (a caller-built one; the
+ * receiver never delivers such) reaches no hook: a typed handler got the
+ * struct the previous frame left in the dispatcher. */
+static void a_frame_without_its_data_reaches_no_handler(void **state)
+{
+    tase_rx_t rx;
+    tase_dispatch_t d;
+    log_t l;
+    tase_frame_t f;
+    (void)state;
+    start(&rx, &d, &l, all_typed);
+    feed(&rx, &d, 0x00, 0x80, 8, 0x12); /* a GIMBAL_CMD, typed */
+    assert_int_equal(l.typed[TASE_PKT_GIMBAL_CMD], 1);
+    memset(&f, 0, sizeof f);
+    f.group = 0x00;
+    f.type = 0x80;
+    f.len = 8;
+    f.data = NULL;
+    tase_dispatch_frame(&d, &f);
+    f.group = 0x7F; /* unknown: on_default would read data[0..len) */
+    tase_dispatch_frame(&d, &f);
+    assert_int_equal(l.typed[TASE_PKT_GIMBAL_CMD], 1);
+    assert_int_equal(l.defaults + l.errors, 0);
+    assert_int_equal(rx.stats.unknown + rx.stats.bad_length, 0);
+    /* a zero-length one with data NULL is a query: dispatched */
+    f.group = 0x00;
+    f.len = 0;
+    tase_dispatch_frame(&d, &f);
+    assert_int_equal(l.typed[TASE_PKT_GIMBAL_CMD] + l.errors, 2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(dispatch_api_rejects_bad_arguments),
+        cmocka_unit_test(a_frame_without_its_data_reaches_no_handler),
         cmocka_unit_test(each_packet_reaches_its_typed_handler_decoded),
         cmocka_unit_test(queries_and_short_forms_reach_the_typed_handler),
         cmocka_unit_test(unknown_packets_pass_through_intact_and_are_counted),

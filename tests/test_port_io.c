@@ -169,6 +169,97 @@ static void write_all_counts_zero_and_enobufs_as_no_progress(void **state)
     assert_int_equal(full.calls, TASE_PORT_WRITE_TRIES);
 }
 
+/* A TX ring of 64 bytes that a 9600-baud UART drains (a byte every 1042
+ * us), refusing while full; each write() costs 2 us of a microsecond
+ * clock that now_ms() reads in milliseconds. A 71-byte frame
+ * (GEOREFERENCE_DATA) needs 7 ms of draining: the helper gave up after 64
+ * refusals, 0.13 ms, with 64 bytes on the wire (TASE_ENOBUFS). */
+typedef struct {
+    uint64_t us;
+    size_t used, sent;
+    unsigned calls;
+    uint32_t frozen; /* 1: now_ms() stands still; 2: it only goes back (and
+                      * the UART is stopped: nothing drains) */
+} ring_t;
+
+static void ring_drain(ring_t *r)
+{
+    uint64_t drained = r->us / 1042u;
+    if (r->frozen != 0u) {
+        return;
+    }
+    while (r->sent < drained && r->used > 0u) {
+        r->used--;
+        r->sent++;
+    }
+    r->sent = (size_t)drained;
+}
+
+static int ring_write(void *ctx, const uint8_t *data, size_t n)
+{
+    ring_t *r = ctx;
+    size_t room;
+    (void)data;
+    r->calls++;
+    r->us += 2u;
+    ring_drain(r);
+    room = 64u - r->used;
+    if (room == 0u) {
+        return TASE_EAGAIN;
+    }
+    if (n > room) {
+        n = room;
+    }
+    r->used += n;
+    return (int)n;
+}
+
+static uint32_t ring_now(void *ctx)
+{
+    const ring_t *r = ctx;
+    if (r->frozen == 1u) {
+        return 5000u;
+    }
+    if (r->frozen == 2u) {
+        return 5000u - (r->calls & 1u); /* a clock that only goes back */
+    }
+    return (uint32_t)(r->us / 1000u);
+}
+
+static const tase_port_ops_t ring_ops = {ring_write, NULL, ring_now};
+
+static void a_tx_ring_that_refuses_fast_is_retried_until_the_deadline(void **state)
+{
+    ring_t r;
+    tase_port_t p = {&ring_ops, &r, 960};
+    uint8_t frame[TASE_FRAME_MAX];
+    (void)state;
+    memset(frame, 0x5A, sizeof frame);
+    memset(&r, 0, sizeof r);
+    r.us = 1000000u;
+    r.sent = (size_t)(r.us / 1042u);
+    assert_int_equal(tase_port_write_all(&p, frame, 71), 71);
+    assert_true(r.us - 1000000u < 10000u); /* about 7 ms of draining */
+    /* the longest frame: what drains in 100 ms goes, then ENOBUFS */
+    memset(&r, 0, sizeof r);
+    r.us = 1000000u;
+    r.sent = (size_t)(r.us / 1042u);
+    assert_int_equal(tase_port_send_frame(&p, 0x00, 0x42, frame, 253), TASE_ENOBUFS);
+    assert_true(r.us - 1000000u >= (uint64_t)TASE_PORT_WRITE_TIMEOUT_MS * 1000u);
+    assert_true(r.us - 1000000u < ((uint64_t)TASE_PORT_WRITE_TIMEOUT_MS + 1u) * 1000u);
+    /* a clock that stands still, or only goes back: the backstop counts
+     * the refused calls in a row */
+    memset(&r, 0, sizeof r);
+    r.used = 64u;
+    r.frozen = 1u;
+    assert_int_equal(tase_port_write_all(&p, frame, 8), TASE_EAGAIN);
+    assert_int_equal(r.calls, TASE_PORT_WRITE_SPINS);
+    r.calls = 0u;
+    r.frozen = 2u;
+    assert_int_equal(tase_port_write_all(&p, frame, 8), TASE_EAGAIN);
+    assert_int_equal(r.calls, TASE_PORT_WRITE_SPINS);
+}
+
 static void send_frame_checks_the_frame_before_the_port(void **state)
 {
     fake_port_t *f = new_fake();
@@ -498,6 +589,7 @@ int main(void)
         cmocka_unit_test(write_all_rejects_a_port_claiming_more_than_asked),
         cmocka_unit_test(write_all_counts_zero_and_enobufs_as_no_progress),
         cmocka_unit_test(send_frame_checks_the_frame_before_the_port),
+        cmocka_unit_test(a_tx_ring_that_refuses_fast_is_retried_until_the_deadline),
         cmocka_unit_test(a_stuck_port_costs_one_write_bound_per_frame_not_64),
         cmocka_unit_test(write_all_keeps_its_contract_under_random_faults),
         cmocka_unit_test(elapsed_is_wrap_safe_and_a_stale_sample_is_no_time),

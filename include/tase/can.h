@@ -147,7 +147,7 @@ typedef struct {
 
 /* A CAN receiver: role acceptance in front of a datalink receiver. `rx`
  * (datalink counters in rx.stats) and `stats` may be read; the rest is
- * private. About 350 bytes. */
+ * private. 380 bytes (docs/FOOTPRINT.md). */
 typedef struct {
     tase_rx_t rx;
     tase_can_rx_stats_t stats;

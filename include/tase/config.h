@@ -27,10 +27,14 @@
  * THE OPTIONS
  *   TASE_PORT_WRITE_TIMEOUT_MS (default 100)  the deadline of one frame
  *       write by tase_port_write_all() (tase/port_io.h).
- *   TASE_PORT_WRITE_TRIES (default 64)  tase_port_write_all()'s give-up
- *       count for a port whose clock does not move (tase/port_io.h).
- *       Both are used only inside the library: the values the library
- *       was built with are the ones that apply.
+ *   TASE_PORT_WRITE_TRIES (default 64, 1..255)  tase_port_write_all()'s
+ *       give-up count for a port without a clock (tase/port_io.h).
+ *   TASE_PORT_WRITE_SPINS (default 1048576, 1..2^31)  the same for a port
+ *       whose clock stands still: refused calls in a row while its clock
+ *       shows no time passing. Far more than a port refuses within one
+ *       tick of a working clock (a 1 ms tick and a 20 ns call: 50,000).
+ *       The three are used only inside the library: the values the
+ *       library was built with are the ones that apply.
  *   TASE_RX_QUIET_MS (default 20, 1..65535)  the margin of the
  *       receiver's time bound, the longest pause inside a real frame as a
  *       receiver sees it (tase/frame.h, TIME BOUND); the value the library
@@ -97,6 +101,12 @@
 #endif
 #if TASE_PORT_WRITE_TRIES < 1 || TASE_PORT_WRITE_TRIES > 255
 #error "TASE_PORT_WRITE_TRIES must be 1..255"
+#endif
+#ifndef TASE_PORT_WRITE_SPINS
+#define TASE_PORT_WRITE_SPINS 1048576u
+#endif
+#if TASE_PORT_WRITE_SPINS < 1 || TASE_PORT_WRITE_SPINS > 0x80000000
+#error "TASE_PORT_WRITE_SPINS must be 1..2^31"
 #endif
 
 /* The link-name tag: "abi" and the ABI level. An option that changes a

@@ -104,8 +104,9 @@ int tase_dispatch_init(tase_dispatch_t *d, const tase_packet_handler_t *handlers
                        tase_rx_stats_t *stats);
 
 /* Dispatch one frame as described above; `dispatcher` is a
- * tase_dispatch_t *. Ignores the call if either argument is NULL (no
- * callback runs, nothing is counted).
+ * tase_dispatch_t *. Ignores the call if either argument is NULL, or if
+ * the frame's data is NULL with len > 0 (not a frame a receiver
+ * delivers): no callback runs, nothing is counted.
  * O(frame length). Reentrant for different dispatchers; ISR-safe if the
  * handlers are. */
 void tase_dispatch_frame(void *dispatcher, const tase_frame_t *frame);

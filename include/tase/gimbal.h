@@ -249,7 +249,7 @@ typedef struct {
     uint8_t rate; /* packets per second, 0 = off */
 } tase_gimbal_sched_t;
 
-/* Gimbal instance (516 bytes on Cortex-M, docs/FOOTPRINT.md; the
+/* Gimbal instance (512 bytes on Cortex-M, docs/FOOTPRINT.md; the
  * receivers are the caller's, see tase_gimbal_init()). Treat every field
  * except `stats` as private. */
 typedef struct {
@@ -278,7 +278,7 @@ typedef struct {
  * is NULL leaves that port absent: nothing is sent there), app is copied
  * (NULL: no callbacks), setup packets take their defaults and every
  * stream is anchored at now_ms (first packets one period later).
- * rx is the caller's array of nports receivers (356 bytes each), one per
+ * rx is the caller's array of nports receivers (360 bytes each), one per
  * port, used by tase_gimbal_feed() and tase_gimbal_service(); init
  * initialises them, sets each one's time bound to its port's byte rate
  * (tase_rx_set_timing()) and keeps the pointer. Each port's telemetry

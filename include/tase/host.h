@@ -66,7 +66,7 @@
  *
  * All functions: not reentrant per instance, not ISR-safe (call from one
  * context); different instances are independent. No allocation, no
- * globals. sizeof(tase_host_t) is about 660 bytes on Cortex-M (a tase_rx_t plus a copy
+ * globals. sizeof(tase_host_t) is 696 bytes on Cortex-M (a tase_rx_t plus a copy
  * of the pending request for re-sending).
  */
 #ifndef TASE_HOST_H

@@ -20,10 +20,12 @@
  * ports) returns short only once its own W has passed, so with W at
  * least the deadline (the defaults: 1000 and 100 ms) it is never called
  * twice for a frame and the bound is W alone; a port that does not wait
- * (a full TX ring) is retried until the deadline. A clock sample
- * older than the start counts as no time (see tase_port_elapsed_ms()).
- * A port without now_ms is bounded by calls instead: at most
- * TASE_PORT_WRITE_TRIES calls that take nothing.
+ * (a full TX ring) is retried until the deadline, however fast it
+ * refuses. A clock sample older than the start counts as no time (see
+ * tase_port_elapsed_ms()). A port without now_ms is bounded by calls
+ * instead: at most TASE_PORT_WRITE_TRIES calls that take nothing; and a
+ * port whose clock stands still (or only goes back) by
+ * TASE_PORT_WRITE_SPINS such calls in a row.
  * tase_port_send_frame() and tase_port_send_msg() write a frame in pieces
  * of 16 bytes (at most 17), keeping the one deadline and the TRIES count
  * across them. The deadline is checked while a piece is refused or only
@@ -31,8 +33,8 @@
  * each call is called once per piece: up to 17 W for the longest frame
  * (a POSIX port blocks only while its kernel queue is full; a TX ring
  * never). A port that refuses every other call uses up the
- * TASE_PORT_WRITE_TRIES count about one call per piece sooner than
- * tase_port_write_all() of the same frame.
+ * TASE_PORT_WRITE_TRIES count of a port without a clock about one call
+ * per piece sooner than tase_port_write_all() of the same frame.
  */
 #ifndef TASE_PORT_IO_H
 #define TASE_PORT_IO_H
@@ -45,10 +47,13 @@ extern "C" {
 
 /* TASE_PORT_WRITE_TIMEOUT_MS (tase/config.h, default 100): the deadline
  * of one frame write (see LONGEST BLOCK).
- * TASE_PORT_WRITE_TRIES (tase/config.h, default 64): backstop for a port
- * whose clock does not move (or that has none): calls to write() that took
- * nothing (TASE_EAGAIN, TASE_ENOBUFS or 0) after which
- * tase_port_write_all() gives up even before the deadline. */
+ * TASE_PORT_WRITE_TRIES (tase/config.h, default 64): the bound of a port
+ * without a clock: calls to write() that took nothing (TASE_EAGAIN,
+ * TASE_ENOBUFS or 0) after which tase_port_write_all() gives up.
+ * TASE_PORT_WRITE_SPINS (tase/config.h, default 2^20): the backstop for a
+ * port whose clock stands still: such calls in a row while the clock
+ * shows no time passing (a working clock resets the count as it moves
+ * on, so a TX ring is retried until the deadline). */
 
 /* Milliseconds from since_ms to now_ms on a clock that wraps modulo 2^32
  * (unsigned difference). A now_ms sampled before since_ms (a stale sample
@@ -65,8 +70,9 @@ uint32_t tase_port_elapsed_ms(uint32_t now_ms, uint32_t since_ms);
  *   TASE_EAGAIN / TASE_ENOBUFS  the port took nothing before the deadline
  *                (its own refusal code; nothing was sent: retry later);
  *   TASE_ENOBUFS the deadline passed part-way: the port's queue stayed
- *                full (some bytes were sent; a receiver discards the cut
- *                frame by its checksum and finds the next one);
+ *                full, or it drains slower than the frame needs (some
+ *                bytes were sent; a receiver discards the cut frame by
+ *                its checksum and finds the next one);
  *   TASE_EIO     write() claimed more than it was given (a broken port);
  *   any other negative code the port's write() returned (at once).
  * O(n) plus the port's cost. Reentrant if the port's write is; not
