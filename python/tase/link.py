@@ -503,11 +503,20 @@ class Link:
     # -- the CLI's safe verbs (tase point/rate/spoi/retract/deploy/camera)
 
     def point(self, pan, tilt, stab=True):
-        """GIMBAL_CMD position (`tase point`): pan and tilt in degrees,
-        -180..180 each."""
-        for name, v in (("pan", pan), ("tilt", tilt)):
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not -180 <= v <= 180:
-                raise FieldError("point: %s %r is not a number in -180..180 degrees" % (name, v))
+        """GIMBAL_CMD position (`tase point`): pan -180..180 and tilt
+        -270..90 degrees (the spec's ranges, tase/units.h)."""
+        for name, v, lo, hi in (
+            ("pan", pan, lib.TASE_PAN_MIN_CDEG, lib.TASE_PAN_MAX_CDEG),
+            ("tilt", tilt, lib.TASE_TILT_MIN_CDEG, lib.TASE_TILT_MAX_CDEG),
+        ):
+            if (
+                isinstance(v, bool)
+                or not isinstance(v, (int, float))
+                or not lo / 100 <= v <= hi / 100
+            ):
+                raise FieldError(
+                    "point: %s %r is not a number in %g..%g degrees" % (name, v, lo / 100, hi / 100)
+                )
         flags = lib.TASE_GIMBAL_FLAGS_POSITION_STAB if stab else lib.TASE_GIMBAL_FLAGS_POSITION
         return self.send(_gimbal_cmd(pan, tilt, flags))
 

@@ -66,12 +66,14 @@ def test_verbs_round_the_decimal_written(silent_pty):
     url, master = silent_pty
     with tase.connect(url) as link:
         link.point(1.005, -1.005)
+        link.point(0, -250)  # inside tilt's -270..90 (it was refused: -180..180)
         link.rate(8.345, -0.285)
         link.camera(hfov=0.015)
         link.camera(zoom=4.015)
         got = tase.decode(_drain(master))
     assert [(p.name, p.raw.get("pan"), p.raw.get("tilt"), p.raw.get("hfov")) for p in got] == [
         ("GIMBAL_CMD", 101, -101, None),
+        ("GIMBAL_CMD", 0, -25000, None),
         ("GIMBAL_CMD", 835, -29, None),
         ("CAMERA_CMD", None, None, 2),
         ("CAMERA_CMD", None, None, -402),
@@ -94,8 +96,11 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
 @pytest.mark.parametrize(
     "call, exc, text",
     [
-        (lambda l: l.point(200, 0), tase.FieldError, "-180..180"),
+        (lambda l: l.point(200, 0), tase.FieldError, "pan 200 .* -180..180"),
         (lambda l: l.point(float("nan"), 0), tase.FieldError, "-180..180"),
+        # tilt is -270..90 (the spec's range, as `tase point`): 150 was sent
+        (lambda l: l.point(0, 150), tase.FieldError, "tilt 150 .* -270..90"),
+        (lambda l: l.point(0, -270.01), tase.FieldError, "-270..90"),
         (lambda l: l.rate(400, 0), tase.FieldError, "327.67"),
         (lambda l: l.send(tase.Packet("GIMBAL_ANGLE", pan=0, tilt=0, roll=0)), tase.FieldError,
          "sent by the gimbal"),

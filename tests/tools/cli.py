@@ -269,7 +269,19 @@ log = write("plain.log", "\n".join(l for _, l in l0) + "\n")
 expect("a candump log decoded without --candump: hint and exit 4", ["decode", log], 4,
        r"no TASE packet found in .*plain.log: it looks like a candump log \(add --candump\)")
 expect("noise only: hint and exit 4", ["decode", write("noise.bin", bytes(range(1, 200)))], 4,
-       "no TASE packet found")
+       r"no TASE packet found .*\(not a capture of a TASE serial line\?\)")
+# a frame whose checksum fails is not "no frame of ID ..." (the hint said so)
+bad = "(1700000000.007000) vcan0 10000000#00FF5A0808100001\n" \
+      "(1700000000.007000) vcan0 10000000#000000000179\n"
+expect("candump: datalink frames whose packet fails its checksum: the hint says so",
+       ["decode", "--candump", write("badsum.log", bad)], 4,
+       r"badsum.log \(candidate frames were found, each with a bad checksum\)")
+expect("candump: datalink frames with no whole frame in them",
+       ["decode", "--candump", write("cut.log", "(1700000000.007000) vcan0 10000000#00FF5A08\n")],
+       4, r"cut.log \(its frames of ID 10000000 and 11000000 hold no whole frame\)")
+expect("candump: no datalink frame at all",
+       ["decode", "--candump", write("other.log", "(1700000000.007000) vcan0 12345678#00FF\n")],
+       4, r"other.log \(no frame of ID 10000000 or 11000000\)")
 rc, out, err = run(["decode", write("empty.bin", b"")])
 ok("an empty input is no error", rc == 0 and out == "" and err == "", err)
 # klv follows decode's rule

@@ -105,6 +105,21 @@ $U can-pcap "$dir/can.pcap" "$DATA/decode_candump.log"
 compare canpcap "SocketCAN pcap (Wireshark's CAN dissector)" "$dir/can.pcap" "$dir/can.pcap"
 $U serial-pcap "$dir/noisy.pcap" 5 0.001-3 "$DATA/decode_noisy.bin:out" "$DATA/decode_noisy.bin:in"
 compare noisy "noisy serial capture, both directions" "$dir/noisy.pcap" "$dir/noisy.pcap"
+# AXIS_SETTING's two layouts (docs/PROTOCOL-NOTES.md S2): the 22-byte one
+# was "wrong length" in the dissector while tase decode showed its fields
+${TASE_PYTHON:-python3} -c '
+import sys, tase
+f = dict(pan_max_rate=50, tilt_max_rate=21, roll_max_rate=22, pan_pos_gain=7, temporary=1)
+out = b"".join(tase.encode(p) for p in (tase.Packet("AXIS_SETTING", raw=f),
+                                        tase.Packet("AXIS_SETTING", length=22, raw=f),
+                                        tase.Packet.query("AXIS_SETTING")))
+open(sys.argv[1], "wb").write(out)' "$dir/axis.bin"
+$U serial-pcap "$dir/axis.pcap" 5 0.001-3 "$dir/axis.bin:out" "$dir/axis.bin:in"
+compare axis "AXIS_SETTING in its 23- and 22-byte layouts, both directions" "$dir/axis.pcap" \
+    "$dir/axis.pcap"
+check "... the 22-byte one with its fields, tilt_max_rate 21 one byte earlier" \
+    eval '[ "$(grep -c "name=\"tase.axis_setting.tilt_max_rate\" .*show=\"21\"" "$dir/axis.pdml")" -eq 4 ] &&
+          ! grep -q "wrong length" "$dir/axis.pdml"'
 
 # Issue 27: a gap in the record times ends a held candidate in both tools
 # as the live receiver's time bound did: after the false sync 00 FF 5A FF

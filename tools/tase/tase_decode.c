@@ -12,7 +12,7 @@
 #define BAD_LINES_SHOWN 10u
 
 /* What the start of an input that held no packet looks like. */
-static const char *input_guess(const cli_input_t *in, bool candump)
+static const char *input_guess(const cli_input_t *in, const tk_dec_t *d, bool candump)
 {
     size_t eol;
     const char *s = (const char *)in->head;
@@ -28,6 +28,12 @@ static const char *input_guess(const cli_input_t *in, bool candump)
     }
     if (!candump && cli_input_is_text(in)) {
         return ": it is text, not a raw serial capture";
+    }
+    if (d->n.checksum_errors > 0u) {
+        return " (candidate frames were found, each with a bad checksum)";
+    }
+    if (candump && d->n.can_frames > d->n.can_other) {
+        return " (its frames of ID 10000000 and 11000000 hold no whole frame)";
     }
     if (candump) {
         return " (no frame of ID 10000000 or 11000000)";
@@ -232,7 +238,7 @@ int cli_cmd_decode(cli_args_t *a)
                 capture ? "record" : "line", bad == 1 ? "" : "s");
     }
     if (d.n.frames == 0 && in.nhead > 0) {
-        tk_exit(TK_EXIT_INPUT, "no TASE packet found in %s%s", in.name, input_guess(&in, candump));
+        tk_exit(TK_EXIT_INPUT, "no TASE packet found in %s%s", in.name, input_guess(&in, &d, candump));
     }
     return TK_EXIT_OK;
 }

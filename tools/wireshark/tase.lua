@@ -80,9 +80,10 @@ tase.prefs.baud = Pref.uint("Serial line baud rate", 57600,
         .. "at least 20 ms")
 
 -- BEGIN GENERATED (tools/wireshark/schema_lua.c; do not edit by hand)
--- {group, type, name, data length, flags, {{field, offset, width, signed}...}}
+-- {group, type, name, data length, flags, {{field, offset, width, signed[, shift]}...}}
 -- flags: q = zero-length query form, 1 = one-byte form, t = free bytes after
--- the fields (CAMERA_PASS)
+-- the fields (CAMERA_PASS), s = a short layout one byte shorter, where the
+-- fields marked shift sit one byte earlier (AXIS_SETTING's 22 bytes)
 local SCHEMA = {
     {0x00, 0x80, "GIMBAL_CMD", 8, "", {
         {"pan", 0, 2, true}, {"tilt", 2, 2, true}, {"roll", 4, 2, true},
@@ -158,13 +159,13 @@ local SCHEMA = {
     {0x48, 0x01, "SENSOR_FILTER", 2, "q", {
         {"cutoff", 0, 1, false}, {"decimation", 1, 1, false},
     }},
-    {0x48, 0x02, "AXIS_SETTING", 23, "q", {
+    {0x48, 0x02, "AXIS_SETTING", 23, "qs", {
         {"pan_nogo_center", 0, 2, true}, {"pan_nogo_range", 2, 2, false}, {"tilt_nogo_center", 4, 2, true},
         {"tilt_nogo_range", 6, 2, false}, {"roll_nogo_center", 8, 2, true}, {"roll_nogo_range", 10, 2, false},
-        {"pan_max_rate", 12, 1, false}, {"tilt_max_rate", 14, 1, false}, {"roll_max_rate", 15, 1, false},
-        {"pan_max_accel", 16, 1, false}, {"tilt_max_accel", 17, 1, false}, {"roll_max_accel", 18, 1, false},
-        {"pan_pos_gain", 19, 1, false}, {"tilt_pos_gain", 20, 1, false}, {"roll_pos_gain", 21, 1, false},
-        {"temporary", 22, 1, false},
+        {"pan_max_rate", 12, 1, false}, {"tilt_max_rate", 14, 1, false, true}, {"roll_max_rate", 15, 1, false, true},
+        {"pan_max_accel", 16, 1, false, true}, {"tilt_max_accel", 17, 1, false, true}, {"roll_max_accel", 18, 1, false, true},
+        {"pan_pos_gain", 19, 1, false, true}, {"tilt_pos_gain", 20, 1, false, true}, {"roll_pos_gain", 21, 1, false, true},
+        {"temporary", 22, 1, false, true},
     }},
     {0x48, 0x03, "SYSTEM_VERSION", 42, "q", {
         {"major", 0, 1, false}, {"minor", 1, 1, false}, {"sub", 2, 1, false},
@@ -246,7 +247,7 @@ for _, row in ipairs(SCHEMA) do
         local abbr = "tase." .. row[3]:lower() .. "." .. fr[1]
         local ctor = (fr[4] and "int" or "uint") .. (8 * fr[3])
         local pf = ProtoField[ctor](abbr, fr[1])
-        p.fields[#p.fields + 1] = {name = fr[1], offset = fr[2], width = fr[3], pf = pf}
+        p.fields[#p.fields + 1] = {name = fr[1], offset = fr[2], width = fr[3], shift = fr[5], pf = pf}
         field_list[#field_list + 1] = pf
     end
     PACKETS[row[1] * 256 + row[2]] = p
@@ -256,11 +257,18 @@ tase_serial.fields = {F.serial_dir, F.serial_bytes}
 tase.experts = {E.wrong_length, E.merged}
 tase_serial.experts = {E.bad_dir}
 
+-- Whether len selects the packet's short layout (tase/schema.h, TWO
+-- LAYOUTS; docs/PROTOCOL-NOTES.md S2).
+local function short_layout(p, len)
+    return len + 1 == p.len and p.flags:find("s", 1, true) ~= nil
+end
+
 -- The data lengths a packet accepts (tase_schema_length_ok()).
 local function length_ok(p, len)
     return len == p.len or (len == 0 and p.flags:find("q", 1, true) ~= nil)
         or (len == 1 and p.flags:find("1", 1, true) ~= nil)
         or (len >= p.len and p.flags:find("t", 1, true) ~= nil)
+        or short_layout(p, len)
 end
 
 -- ---- reassembly, one stream per direction and interface ----
@@ -444,9 +452,11 @@ local function add_frame(tree, fr, dir)
         t:add(F.error, ftvb(3, 1), "wrong length")
         t:add_proto_expert_info(E.wrong_length)
     else
+        local short = short_layout(p, len)
         for _, f in ipairs(p.fields) do
-            if f.offset + f.width > len then break end -- short forms: the fields that fit
-            t:add(f.pf, ftvb(6 + f.offset, f.width))
+            local at = (short and f.shift and f.offset > 0) and f.offset - 1 or f.offset
+            if at + f.width > len then break end -- short forms: the fields that fit
+            t:add(f.pf, ftvb(6 + at, f.width))
         end
         if p.flags:find("t", 1, true) then -- CAMERA_PASS: its camera bytes, maybe none
             t:add(F.data, ftvb(6 + p.len, len - p.len))
