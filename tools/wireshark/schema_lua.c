@@ -13,7 +13,8 @@ int main(void)
     size_t i;
     tase_field_iter_t it;
     puts("-- BEGIN GENERATED (tools/wireshark/schema_lua.c; do not edit by hand)");
-    puts("-- {group, type, name, data length, flags, {{field, offset, width, signed[, shift]}...}}");
+    puts("-- {group, type, name, data length, flags,");
+    puts("--  {{field, offset, width, signed[, shift]}...}}");
     puts("-- flags: q = zero-length query form, 1 = one-byte form, t = free bytes after");
     puts("-- the fields (CAMERA_PASS), s = a short layout one byte shorter, where the");
     puts("-- fields marked shift sit one byte earlier (AXIS_SETTING's 22 bytes)");

@@ -80,7 +80,8 @@ tase.prefs.baud = Pref.uint("Serial line baud rate", 57600,
         .. "at least 20 ms")
 
 -- BEGIN GENERATED (tools/wireshark/schema_lua.c; do not edit by hand)
--- {group, type, name, data length, flags, {{field, offset, width, signed[, shift]}...}}
+-- {group, type, name, data length, flags,
+--  {{field, offset, width, signed[, shift]}...}}
 -- flags: q = zero-length query form, 1 = one-byte form, t = free bytes after
 -- the fields (CAMERA_PASS), s = a short layout one byte shorter, where the
 -- fields marked shift sit one byte earlier (AXIS_SETTING's 22 bytes)
