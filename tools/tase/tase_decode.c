@@ -238,7 +238,8 @@ int cli_cmd_decode(cli_args_t *a)
                 capture ? "record" : "line", bad == 1 ? "" : "s");
     }
     if (d.n.frames == 0 && in.nhead > 0) {
-        tk_exit(TK_EXIT_INPUT, "no TASE packet found in %s%s", in.name, input_guess(&in, &d, candump));
+        tk_exit(TK_EXIT_INPUT, "no TASE packet found in %s%s", in.name,
+                input_guess(&in, &d, candump));
     }
     return TK_EXIT_OK;
 }
