@@ -257,6 +257,14 @@ static const unit_t *unit_of(const tase_packet_desc_t *p, const char *field)
     return NULL;
 }
 
+/* Whether all ones in the field of u mean "unavailable": the spec says so
+ * of HOST_SENSOR's TAS only (4.2.3, "0xFFFF if this value is
+ * unavailable"). */
+static bool unavailable_ones(const unit_t *u)
+{
+    return u->pkt == TASE_PKT_HOST_SENSOR && strcmp(u->field, "tas") == 0;
+}
+
 bool tk_unit(const tase_packet_desc_t *p, const char *field, tk_unit_info_t *out)
 {
     const unit_t *u = unit_of(p, field);
@@ -267,7 +275,25 @@ bool tk_unit(const tase_packet_desc_t *p, const char *field, tk_unit_info_t *out
     out->label = unit_kinds[u->kind].label;
     out->decimals = u->decimals;
     out->scale = u->scale;
+    out->unavailable_ones = unavailable_ones(u);
     return true;
+}
+
+/* Why the current field of `it`, of unit u, holding v has no engineering
+ * value: "no change" (its "do not change" value: AXIS_SETTING's 0xFF and
+ * 0xFFFF), "unavailable" (TAS 0xFFFF), or NULL when it has one. */
+static const char *no_value(const tase_field_iter_t *it, const unit_t *u, int64_t v)
+{
+    uint32_t ones = (it->width >= 4u) ? 0xFFFFFFFFu : (UINT32_C(1) << (8u * it->width)) - 1u;
+    uint32_t bits = (uint32_t)((uint64_t)v & ones);
+    uint32_t keep;
+    if (tase_field_iter_keep_bits(it, &keep) && bits == keep) {
+        return "no change";
+    }
+    if (unavailable_ones(u) && bits == ones) {
+        return "unavailable";
+    }
+    return NULL;
 }
 
 /* ---- a bounded line builder ---- */
@@ -433,7 +459,11 @@ static void json_units(sb_t *b, const tase_packet_desc_t *p, const tase_frame_t 
             sb_str(b, unit_kinds[u->kind].suffix);
         }
         sb_str(b, "\":");
-        sb_real(b, (double)v * u->scale, u->decimals);
+        if (no_value(&it, u, v) != NULL) {
+            sb_str(b, "null");
+        } else {
+            sb_real(b, (double)v * u->scale, u->decimals);
+        }
     }
     if (any) {
         sb_c(b, '}');
@@ -646,11 +676,16 @@ static void text_frame(sb_t *b, const tk_fmt_t *fmt, const tk_meta_t *m, const t
         sb_c(b, '=');
         sb_i64(b, v);
         if (fmt->units && (u = unit_of(p, name)) != NULL) {
+            const char *why = no_value(&it, u, v);
             sb_str(b, " (");
-            sb_real(b, (double)v * u->scale, u->decimals);
-            if (unit_kinds[u->kind].label[0] != '\0') {
-                sb_c(b, ' ');
-                sb_str(b, unit_kinds[u->kind].label);
+            if (why != NULL) {
+                sb_str(b, why);
+            } else {
+                sb_real(b, (double)v * u->scale, u->decimals);
+                if (unit_kinds[u->kind].label[0] != '\0') {
+                    sb_c(b, ' ');
+                    sb_str(b, unit_kinds[u->kind].label);
+                }
             }
             sb_c(b, ')');
         }

@@ -238,6 +238,7 @@ typedef struct {
     const char *label;
     unsigned decimals;
     double scale;
+    bool unavailable_ones; /* all ones means "unavailable" (TAS): no value */
 } tk_unit_info_t;
 bool tk_unit(const tase_packet_desc_t *p, const char *field, tk_unit_info_t *out);
 

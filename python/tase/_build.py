@@ -156,6 +156,7 @@ typedef struct {
     const char *unit_label;
     unsigned decimals;
     double scale;
+    int unavailable_ones; /* all ones: "unavailable", no engineering value */
 } py_field_t;
 int py_field(size_t pkt, size_t i, size_t len, py_field_t *out);
 int py_decode(size_t pkt, const uint8_t *data, size_t len, int64_t *vals, size_t cap);
@@ -248,6 +249,7 @@ int py_field(size_t pkt, size_t i, size_t len, py_field_t *out)
         out->unit_label = u.label;
         out->decimals = u.decimals;
         out->scale = u.scale;
+        out->unavailable_ones = u.unavailable_ones;
     }
     return TASE_OK;
 }

@@ -108,9 +108,10 @@ def error(code, what, cls=None):
 
 class Field:
     """One field of a packet's table: name, width (bytes), signedness, the
-    wire range, the "do not change" value (keep, or None) and the
-    engineering unit (unit: JSON key suffix such as "deg", or None; label;
-    scale: unit per wire count; decimals printed by `tase --units`)."""
+    wire range, the "do not change" value (keep, or None), the
+    "unavailable" value (none, or None: TAS 0xFFFF) and the engineering
+    unit (unit: JSON key suffix such as "deg", or None; label; scale: unit
+    per wire count; decimals printed by `tase --units`)."""
 
     __slots__ = (
         "name",
@@ -120,6 +121,7 @@ class Field:
         "min",
         "max",
         "keep",
+        "none",
         "unit",
         "label",
         "scale",
@@ -269,6 +271,9 @@ def _load_schema():
             f.min = -(1 << (bits - 1)) if f.signed else 0
             f.max = (1 << (bits - 1)) - 1 if f.signed else (1 << bits) - 1
             f.keep = out.keep if out.has_keep else None
+            f.none = None
+            if out.has_unit and out.unavailable_ones:
+                f.none = -1 if f.signed else f.max
             if out.has_unit:
                 f.unit = ffi.string(out.unit_suffix).decode()
                 f.label = ffi.string(out.unit_label).decode()
@@ -477,7 +482,9 @@ class Packet(tuple):
 
     @property
     def units(self):
-        """The engineering values `tase --units` adds: {"pan_deg": 12.34, ...}."""
+        """The engineering values `tase --units` adds: {"pan_deg": 12.34, ...};
+        None for a field holding its "do not change" value (AXIS_SETTING's
+        0xFF/0xFFFF) or its "unavailable" one (TAS 0xFFFF), as its null."""
         t = _BY_ID.get(self.id)
         if t is None:
             return {}
@@ -485,7 +492,9 @@ class Packet(tuple):
         for k, v in self.raw.items():
             f = t.by_name[k]
             if f.unit is not None:
-                out[k + "_" + f.unit if f.unit else k] = f.to_eng(v)
+                out[k + "_" + f.unit if f.unit else k] = (
+                    None if v == f.keep or v == f.none else f.to_eng(v)
+                )
         return out
 
     @property

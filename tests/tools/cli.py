@@ -604,6 +604,44 @@ ok("decimal arguments round half away from zero on the decimal typed",
    got == [(101, -101), (835, -29), (2,), (-402,), (162000001, 0, 101)], repr(got))
 fg.close()
 
+# ---- --units: "do not change" and "unavailable" have no engineering value ----
+# (AXIS_SETTING's 0xFF/0xFFFF showed as 1275 deg/s, -0.01 deg; TAS 0xFFFF as
+# 655.35 m/s)
+def monitor_units(extra):
+    m, s = os.openpty()
+    p = subprocess.Popen(VG + [TASE, "monitor", "--serial", os.ttyname(s), "--units", "--count",
+                               "2", "--seconds", str(10 * SLOW)] + extra,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    time.sleep(0.5 * SLOW)  # the line set up before the bytes come
+    keep = dict(pan_nogo_center=-1, pan_nogo_range=0xFFFF, pan_max_rate=255, tilt_max_rate=20,
+                pan_pos_gain=255, tilt_pos_gain=40, temporary=1)
+    sensor = dict(time=1000, roll=1, pitch=2, yaw=3, flags=0xA0, sample_rate=100, x_accel=-200,
+                  y_accel=0, z_accel=0, tas=0xFFFF)
+    os.write(m, tase.encode(tase.Packet("AXIS_SETTING", raw=keep)) +
+             tase.encode(tase.Packet("HOST_SENSOR", raw=sensor)))
+    out, err = p.communicate(timeout=20 * SLOW)
+    os.close(m)
+    os.close(s)
+    return out.decode(), err.decode()
+
+
+out, err = monitor_units(["--json"])
+u = [o.get("units", {}) for o in jsonl(out)]
+ok("monitor --json --units: null for 'do not change' and 'unavailable', values elsewhere",
+   len(u) == 2 and u[0]["pan_nogo_center_deg"] is None and u[0]["pan_nogo_range_deg"] is None and
+   u[0]["pan_max_rate_dps"] is None and u[0]["tilt_max_rate_dps"] == 100 and
+   u[0]["pan_pos_gain_dps_per_deg"] is None and u[0]["tilt_pos_gain_dps_per_deg"] == 4.0 and
+   u[1]["tas_mps"] is None and u[1]["time_s"] == 1.0, repr(out) + err)
+out, err = monitor_units([])
+ok("monitor --units (text): '(no change)' and '(unavailable)'",
+   "pan_max_rate=255 (no change)" in out and "tilt_max_rate=20 (100 deg/s)" in out and
+   "tas=65535 (unavailable)" in out, repr(out) + err)
+# the Python package's .units is the same
+p = tase.decode(tase.encode(tase.Packet("HOST_SENSOR", time=1, roll=0, pitch=0, yaw=0, flags=0,
+                                        sample_rate=1, x_accel=0, y_accel=0, z_accel=0,
+                                        raw={"tas": 0xFFFF})))[0]
+ok("python: Packet.units gives None for TAS 0xFFFF", p.units["tas_mps"] is None, repr(p.units))
+
 # ---- 64-bit offsets (4 GiB through a pipe: about 1.5 s of CPU; not under memcheck) ----
 gen = ("import os,sys,fcntl\n"
        "try: fcntl.fcntl(1, 1031, 1 << 20)\n"
