@@ -28,11 +28,14 @@
 #define KLV_PERIOD_MS 900u /* spec section 6: about every 900 ms */
 
 static const char usage[] =
-    "usage: tase-sim [--link PATH [--baud N] | --can IFACE] [--klv-link PATH]\n"
-    "                [--seconds S] [--quiet]\n"
+    "usage: tase-sim [--link PATH [--baud N | --can-pty] | --can IFACE]\n"
+    "                [--klv-link PATH] [--seconds S] [--quiet]\n"
     "A simulated TASE gimbal. By default it serves the serial datalink on a new\n"
     "pseudo-terminal and prints its path; --link PATH also makes PATH a symlink to\n"
     "it. --can IFACE serves the CAN datalink on a SocketCAN interface instead.\n"
+    "--can-pty serves the CAN datalink's bytes on the pseudo-terminal, for a bridge\n"
+    "that carries them in CAN frames (the Python package's virtual bus): the link\n"
+    "is then port 3 with the CAN port's capacity.\n"
     "--klv-link PATH adds the KLV metadata output (an 87-byte packet about every\n"
     "900 ms) on a second pseudo-terminal, symlinked at PATH. It answers every In\n"
     "packet of the spec and streams GIMBAL_ANGLE, GIMBAL_RATE and GEOREFERENCE_DATA\n"
@@ -298,6 +301,7 @@ int main(int argc, char **argv)
     double seconds = 0.0;
     long long baud = 57600;
     bool baud_given = false;
+    bool can_pty = false;
     char path[256], klv_path[256];
     tk_link_t dl, kl;
     tase_port_t port, klv_port, ports[TASE_GIMBAL_PORTS];
@@ -332,6 +336,8 @@ int main(int argc, char **argv)
             return 0;
         } else if (strcmp(a, "--quiet") == 0) {
             s.quiet = true;
+        } else if (strcmp(a, "--can-pty") == 0) {
+            can_pty = true;
         } else if (strcmp(a, "--link") == 0 && more) {
             link = argv[++i];
         } else if (strcmp(a, "--can") == 0 && more) {
@@ -362,6 +368,10 @@ int main(int argc, char **argv)
     if (can != NULL && baud_given) {
         tk_usage_error("--baud is for the serial link, not --can");
     }
+    if (can_pty && (can != NULL || baud_given)) {
+        tk_usage_error("--can-pty is a pseudo-terminal at CAN's capacity: not with %s",
+                       can != NULL ? "--can" : "--baud");
+    }
     if (link != NULL && klv_link != NULL) {
         char a[PATH_MAX], b[PATH_MAX];
         if (strcmp(link, klv_link) == 0 ||
@@ -386,10 +396,11 @@ int main(int argc, char **argv)
     }
     port = tk_link_port(&dl);
     if (can == NULL) {
-        /* a pty has no speed of its own: the simulated line's is --baud; the
-         * gimbal role sizes telemetry (its capacity) and the receiver's time
-         * bound by it */
-        port.bytes_per_s = TASE_UART_BYTES_PER_S((uint32_t)baud);
+        /* a pty has no speed of its own: the simulated line's is --baud
+         * (--can-pty: the CAN port's); the gimbal role sizes telemetry (its
+         * capacity) and the receiver's time bound by it */
+        port.bytes_per_s =
+            can_pty ? TASE_SOCKETCAN_BYTES_PER_S : TASE_UART_BYTES_PER_S((uint32_t)baud);
     }
     if (klv_link != NULL) {
         tk_link_pty(&kl, tk_pty_open(klv_path, sizeof(klv_path), klv_link, &klv_slave));
@@ -407,7 +418,7 @@ int main(int argc, char **argv)
     /* the link is one of PACKET_RATE's ports 1..3 (PROTOCOL-NOTES A2); the
      * other two are absent */
     memset(ports, 0, sizeof(ports));
-    s.link = sim_link_port(can != NULL, (uint32_t)baud);
+    s.link = sim_link_port(can != NULL || can_pty, (uint32_t)baud);
     ports[s.link] = port;
     for (i = 0; i < (int)TASE_GIMBAL_PORTS; i++) {
         sim_rate_reset(&s.georef_rate[i], now);

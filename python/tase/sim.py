@@ -6,7 +6,8 @@
 It runs `tase-sim` on a new pseudo-terminal (its --link symlink in a
 temporary directory), with can="IFACE" on a SocketCAN interface, or with
 virtual="NAME" on python-can's in-process virtual bus NAME (tase-sim on a
-pty, its bytes carried to and from the bus in CAN frames of the spec's
+pty with --can-pty, so that its link is the CAN port, PACKET_RATE's port 3;
+its bytes carried to and from the bus in CAN frames of the spec's
 encapsulation by a thread of this process: CAN without kernel support),
 and stops it on exit from the with block, also on an exception. The
 program is found as $TASE_SIM, else `tase-sim` on the PATH.
@@ -58,7 +59,9 @@ class Sim:
             self.url = "socketcan:" + can
         else:
             link = os.path.join(self.dir, "gimbal")
-            args += ["--link", link, "--baud", str(baud)]
+            # the virtual bus carries the pty's bytes in CAN frames: the
+            # gimbal's CAN port (PACKET_RATE port 3, CAN's capacity)
+            args += ["--link", link] + (["--can-pty"] if virtual is not None else ["--baud", str(baud)])
             self.url = "serial:%s:%d" % (link, baud)
             self.link = link
         if seconds is not None:

@@ -238,7 +238,15 @@ def test_tase_sim_on_a_virtual_can_bus(tase_sim):
             link.rate(10, 0)
             names = {p.name for p in link.packets(timeout=0.5)}
             assert {"GIMBAL_ANGLE", "GIMBAL_RATE"} <= names
+            # the link is the CAN port, PACKET_RATE's port 3 (it took port
+            # 2's rates: 10 GIMBAL_ANGLE a second)
+            rates = link.query("PACKET_RATE")
+            link.query(rates.replace(raw=dict(angle_2=20, angle_3=2, rate_3=2, geo_ref_3=1)))
+            t0 = time.monotonic()
+            n = sum(p.name == "GIMBAL_ANGLE" for p in link.packets(timeout=2.0))
+            assert 2 <= n <= 6, (n, time.monotonic() - t0)  # 2 a second for 2 s
     assert "GIMBAL_CMD: rate" in sim.log()
+    assert "PACKET_RATE port 3" in sim.log() and "port 3 (this link)" in sim.log()
 
 
 def test_units_json_equals_tase_monitor(sim, tase_cli):

@@ -187,6 +187,9 @@ expect("a negative number is still a value", ["camera", "--hfov", "-5"] + L, 2,
 expect("tase-sim --link given twice is refused",
        [SIM, "--link", os.path.join(TMP, "a"), "--link", os.path.join(TMP, "b"), "--seconds", "1"],
        2, "option --link given twice")
+expect("tase-sim --can-pty is not for --baud",
+       [SIM, "--can-pty", "--baud", "9600", "--seconds", "1"], 2,
+       "--can-pty is a pseudo-terminal at CAN's capacity: not with --baud")
 expect("tase-sim --link followed by an option: the value is missing",
        [SIM, "--link", "--quiet", "--seconds", "1"], 2, "option --link needs a value")
 
