@@ -494,6 +494,35 @@ static void navigation_sources_select_host_data(void **state)
     assert_int_equal(sim_model_camera_cmd(&m, 2, false, 0.0), SIM_CAM_OK);
 }
 
+/* A camera CAMERA_TYPE removes (0xFF) loses its lens, and the active one
+ * hands over to the first that exists (it stayed active, with camera A's
+ * lens, so GEOREFERENCE_DATA named a camera that is not there). One added
+ * back gets camera A's lens at start even with camera A gone. */
+static void a_removed_camera_is_gone_from_every_report(void **state)
+{
+    sim_model_t m;
+    uint8_t types[SIM_CAMERAS] = {TASE_CAMTYPE_NO_CHANGE, TASE_CAMTYPE_NONE, TASE_CAMTYPE_NO_CHANGE};
+    (void)state;
+    sim_model_init(&m);
+    assert_int_equal(sim_model_camera_cmd(&m, 1, false, 0.0), SIM_CAM_OK);
+    assert_int_equal(m.active_cam, 1);
+    sim_model_camera_types(&m, types);
+    assert_int_equal(m.cam[1].type, TASE_CAMTYPE_NONE);
+    near(m.cam[1].max_hfov, 0.0, 0.0);
+    near(m.cam[1].min_hfov, 0.0, 0.0);
+    assert_int_equal(m.active_cam, 0);
+    assert_int_equal(sim_model_camera_cmd(&m, 1, false, 0.0), SIM_CAM_NO_CAMERA);
+    /* A gone too: C is added, A's lens at start, and becomes active */
+    types[0] = TASE_CAMTYPE_NONE;
+    types[1] = TASE_CAMTYPE_NO_CHANGE;
+    types[2] = 98;
+    sim_model_camera_types(&m, types);
+    assert_int_equal(m.active_cam, 2);
+    near(m.cam[2].max_hfov, SIM_CAM_A_MAX_HFOV, 0.0);
+    near(m.cam[2].min_hfov, SIM_CAM_A_MIN_HFOV, 0.0);
+    near(m.cam[2].hfov, SIM_CAM_A_MAX_HFOV, 0.0);
+}
+
 /* Item 8: filter mode "normal" is 4 (P8, the vendor's numbering). */
 static void nav_health_reports_filter_mode_normal_4(void **state)
 {
@@ -690,6 +719,7 @@ int main(void)
         cmocka_unit_test(camera_pass_reports_its_baud_and_disables_camera_control),
         cmocka_unit_test(navigation_sources_select_host_data),
         cmocka_unit_test(nav_health_reports_filter_mode_normal_4),
+        cmocka_unit_test(a_removed_camera_is_gone_from_every_report),
         cmocka_unit_test(retracted_gimbal_holds_still_until_deployed),
         cmocka_unit_test(spoi_geometry_matches_an_independent_wgs84_reference),
     };

@@ -100,9 +100,9 @@ void sim_model_init(sim_model_t *m)
     m->tax_target_deployed = true;
     m->tax_duration = 2.0;
     m->cam[0].type = 68; /* SONY_FCB_EX1010, 36x optical zoom */
-    m->cam[0].max_hfov = 57.80;
-    m->cam[0].min_hfov = 1.70;
-    m->cam[0].hfov = 57.80;
+    m->cam[0].max_hfov = SIM_CAM_A_MAX_HFOV;
+    m->cam[0].min_hfov = SIM_CAM_A_MIN_HFOV;
+    m->cam[0].hfov = SIM_CAM_A_MAX_HFOV;
     m->cam[0].baud = 8;  /* 9600, VISCA */
     m->cam[1].type = 97; /* FLIR_320_PHOTON_23 */
     m->cam[1].max_hfov = 23.0;
@@ -170,12 +170,24 @@ void sim_model_camera_types(sim_model_t *m, const uint8_t types[SIM_CAMERAS])
         if (types[i] == TASE_CAMTYPE_NO_CHANGE) {
             continue;
         }
-        if (c->type == TASE_CAMTYPE_NONE && types[i] != TASE_CAMTYPE_NONE) {
-            *c = m->cam[0]; /* a new camera: camera A's lens, at its widest */
+        if (types[i] == TASE_CAMTYPE_NONE) {
+            memset(c, 0, sizeof(*c)); /* no lens, as camera C at start */
+        } else if (c->type == TASE_CAMTYPE_NONE) {
+            /* a new camera: camera A's lens at start, at its widest */
+            c->max_hfov = SIM_CAM_A_MAX_HFOV;
+            c->min_hfov = SIM_CAM_A_MIN_HFOV;
             c->hfov = c->max_hfov;
             c->baud = 8;
+        } else {
+            /* another type in the same place: the lens stays */
         }
         c->type = types[i];
+    }
+    /* the active camera is one that exists: the first there is */
+    for (i = 0; i < SIM_CAMERAS && !camera_present(m, m->active_cam); i++) {
+        if (camera_present(m, i)) {
+            m->active_cam = i;
+        }
     }
 }
 

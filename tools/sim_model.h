@@ -172,6 +172,10 @@ int sim_model_spoi(sim_model_t *m, const sim_pos_t *target);
  * axes where they are (position mode holding the current angles). */
 void sim_model_retract_deploy(sim_model_t *m, bool deploy);
 
+/* Camera A's lens at start (degrees of HFOV, widest and narrowest). */
+#define SIM_CAM_A_MAX_HFOV 57.80
+#define SIM_CAM_A_MIN_HFOV 1.70
+
 /* CAMERAS. Camera A a Sony FCB-EX1010 (type 68, HFOV 57.8..1.7 deg),
  * camera B a FLIR Photon 23 deg (type 97), no camera C. Sending a
  * CAMERA_PASS disables the gimbal's camera control (4.1.5): from then on
@@ -192,7 +196,10 @@ int sim_model_camera_legacy_zoom(sim_model_t *m, unsigned zoom);
  * SIM_CAM_NO_CAMERA. Disables camera control (above). */
 int sim_model_camera_pass(sim_model_t *m, unsigned camera, unsigned baud);
 /* CAMERA_TYPE: each type that is not 0 ("do not change") replaces the
- * camera's; a camera added where there was none gets camera A's lens. */
+ * camera's; a camera added where there was none gets camera A's lens at
+ * start, one removed (0xFF) loses its lens (SYSTEM_VERSION: HFOV 0..0, as
+ * camera C at start), and an active camera removed hands over to the
+ * first that exists (A, B, C). */
 void sim_model_camera_types(sim_model_t *m, const uint8_t types[SIM_CAMERAS]);
 
 /* The port index (tase/gimbal.h: index i is PACKET_RATE's port i + 1) of
