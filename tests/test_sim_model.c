@@ -501,7 +501,8 @@ static void navigation_sources_select_host_data(void **state)
 static void a_removed_camera_is_gone_from_every_report(void **state)
 {
     sim_model_t m;
-    uint8_t types[SIM_CAMERAS] = {TASE_CAMTYPE_NO_CHANGE, TASE_CAMTYPE_NONE, TASE_CAMTYPE_NO_CHANGE};
+    uint8_t types[SIM_CAMERAS] = {TASE_CAMTYPE_NO_CHANGE, TASE_CAMTYPE_NONE,
+                                  TASE_CAMTYPE_NO_CHANGE};
     (void)state;
     sim_model_init(&m);
     assert_int_equal(sim_model_camera_cmd(&m, 1, false, 0.0), SIM_CAM_OK);
