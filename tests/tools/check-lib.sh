@@ -46,7 +46,7 @@ under_valgrind() {
     local v
     [ "${TASE_UNDER_VALGRIND:-}" = 1 ] || return 0
     for v in "$@"; do
-        printf '#!/bin/sh\nexec valgrind -q --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect --show-leak-kinds=definite,indirect "%s" "$@"\n' \
+        printf '#!/bin/sh\nexec valgrind -q --vgdb=no --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect --show-leak-kinds=definite,indirect "%s" "$@"\n' \
             "${!v}" >"$dir/vg-$v"
         chmod +x "$dir/vg-$v"
         eval "$v=\$dir/vg-\$v"
