@@ -299,7 +299,8 @@ static inline bool tase_field_iter_keep_bits(const tase_field_iter_t *it, uint32
     if (it->next == 0u) { /* no field yet: begin() or bound to none */
         return false;
     }
-    ones = (it->width >= 4u) ? 0xFFFFFFFFu : (UINT32_C(1) << (8u * it->width)) - 1u;
+    /* no UINT32_C(): C++98 has it only on request (newlib) */
+    ones = (it->width >= 4u) ? 0xFFFFFFFFu : (0xFFFFFFFFu >> (8u * (4u - it->width)));
     switch (TASE_FIELD_KEEP(it->field)) {
     case TASE_FIELD_KEEP_ONES: *bits = ones; return true;
     case TASE_FIELD_KEEP_ZERO: *bits = 0u; return true;

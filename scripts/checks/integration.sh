@@ -111,7 +111,19 @@ for std in c++98 c++11 c++14 c++17 c++20; do
         -c "$out/hdr/all.cpp" -o "$out/hdr/cxx.o"
     clang++ -std=$std -Weverything -Wno-padded -Werror "${inc[@]}" -c "$out/hdr/all.cpp" -o "$out/hdr/cxx.o"
 done
-echo "   clean: C99 (gcc, clang), C++98, 11, 14, 17, 20 (g++, clang++)"
+# and as firmware's C++ sees them: arm-none-eabi-g++ with newlib, whose
+# <stdint.h> defines UINT32_C() before C++11 only on request (schema.h
+# used it: C++98 failed there)
+gen_all "$TASE_ROOT/include" "$out/hdr-arm"
+for p in "$TASE_ROOT"/port/baremetal/tase/*.h; do echo "#include \"tase/$(basename "$p")\""; done \
+    >>"$out/hdr-arm/tase_all.h"
+cp "$out/hdr/all.cpp" "$out/hdr-arm/all.cpp"
+for std in c++98 c++11 c++20; do
+    arm-none-eabi-g++ -std=$std -mcpu=cortex-m4 -mthumb -Wall -Wextra -Wpedantic -Wold-style-cast \
+        -Wuseless-cast -Wshadow -Werror -I"$out/hdr-arm" -I"$TASE_ROOT/include" \
+        -I"$TASE_ROOT/port/baremetal" -c "$out/hdr-arm/all.cpp" -o "$out/hdr-arm/cxx.o"
+done
+echo "   clean: C99 (gcc, clang), C++98, 11, 14, 17, 20 (g++, clang++), C++98, 11, 20 (arm-none-eabi-g++)"
 
 tase_step "3. add_subdirectory and FetchContent(SOURCE_DIR) from a parent with extra warnings"
 extra="-Wall -Wextra -Wfloat-equal -Wundef -Wcast-qual -Wstrict-prototypes -Wmissing-prototypes \
