@@ -25,6 +25,53 @@ int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on
     return TASE_OK;
 }
 
+/* Whether now is before `until` (on the wrapping clock; the window is
+ * shorter than 2^31 ms). */
+static bool before(uint32_t now, uint32_t until)
+{
+    uint32_t d = until - now;
+    return d != 0u && d < 0x80000000u;
+}
+
+/* The pending request ends leaving n of its attempts unanswered: n answers
+ * of its group and type are owed until `until` (host.h, MATCHING), on top
+ * of those still owed of the same type. */
+static void owe(tase_host_t *h, unsigned n, uint32_t until)
+{
+    unsigned total = n;
+    uint32_t end = until;
+    if (n == 0u) {
+        return;
+    }
+    if (h->owed > 0u && h->owed_group == h->group && h->owed_type == h->type &&
+        before(h->now, h->owed_until)) {
+        total += h->owed;
+        if (before(until, h->owed_until)) {
+            end = h->owed_until;
+        }
+    }
+    h->owed = (uint8_t)(total < 255u ? total : 255u);
+    h->owed_group = h->group;
+    h->owed_type = h->type;
+    h->owed_until = end;
+}
+
+/* Whether frame is an owed answer (counted, and one fewer owed). */
+static bool owed_answer(tase_host_t *h, const tase_frame_t *frame)
+{
+    if (h->owed == 0u || frame->group != h->owed_group || frame->type != h->owed_type ||
+        frame->len == 0u) {
+        return false;
+    }
+    if (!before(h->now, h->owed_until)) {
+        h->owed = 0u; /* no longer: it is an answer like any other */
+        return false;
+    }
+    h->owed--;
+    h->stats.late++;
+    return true;
+}
+
 static int host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len)
 {
     return tase_port_count_tx(tase_port_send_frame(&h->port, group, type, data, len),
@@ -65,6 +112,9 @@ static int request_send(tase_host_t *h, uint8_t group, uint8_t type, size_t len,
     h->timeout_ms = timeout_ms;
     h->retries_left = retries;
     h->sent_at = now_ms;
+    h->first_at = now_ms;
+    h->now = now_ms;
+    h->attempts = 1u;
     h->result = TASE_EAGAIN;
     h->state = HOST_WAITING;
     h->stats.requests++;
@@ -143,14 +193,17 @@ static int decode_reply(tase_host_t *h, size_t len)
 
 int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
 {
+    bool mine;
     if (h == NULL || frame == NULL || frame->data == NULL) {
         return TASE_EARG;
     }
     h->stats.frames_rx++;
     /* A zero-length frame is somebody's query (possibly our own, looped
-     * back), never the gimbal's answer. */
-    if (h->state == HOST_WAITING && frame->group == h->group && frame->type == h->type &&
-        frame->len > 0) {
+     * back), never the gimbal's answer; an owed one answers an earlier
+     * request. */
+    mine = h->state == HOST_WAITING && frame->group == h->group && frame->type == h->type &&
+           frame->len > 0;
+    if (mine && !owed_answer(h, frame)) {
         if (h->reply == NULL) {
             h->result = (int)frame->len;
         } else if (frame->len > h->reply_cap) {
@@ -164,7 +217,14 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
         }
         h->state = HOST_COMPLETE;
         h->stats.replies++;
+        /* the other attempts may still be answered, as late as this one
+         * came after the first attempt */
+        owe(h, h->attempts - 1u,
+            h->sent_at + tase_port_elapsed_ms(h->now, h->first_at) + h->timeout_ms);
         return 1;
+    }
+    if (!mine) {
+        (void)owed_answer(h, frame); /* counted however it comes */
     }
     if (h->on_frame != NULL) {
         h->on_frame(h->user, frame);
@@ -184,6 +244,7 @@ int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_
     if (h == NULL) {
         return TASE_EARG;
     }
+    h->now = now_ms;
     r = tase_rx_feed(&h->rx, bytes, n, host_rx, h);
     if (r < 0) {
         return r;
@@ -198,6 +259,7 @@ int tase_host_poll(tase_host_t *h, uint32_t now_ms)
     if (h == NULL) {
         return TASE_EARG;
     }
+    h->now = now_ms;
     if (h->state == HOST_COMPLETE) {
         h->state = HOST_IDLE;
         return h->result;
@@ -211,10 +273,14 @@ int tase_host_poll(tase_host_t *h, uint32_t now_ms)
     if (h->retries_left == 0) {
         h->state = HOST_IDLE;
         h->stats.timeouts++;
+        owe(h, h->attempts, now_ms + h->timeout_ms);
         return TASE_ETIMEOUT;
     }
     h->retries_left--;
     h->stats.retries++;
+    if (h->attempts < 255u) {
+        h->attempts++;
+    }
     h->sent_at = now_ms;
     (void)host_send(h, h->group, h->type, h->req, h->req_len);
     return TASE_EAGAIN;
@@ -224,6 +290,9 @@ int tase_host_cancel(tase_host_t *h)
 {
     if (h == NULL) {
         return TASE_EARG;
+    }
+    if (h->state == HOST_WAITING) {
+        owe(h, h->attempts, h->now + h->timeout_ms);
     }
     h->state = HOST_IDLE;
     return TASE_OK;

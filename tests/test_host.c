@@ -112,6 +112,72 @@ static void a_query_is_a_zero_length_frame_completed_by_the_echo(void **state)
     assert_int_equal(x->host.stats.requests, 1);
 }
 
+/* Start a PACKET_RATE query into reply (64 bytes). */
+static void query_rates(fix_t *x, uint8_t *reply, uint32_t timeout_ms, uint8_t retries,
+                        uint32_t now)
+{
+    assert_int_equal(tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x00, reply, 64, timeout_ms,
+                                           retries, now),
+                     TASE_OK);
+}
+
+/* A gimbal that answers 600 ms after each frame, with a 500 ms attempt
+ * timeout: the query's second attempt is answered after the query has
+ * completed, and that answer completed the setting sent next, which then
+ * reported the old settings as the gimbal's echo (`tase send` exit 3 for a
+ * setting the gimbal applied). Now the late answer is owed to the query:
+ * it goes to on_frame, and the setting completes by its own echo. */
+static void a_late_answer_to_an_ended_request_never_completes_the_next(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64], set[16];
+
+    memcpy(set, rates, sizeof set);
+    set[5] = 15; /* angle_2 */
+    query_rates(x, reply, 500, 2, 0);
+    assert_int_equal(tase_host_poll(&x->host, 500), TASE_EAGAIN); /* attempt 2 */
+    assert_int_equal(fake_frames_out(&x->port), 2);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 600); /* answers attempt 1 */
+    assert_int_equal(tase_host_poll(&x->host, 600), 16);
+    assert_int_equal(tase_host_request_start(&x->host, TASE_GROUP_SETUP, 0x00, set, sizeof set,
+                                             reply, sizeof reply, 500, 2, 610),
+                     TASE_OK);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 1100); /* answers attempt 2: old */
+    assert_int_equal(tase_host_poll(&x->host, 1100), TASE_EAGAIN);
+    assert_int_equal(x->others, 1);
+    assert_int_equal(x->host.stats.late, 1);
+    feed_frame(x, 0x48, 0x00, set, sizeof set, 1210); /* the setting's echo */
+    assert_int_equal(tase_host_poll(&x->host, 1210), 16);
+    assert_memory_equal(reply, set, 16);
+    assert_int_equal(x->host.stats.replies, 2);
+    /* nothing more is owed: the next answer completes the next request */
+    query_rates(x, reply, 500, 0, 1300);
+    feed_frame(x, 0x48, 0x00, set, sizeof set, 1310);
+    assert_int_equal(tase_host_poll(&x->host, 1310), 16);
+}
+
+/* A failed request owes all its attempts, for one attempt timeout: an
+ * answer within it goes to on_frame; after it, answers complete requests
+ * again (a gimbal that never answers does not make every later request
+ * fail). */
+static void a_failed_request_owes_its_answers_for_one_timeout(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    query_rates(x, reply, 100, 1, 0);
+    assert_int_equal(tase_host_poll(&x->host, 100), TASE_EAGAIN);
+    assert_int_equal(tase_host_poll(&x->host, 200), TASE_ETIMEOUT); /* owes 2 until 300 */
+    query_rates(x, reply, 100, 3, 210);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 250); /* owed */
+    assert_int_equal(tase_host_poll(&x->host, 250), TASE_EAGAIN);
+    assert_int_equal(x->host.stats.late, 1);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 300); /* the window has passed */
+    assert_int_equal(tase_host_poll(&x->host, 300), 16);
+    assert_int_equal(x->host.stats.late, 1);
+    assert_int_equal(x->others, 1);
+}
+
 static void an_echo_of_another_type_does_not_complete_the_query(void **state)
 {
     fix_t *x = *state;
@@ -837,6 +903,10 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(host_api_rejects_bad_arguments),
         cmocka_unit_test_setup_teardown(a_query_is_a_zero_length_frame_completed_by_the_echo, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(a_late_answer_to_an_ended_request_never_completes_the_next,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(a_failed_request_owes_its_answers_for_one_timeout, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(an_echo_of_another_type_does_not_complete_the_query, setup,
                                         teardown),

@@ -40,6 +40,18 @@
  * type never completes it. Frames that do not complete the request
  * (telemetry, other answers, unsolicited frames) go to the on_frame
  * callback given at init; the completing reply does not.
+ * A request that ended after n attempts (completed by one answer: n - 1;
+ * failed or cancelled: n) may still be answered for the others: that many
+ * answers of its group and type are then OWED, and an owed answer never
+ * completes a later request (a slow gimbal answering an earlier query
+ * must not pass for the echo of the setting sent after it); it goes to
+ * on_frame and counts in stats.late. Answers are owed for a while: after
+ * a completed request, the time it took plus one attempt timeout after
+ * its last attempt; after a failed or cancelled one, one attempt timeout.
+ * Only the last request's group and type is tracked (a request of another
+ * type forgets what an earlier one was owed once it owes answers itself).
+ * When an owed answer was lost, the next request of that type takes the
+ * timeout and a retry to complete: slower, never wrong.
  *
  * TIME. The core never reads a clock by itself: the poll-driven API takes
  * `now_ms` (any monotonic millisecond count that wraps modulo 2^32, e.g.
@@ -66,7 +78,7 @@
  *
  * All functions: not reentrant per instance, not ISR-safe (call from one
  * context); different instances are independent. No allocation, no
- * globals. sizeof(tase_host_t) is 696 bytes on Cortex-M (a tase_rx_t plus a copy
+ * globals. sizeof(tase_host_t) is 716 bytes on Cortex-M (a tase_rx_t plus a copy
  * of the pending request for re-sending).
  */
 #ifndef TASE_HOST_H
@@ -89,6 +101,7 @@ typedef struct {
     uint32_t retries;   /* requests re-sent after a timeout */
     uint32_t replies;   /* requests completed by a matching frame */
     uint32_t timeouts;  /* requests that failed after their last attempt */
+    uint32_t late;      /* owed answers of ended requests (MATCHING) */
 } tase_host_stats_t;
 
 /* Host instance. Treat every field except `stats` and `rx.stats` as
@@ -105,9 +118,16 @@ typedef struct {
     size_t reply_cap;
     uint32_t timeout_ms; /* per attempt */
     uint32_t sent_at;    /* when the current attempt was sent */
+    uint32_t first_at;   /* when the first attempt was sent */
+    uint32_t now;        /* the latest now_ms given (feed, poll, start) */
+    uint32_t owed_until; /* answers are owed (MATCHING) until then */
     int result;          /* reply length or error once complete */
     uint8_t state;       /* idle / waiting / complete */
     uint8_t retries_left;
+    uint8_t attempts; /* of the pending request, sent so far */
+    uint8_t owed;     /* answers owed of owed_group/owed_type */
+    uint8_t owed_group;
+    uint8_t owed_type;
     uint8_t group; /* of the pending request */
     uint8_t type;
     uint8_t req_len;

@@ -296,11 +296,11 @@ static inline uint64_t tase_field_iter_bits_(const tase_field_iter_t *it, const 
 static inline bool tase_field_iter_keep_bits(const tase_field_iter_t *it, uint32_t *bits)
 {
     uint32_t ones;
+    uint32_t one = 1u;    /* not UINT32_C(1): C++98 has it only on request (newlib) */
     if (it->next == 0u) { /* no field yet: begin() or bound to none */
         return false;
     }
-    /* no UINT32_C(): C++98 has it only on request (newlib) */
-    ones = (it->width >= 4u) ? 0xFFFFFFFFu : (0xFFFFFFFFu >> (8u * (4u - it->width)));
+    ones = (it->width >= 4u) ? 0xFFFFFFFFu : (one << (8u * it->width)) - 1u;
     switch (TASE_FIELD_KEEP(it->field)) {
     case TASE_FIELD_KEEP_ONES: *bits = ones; return true;
     case TASE_FIELD_KEEP_ZERO: *bits = 0u; return true;

@@ -117,6 +117,7 @@ typedef struct {
     uint32_t retries;
     uint32_t replies;
     uint32_t timeouts;
+    uint32_t late;
 } tase_host_stats_t;
 typedef struct {
     tase_host_stats_t stats;

@@ -492,6 +492,7 @@ class Link:
             "retries": h.retries,
             "replies": h.replies,
             "timeouts": h.timeouts,
+            "late": h.late,
             "bytes_in": rx.bytes_in,
             "checksum_errors": rx.checksum_errors,
             "bad_size": rx.bad_size,
