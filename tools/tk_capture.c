@@ -505,6 +505,9 @@ int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap)
         return TK_CAP_END;
     }
     if (rc != 1) {
+        /* a read a signal broke off (a pipe or FIFO): the signal's exit,
+         * not libpcap's "Interrupted system call" */
+        tk_exit_if_signalled();
         tk_die("%s: after record %lu: %s", r->path, r->index, pcap_geterr(r->pcap));
     }
     memset(rec, 0, sizeof(*rec));

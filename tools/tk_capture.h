@@ -179,6 +179,7 @@ typedef struct {
     const char *can; /* interface, or NULL */
     tk_cap_dirs_t dirs;
     double speed;
+    unsigned long records; /* in the capture (tk_cap_check() counted them) */
 } tk_replay_opts_t;
 unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o);
 /* The check replay makes before sending anything: read every record of r

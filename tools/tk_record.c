@@ -29,11 +29,12 @@ static void print_recorded(const tk_cap_writer_t *w, unsigned long bytes, const 
            what, w->path);
 }
 
-static void print_recording(const tk_cap_writer_t *w, const char *what, const char *tap_in,
-                            double seconds)
+/* Said before the capture is created: output that fails (a closed pipe,
+ * /dev/full) ends the run before any file exists. */
+static void print_recording(const char *path, const char *what, const char *tap_in, double seconds)
 {
     printf("recording %s%s%s to %s ", what, tap_in != NULL ? " and " : "",
-           tap_in != NULL ? tap_in : "", w->path);
+           tap_in != NULL ? tap_in : "", path);
     if (seconds > 0.0) {
         printf("for %g s\n", seconds);
     } else {
@@ -67,8 +68,8 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *path, const char *dev,
         tk_link_serial(&links[1], tap_in, baud);
     }
     /* the sources are open: only now is the capture created */
+    print_recording(path, dev, tap_in, seconds);
     tk_cap_create(w, path, TK_CAP_LINKTYPE_SERIAL, false);
-    print_recording(w, dev, tap_in, seconds);
     for (i = 0; i < n; i++) {
         ports[i] = tk_link_port(&links[i]);
         pfd[i].fd = links[i].uart.fd;
@@ -153,8 +154,8 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *path, const char *iface, 
     int fd = open_can_recorder(iface);
     double t_end = seconds > 0.0 ? tk_now_s() + seconds : 0.0;
     unsigned long frames = 0;
+    print_recording(path, iface, NULL, seconds);
     tk_cap_create(w, path, TK_CAP_LINKTYPE_CAN, false); /* the source is open */
-    print_recording(w, iface, NULL, seconds);
     while (tk_signal == 0) {
         struct pollfd pfd = {fd, POLLIN, 0};
         int timeout = ms_left(t_end), pr;
@@ -412,8 +413,8 @@ unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
         replay_send(&rp, r, &rec);
     }
     tk_link_close(&rp.link);
-    printf("replayed %lu of %lu records (%lu bytes) to %s in %.3f s%s", rp.sent, r->index, rp.bytes,
-           o->can != NULL ? o->can : o->serial, started ? tk_now_s() - start : 0.0,
+    printf("replayed %lu of %lu records (%lu bytes) to %s in %.3f s%s", rp.sent, o->records,
+           rp.bytes, o->can != NULL ? o->can : o->serial, started ? tk_now_s() - start : 0.0,
            tk_signal != 0 ? ", interrupted" : "");
     if (rp.skipped > 0) {
         printf("; %lu CAN FD/remote/error frame%s not sent", rp.skipped,

@@ -13,6 +13,7 @@ import json
 import os
 import re
 import select
+import signal
 import subprocess
 import sys
 import tempfile
@@ -318,6 +319,24 @@ err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.mat
 ok("a reader that goes away ends decode quietly with 141 (SIGPIPE's status)",
    rc == 141 and err == "", "exit %d %r" % (rc, err))
 
+# ---- a signal ends decode/klv of an input that never blocks ----
+# (a file or /dev/zero never gives EINTR: decode of /dev/zero spun at 100%
+# CPU through SIGINT, SIGTERM and SIGHUP until SIGKILL)
+for cmd, sig, want in (("decode", signal.SIGINT, 130), ("klv", signal.SIGTERM, 143),
+                       ("decode", signal.SIGHUP, 129)):
+    p = subprocess.Popen(VG + [TASE, cmd, "/dev/zero"], stdout=subprocess.DEVNULL,
+                         stderr=subprocess.PIPE)
+    time.sleep(0.3 * SLOW)
+    p.send_signal(sig)
+    try:
+        rc = p.wait(timeout=5 * SLOW)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        rc = p.wait()
+    err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
+    ok("%s /dev/zero ends on %s with %d" % (cmd, sig.name, want),
+       rc == want and "interrupted by %s" % sig.name in err, "exit %d %r" % (rc, err))
+
 # ---- live input is read as it arrives ----
 def live(args, data, what):
     fifo = os.path.join(TMP, "fifo-" + what)
@@ -349,7 +368,6 @@ ok("tase decode on a live input prints a packet while the writer is still open",
    b'"pan":7,' in got, repr(got[:200]))
 
 # ---- a serial device named as the input: opened raw, given back as found ----
-import signal
 import termios
 
 

@@ -237,7 +237,9 @@ int cli_cmd_decode(cli_args_t *a)
         tk_exit(TK_EXIT_INPUT, "%s: %lu bad %s%s (the rest was decoded)", in.name, bad,
                 capture ? "record" : "line", bad == 1 ? "" : "s");
     }
-    if (d.n.frames == 0 && in.nhead > 0) {
+    /* an input with nothing in it is no error: for a capture, one without
+     * records (a silent line recorded), not the pcap file header */
+    if (d.n.frames == 0 && (capture ? d.n.bytes > 0u || d.n.can_frames > 0u : in.nhead > 0)) {
         tk_exit(TK_EXIT_INPUT, "no TASE packet found in %s%s", in.name,
                 input_guess(&in, &d, candump));
     }

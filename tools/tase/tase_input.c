@@ -103,7 +103,12 @@ size_t cli_input_read(cli_input_t *in, uint8_t *buf, size_t cap)
         }
     }
     for (;;) {
-        ssize_t n = read(in->fd, buf, cap);
+        ssize_t n;
+        /* a file or pipe that never blocks never gives EINTR: a signal
+         * ends the run here, at the next read (decode of /dev/zero spun
+         * until SIGKILL) */
+        tk_exit_if_signalled();
+        n = read(in->fd, buf, cap);
         if (n > 0) {
             return input_keep_head(in, buf, (size_t)n);
         }

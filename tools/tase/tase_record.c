@@ -130,6 +130,7 @@ int cli_cmd_replay(cli_args_t *a)
     }
     tk_cap_reader_open(&r, in.fd, NULL, 0, in.name);
     bad = tk_cap_check(&r, &ro, &backward);
+    ro.records = r.index; /* the summary's M, also when interrupted */
     tk_cap_reader_close(&r);
     if (bad > 0) {
         tk_exit(TK_EXIT_INPUT, "%s: %lu bad record%s: nothing was sent", in.name, bad,
