@@ -281,6 +281,7 @@ static void send_bytes(replay_t *rp, const uint8_t *d, size_t n, unsigned dir)
     } else {
         int rc = tk_port_write_all(&rp->port, d, n);
         if (rc != 0) {
+            tk_exit_if_signalled(); /* the write a signal cut short */
             tk_die("cannot write to %s: %s", rp->o->serial, tase_strerror(rc));
         }
     }

@@ -471,7 +471,9 @@ int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n)
     size_t done = 0;
     double deadline = tk_now_s() + 2.0;
     while (done < n) {
-        int w = p->ops->write(p->ctx, data + done, n - done);
+        int w;
+        tk_exit_if_signalled(); /* Ctrl-C between the attempts on a stalled line */
+        w = p->ops->write(p->ctx, data + done, n - done);
         if (w > 0) {
             done += (size_t)w;
         } else if (w == TASE_EAGAIN || w == TASE_ENOBUFS || w == 0) {

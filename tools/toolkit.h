@@ -154,8 +154,9 @@ void tk_link_close(tk_link_t *l);
  * down"; otherwise tase_strerror(rc). */
 const char *tk_link_error(const tk_link_t *l, int rc);
 
-/* Write a whole buffer through a port, waiting while it is busy. Returns
- * 0 or a negative TASE_E* code. */
+/* Write a whole buffer through a port, waiting while it is busy (2 s at
+ * most). Returns 0 or a negative TASE_E* code; a signal that came
+ * (tk_signal) ends the run between attempts, tk_exit_if_signalled(). */
 int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n);
 
 /* Create a pseudo-terminal; returns the master descriptor, writes the

@@ -19,6 +19,7 @@ import sys
 import tempfile
 import threading
 import time
+import tty
 
 PY = os.environ.get("TASE_PYTHON")
 if PY and not os.path.samefile(PY, sys.executable):
@@ -336,6 +337,28 @@ for cmd, sig, want in (("decode", signal.SIGINT, 130), ("klv", signal.SIGTERM, 1
     err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
     ok("%s /dev/zero ends on %s with %d" % (cmd, sig.name, want),
        rc == want and "interrupted by %s" % sig.name in err, "exit %d %r" % (rc, err))
+
+# ---- Ctrl-C while the device takes no bytes (its queue full, nobody reading) ----
+# (it ended with exit 1 "try again" after the write gave up, not 130)
+sm, ss = os.openpty()
+tty.setraw(sm)
+tty.setraw(ss)
+os.set_blocking(ss, False)
+try:
+    while True:
+        os.write(ss, b"\x55" * 1024)
+except BlockingIOError:
+    pass
+p = subprocess.Popen(VG + [TASE, "point", "1", "1", "--serial", os.ttyname(ss)],
+                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+time.sleep(0.2 * SLOW)
+p.send_signal(signal.SIGINT)
+rc = p.wait(timeout=10 * SLOW)
+err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
+ok("point to a stalled line, SIGINT: exit 130 once the write gives up",
+   rc == 130 and err == "tase: interrupted by SIGINT\n", "exit %d %r" % (rc, err))
+os.close(sm)
+os.close(ss)
 
 # ---- live input is read as it arrives ----
 def live(args, data, what):

@@ -110,6 +110,7 @@ void cli_send_frame(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t
 {
     int rc = tase_host_send(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len);
     if (rc < 0) {
+        tk_exit_if_signalled(); /* a stalled line's write a signal came in */
         tk_die("cannot send %s to %s: %s", tase_schema_packet_name(p), s->name,
                tk_link_error(&s->link, rc));
     }
