@@ -189,6 +189,9 @@ expect("a negative number is still a value", ["camera", "--hfov", "-5"] + L, 2,
 expect("tase-sim --link given twice is refused",
        [SIM, "--link", os.path.join(TMP, "a"), "--link", os.path.join(TMP, "b"), "--seconds", "1"],
        2, "option --link given twice")
+expect("record --tap-in the same line as --serial: a usage error, not 'busy'",
+       ["record", "--serial", "/dev/null", "--tap-in", "/dev/./null", "-o", os.path.join(TMP, "t.pcap")],
+       2, "--tap-in must be the other line of the tap, not --serial's /dev/null")
 expect("tase-sim --can-pty is not for --baud",
        [SIM, "--can-pty", "--baud", "9600", "--seconds", "1"], 2,
        "--can-pty is a pseudo-terminal at CAN's capacity: not with --baud")

@@ -2,6 +2,7 @@
  * tk_capture.h. */
 #include <errno.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "tase_cli.h"
@@ -47,6 +48,18 @@ int cli_cmd_record(cli_args_t *a)
     }
     if (tap_in != NULL && lo.serial == NULL) {
         tk_usage_error("--tap-in is the second line of a serial tap: it needs --serial");
+    }
+    if (tap_in != NULL) {
+        struct stat s1, s2;
+        /* the same line twice (by any path: symlinks followed) would be
+         * "busy: in use by another program", the other program being this
+         * one */
+        if (strcmp(tap_in, lo.serial) == 0 ||
+            (stat(tap_in, &s1) == 0 && stat(lo.serial, &s2) == 0 && s1.st_dev == s2.st_dev &&
+             s1.st_ino == s2.st_ino)) {
+            tk_usage_error("--tap-in must be the other line of the tap, not --serial's %s",
+                           lo.serial);
+        }
     }
     /* a signal is the normal end of a recording: the loops stop on it and
      * close the capture, and the command succeeds */
