@@ -634,6 +634,23 @@ rc, out, err = run(["send", "AXIS_SETTING", "pan_pos_gain=41", "--serial", fg.pa
 ok("... the text output says which layout was used",
    rc == 0 and "22-byte layout the gimbal answered" in out and fg.settings[18] == 41,
    "exit %d %r %r" % (rc, err, out))
+# A gimbal answering a query with a length the packet does not have: the
+# answer is shown as it came, and the query fails (it exited 0)
+class ShortAnswers(FakeGimbal):
+    def frame(self, group, ptype, data):
+        self.got.append((group, ptype, bytes(data)))
+        if (group, ptype) == (0x48, 0x00):
+            os.write(self.master, tase.Packet.from_data(0x48, 0x00, bytes(5)).encode())
+
+
+sa = ShortAnswers()
+rc, out, err = run(["query", "PACKET_RATE", "--serial", sa.path, "--json"])
+ok("query answered with a wrong length: shown, then exit 1",
+   rc == 1 and '"error":"wrong length"' in out and
+   "the answer to PACKET_RATE has 5 data bytes, a length PACKET_RATE does not have" in err,
+   "exit %d %r %r" % (rc, out, err))
+sa.close()
+
 # Decimal degrees and metres round half away from zero on the decimal as
 # typed: 1.005 deg is 100.49999999999999 cdeg as a double (it gave 100).
 fg.got.clear()

@@ -400,6 +400,11 @@ int cli_cmd_query(cli_args_t *a)
     n = cli_transact(&s, p, NULL, 0, reply, &r);
     cli_print_packet(p, reply, (size_t)n, r.json, "out", NULL);
     cli_session_close(&s);
+    if (!tase_schema_length_ok(p, (size_t)n)) {
+        /* shown as it came ("wrong length"), but no answer to the query */
+        tk_die("the answer to %s has %d data bytes, a length %s does not have",
+               tase_schema_packet_name(p), n, tase_schema_packet_name(p));
+    }
     return TK_EXIT_OK;
 }
 
