@@ -17,6 +17,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import termios
 import threading
 import time
 import tty
@@ -341,27 +342,26 @@ for cmd, sig, want in (("decode", signal.SIGINT, 130), ("klv", signal.SIGTERM, 1
     ok("%s /dev/zero ends on %s with %d" % (cmd, sig.name, want),
        rc == want and "interrupted by %s" % sig.name in err, "exit %d %r" % (rc, err))
 
-# ---- Ctrl-C while the device takes no bytes (its queue full, nobody reading) ----
+# ---- Ctrl-C while the device takes no bytes ----
 # (it ended with exit 1 "try again" after the write gave up, not 130)
-sm, ss = os.openpty()
-tty.setraw(sm)
-tty.setraw(ss)
-os.set_blocking(ss, False)
-try:
-    while True:
-        os.write(ss, b"\x55" * 1024)
-except BlockingIOError:
-    pass
-p = subprocess.Popen(VG + [TASE, "point", "1", "1", "--serial", os.ttyname(ss)],
-                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-time.sleep(0.2 * SLOW)
-p.send_signal(signal.SIGINT)
-rc = p.wait(timeout=10 * SLOW)
-err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
-ok("point to a stalled line, SIGINT: exit 130 once the write gives up",
-   rc == 130 and err == "tase: interrupted by SIGINT\n", "exit %d %r" % (rc, err))
-os.close(sm)
-os.close(ss)
+# (output suspended, as by a received XOFF: the pty takes no byte; a full
+# queue is not enough, the kernel makes room again as it moves its buffers)
+# Not under memcheck: its start-up takes about the port's 1 s write bound.
+if not VALGRIND:
+    sm, ss = os.openpty()
+    tty.setraw(sm)
+    tty.setraw(ss)
+    termios.tcflow(ss, termios.TCOOFF)
+    p = subprocess.Popen(VG + [TASE, "point", "1", "1", "--serial", os.ttyname(ss)],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    time.sleep(0.2 * SLOW)
+    p.send_signal(signal.SIGINT)
+    rc = p.wait(timeout=10 * SLOW)
+    err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
+    ok("point to a stalled line, SIGINT: exit 130 once the write gives up",
+       rc == 130 and err == "tase: interrupted by SIGINT\n", "exit %d %r" % (rc, err))
+    os.close(sm)
+    os.close(ss)
 
 # ---- live input is read as it arrives ----
 def live(args, data, what):
@@ -394,7 +394,6 @@ ok("tase decode on a live input prints a packet while the writer is still open",
    b'"pan":7,' in got, repr(got[:200]))
 
 # ---- a serial device named as the input: opened raw, given back as found ----
-import termios
 
 
 def cooked_pty(args, data, expect_lines):
