@@ -675,7 +675,11 @@ def monitor_units(extra):
     p = subprocess.Popen(VG + [TASE, "monitor", "--serial", os.ttyname(s), "--units", "--count",
                                "2", "--seconds", str(10 * SLOW)] + extra,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    time.sleep(0.5 * SLOW)  # the line set up before the bytes come
+    # the bytes only once monitor has made the line raw (a cooked line
+    # would translate them)
+    deadline = time.monotonic() + 10 * SLOW
+    while termios.tcgetattr(s)[3] & termios.ICANON and time.monotonic() < deadline:
+        time.sleep(0.02)
     keep = dict(pan_nogo_center=-1, pan_nogo_range=0xFFFF, pan_max_rate=255, tilt_max_rate=20,
                 pan_pos_gain=255, tilt_pos_gain=40, temporary=1)
     sensor = dict(time=1000, roll=1, pitch=2, yaw=3, flags=0xA0, sample_rate=100, x_accel=-200,
