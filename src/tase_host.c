@@ -25,14 +25,6 @@ int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on
     return TASE_OK;
 }
 
-/* Whether now is before `until` (on the wrapping clock; the window is
- * shorter than 2^31 ms). */
-static bool before(uint32_t now, uint32_t until)
-{
-    uint32_t d = until - now;
-    return d != 0u && d < 0x80000000u;
-}
-
 /* The pending request ends leaving n of its attempts unanswered: n answers
  * of its group and type are owed until `until` (host.h, MATCHING), on top
  * of those still owed of the same type. */
@@ -43,10 +35,12 @@ static void owe(tase_host_t *h, unsigned n, uint32_t until)
     if (n == 0u) {
         return;
     }
+    /* tase_port_elapsed_ms(b, a) != 0: a is before b on the wrapping
+     * clock (the windows are shorter than 2^31 ms) */
     if (h->owed > 0u && h->owed_group == h->group && h->owed_type == h->type &&
-        before(h->now, h->owed_until)) {
+        tase_port_elapsed_ms(h->owed_until, h->now) != 0u) {
         total += h->owed;
-        if (before(until, h->owed_until)) {
+        if (tase_port_elapsed_ms(h->owed_until, until) != 0u) {
             end = h->owed_until;
         }
     }
@@ -63,7 +57,7 @@ static bool owed_answer(tase_host_t *h, const tase_frame_t *frame)
         frame->len == 0u) {
         return false;
     }
-    if (!before(h->now, h->owed_until)) {
+    if (tase_port_elapsed_ms(h->owed_until, h->now) == 0u) {
         h->owed = 0u; /* no longer: it is an answer like any other */
         return false;
     }
@@ -193,17 +187,17 @@ static int decode_reply(tase_host_t *h, size_t len)
 
 int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
 {
-    bool mine;
+    bool owed;
     if (h == NULL || frame == NULL || frame->data == NULL) {
         return TASE_EARG;
     }
     h->stats.frames_rx++;
     /* A zero-length frame is somebody's query (possibly our own, looped
      * back), never the gimbal's answer; an owed one answers an earlier
-     * request. */
-    mine = h->state == HOST_WAITING && frame->group == h->group && frame->type == h->type &&
-           frame->len > 0;
-    if (mine && !owed_answer(h, frame)) {
+     * request (counted however it comes). */
+    owed = owed_answer(h, frame);
+    if (!owed && h->state == HOST_WAITING && frame->group == h->group && frame->type == h->type &&
+        frame->len > 0) {
         if (h->reply == NULL) {
             h->result = (int)frame->len;
         } else if (frame->len > h->reply_cap) {
@@ -222,9 +216,6 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
         owe(h, h->attempts - 1u,
             h->sent_at + tase_port_elapsed_ms(h->now, h->first_at) + h->timeout_ms);
         return 1;
-    }
-    if (!mine) {
-        (void)owed_answer(h, frame); /* counted however it comes */
     }
     if (h->on_frame != NULL) {
         h->on_frame(h->user, frame);
