@@ -684,8 +684,18 @@ def monitor_units(extra):
                 pan_pos_gain=255, tilt_pos_gain=40, temporary=1)
     sensor = dict(time=1000, roll=1, pitch=2, yaw=3, flags=0xA0, sample_rate=100, x_accel=-200,
                   y_accel=0, z_accel=0, tas=0xFFFF)
-    os.write(m, tase.encode(tase.Packet("AXIS_SETTING", raw=keep)) +
-             tase.encode(tase.Packet("HOST_SENSOR", raw=sensor)))
+    pair = (tase.encode(tase.Packet("AXIS_SETTING", raw=keep)) +
+            tase.encode(tase.Packet("HOST_SENSOR", raw=sensor)))
+    # Opening the line drops input that came before (the port's TCIFLUSH,
+    # a moment after the raw mode): the pair again until monitor has its
+    # two frames and ends
+    for _ in range(20):
+        os.write(m, pair)
+        try:
+            p.wait(timeout=0.5 * SLOW)
+            break
+        except subprocess.TimeoutExpired:
+            pass
     out, err = p.communicate(timeout=20 * SLOW)
     os.close(m)
     os.close(s)
