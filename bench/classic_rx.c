@@ -5,7 +5,6 @@ enum { C_SYNC1, C_SYNC2, C_SYNC3, C_SIZE, C_BODY, C_CHECK1, C_CHECK2 };
 
 void classic_rx_init(classic_rx_t *p)
 {
-    p->bytes = 0u;
     p->frames = 0u;
     p->sum = 0u;
     p->idx = 0u;
@@ -16,7 +15,6 @@ void classic_rx_init(classic_rx_t *p)
 
 int classic_rx_push(classic_rx_t *p, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    p->bytes++;
     switch (p->state) {
     case C_SYNC1:
         if (b == TASE_SYNC1) {
@@ -58,7 +56,7 @@ int classic_rx_push(classic_rx_t *p, uint8_t b, tase_rx_handler_t on_frame, void
         p->frames++;
         if (on_frame != NULL) {
             tase_frame_t f;
-            f.offset = p->bytes - (uint32_t)p->size - 6u;
+            f.offset = 0u; /* not kept: see classic_rx.h */
             f.group = p->body[0];
             f.type = p->body[1];
             f.len = (uint8_t)(p->size - 2u);
