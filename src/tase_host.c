@@ -328,20 +328,22 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms)
     return n;
 }
 
-/* Service the port and poll until the pending request completes. */
+/* Service the port and poll until the pending request completes. The
+ * port is read before each poll, so an answer that came while the request
+ * was being written is taken even when the write outlasted the attempt's
+ * timeout (a read with no time left does not wait); polling first timed
+ * such a request out, or re-sent it, with the answer unread. */
 static int transact_wait(tase_host_t *h)
 {
     for (;;) {
-        uint32_t now = h->port.ops->now_ms(h->port.ctx);
-        uint32_t waited;
-        int r = tase_host_poll(h, now);
-        if (r != TASE_EAGAIN) {
-            return r;
-        }
-        waited = tase_port_elapsed_ms(now, h->sent_at);
-        r = tase_host_service(h, waited < h->timeout_ms ? h->timeout_ms - waited : 0u);
+        uint32_t waited = tase_port_elapsed_ms(h->port.ops->now_ms(h->port.ctx), h->sent_at);
+        int r = tase_host_service(h, waited < h->timeout_ms ? h->timeout_ms - waited : 0u);
         if (r < 0) {
             (void)tase_host_cancel(h);
+            return r;
+        }
+        r = tase_host_poll(h, h->port.ops->now_ms(h->port.ctx));
+        if (r != TASE_EAGAIN) {
             return r;
         }
     }

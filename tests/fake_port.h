@@ -20,6 +20,7 @@ typedef struct {
     int write_result;   /* < 0: every write fails with it */
     size_t write_limit; /* > 0: a write takes at most this many bytes */
     unsigned writes;    /* write() calls that took bytes */
+    uint32_t write_ms;  /* each write() call blocks this long (fake clock) */
     int discard;        /* true: count written bytes, keep none */
     size_t discarded;
     /* Scripted peer: after `reply_after` frames were written, the frame
@@ -48,6 +49,7 @@ static inline void fake_push_frame(fake_port_t *f, uint8_t group, uint8_t type, 
 static inline int fake_write(void *ctx, const uint8_t *data, size_t n)
 {
     fake_port_t *f = ctx;
+    f->now += f->write_ms;
     if (f->write_result < 0) {
         return f->write_result;
     }

@@ -393,6 +393,32 @@ static void noise_before_the_echo_delays_it_only_up_to_the_quiet_limit(void **st
     assert_true(x->port.now - 5001u >= 1000u);
 }
 
+/* A write that blocks longer than the attempt's timeout (the POSIX port's
+ * write waits up to 1 s for room): the answer already waiting must still
+ * be read. transact polled before its first read, so it timed out with
+ * the answer unread (retries 0), or re-sent first (retries 2). */
+static void an_answer_waiting_after_a_slow_write_is_read_not_timed_out(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    int n;
+
+    x->port.nreply =
+        (size_t)tase_frame_build(0x48, 0x00, rates, 16, x->port.reply, sizeof x->port.reply);
+    x->port.reply_after = 1;
+    x->port.write_ms = 300;
+    n = tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 200, 0);
+    assert_int_equal(n, 16);
+    assert_memory_equal(reply, rates, 16);
+    assert_int_equal(x->host.stats.timeouts, 0);
+
+    x->port.reply_after = 2; /* the next request's first attempt answered */
+    n = tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 200, 2);
+    assert_int_equal(n, 16);
+    assert_int_equal(fake_frames_out(&x->port), 2); /* no attempt re-sent */
+    assert_int_equal(x->host.stats.retries, 0);
+}
+
 static void transact_times_out_after_all_attempts(void **state)
 {
     fix_t *x = *state;
@@ -923,6 +949,8 @@ int main(void)
                                         teardown),
         cmocka_unit_test_setup_teardown(transact_blocks_until_the_scripted_gimbal_answers, setup,
                                         teardown),
+        cmocka_unit_test_setup_teardown(an_answer_waiting_after_a_slow_write_is_read_not_timed_out,
+                                        setup, teardown),
         cmocka_unit_test_setup_teardown(transact_times_out_after_all_attempts, setup, teardown),
         cmocka_unit_test_setup_teardown(noise_before_the_echo_delays_it_only_up_to_the_quiet_limit,
                                         setup, teardown),

@@ -1,6 +1,7 @@
 /* Tests of the POSIX serial port on a real pseudo-terminal pair. */
-#define _DEFAULT_SOURCE
+#define _GNU_SOURCE /* RTLD_NEXT */
 
+#include <dlfcn.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <pthread.h>
@@ -21,8 +22,58 @@
 #include <unistd.h>
 
 #include <cmocka.h>
+#include <poll.h>
 
 #include "tase/posix_uart.h"
+
+/* ---- signal storms: read(), write() and poll() on one descriptor fail
+ * with EINTR until a time (the port's calls resolve to these definitions;
+ * every other descriptor, and this one outside the storm, goes to libc). */
+static int storm_fd = -1;
+static uint32_t storm_until_ms;
+
+static bool in_storm(int fd)
+{
+    return fd >= 0 && fd == storm_fd && (int32_t)(tase_posix_now_ms() - storm_until_ms) < 0;
+}
+
+ssize_t read(int fd, void *buf, size_t n)
+{
+    ssize_t (*real)(int, void *, size_t);
+    if (in_storm(fd)) {
+        errno = EINTR;
+        return -1;
+    }
+    *(void **)&real = dlsym(RTLD_NEXT, "read");
+    return real(fd, buf, n);
+}
+
+ssize_t write(int fd, const void *buf, size_t n)
+{
+    ssize_t (*real)(int, const void *, size_t);
+    if (in_storm(fd)) {
+        errno = EINTR;
+        return -1;
+    }
+    *(void **)&real = dlsym(RTLD_NEXT, "write");
+    return real(fd, buf, n);
+}
+
+/* glibc declares poll()'s array write-only (access attribute), so gcc
+ * calls reading its fd "maybe uninitialized"; poll() reads it. */
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+int poll(struct pollfd *fds, nfds_t nfds, int timeout)
+{
+    int (*real)(struct pollfd *, nfds_t, int);
+    if (fds != NULL && nfds == 1u && in_storm(fds->fd)) {
+        errno = EINTR;
+        return -1;
+    }
+    *(void **)&real = dlsym(RTLD_NEXT, "poll");
+    return real(fds, nfds, timeout);
+}
+#pragma GCC diagnostic pop
 
 typedef struct {
     int master, slave;
@@ -245,6 +296,15 @@ static void a_file_that_is_not_a_terminal_is_enodev(void **state)
     unlink(path);
 }
 
+/* A directory is "not a terminal" like a file (EISDIR gave TASE_EIO). */
+static void a_directory_is_enodev(void **state)
+{
+    tase_posix_uart_t a;
+    (void)state;
+    assert_int_equal(tase_posix_uart_open(&a, "/tmp", 9600), TASE_ENODEV);
+    assert_int_equal(a.fd, -1);
+}
+
 static void an_unsupported_rate_fails_before_the_device_is_touched(void **state)
 {
     pty_t p;
@@ -323,6 +383,96 @@ static void write_gives_up_after_its_timeout_when_the_peer_never_reads(void **st
     assert_true(n < (int)sizeof big); /* ... but not a megabyte */
     assert_true(tase_posix_now_ms() - t0 >= 100);
     assert_int_equal(pa.ops->write(pa.ctx, big, 16), TASE_EAGAIN); /* queue full */
+    tase_posix_uart_close(&a);
+    pty_close(&p);
+}
+
+/* A pty master whose peer closed: the kernel takes bytes until its queue
+ * is full, then poll() reports POLLHUP without POLLOUT at once. The write
+ * looped on that until its bound (1 s of CPU a call, TASE_EAGAIN); it is a
+ * hang-up, TASE_EIO, at once. */
+static void a_write_to_a_master_whose_peer_closed_fails_with_eio_at_once(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a;
+    tase_port_t pa;
+    static uint8_t chunk[4096];
+    uint32_t t0 = 0;
+    int r = 0, i;
+    (void)state;
+
+    pty_open(&p);
+    assert_int_equal(tase_posix_uart_attach(&a, p.master, 57600), TASE_OK);
+    p.master = -1; /* the port closes it */
+    pa = tase_posix_uart_port(&a);
+    a.write_timeout_ms = 1000;
+    close(p.slave);
+    p.slave = -1;
+    /* The queue fills within a few calls (the kernel may make a little
+     * room again as it moves its buffers: those calls take part of the
+     * chunk); no call waits for the bound, and the hang-up is TASE_EIO. */
+    for (i = 0; i < 1000 && r != TASE_EIO; i++) {
+        t0 = tase_posix_now_ms();
+        r = pa.ops->write(pa.ctx, chunk, sizeof chunk);
+        assert_true(r > 0 || r == TASE_EIO);
+        assert_true(tase_posix_now_ms() - t0 < 500u); /* not the 1 s bound */
+    }
+    assert_int_equal(r, TASE_EIO);
+    tase_posix_uart_close(&a);
+    pty_close(&p);
+}
+
+/* EINTR is resumed with the time left (port.h): a storm of signals cannot
+ * hold read() or write() past their bounds (they retried for as long as
+ * the storm lasted). */
+static void a_storm_of_signals_does_not_hold_a_call_past_its_bound(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a;
+    tase_port_t pa;
+    uint8_t buf[8] = {0};
+    uint32_t t0;
+    int r;
+    (void)state;
+
+    pty_open(&p);
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 9600), TASE_OK);
+    pa = tase_posix_uart_port(&a);
+    a.write_timeout_ms = 300;
+    storm_fd = a.fd;
+    storm_until_ms = tase_posix_now_ms() + 4000u;
+
+    t0 = tase_posix_now_ms();
+    r = pa.ops->read(pa.ctx, buf, sizeof buf, 100);
+    assert_int_equal(r, 0);
+    assert_true(tase_posix_now_ms() - t0 < 2000u);
+
+    t0 = tase_posix_now_ms();
+    r = pa.ops->write(pa.ctx, buf, sizeof buf);
+    assert_int_equal(r, TASE_EAGAIN); /* nothing went out */
+    assert_true(tase_posix_now_ms() - t0 >= 300u);
+    assert_true(tase_posix_now_ms() - t0 < 2000u);
+
+    storm_fd = -1;
+    assert_int_equal(pa.ops->write(pa.ctx, buf, sizeof buf), (int)sizeof buf);
+    tase_posix_uart_close(&a);
+    pty_close(&p);
+}
+
+/* port.h: write() returns n when all n bytes were accepted, so 0 for 0
+ * (it said TASE_EAGAIN, "nothing sent, retry"). */
+static void a_write_of_nothing_returns_zero(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a;
+    tase_port_t pa;
+    (void)state;
+
+    pty_open(&p);
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 9600), TASE_OK);
+    pa = tase_posix_uart_port(&a);
+    assert_int_equal(pa.ops->write(pa.ctx, (const uint8_t *)"x", 0), 0);
+    assert_int_equal(pa.ops->write(pa.ctx, NULL, 0), 0);
     tase_posix_uart_close(&a);
     pty_close(&p);
 }
@@ -611,9 +761,13 @@ int main(void)
         cmocka_unit_test(open_puts_the_line_in_raw_8n1_without_flow_control),
         cmocka_unit_test(a_missing_device_is_enodev),
         cmocka_unit_test(a_file_that_is_not_a_terminal_is_enodev),
+        cmocka_unit_test(a_directory_is_enodev),
         cmocka_unit_test(an_unsupported_rate_fails_before_the_device_is_touched),
         cmocka_unit_test(permission_denied_is_eacces),
         cmocka_unit_test(write_gives_up_after_its_timeout_when_the_peer_never_reads),
+        cmocka_unit_test(a_write_to_a_master_whose_peer_closed_fails_with_eio_at_once),
+        cmocka_unit_test(a_storm_of_signals_does_not_hold_a_call_past_its_bound),
+        cmocka_unit_test(a_write_of_nothing_returns_zero),
         cmocka_unit_test(a_hung_up_line_reads_as_eio),
         cmocka_unit_test(a_hung_up_line_reads_as_eio_also_without_waiting),
         cmocka_unit_test(the_clock_is_monotonic_milliseconds),

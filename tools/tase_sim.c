@@ -465,6 +465,18 @@ int main(int argc, char **argv)
             sim_log(&s, now, "RETRACT_DEPLOY_CMD: %s, echoed",
                     rd.deploy ? "deployed" : "retracted");
         }
+        if (slave_fd >= 0 && tk_pty_clear_stale_excl(slave_fd)) {
+            sim_log(&s, now,
+                    "%s: cleared the exclusive-use flag of a program that is gone "
+                    "(killed while it held the link)",
+                    path);
+        }
+        if (klv_slave >= 0 && tk_pty_clear_stale_excl(klv_slave)) {
+            sim_log(&s, now,
+                    "%s: cleared the exclusive-use flag of a program that is gone "
+                    "(killed while it held the link)",
+                    klv_path);
+        }
         if (slave_fd >= 0 && tk_pty_unread(slave_fd) > 2048) {
             /* nobody has read the link for a while: keep only fresh data */
             (void)tk_pty_drop_unread(slave_fd);

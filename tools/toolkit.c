@@ -12,6 +12,7 @@
 #include <string.h>
 #include <limits.h>
 #include <stddef.h>
+#include <sys/file.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -637,6 +638,27 @@ int tk_pty_unread(int slave_fd)
 {
     int n = 0;
     return ioctl(slave_fd, FIONREAD, &n) == 0 && n > 0 ? n : 0;
+}
+
+bool tk_pty_clear_stale_excl(int slave_fd)
+{
+#if defined(TIOCGEXCL) && defined(TIOCNXCL)
+    int excl = 0;
+    if (ioctl(slave_fd, TIOCGEXCL, &excl) != 0 || excl == 0) {
+        return false;
+    }
+    /* The lock is the owner's: held, it is still there (and our attempt
+     * changes nothing); free, the flag outlived it. */
+    if (flock(slave_fd, LOCK_EX | LOCK_NB) != 0) {
+        return false;
+    }
+    (void)ioctl(slave_fd, TIOCNXCL);
+    (void)flock(slave_fd, LOCK_UN);
+    return true;
+#else
+    (void)slave_fd;
+    return false;
+#endif
 }
 
 int tk_pty_drop_unread(int slave_fd)

@@ -178,6 +178,13 @@ int tk_canonical_path(const char *path, char *out, size_t cap);
 int tk_pty_drop_unread(int slave_fd);
 /* Bytes waiting unread in a pty slave's input. */
 int tk_pty_unread(int slave_fd);
+/* A program that took the pty for itself (tase/posix_uart.h, EXCLUSIVE
+ * ACCESS: flock plus TIOCEXCL) and was killed with SIGKILL leaves
+ * TIOCEXCL set, because the simulator keeps the slave open: every later
+ * open but root's then fails with "device busy" although nobody uses the
+ * device. If the flag is set and nobody holds the device's lock, clear
+ * it. Returns true when it did. */
+bool tk_pty_clear_stale_excl(int slave_fd);
 
 /* ---- packets (the library's schema table, tase/schema.h) ---- */
 

@@ -171,8 +171,12 @@ int tase_can_rx_init(tase_can_rx_t *crx, tase_can_role_t role);
  * instance (nothing counted, nothing changed). From inside on_frame,
  * tase_can_rx_init() is allowed: it resets the instance and the call that
  * made the callback returns as soon as it does (see frame.h, RE-ENTRANCY);
- * reading or clearing the counters is allowed too. The returned count is
- * never negative except for these codes. O(dlc) plus the datalink
+ * reading or clearing the counters is allowed too. tase_rx_stop() on
+ * crx->rx is not: the call would return with the rest of this CAN
+ * frame's payload not taken in, and nothing keeps it (copy the frame out
+ * in on_frame instead; the gimbal role's stop-and-handle pattern is for
+ * its UART ports). The returned count is never negative except for these
+ * codes. O(dlc) plus the datalink
  * receiver's cost. */
 int tase_can_rx_feed(tase_can_rx_t *crx, const tase_can_frame_t *f, tase_rx_handler_t on_frame,
                      void *user);

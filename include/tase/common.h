@@ -76,7 +76,7 @@ extern "C" {
 /* Bytes per second a UART carries at `baud` with 8N1 framing (10 bits per
  * byte: start, 8 data, stop): TASE_UART_BYTES_PER_S(57600) is 5760. The
  * byte rate of tase_port_t and tase_rx_set_timing(). */
-#define TASE_UART_BYTES_PER_S(baud) ((uint32_t)(baud) / 10u)
+#define TASE_UART_BYTES_PER_S(baud) (TASE_CAST_(uint32_t, baud) / 10u)
 
 #define TASE_OK 0
 #define TASE_EARG (-1)          /* NULL pointer or out-of-range argument */

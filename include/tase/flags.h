@@ -21,24 +21,27 @@
 /* ---- MSB-first bit helpers (spec 3.1) -------------------------------- */
 
 /* Spec bit n (0 = MSB) of a byte / of a 16-bit word. */
-#define TASE_BIT8(n) ((uint8_t)(0x80u >> (n)))
-#define TASE_BIT16(n) ((uint16_t)(0x8000u >> (n)))
+#define TASE_BIT8(n) TASE_CAST_(uint8_t, 0x80u >> (n))
+#define TASE_BIT16(n) TASE_CAST_(uint16_t, 0x8000u >> (n))
 /* Mask of spec bits first..last (inclusive, first <= last). */
-#define TASE_MASK8(first, last) ((uint8_t)(((0xFFu >> (first)) & (0xFFu << (7u - (last)))) & 0xFFu))
+#define TASE_MASK8(first, last)                                                                    \
+    TASE_CAST_(uint8_t, ((0xFFu >> (first)) & (0xFFu << (7u - (last)))) & 0xFFu)
 #define TASE_MASK16(first, last)                                                                   \
-    ((uint16_t)(((0xFFFFu >> (first)) & (0xFFFFu << (15u - (last)))) & 0xFFFFu))
+    TASE_CAST_(uint16_t, ((0xFFFFu >> (first)) & (0xFFFFu << (15u - (last)))) & 0xFFFFu)
 /* Value of spec bits first..last of v, right-aligned. */
 #define TASE_BITS8_GET(v, first, last)                                                             \
-    ((unsigned)(((unsigned)(v)&TASE_MASK8(first, last)) >> (7u - (last))))
+    ((TASE_CAST_(unsigned, v) & TASE_MASK8(first, last)) >> (7u - (last)))
 #define TASE_BITS16_GET(v, first, last)                                                            \
-    ((unsigned)(((unsigned)(v)&TASE_MASK16(first, last)) >> (15u - (last))))
+    ((TASE_CAST_(unsigned, v) & TASE_MASK16(first, last)) >> (15u - (last)))
 /* v with spec bits first..last replaced by x (excess bits of x dropped). */
 #define TASE_BITS8_SET(v, first, last, x)                                                          \
-    ((uint8_t)(((unsigned)(v) & ~(unsigned)TASE_MASK8(first, last)) |                              \
-               (((unsigned)(x) << (7u - (last))) & TASE_MASK8(first, last))))
+    TASE_CAST_(uint8_t,                                                                            \
+               (TASE_CAST_(unsigned, v) & ~TASE_CAST_(unsigned, TASE_MASK8(first, last))) |        \
+                   ((TASE_CAST_(unsigned, x) << (7u - (last))) & TASE_MASK8(first, last)))
 #define TASE_BITS16_SET(v, first, last, x)                                                         \
-    ((uint16_t)(((unsigned)(v) & ~(unsigned)TASE_MASK16(first, last)) |                            \
-                (((unsigned)(x) << (15u - (last))) & TASE_MASK16(first, last))))
+    TASE_CAST_(uint16_t,                                                                           \
+               (TASE_CAST_(unsigned, v) & ~TASE_CAST_(unsigned, TASE_MASK16(first, last))) |       \
+                   ((TASE_CAST_(unsigned, x) << (15u - (last))) & TASE_MASK16(first, last)))
 
 /* ---- GIMBAL_CMD flags byte (4.1.1) ----------------------------------- */
 /* Legacy encoding: high nibble zero, bit 6 stabilisation, bit 7 position. */
@@ -62,7 +65,7 @@
 #define TASE_GIMBAL_KIND(flags) TASE_BITS8_GET(flags, 1, 3)
 /* Flags byte for a kind and stabilisation (0/1). */
 #define TASE_GIMBAL_FLAGS(kind, stab)                                                              \
-    ((uint8_t)(TASE_BITS8_SET(0u, 1, 3, kind) | ((stab) ? TASE_GIMBAL_STAB : 0u)))
+    TASE_CAST_(uint8_t, TASE_BITS8_SET(0u, 1, 3, kind) | ((stab) ? TASE_GIMBAL_STAB : 0u))
 /* The values of the spec's table. */
 #define TASE_GIMBAL_FLAGS_RATE 0x10u
 #define TASE_GIMBAL_FLAGS_RATE_STAB 0x90u

@@ -229,7 +229,8 @@ typedef struct {
     uint32_t frames_rx;            /* valid frames received on all ports */
     uint32_t setup_applied;        /* setup packets accepted and stored */
     uint32_t setup_refused;        /* setup packets apply_setup() refused */
-    uint32_t setup_queries;        /* zero-length setup queries answered */
+    uint32_t setup_queries;        /* setup queries answered: zero-length ones and
+                                    * 42-byte SYSTEM_VERSIONs (R1) */
     uint32_t bad_length;           /* setup packets with a wrong data length */
     uint32_t telemetry_tx;         /* telemetry frames written */
     uint32_t telemetry_skipped;    /* due slots fill_telemetry() declined */

@@ -10,9 +10,10 @@
 
 #include "tase/common.h"
 
-#define TASE_ID(group, type) ((uint16_t)(((unsigned)(group) << 8) | (unsigned)(type)))
-#define TASE_ID_GROUP(id) ((uint8_t)((unsigned)(id) >> 8))
-#define TASE_ID_TYPE(id) ((uint8_t)(0xFFu & (unsigned)(id)))
+#define TASE_ID(group, type)                                                                       \
+    TASE_CAST_(uint16_t, (TASE_CAST_(unsigned, group) << 8) | TASE_CAST_(unsigned, type))
+#define TASE_ID_GROUP(id) TASE_CAST_(uint8_t, TASE_CAST_(unsigned, id) >> 8)
+#define TASE_ID_TYPE(id) TASE_CAST_(uint8_t, 0xFFu & TASE_CAST_(unsigned, id))
 
 /* Groups (spec table 3) */
 #define TASE_GROUP_COMMAND 0x00u  /* command and control input */

@@ -253,7 +253,7 @@ uint16_t tase_klv_fov_raw(double deg);   /* [0, 180) */
 /* ---- GPS status word ---------------------------------------------------
  * The spec numbers bits MSB first (section 3.1): bit 0 is 0x8000, bit 15
  * is 0x0001. TASE_KLV_GPS_BIT(n) maps spec bit n to its mask. */
-#define TASE_KLV_GPS_BIT(n) ((uint16_t)(0x8000u >> (n)))
+#define TASE_KLV_GPS_BIT(n) TASE_CAST_(uint16_t, 0x8000u >> (n))
 
 /* Fix type: spec bits 0-2 (mask 0xE000), read with tase_klv_gps_fix(). */
 #define TASE_KLV_GPS_FIX_MASK 0xE000u

@@ -112,6 +112,7 @@ static int map_open_errno(int e)
     case ENXIO:
     case ENODEV:
     case ENOTDIR:
+    case EISDIR:
     case ENOTTY: return TASE_ENODEV;
     case EACCES:
     case EPERM:
@@ -334,32 +335,43 @@ static int uart_write(void *ctx, const uint8_t *data, size_t n)
     if (u == NULL || u->fd < 0 || (data == NULL && n > 0) || n > 0x7FFFFFFFu) {
         return TASE_EARG;
     }
+    if (n == 0u) {
+        return 0;
+    }
     while (done < n) {
+        struct pollfd pfd;
+        int left, pr;
         ssize_t w = write(u->fd, data + done, n - done);
+        bool intr = w < 0 && errno == EINTR;
         if (w > 0) {
             done += (size_t)w;
             continue;
         }
-        if (w < 0 && errno == EINTR) {
-            continue;
-        }
-        if (w < 0 && !would_block(errno)) {
+        if (w < 0 && !intr && !would_block(errno)) {
             return TASE_EIO;
         }
-        {
-            struct pollfd pfd;
-            int left = time_left(start, u->write_timeout_ms);
-            int pr;
-            if (left == 0) {
-                break;
-            }
-            pfd.fd = u->fd;
-            pfd.events = POLLOUT;
-            pfd.revents = 0;
-            pr = poll(&pfd, 1, left);
-            if (pr < 0 && errno != EINTR) {
-                return TASE_EIO;
-            }
+        /* Full (or interrupted): wait for room within the bound. A signal
+         * resumes with the time left, so a storm of them cannot hold the
+         * call past it. */
+        left = time_left(start, u->write_timeout_ms);
+        if (left == 0) {
+            break;
+        }
+        if (intr) {
+            continue;
+        }
+        pfd.fd = u->fd;
+        pfd.events = POLLOUT;
+        pfd.revents = 0;
+        pr = poll(&pfd, 1, left);
+        if (pr < 0 && errno != EINTR) {
+            return TASE_EIO;
+        }
+        /* A pty master whose peer closed reports POLLHUP without POLLOUT
+         * at once: without this test the loop spun until the bound. */
+        if (pr > 0 && (pfd.revents & POLLOUT) == 0 &&
+            (pfd.revents & (POLLHUP | POLLERR | POLLNVAL)) != 0) {
+            return done > 0 ? (int)done : TASE_EIO;
         }
     }
     return done > 0 ? (int)done : TASE_EAGAIN;
@@ -381,20 +393,26 @@ static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
         struct pollfd pfd;
         int pr, left;
         ssize_t r = read(u->fd, buf, cap);
+        bool intr = r < 0 && errno == EINTR;
         if (r > 0) {
             return (int)r;
         }
         /* With VMIN = VTIME = 0 an empty tty reads as 0, not EAGAIN, and so
          * does a hung-up one: poll() below tells them apart. */
-        if (r < 0 && errno == EINTR) {
-            continue;
-        }
-        if ((r < 0 && !would_block(errno)) || hangup) {
+        if ((r < 0 && !intr && !would_block(errno)) || hangup) {
             return TASE_EIO;
         }
         /* With no time left poll() still runs, with a zero timeout: a
-         * caller that never waits must see a hang-up too, not an idle line. */
+         * caller that never waits must see a hang-up too, not an idle line.
+         * A signal resumes with the time left; once none is, the call ends
+         * as an idle line would (a storm of signals cannot hold it). */
         left = time_left(start, timeout_ms);
+        if (intr) {
+            if (left == 0) {
+                return 0;
+            }
+            continue;
+        }
         pfd.fd = u->fd;
         pfd.events = POLLIN;
         pfd.revents = 0;
@@ -402,7 +420,7 @@ static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
         if (pr < 0 && errno != EINTR) {
             return TASE_EIO;
         }
-        if (pr == 0) {
+        if (pr == 0 || (pr < 0 && left == 0)) {
             return 0;
         }
         /* Hang-up reports POLLIN too (read gives 0): read once more for

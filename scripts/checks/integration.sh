@@ -9,7 +9,8 @@
 #      C++98..C++20 (g++, clang++ -Weverything) with warnings as errors;
 #   3. add_subdirectory() and FetchContent(SOURCE_DIR) from a parent with
 #      extra warning flags: no warning, no -Werror, no tests, tools or
-#      install rules forced on the parent (TASE_INSTALL opts in);
+#      install rules forced on the parent (TASE_INSTALL opts in); a parent
+#      that enables C++ only; a clang parent with -Weverything;
 #   4. pkg-config from the installed tree;
 #   5. a CubeMX-style flat Makefile (one object folder, notdir + vpath)
 #      with the application's own can.c and one TASE_CONFIG_HEADER;
@@ -153,6 +154,36 @@ for how in subdir fetch; do
     fi
     echo "   $how: built warning-free with $port, nothing of tase installed"
 done
+# A parent that enables C++ only: tase's C99 requirement stays inside its
+# own targets (a PUBLIC c_std_99 made CMake fail to generate such a parent:
+# "No known features for C compiler").
+for how in subdir fetch; do
+    b="$out/$how-cxx"
+    gen_all "$TASE_ROOT/include" "$b/gen"
+    cmake -S "$cons/consumer" -B "$b" -DHOW=$how -DTASE_SRC="$TASE_ROOT" -DCXX_ONLY=ON \
+        -DCMAKE_CXX_FLAGS="-Wall -Wextra -Wpedantic -Wold-style-cast -Werror" >"$b.log" 2>&1 || {
+        cat "$b.log"
+        tase_fail "$how: a C++-only parent does not configure"
+    }
+    cmake --build "$b" -j$jobs >/dev/null
+    "$b/app_cxx"
+    echo "   $how: a parent with only C++ enabled builds and runs its C++ program"
+done
+# A clang parent with -Weverything (less the three README names): the
+# library with each port, the hosted ring's barrier included (it was an
+# implicit seq_cst atomic).
+for port in posix_uart baremetal socketcan; do
+    b="$out/weverything-$port"
+    cmake -S "$cons/consumer" -B "$b" -DHOW=subdir -DTASE_SRC="$TASE_ROOT" -DPORT=$port \
+        -DCMAKE_C_COMPILER=clang \
+        -DCMAKE_C_FLAGS="-Weverything -Wno-padded -Wno-declaration-after-statement -Wno-reserved-identifier -Werror" \
+        >/dev/null
+    cmake --build "$b" -j$jobs >"$b/build.log" 2>&1 || {
+        grep -B2 -A6 "error:" "$b/build.log" | head -40
+        tase_fail "clang -Weverything parent with $port: the build failed"
+    }
+done
+echo "   clang -Weverything parent: library and every port clean"
 cmake -S "$cons/consumer" -B "$out/subdir" -DTASE_INSTALL=ON >/dev/null
 cmake --build "$out/subdir" -j$jobs >/dev/null
 cmake --install "$out/subdir" >/dev/null

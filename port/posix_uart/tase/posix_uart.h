@@ -11,7 +11,12 @@
  * but root. Two readers of one serial line would each get a random half
  * of the byte stream; this makes that impossible by accident.
  * TASE_POSIX_UART_SHARED (tase_posix_uart_open_flags()) opens without
- * either. Both end when the device is closed (or the process exits).
+ * either. Both end when the device is closed. When the process exits
+ * without closing it, the lock ends with it, but the kernel keeps the
+ * flag while another process still has the device open (a pty that
+ * tase-sim holds): the tools clear it on the signals they can catch, and
+ * tase-sim clears a flag whose owner's lock is gone (SIGKILL); elsewhere
+ * root, or closing every other open of the device, clears it.
  *
  * SETTINGS GIVEN BACK. The device's termios settings as found at open are
  * saved and restored by tase_posix_uart_close(), so a shell, `cat` or
