@@ -332,20 +332,35 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms)
  * port is read before each poll, so an answer that came while the request
  * was being written is taken even when the write outlasted the attempt's
  * timeout (a read with no time left does not wait); polling first timed
- * such a request out, or re-sent it, with the answer unread. */
+ * such a request out, or re-sent it, with the answer unread. A port whose
+ * clock stands still while its read() returns nothing at once would make
+ * this loop endless: TASE_PORT_WRITE_SPINS such reads in a row end it as
+ * a timeout (the backstop tase_port_write_all() has for writes). */
 static int transact_wait(tase_host_t *h)
 {
+    uint32_t last = h->port.ops->now_ms(h->port.ctx);
+    uint32_t idle = 0u;
     for (;;) {
-        uint32_t waited = tase_port_elapsed_ms(h->port.ops->now_ms(h->port.ctx), h->sent_at);
-        int r = tase_host_service(h, waited < h->timeout_ms ? h->timeout_ms - waited : 0u);
-        if (r < 0) {
+        uint32_t now = h->port.ops->now_ms(h->port.ctx);
+        uint32_t waited = tase_port_elapsed_ms(now, h->sent_at);
+        int n = tase_host_service(h, waited < h->timeout_ms ? h->timeout_ms - waited : 0u);
+        int r;
+        if (n < 0) {
             (void)tase_host_cancel(h);
-            return r;
+            return n;
         }
-        r = tase_host_poll(h, h->port.ops->now_ms(h->port.ctx));
+        now = h->port.ops->now_ms(h->port.ctx);
+        r = tase_host_poll(h, now);
         if (r != TASE_EAGAIN) {
             return r;
         }
+        idle = (n == 0 && tase_port_elapsed_ms(now, last) == 0u) ? idle + 1u : 0u;
+        if (idle >= TASE_PORT_WRITE_SPINS) {
+            (void)tase_host_cancel(h);
+            h->stats.timeouts++;
+            return TASE_ETIMEOUT;
+        }
+        last = now;
     }
 }
 

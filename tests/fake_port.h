@@ -21,6 +21,7 @@ typedef struct {
     size_t write_limit; /* > 0: a write takes at most this many bytes */
     unsigned writes;    /* write() calls that took bytes */
     uint32_t write_ms;  /* each write() call blocks this long (fake clock) */
+    int frozen;         /* true: the clock never moves, an empty read returns at once */
     int discard;        /* true: count written bytes, keep none */
     size_t discarded;
     /* Scripted peer: after `reply_after` frames were written, the frame
@@ -88,7 +89,9 @@ static inline int fake_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeou
     }
     n = f->nin - f->rin;
     if (n == 0) {
-        f->now += timeout_ms; /* waited in vain */
+        if (!f->frozen) {
+            f->now += timeout_ms; /* waited in vain */
+        }
         return 0;
     }
     if (n > cap) {

@@ -419,6 +419,24 @@ static void an_answer_waiting_after_a_slow_write_is_read_not_timed_out(void **st
     assert_int_equal(x->host.stats.retries, 0);
 }
 
+/* A broken port: its clock stands still and an empty read returns at once
+ * (port.h allows a read to return 0 early). transact looped for ever; it
+ * ends as a timeout after TASE_PORT_WRITE_SPINS such reads. */
+static void transact_on_a_port_whose_clock_stands_still_ends(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    x->port.frozen = 1;
+    x->port.now = 1234;
+    assert_int_equal(tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 100, 1),
+                     TASE_ETIMEOUT);
+    assert_false(tase_host_busy(&x->host));
+    assert_int_equal(x->host.stats.timeouts, 1);
+    assert_int_equal(fake_frames_out(&x->port), 1); /* the clock never said to re-send */
+    assert_int_equal(x->port.now, 1234u);
+}
+
 static void transact_times_out_after_all_attempts(void **state)
 {
     fix_t *x = *state;
@@ -951,6 +969,8 @@ int main(void)
                                         teardown),
         cmocka_unit_test_setup_teardown(an_answer_waiting_after_a_slow_write_is_read_not_timed_out,
                                         setup, teardown),
+        cmocka_unit_test_setup_teardown(transact_on_a_port_whose_clock_stands_still_ends, setup,
+                                        teardown),
         cmocka_unit_test_setup_teardown(transact_times_out_after_all_attempts, setup, teardown),
         cmocka_unit_test_setup_teardown(noise_before_the_echo_delays_it_only_up_to_the_quiet_limit,
                                         setup, teardown),

@@ -259,7 +259,10 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms);
  * or a negative code (TASE_ETIMEOUT after 1 + retries attempts). Waits at
  * most about (1 + retries) * timeout_ms. Frames that arrive meanwhile go
  * to on_frame. TASE_EARG also for h without port ops (never initialised),
- * TASE_EUNSUPPORTED for a port without read or now_ms (nothing sent). */
+ * TASE_EUNSUPPORTED for a port without read or now_ms (nothing sent).
+ * A broken port whose clock stands still while read() returns nothing at
+ * once ends with TASE_ETIMEOUT after TASE_PORT_WRITE_SPINS such reads in a
+ * row (tase/config.h), instead of never. */
 int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len,
                        uint8_t *reply, size_t reply_cap, uint32_t timeout_ms, uint8_t retries);
 
