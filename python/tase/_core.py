@@ -385,8 +385,19 @@ class Packet(tuple):
     @classmethod
     def from_data(cls, group, type, data, offset=0):
         """A packet of (group, type) carrying `data` as received (unknown
-        packets and wrong lengths included)."""
-        return _from_data((group & 0xFF) << 8 | (type & 0xFF), bytes(data), offset)
+        packets and wrong lengths included). Group and type are 0..255 and
+        data at most 253 bytes (what a frame can carry), else FieldError."""
+        for what, v in (("group", group), ("type", type)):
+            if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 0xFF:
+                raise FieldError("from_data: %s %r is not 0..255" % (what, v))
+        data = bytes(data)
+        if len(data) > lib.TASE_DATA_MAX:
+            raise FieldError(
+                "from_data: %d data bytes, a frame carries at most %d"
+                % (len(data), lib.TASE_DATA_MAX),
+                lib.TASE_ELENGTH,
+            )
+        return _from_data(group << 8 | type, data, offset)
 
     offset = property(operator.itemgetter(_OFF), doc="stream offset of the first sync byte")
 
@@ -506,7 +517,9 @@ class Packet(tuple):
         return self.payload[t.len :]
 
     def replace(self, **fields):
-        """A copy with some fields changed (engineering values; raw= too)."""
+        """A copy with some fields changed (engineering values; raw= too).
+        A shorter form keeps its length: a field it does not carry is a
+        FieldError (CAMERA_CMD's 1-byte form has only `camera`)."""
         t = _BY_ID.get(self.id)
         if t is None:
             raise UnknownPacketError("an unknown packet has no fields", lib.TASE_EUNKNOWN)
@@ -609,6 +622,13 @@ def _make(t, raw, length, data):
             and 0 <= tmp.offset
             and tmp.offset + f.width <= n
         }
+        beyond = [k for k in raw if k not in sent]
+        if beyond:
+            # a given value the form cannot carry is never dropped silently
+            raise FieldError(
+                "%s: the %d-byte form carries only %s, not %s"
+                % (t.name, n, ", ".join(f.name for f in t.fields if f.name in sent), ", ".join(beyond))
+            )
     for f in t.fields:
         if f.name in raw:
             v = f._check(raw[f.name], t.name)

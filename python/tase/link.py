@@ -13,10 +13,12 @@ and echoes to requests, with retries; Python only moves the bytes.
 
 import collections
 import errno
+import math
 import os
 import re
 import select
 import time
+import weakref
 
 from ._core import (
     Error,
@@ -32,6 +34,7 @@ from ._core import (
     error,
     ffi,
     lib,
+    packet_type,
 )
 
 __all__ = ["connect", "Link", "parse_url"]
@@ -140,13 +143,23 @@ class _SerialTransport:
         self.name = dev
         self.bytes_per_s = baud // 10
 
+    # The port contract (tase/port.h): a write blocks at most its bound W
+    # (1 s, the POSIX serial port's default), then returns what went out,
+    # or TASE_EAGAIN when nothing did. It waited for room for ever: a
+    # gimbal that stopped reading hung send() and query().
+    WRITE_BOUND_S = 1.0
+
     def write(self, data):
         n = 0
+        deadline = time.monotonic() + self.WRITE_BOUND_S
         while n < len(data):
             try:
                 k = os.write(self.fd, data[n:])
             except BlockingIOError:
-                select.select([], [self.fd], [], 1.0)
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    break
+                select.select([], [self.fd], [], left)
                 continue
             except OSError as e:
                 raise LinkError(
@@ -154,7 +167,7 @@ class _SerialTransport:
                     lib.TASE_EIO,
                 ) from e
             n += k
-        return n
+        return n if n > 0 or not data else lib.TASE_EAGAIN
 
     def read(self, cap, timeout_s):
         try:
@@ -257,7 +270,9 @@ class _CanTransport:
 
 @ffi.def_extern()
 def py_port_write(ctx, data, n):
-    link = ffi.from_handle(ctx)
+    link = ffi.from_handle(ctx)()
+    if link is None:
+        return lib.TASE_EIO
     try:
         return link._t.write(ffi.buffer(data, n)[:])
     except BaseException as e:  # noqa: B902 - handed back to the caller
@@ -267,7 +282,9 @@ def py_port_write(ctx, data, n):
 
 @ffi.def_extern()
 def py_port_read(ctx, buf, cap, timeout_ms):
-    link = ffi.from_handle(ctx)
+    link = ffi.from_handle(ctx)()
+    if link is None:
+        return lib.TASE_EIO
     try:
         data = link._t.read(cap, timeout_ms / 1000.0)
     except BaseException as e:  # noqa: B902
@@ -298,6 +315,22 @@ _GIMBAL_CMD_FLAGS = {
 for _f in range(lib.TASE_GIMBAL_FLAGS_LEGACY_RATE, lib.TASE_GIMBAL_FLAGS_LEGACY_POSITION_STAB + 1):
     _GIMBAL_CMD_FLAGS[_f] = "legacy"
 
+# Flags fields of packets to the gimbal with bits the spec reserves ("set to
+# zero"), as `tase send` refuses them (mask, the bits in spec numbering).
+_RESERVED_FLAGS = {
+    "CAMERA_CMD": (0x78, "bits 1-4 (0x78), 4.1.3"),
+    "HOST_SENSOR": (0x1F, "bits 3-7 (0x1F), 4.2.3"),
+    "HOST_ATTITUDE": (0xFC, "bits 0-5 (0xFC), 4.2.4"),
+    "SPOI_CMD": (0x7F, "bits 1-7 (0x7F): to the gimbal only bit 0, 4.3.2"),
+}
+
+
+def _seconds(what, v):
+    """A timeout in seconds: a number >= 0 (not NaN), else FieldError."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v) or v < 0:
+        raise FieldError("%s: %r is not a number of seconds >= 0" % (what, v))
+    return v
+
 
 class Link:
     """A link to a gimbal, as the host. Made by tase.connect()."""
@@ -308,7 +341,10 @@ class Link:
         self.timeout = timeout
         self.retries = retries
         self._exc = None
-        self._handle = ffi.new_handle(self)
+        # the C side reaches the link through a weak reference: a handle of
+        # the link itself would be a cycle, and a link dropped unclosed kept
+        # its device (and its lock) until the cyclic collector ran
+        self._handle = ffi.new_handle(weakref.ref(self))
         self._host = ffi.new("tase_host_t *")
         self._sink = _Sink(1 << 18, cap=1 << 15, timed=True)
         self._ctx = ffi.new("py_ctx_t *")
@@ -334,6 +370,13 @@ class Link:
         if not self._closed:
             self._closed = True
             self._t.close()
+
+    def __del__(self):
+        if not getattr(self, "_closed", True):
+            try:
+                self.close()
+            except Exception:  # noqa: BLE001 - nothing to report to at collection
+                pass
 
     def _live(self):
         if self._closed:
@@ -362,7 +405,7 @@ class Link:
 
     # -- sending
 
-    def _checked(self, packet):
+    def _checked(self, packet, reserved=False):
         if not isinstance(packet, Packet):
             raise TypeError("send() takes a tase.Packet, not %s" % type(packet).__name__)
         t = packet.packet_type
@@ -375,6 +418,18 @@ class Link:
             raise FieldError("%s is sent by the gimbal, not to it: not sent" % t.name)
         if packet.error is not None:
             raise FieldError("%s: %s: not sent" % (t.name, packet.error))
+        if t.name == "SYSTEM_VERSION" and packet.size > 0:
+            raise FieldError(
+                "SYSTEM_VERSION is query-only: use query(\"SYSTEM_VERSION\"); not sent"
+            )
+        bad = _RESERVED_FLAGS.get(t.name)
+        if bad is not None and not reserved and packet.size > 0:
+            flags = packet.raw.get("flags")
+            if flags is not None and flags & bad[0]:
+                raise FieldError(
+                    "%s flags=0x%02X sets reserved %s; not sent (send(..., reserved=True) "
+                    "sends it anyway, as tase send --raw)" % (t.name, flags, bad[1])
+                )
         if t.name == "GIMBAL_CMD" and packet.size > 0:
             flags = packet.raw["flags"]
             if flags not in _GIMBAL_CMD_FLAGS:
@@ -384,12 +439,15 @@ class Link:
                 )
         return t
 
-    def send(self, packet):
+    def send(self, packet, reserved=False):
         """Send one packet to the gimbal now (no answer awaited). Packets
-        the gimbal sends, unknown ones, wrong lengths and GIMBAL_CMD flags
-        outside the spec's table 5 are refused (FieldError), nothing sent."""
+        the gimbal sends, unknown ones, wrong lengths, a full-length
+        SYSTEM_VERSION (query-only), GIMBAL_CMD flags outside the spec's
+        table 5 and flags with bits the spec reserves (CAMERA_CMD,
+        HOST_SENSOR, HOST_ATTITUDE, SPOI_CMD; reserved=True sends those
+        anyway) are refused (FieldError), nothing sent, as `tase send`."""
         self._live()
-        self._checked(packet)
+        self._checked(packet, reserved)
         data = packet.payload
         r = self._call(lib.tase_host_send, self._host, packet.group, packet.type, data, len(data))
         if r < 0:
@@ -400,13 +458,25 @@ class Link:
         """Ask the gimbal and return its answer (a Packet, dir "out").
 
         `what` is a packet name (its zero-length query: setup packets,
-        SPOI_CMD, SYSTEM_VERSION) or a Packet to set and confirm (a setup
-        packet, SPOI_CMD with the echo flag, RETRACT_DEPLOY_CMD): the answer
-        is the gimbal's frame of the same group and type (the library's
-        host role matches it and re-sends after each `timeout` s, up to
+        SPOI_CMD, SYSTEM_VERSION; any other name is a FieldError, nothing
+        sent) or a Packet: such a query, or a setting to confirm (a setup
+        packet, SPOI_CMD with the echo flag; RETRACT_DEPLOY_CMD is answered
+        when the move ends: retract()/deploy() with wait). The answer is
+        the gimbal's frame of the same group and type (the library's host
+        role matches it and re-sends after each `timeout` s, up to
         `retries` more times). TimeoutError when none comes."""
         self._live()
-        if isinstance(what, Packet):
+        if isinstance(what, str):
+            t = packet_type(what)
+            if not t.has_query:
+                raise FieldError(
+                    "%s has no zero-length query form (queryable: the setup packets, "
+                    "SPOI_CMD, SYSTEM_VERSION): nothing sent" % t.name
+                )
+            what = Packet.query(t.name)
+        if isinstance(what, Packet) and what.is_query and what.packet_type.has_query:
+            req = what
+        elif isinstance(what, Packet):
             t = self._checked(what)
             echoed = t.group == 0x48 or (
                 t.name == "SPOI_CMD" and what.size > 0 and what.raw["flags"] & lib.TASE_SPOI_ECHO
@@ -419,7 +489,7 @@ class Link:
                 )
             req = what
         else:
-            req = Packet.query(what)
+            raise TypeError("query() takes a packet name or a tase.Packet, not %s" % type(what).__name__)
         t = req.packet_type
         timeout = self.timeout if timeout is None else timeout
         retries = self.retries if retries is None else retries
@@ -457,17 +527,23 @@ class Link:
         seconds have passed in all (None: no limit) or `count` packets
         were given."""
         self._live()
+        if timeout is not None:
+            _seconds("packets: timeout", timeout)
         deadline = None if timeout is None else time.monotonic() + timeout
         given = 0
+        looked = False
         while count is None or given < count:
+            self._live()  # closed meanwhile (by the caller, another thread)
             if self._queue:
                 given += 1
                 yield self._queue.popleft()
                 continue
             wait = 0.2 if deadline is None else deadline - time.monotonic()
-            if wait <= 0:
+            if wait <= 0 and looked:
                 return
-            ms = max(1, min(int(wait * 1000), 200))
+            # at least one look at the port, also with timeout 0 (a poll)
+            ms = 0 if wait <= 0 else max(1, min(int(wait * 1000), 200))
+            looked = True
             r = self._call(lib.tase_host_service, self._host, ms)
             if r < 0:
                 raise error(r, "%s: receive" % self.url)

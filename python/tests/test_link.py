@@ -111,7 +111,19 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
         (lambda l: l.send(tase.Packet.from_data(0, 0x80, b"\x01")), tase.FieldError,
          "wrong length"),
         (lambda l: l.query("NO_SUCH"), tase.UnknownPacketError, "unknown packet name"),
-        (lambda l: l.query("GIMBAL_CMD"), tase.FieldError, "no zero-length form"),
+        (lambda l: l.query("GIMBAL_CMD"), tase.FieldError, "no zero-length query form"),
+        # a command with a zero-length form is not a query: it was sent 3 times
+        (lambda l: l.query("GYRO_ZERO_CMD"), tase.FieldError, "no zero-length query form"),
+        # as `tase send`: query-only, and flags with reserved bits
+        (lambda l: l.send(tase.Packet.from_data(0x48, 0x03, bytes(42))), tase.FieldError,
+         "query-only"),
+        (lambda l: l.send(tase.Packet("CAMERA_CMD", raw={"flags": 0xF8})), tase.FieldError,
+         "reserved bits 1-4"),
+        (lambda l: l.send(tase.Packet("HOST_ATTITUDE", time=0, roll=0, pitch=0, yaw=0, flags=0xFC,
+                                      sample_rate=0)), tase.FieldError, "reserved bits 0-5"),
+        (lambda l: l.send(tase.Packet("SPOI_CMD", lat=0, lon=0, height=0, vnorth=0, veast=0,
+                                      vdown=0, flags=0x7F)), tase.FieldError, "reserved bits 1-7"),
+        (lambda l: l.recv(float("nan")), tase.FieldError, "seconds"),
         (lambda l: l.camera("D"), tase.FieldError, "A, B or C"),
         (lambda l: l.camera(hfov=0), tase.FieldError, "0.01..327.67"),
         (lambda l: l.spoi(91, 0, 0), tase.FieldError, "out of range"),
@@ -128,6 +140,86 @@ def test_refused_input_sends_nothing(silent_pty, call, exc, text):
             call(link)
         assert link.stats["frames_tx"] == 0
     assert _drain(master, 0.05) == b""
+
+
+def test_reserved_bits_go_out_when_asked(silent_pty):
+    url, master = silent_pty
+    p = tase.Packet("CAMERA_CMD", raw={"flags": 0xF8})
+    with tase.connect(url) as link:
+        link.send(p, reserved=True)
+    assert tase.decode(_drain(master)) == [p]
+
+
+def test_a_query_packet_is_a_query(silent_pty):
+    # Packet.query("SPOI_CMD") was refused as "not echoed"; query("SPOI_CMD") sent it
+    url, master = silent_pty
+    with tase.connect(url) as link:
+        with pytest.raises(TimeoutError):
+            link.query(tase.Packet.query("SPOI_CMD"), timeout=0.05, retries=0)
+    assert _drain(master) == tase.encode(tase.Packet.query("SPOI_CMD"))
+
+
+def test_recv_with_no_wait_reads_what_is_there(silent_pty):
+    url, master = silent_pty
+    p = tase.Packet("GIMBAL_ANGLE", pan=1, tilt=2, roll=3)
+    with tase.connect(url) as link:
+        os.write(master, tase.encode(p))
+        time.sleep(0.2)
+        assert link.recv(0) == p  # it never looked: TimeoutError
+        assert list(link.packets(timeout=0)) == []
+
+
+def test_packets_stops_at_close(silent_pty):
+    # the iterator went on reading the closed link's descriptor number,
+    # whatever file had it by then
+    url, master = silent_pty
+    p = tase.Packet("GIMBAL_ANGLE", pan=1, tilt=2, roll=3)
+    link = tase.connect(url)
+    os.write(master, tase.encode(p) * 2)
+    gen = link.packets(timeout=2)
+    assert next(gen) == p
+    link.close()
+    with pytest.raises(tase.Error, match="closed"):
+        next(gen)
+
+
+def test_send_to_a_gimbal_that_stopped_reading_ends(silent_pty):
+    # nobody reads the pty: its queue fills and each write waits for room;
+    # it waited for ever, now the port's bound (1 s) ends the send
+    url, master = silent_pty
+    out = {}
+
+    def flood():
+        try:
+            with tase.connect(url) as link:
+                for _ in range(100000):
+                    link.point(1, 1)
+        except tase.Error as e:
+            out["error"] = e
+
+    t = threading.Thread(target=flood, daemon=True)
+    t0 = time.monotonic()
+    t.start()
+    t.join(30)
+    assert not t.is_alive(), "send() still blocked after 30 s"
+    assert "error" in out and time.monotonic() - t0 < 30
+    assert "again" in str(out["error"]) or "full" in str(out["error"]), out["error"]
+
+
+def test_a_dropped_link_frees_its_device(silent_pty):
+    # a reference cycle kept a dropped link's port (and its lock) until the
+    # cyclic collector ran: the next connect got "Could not exclusively lock"
+    import gc
+
+    url, master = silent_pty
+    gc.disable()
+    try:
+        link = tase.connect(url)
+        del link
+        with tase.connect(url) as again:
+            again.point(0, 0)
+    finally:
+        gc.enable()
 
 
 @pytest.mark.parametrize(

@@ -184,3 +184,23 @@ def test_examples_of_docs_python_md():
     r = doctest.testfile(os.path.join(ROOT, "docs", "PYTHON.md"), module_relative=False,
                          optionflags=doctest.NORMALIZE_WHITESPACE)
     assert r.attempted >= 5 and r.failed == 0
+
+
+def test_from_data_refuses_what_no_frame_carries():
+    # 300 bytes overflowed into the id: a SENSOR_FILTER of 44 bytes came out
+    with pytest.raises(tase.FieldError, match="at most 253"):
+        tase.Packet.from_data(0x48, 0, bytes(300))
+    with pytest.raises(tase.FieldError, match="group"):
+        tase.Packet.from_data(0x300, 1, b"ab")
+    with pytest.raises(tase.FieldError, match="type"):
+        tase.Packet.from_data(0, 0x1FF, b"ab")
+    assert tase.Packet.from_data(0x48, 0, bytes(253)).size == 253
+
+
+def test_a_short_form_never_drops_a_given_field():
+    with pytest.raises(tase.FieldError, match="1-byte form carries only camera, not hfov"):
+        tase.Packet("CAMERA_CMD", camera=1, hfov=5, length=1)
+    short = tase.Packet("CAMERA_CMD", camera=1, length=1)
+    with pytest.raises(tase.FieldError, match="not hfov"):
+        short.replace(hfov=5)
+    assert short.replace(camera=2).raw == {"camera": 2}

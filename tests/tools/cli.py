@@ -119,6 +119,11 @@ expect("pan=' 5' refused", ["send", "HOST_SENSOR", "roll= 5", "--zero"] + L, 2,
 expect("0X10 refused (hex is 0x)", ["send", "HOST_SENSOR", "roll=0X10", "--zero"] + L, 2,
        "not a number")
 expect("empty value refused", ["send", "HOST_SENSOR", "roll=", "--zero"] + L, 2, "empty")
+expect("a field the short form does not carry is refused (it was dropped: camera only sent)",
+       ["send", "CAMERA_CMD", "camera=1", "hfov=500", "--len", "1"] + L, 2,
+       "the 1-byte form does not carry hfov; nothing sent")
+expect("the short form with its own field reaches the link",
+       ["send", "CAMERA_CMD", "camera=1", "--len", "1"] + L, 1, "cannot open serial device")
 expect("duplicate field refused", ["send", "HOST_SENSOR", "roll=100", "roll=200", "--zero"] + L,
        2, "HOST_SENSOR.roll given twice")
 expect("empty data list items refused", ["send", "CAMERA_PASS", "camera=0", "baud=0",

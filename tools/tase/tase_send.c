@@ -289,6 +289,13 @@ int cli_cmd_send(cli_args_t *a)
         tk_usage_error("%s does not accept a data length of %lu", name, (unsigned long)len);
     }
     nf = cli_fields_within(p, len);
+    for (i = nf; i < p->nfields; i++) {
+        if (fs.given[i]) {
+            /* a value the form cannot carry was dropped without a word */
+            tk_usage_error("%s: the %lu-byte form does not carry %s; nothing sent", name,
+                           (unsigned long)len, tase_schema_field_name(p, (unsigned)i));
+        }
+    }
     tfi = tase_schema_field_index(p, "temporary");
     if (setup && tfi >= 0 && (unsigned)tfi < nf && !fs.given[tfi]) {
         /* A setup packet with temporary 0 is written to the gimbal's
