@@ -7,11 +7,12 @@ packet's time that of the record carrying its last byte.
 """
 
 import collections
+import errno
 import os
 import struct
 import time
 
-from ._core import Decoder, Error, _with_meta, ffi, lib
+from ._core import Decoder, Error, LinkError, TimeoutError_, _with_meta, ffi, lib
 
 __all__ = ["read_capture", "records", "CaptureLink", "CaptureWriter"]
 
@@ -36,6 +37,15 @@ class CaptureError(Error, ValueError):
     """A file that is not a capture tase can read."""
 
 
+# libpcap's bounds (sf-pcap.c, sf-pcapng.c): a record longer than any
+# snapshot length, a block longer than its reader takes, is a damaged file
+# (and would be read into memory whole)
+_MAX_SNAPLEN = 262144
+_MAX_BLOCK = 16 * 1024 * 1024
+_SHB = b"\x0a\x0d\x0d\x0a"
+_BOM = 0x1A2B3C4D
+
+
 def _pcap(f, head):
     magic = head[:4]
     if magic in MAGICS[0:2]:
@@ -57,6 +67,11 @@ def _pcap(f, head):
         if len(h) < 16:
             raise CaptureError("record %d: header cut short" % (index + 1))
         sec, frac, incl, orig = struct.unpack(e + "IIII", h)
+        if incl > _MAX_SNAPLEN:
+            raise CaptureError(
+                "record %d: invalid packet capture length %d, bigger than maximum of %d"
+                % (index + 1, incl, _MAX_SNAPLEN)
+            )
         data = f.read(incl)
         index += 1
         if len(data) < incl:
@@ -65,71 +80,204 @@ def _pcap(f, head):
         yield index, linktype, sec * 1000000 + usec, data, incl < orig
 
 
+class _Block:
+    """The body of a pcapng block, taken field by field: what it does not
+    hold is a CaptureError (libpcap's "block of type N ... is too short")."""
+
+    def __init__(self, btype, body, e, where):
+        self.btype = btype
+        self.body = body
+        self.at = 0
+        self.e = e
+        self.where = where
+
+    def left(self):
+        return len(self.body) - self.at
+
+    def take(self, n):
+        if self.left() < n:
+            raise CaptureError(
+                "%sblock of type %d in pcapng dump file is too short" % (self.where, self.btype)
+            )
+        out = self.body[self.at : self.at + n]
+        self.at += n
+        return out
+
+    def unpack(self, fmt):
+        return struct.unpack(self.e + fmt, self.take(struct.calcsize(self.e + fmt)))
+
+
+def _idb_options(blk):
+    """(ticks per second, offset in seconds) of an Interface Description
+    Block's options (if_tsresol, if_tsoffset), checked as libpcap does."""
+    res, offset = 1000000, 0
+    seen = set()
+    while blk.left():
+        code, olen = blk.unpack("HH")
+        value = blk.take((olen + 3) // 4 * 4)[:olen]
+        if code == 0:  # opt_endofopt
+            if olen != 0:
+                raise CaptureError(
+                    "%sInterface Description Block has opt_endofopt option with length %d != 0"
+                    % (blk.where, olen)
+                )
+            break
+        if code in (9, 14):
+            name, size = ("if_tsresol", 1) if code == 9 else ("if_tsoffset", 8)
+            if olen != size:
+                raise CaptureError(
+                    "%sInterface Description Block has %s option with length %d != %d"
+                    % (blk.where, name, olen, size)
+                )
+            if code in seen:
+                raise CaptureError(
+                    "%sInterface Description Block has more than one %s option" % (blk.where, name)
+                )
+            seen.add(code)
+            if code == 14:
+                offset = struct.unpack(blk.e + "q", value)[0]
+                continue
+            r = value[0]
+            if (r & 0x7F > 63) if r & 0x80 else (r > 19):
+                raise CaptureError(
+                    "%sInterface Description Block if_tsresol option resolution %s is too high"
+                    % (blk.where, "2^-%d" % (r & 0x7F) if r & 0x80 else "10^-%d" % r)
+                )
+            res = 2 ** (r & 0x7F) if r & 0x80 else 10**r
+    return res, offset
+
+
 def _pcapng(f, head):
+    """The records of a pcapng file whose first 8 bytes are head. Every
+    block is checked as libpcap checks it (the reader of `tase decode`):
+    its length (>= 12, a multiple of 4, the trailer's), the fixed fields of
+    its type and what its lengths claim within it; a damaged block is a
+    CaptureError saying which, never a partial record."""
     index = 0
-    e = "<"
+    e = None  # the byte order of the sections, from the first one's magic
     ifaces = []
     while True:
-        h = head if head else f.read(8)
+        where = "after record %d: " % index
+        h = head if head is not None else f.read(8)
         head = None
         if not h:
             return
         if len(h) < 8:
-            raise CaptureError("pcapng block cut short")
-        btype = struct.unpack(e + "I", h[:4])[0]
-        if btype == 0x0A0D0D0A:
+            raise CaptureError("%struncated pcapng dump file: a block header cut short" % where)
+        if h[:4] == _SHB:
             bom = f.read(4)
-            e = "<" if bom == b"\x4d\x3c\x2b\x1a" else ">"
+            if len(bom) < 4:
+                raise CaptureError("%struncated pcapng dump file: section header cut short" % where)
+            if e is None:
+                if struct.unpack("<I", bom)[0] == _BOM:
+                    e = "<"
+                elif struct.unpack(">I", bom)[0] == _BOM:
+                    e = ">"
+                else:
+                    raise CaptureError(
+                        "not a pcapng file: unknown byte-order magic 0x%s" % bom.hex()
+                    )
+            elif struct.unpack(e + "I", bom)[0] != _BOM:
+                if struct.unpack(e + "I", bom[::-1])[0] == _BOM:
+                    why = "sections with different byte orders"
+                else:
+                    why = "a section with a bad byte order magic field"
+                raise CaptureError("%sthe file has %s" % (where, why))
             blen = struct.unpack(e + "I", h[4:8])[0]
-            f.read(blen - 12)
+            if not 28 <= blen <= _MAX_BLOCK or blen % 4:
+                raise CaptureError(
+                    "%sSection Header Block in pcapng dump file has an invalid length %d"
+                    % (where, blen)
+                )
+            rest = f.read(blen - 12)
+            btype = 0x0A0D0D0A
+        else:
+            btype, blen = struct.unpack(e + "II", h)
+            if blen < 12:
+                raise CaptureError(
+                    "%sblock in pcapng dump file has a length of %d < 12" % (where, blen)
+                )
+            if blen % 4:
+                raise CaptureError(
+                    "%sblock in pcapng dump file has a length of %d that is not a multiple of 4"
+                    % (where, blen)
+                )
+            if blen > _MAX_BLOCK:
+                raise CaptureError(
+                    "%spcapng block size %d > maximum %d" % (where, blen, _MAX_BLOCK)
+                )
+            rest = f.read(blen - 8)
+            bom = b""
+        need = blen - 8 - len(bom)
+        if len(rest) < need:
+            raise CaptureError(
+                "%struncated pcapng dump file: block of type %d cut short (%d of its %d bytes)"
+                % (where, btype, 8 + len(bom) + len(rest), blen)
+            )
+        trailer = struct.unpack(e + "I", rest[-4:])[0]
+        if trailer != blen:
+            raise CaptureError(
+                "%sblock total length in header %d and trailer %d don't match"
+                % (where, blen, trailer)
+            )
+        blk = _Block(btype, bom + rest[:-4], e, where)
+        if btype == 0x0A0D0D0A:  # section header: its own interfaces
+            blk.take(4)
+            major, minor = blk.unpack("HH")
+            if major != 1:
+                raise CaptureError(
+                    "%sunsupported pcapng savefile version %d.%d" % (where, major, minor)
+                )
             ifaces = []
-            continue
-        blen = struct.unpack(e + "I", h[4:8])[0]
-        body = f.read(blen - 8)
-        if len(body) < blen - 8 or blen < 12:
-            raise CaptureError("pcapng block cut short")
-        body = body[:-4]
-        if btype == 1:  # interface description
-            linktype = struct.unpack(e + "H", body[:2])[0]
-            res = 1000000
-            opts = body[8:]
-            while len(opts) >= 4:
-                code, olen = struct.unpack(e + "HH", opts[:4])
-                if code == 0:
-                    break
-                if code == 9 and olen >= 1:
-                    r = opts[4]
-                    res = 2 ** (r & 0x7F) if r & 0x80 else 10 ** r
-                opts = opts[4 + (olen + 3) // 4 * 4 :]
-            ifaces.append((linktype, res))
+        elif btype == 1:  # interface description
+            linktype, _, snaplen = blk.unpack("HHI")
+            if snaplen == 0 or snaplen > _MAX_SNAPLEN:
+                snaplen = _MAX_SNAPLEN  # libpcap's adjustment
+            res, offset = _idb_options(blk)
+            ifaces.append((linktype, snaplen, res, offset))
         elif btype in (6, 3):  # enhanced / simple packet
-            index += 1
             if btype == 6:
-                iface, hi, lo, incl, orig = struct.unpack(e + "IIIII", body[:20])
-                data = body[20 : 20 + incl]
+                iface, hi, lo, incl, orig = blk.unpack("IIIII")
             else:
                 iface, hi, lo = 0, 0, 0
-                orig = struct.unpack(e + "I", body[:4])[0]
-                data = body[4:]
-                incl = len(data)
+                (orig,) = blk.unpack("I")
             if iface >= len(ifaces):
-                raise CaptureError("record %d: unknown interface" % index)
-            linktype, res = ifaces[iface]
+                raise CaptureError(
+                    "%sa packet on interface %d, but no Interface Description Block for it"
+                    % (where, iface)
+                )
+            linktype, snaplen, res, offset = ifaces[iface]
+            if btype == 3:  # its data: the packet up to the snapshot length
+                incl = min(orig, snaplen)
+            elif incl > snaplen:
+                raise CaptureError(
+                    "%sinvalid packet capture length %d, bigger than snaplen of %d"
+                    % (where, incl, snaplen)
+                )
+            data = blk.take(incl)
+            index += 1
             ts = hi << 32 | lo
-            usec = ts * 1000000 // res
+            usec = (ts // res + offset) * 1000000 + ts % res * 1000000 // res
             yield index, linktype, usec, data, incl < orig
+
+
+def _records(f):
+    head = f.read(4)
+    if head == _SHB:
+        yield from _pcapng(f, head + f.read(4))
+    else:
+        yield from _pcap(f, head)
 
 
 def records(path):
     """(index, linktype, time_us, bytes, cut) of every record of a pcap or
-    pcapng file."""
-    f = open(path, "rb")
-    with f:
-        head = f.read(4)
-        if head == b"\x0a\x0d\x0d\x0a":
-            yield from _pcapng(f, head + f.read(4))
-        else:
-            yield from _pcap(f, head)
+    pcapng file. A file that is not one, or a damaged record or block, is a
+    CaptureError naming the file (the records before it are given)."""
+    with open(path, "rb") as f:
+        try:
+            yield from _records(f)
+        except CaptureError as e:
+            raise CaptureError("%s: %s" % (path, e)) from None
 
 
 class CaptureWriter:
@@ -207,13 +355,16 @@ class _Stream:
 
 class Capture:
     """Iterate over (time, packet) of a capture; .bad lists the malformed
-    records skipped ((index, reason)), .stats the receivers' counters."""
+    records skipped ((index, reason)), .records the records read, .stats
+    the receivers' counters. Each iteration reads the file from its start
+    with new receivers (the counters are those of the last one)."""
 
     def __init__(self, path, baud=57600):
         self.path = path
         self.rate = baud // 10
         self.bad = []
         self.streams = {}
+        self.records = 0
 
     def _stream(self, dir, rate):
         s = self.streams.get(dir)
@@ -221,9 +372,38 @@ class Capture:
             s = self.streams[dir] = _Stream(dir, rate)
         return s
 
+    @property
+    def stats(self):
+        """The receivers' counters, both directions together (the names of
+        a link's stats): bytes_in, checksum_errors, bad_size,
+        bytes_discarded; records read and bad_records skipped."""
+        st = {
+            "records": self.records,
+            "bad_records": len(self.bad),
+            "bytes_in": 0,
+            "checksum_errors": 0,
+            "bad_size": 0,
+            "bytes_discarded": 0,
+        }
+        for s in self.streams.values():
+            d = s.dec.stats
+            st["bytes_in"] += d["bytes"]
+            st["checksum_errors"] += d["checksum_errors"]
+            st["bad_size"] += d["bad_size"]
+            st["bytes_discarded"] += d["discarded"]
+        return st
+
     def __iter__(self):
+        return self._packets(records(self.path))
+
+    def _packets(self, recs):
+        """(time, packet) of the records `recs`, from new receivers."""
+        self.bad = []
+        self.streams = {}
+        self.records = 0
         frame = ffi.new("tase_can_frame_t *")
-        for index, linktype, t, data, cut in records(self.path):
+        for index, linktype, t, data, cut in recs:
+            self.records += 1
             if linktype == LINKTYPE_SERIAL:
                 if cut:
                     self.bad.append((index, "cut by the snapshot length"))
@@ -275,34 +455,123 @@ def read_capture(path, baud=57600):
     """Yield (time, packet) for every packet of a `tase record` capture, as
     `tase decode FILE` prints them (same packets, order, offsets, times);
     `baud`: the serial line's rate, for the receivers' time bound (as
-    decode's --baud). time is Unix seconds (packet.time_us exact)."""
+    decode's --baud). time is Unix seconds (packet.time_us exact). A file
+    that is not a pcap or pcapng capture, or a damaged record or block in
+    it, is a CaptureError naming the file and the block, raised when the
+    iteration reaches it (`tase decode` fails on those too)."""
     return iter(Capture(path, baud))
 
 
 class CaptureLink:
-    """capture:FILE: a read-only link over a capture (packets() only)."""
+    """capture:FILE: a read-only link over a capture. As any link it is a
+    stream: packets() and recv() go on where the last call stopped, each
+    packet given once, in the order and with the offsets and times of
+    read_capture(); at the end of the file packets() ends and recv()
+    raises TimeoutError (nothing more will come). The file is opened by
+    tase.connect(): one that cannot be opened is a LinkError, one that is
+    not a capture a CaptureError, both at once."""
 
-    def __init__(self, path):
+    def __init__(self, path, baud=57600):
         self.url = "capture:" + path
         self.path = path
-        self._cap = Capture(path)
+        try:
+            self._f = open(path, "rb")
+        except OSError as e:
+            raise LinkError(
+                "cannot open capture %s: %s" % (path, e.strerror or e),
+                lib.TASE_ENODEV if e.errno == errno.ENOENT else lib.TASE_EIO,
+            ) from e
+        try:
+            head = self._f.read(4)
+            self._f.seek(0)
+        except OSError as e:
+            self._f.close()
+            raise LinkError(
+                "cannot read capture %s: %s" % (path, e.strerror or e), lib.TASE_EIO
+            ) from e
+        if head not in MAGICS:
+            self._f.close()
+            raise CaptureError("%s: not a capture tase can read (pcap or pcapng)" % path)
+        self._cap = Capture(path, baud)
+        self._it = self._cap._packets(self._records())
+        self._given = 0
+        self._end = None  # None: more to come; True: the end; or the CaptureError that ended it
+        self._closed = False
+
+    def _records(self):
+        try:
+            yield from _records(self._f)
+        except CaptureError as e:
+            raise CaptureError("%s: %s" % (self.path, e)) from None
 
     def __enter__(self):
         return self
 
     def __exit__(self, *exc):
+        self.close()
         return False
 
     def close(self):
-        pass
+        if not self._closed:
+            self._closed = True
+            self._it.close()
+            self._f.close()
+
+    def _live(self):
+        if self._closed:
+            raise Error("%s: the link is closed" % self.url)
+
+    def _next(self):
+        """The next packet, or None at the end of the capture (a damaged
+        record ends it: its CaptureError, then on every later call)."""
+        if self._end is not None:
+            if isinstance(self._end, BaseException):
+                raise self._end
+            return None
+        try:
+            _, p = next(self._it)
+        except StopIteration:
+            self._end = True
+            return None
+        except CaptureError as e:
+            self._end = e
+            raise
+        self._given += 1
+        return p
 
     def packets(self, timeout=None, count=None):
-        n = 0
-        for _, p in self._cap:
-            if count is not None and n >= count:
+        """Iterate over the packets not given yet, until the end of the
+        capture or `count` packets were given (`timeout` is not waited
+        for: a capture holds what it holds)."""
+        self._live()
+        given = 0
+        while count is None or given < count:
+            self._live()  # closed meanwhile
+            p = self._next()
+            if p is None:
                 return
-            n += 1
+            given += 1
             yield p
+
+    def recv(self, timeout=None):
+        """The next packet, or TimeoutError at the end of the capture."""
+        self._live()
+        p = self._next()
+        if p is None:
+            raise TimeoutError_(
+                "%s: end of the capture: no more packets" % self.url, lib.TASE_ETIMEOUT
+            )
+        return p
+
+    @property
+    def stats(self):
+        """What the capture counted so far: frames_rx (packets given),
+        records read, bad_records (skipped: cut, no direction byte, ...)
+        and the receivers' bytes_in, checksum_errors, bad_size and
+        bytes_discarded (both directions together)."""
+        st = {"frames_rx": self._given}
+        st.update(self._cap.stats)
+        return st
 
     def _read_only(self, *args, **kw):
         raise Error("%s: a capture is read only: nothing can be sent" % self.url)

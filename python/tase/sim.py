@@ -9,8 +9,10 @@ virtual="NAME" on python-can's in-process virtual bus NAME (tase-sim on a
 pty with --can-pty, so that its link is the CAN port, PACKET_RATE's port 3;
 its bytes carried to and from the bus in CAN frames of the spec's
 encapsulation by a thread of this process: CAN without kernel support),
-and stops it on exit from the with block, also on an exception. The
-program is found as $TASE_SIM, else `tase-sim` on the PATH.
+and stops it on exit from the with block, also on an exception (a Sim
+never stopped is stopped when it is garbage collected, at the latest when
+the interpreter exits). The program is found as $TASE_SIM, else
+`tase-sim` on the PATH.
 """
 
 import os
@@ -21,6 +23,7 @@ import subprocess
 import tempfile
 import threading
 import time
+import weakref
 
 from ._core import Error, error, ffi, lib
 
@@ -39,19 +42,64 @@ def find_program():
     return path
 
 
+class _Running:
+    """What a Sim holds outside Python (the process, the CAN bridge's
+    threads, the temporary directory), apart from the Sim so that a
+    finalizer can release it: Sim.stop(), else the Sim's collection, else
+    the interpreter's exit."""
+
+    def __init__(self, dir):
+        self.dir = dir
+        self.proc = None
+        self.bridge = None
+
+    def halt(self):
+        """Stop the bridge and the process (SIGTERM, then SIGKILL after 5 s)."""
+        if self.bridge is not None:
+            bridge, self.bridge = self.bridge, None
+            bridge.stop()
+        proc = self.proc
+        if proc is not None and proc.poll() is None:
+            proc.send_signal(signal.SIGTERM)
+            try:
+                proc.wait(5)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+
+    def release(self):
+        """halt() and remove the temporary directory."""
+        try:
+            self.halt()
+        finally:
+            shutil.rmtree(self.dir, ignore_errors=True)
+
+
 class Sim:
     """A running tase-sim. url: what tase.connect() takes; log(): what it
-    printed so far; pid; stop()."""
+    printed so far; pid; stop(). One never stopped is stopped when it is
+    garbage collected, at the latest when the interpreter exits (its
+    temporary directory removed with it). A program that cannot be run or
+    that does not start is a tase.Error, nothing left behind."""
 
     def __init__(
         self, baud=57600, can=None, seconds=None, program=None, ready_timeout=10.0, virtual=None
     ):
         if can is not None and virtual is not None:
             raise Error("tase.sim.start(): can or virtual, not both")
-        self._bridge = None
         self._log_text = None
         self.program = program or find_program()
         self.dir = tempfile.mkdtemp(prefix="tase-sim-")
+        self._run = _Running(self.dir)
+        # not a method of self: the finalizer must not keep the Sim alive
+        self._finalizer = weakref.finalize(self, self._run.release)
+        try:
+            self._start(baud, can, seconds, ready_timeout, virtual)
+        except BaseException:
+            self._finalizer()
+            raise
+
+    def _start(self, baud, can, seconds, ready_timeout, virtual):
         self.logfile = os.path.join(self.dir, "sim.log")
         args = [self.program]
         if can is not None:
@@ -66,10 +114,13 @@ class Sim:
             self.link = link
         if seconds is not None:
             args += ["--seconds", str(seconds)]
-        with open(self.logfile, "wb") as log:
-            self.proc = subprocess.Popen(
-                args, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT
-            )
+        try:
+            with open(self.logfile, "wb") as log:
+                self.proc = self._run.proc = subprocess.Popen(
+                    args, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT
+                )
+        except OSError as e:
+            raise Error("cannot run tase-sim %s: %s" % (self.program, e.strerror or e)) from e
         self.pid = self.proc.pid
         deadline = time.monotonic() + ready_timeout
         while True:
@@ -77,18 +128,12 @@ class Sim:
             if _READY.search(text) and (can is not None or os.path.exists(self.link)):
                 break
             if self.proc.poll() is not None:
-                self._cleanup()
                 raise Error("tase-sim exited with status %d: %s" % (self.proc.returncode, text.strip()))
             if time.monotonic() > deadline:
-                self.stop()
                 raise Error("tase-sim did not start within %s s: %s" % (ready_timeout, text.strip()))
             time.sleep(0.02)
         if virtual is not None:
-            try:
-                self._bridge = _Bridge(self.link, baud, virtual)
-            except BaseException:
-                self.stop()
-                raise
+            self._run.bridge = _Bridge(self.link, baud, virtual)
             self.url = "virtual:" + virtual
 
     def log(self):
@@ -102,25 +147,13 @@ class Sim:
             return ""
 
     def stop(self):
-        """Stop the simulator (SIGTERM, then SIGKILL after 5 s). Returns
-        its exit status."""
-        if self._bridge is not None:
-            self._bridge.stop()
-            self._bridge = None
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-            try:
-                self.proc.wait(5)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
+        """Stop the simulator (SIGTERM, then SIGKILL after 5 s) and remove
+        its temporary directory. Returns its exit status."""
+        self._run.halt()
         if self._log_text is None:
             self._log_text = self.log()
-        self._cleanup()
+        self._finalizer()
         return self.proc.returncode
-
-    def _cleanup(self):
-        shutil.rmtree(self.dir, ignore_errors=True)
 
     def __enter__(self):
         return self

@@ -3,6 +3,7 @@ the same packets and times as `tase decode`; capture: links."""
 
 import json
 import os
+import struct
 import subprocess
 import sys
 
@@ -114,3 +115,129 @@ def test_bench_script_of_the_docs_runs_against_tase_sim(tase_sim, tmp_path):
     assert "on target at pan" in r.stdout
     assert (tmp_path / "session.png").stat().st_size > 1000
     assert len(list(tase.read_capture(str(tmp_path / "session.pcap")))) > 20
+
+
+def test_capture_link_is_a_stream(recorded):
+    # a second packets() replayed the file from the start with the
+    # receivers' counters of the first: wrong offsets, packets twice
+    cap, lines = recorded
+    with tase.connect("capture:" + cap) as link:
+        got = [p.json() for p in link.packets(count=3)]
+        got += [p.json() for p in link.packets(count=2)]
+        for p in link.packets():
+            got.append(p.json())
+            if len(got) == 10:
+                break  # a loop left early: the packet it had is not given again
+        got += [p.json() for p in link.packets()]
+        assert got == lines
+        assert list(link.packets()) == []
+
+
+def test_capture_link_recv_and_stats(recorded):
+    cap, lines = recorded
+    with tase.connect("capture:" + cap) as link:
+        assert link.stats["frames_rx"] == 0 and link.stats["records"] == 0
+        assert link.recv().json() == lines[0]
+        assert link.recv(0.1).json() == lines[1]
+        assert [p.json() for p in link.packets()] == lines[2:]
+        with pytest.raises(TimeoutError, match="end of the capture"):
+            link.recv(0.1)
+        with pytest.raises(tase.Error):
+            link.recv()
+        st = link.stats
+        assert st["frames_rx"] == len(lines)
+        assert st["records"] > 0 and st["bad_records"] == 0
+        assert st["bytes_in"] > 0 and st["checksum_errors"] == 0
+        assert {"bad_size", "bytes_discarded"} <= set(st)
+    gen = link.packets()
+    with pytest.raises(tase.Error, match="closed"):
+        next(gen)
+
+
+def test_capture_link_to_a_missing_file(tmp_path):
+    # connect() said nothing; the first packets() raised a bare FileNotFoundError
+    with pytest.raises(tase.LinkError, match="nonexistent"):
+        tase.connect("capture:" + str(tmp_path / "nonexistent.pcap"))
+    bad = tmp_path / "text.pcap"
+    bad.write_bytes(b"hello world, not pcap")
+    with pytest.raises(tase.capture.CaptureError, match="not a capture"):
+        tase.connect("capture:" + str(bad))
+
+
+# ---- malformed pcapng: each block a CaptureError, as `tase decode` fails ---
+
+
+def _block(btype, body, e="<", length=None):
+    n = 12 + len(body) if length is None else length
+    return struct.pack(e + "II", btype, n) + body + struct.pack(e + "I", n)
+
+
+def _shb(e="<", bom=0x1A2B3C4D):
+    return _block(0x0A0D0D0A, struct.pack(e + "IHHq", bom, 1, 0, -1), e)
+
+
+def _idb(e="<", options=b""):
+    return _block(1, struct.pack(e + "HHI", 147, 0, 65535) + options, e)
+
+
+def _epb(data, e="<", incl=None):
+    incl = len(data) if incl is None else incl
+    body = struct.pack(e + "IIIII", 0, 0, 1000, incl, len(data)) + data
+    return _block(6, body + b"\0" * (-len(body) % 4), e)
+
+
+_FRAME = b"\x00" + bytes.fromhex("00ff5a08081004d2ee6c000003a9")  # from the gimbal
+MALFORMED = {
+    "epb_4_byte_body": (_shb() + _idb() + _block(6, b"\0\0\0\0"), "block of type 6 .* too short"),
+    "idb_empty_body": (_shb() + _block(1, b""), "block of type 1 .* too short"),
+    "block_length_4": (_shb() + _idb() + struct.pack("<II", 6, 4), "length of 4 < 12"),
+    "unknown_byte_order": (_shb(bom=0x11223344) + _idb() + _epb(_FRAME), "byte-order magic"),
+    "epb_incl_past_block": (_shb() + _idb() + _epb(_FRAME, incl=200),
+                            "block of type 6 .* too short"),
+    "length_not_multiple_of_4": (_shb() + _idb() + _block(6, b"\0" * 22), "multiple of 4"),
+    "trailer_differs": (_shb() + _idb()[:-4] + struct.pack("<I", 24), "trailer"),
+    "shb_too_short": (_block(0x0A0D0D0A, struct.pack("<I", 0x1A2B3C4D)), "Section Header"),
+    "shb_length_4": (struct.pack("<II", 0x0A0D0D0A, 4) + struct.pack("<I", 0x1A2B3C4D),
+                     "Section Header"),
+    "idb_option_past_block": (_shb() + _idb(options=struct.pack("<HH", 9, 8)),
+                              "block of type 1 .* too short"),
+    "epb_before_idb": (_shb() + _epb(_FRAME), "no Interface Description Block"),
+    "cut_inside_block": ((_shb() + _idb() + _epb(_FRAME))[:-6], "cut short"),
+    "byte_order_changes": (_shb() + _idb() + _shb(">") + _idb(">"), "byte order"),
+    "huge_block": (_shb() + struct.pack("<II", 6, 0xFFFFFFF0), "maximum"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(MALFORMED))
+def test_malformed_pcapng_is_a_capture_error(name, tmp_path, tase_cli):
+    data, text = MALFORMED[name]
+    path = tmp_path / (name + ".pcapng")
+    path.write_bytes(data)
+    with pytest.raises(tase.capture.CaptureError, match=text):
+        list(tase.read_capture(str(path)))
+    r = subprocess.run([sys.executable, "-m", "tase", "decode", str(path)],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode != 0 and "Traceback" not in r.stderr, r.stderr
+    assert r.stderr.startswith("tase: ") and str(path) in r.stderr, r.stderr
+    c = subprocess.run([tase_cli, "decode", str(path)], capture_output=True, text=True,
+                       timeout=30)
+    assert c.returncode != 0, c.stdout  # the C tool refuses it too
+
+
+def test_wellformed_pcapng_reads_as_tase_decode(tmp_path, tase_cli):
+    # the writer of the malformed ones, right: both readers agree
+    opts = struct.pack("<HHB3x", 9, 1, 9) + struct.pack("<HH", 0, 0)  # nanoseconds
+    files = {
+        "le.pcapng": _shb() + _idb(options=opts) + _epb(_FRAME) + _shb() + _idb() + _epb(_FRAME)
+        + _block(3, struct.pack("<I", 3) + b"\0ab\0"),
+        "be.pcapng": _shb(">") + _idb(">") + _epb(_FRAME, ">") + _epb(_FRAME[:9], ">")
+        + _epb(b"\0" + _FRAME[9:], ">"),
+    }
+    for name, data in files.items():
+        path = tmp_path / name
+        path.write_bytes(data)
+        c = subprocess.run([tase_cli, "decode", str(path)], capture_output=True, text=True,
+                           timeout=30)
+        assert c.returncode == 0, c.stderr
+        assert len(c.stdout.splitlines()) == 2
+        assert [p.json() for _, p in tase.read_capture(str(path))] == c.stdout.splitlines()

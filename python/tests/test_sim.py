@@ -1,0 +1,75 @@
+"""tase.sim: a simulator that cannot start is a tase.Error and leaves
+nothing behind; one never stopped is stopped when its Sim goes (collected,
+or the interpreter exits)."""
+
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import pytest
+
+import tase
+
+
+def _running(pid):
+    """Whether process pid runs (a zombie nobody reaped does not)."""
+    try:
+        with open("/proc/%d/stat" % pid) as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def _wait_gone(pid, seconds=10.0):
+    deadline = time.monotonic() + seconds
+    while _running(pid) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return not _running(pid)
+
+
+def test_start_with_a_missing_program(tmp_path, monkeypatch):
+    # a bare FileNotFoundError, and the temporary directory left behind
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    with pytest.raises(tase.Error, match="/nonexistent/tase-sim"):
+        tase.sim.start(program="/nonexistent/tase-sim")
+    assert os.listdir(tmp_path) == []
+    prog = tmp_path / "not-a-program"
+    prog.write_text("not executable\n")
+    with pytest.raises(tase.Error, match="not-a-program"):
+        tase.sim.start(program=str(prog))
+    assert os.listdir(tmp_path) == ["not-a-program"]
+
+
+SCRIPT = r"""
+import sys, tase
+sim = tase.sim.start(seconds=60)
+print(sim.pid, sim.dir, flush=True)
+if sys.argv[1] == "collected":
+    pid = sim.pid
+    del sim
+    import os
+    print(os.path.exists("/proc/%d" % pid), flush=True)  # waited for: no zombie either
+"""
+
+
+@pytest.mark.parametrize("how", ["exit", "collected"])
+def test_a_sim_never_stopped_is_stopped(tase_sim, how):
+    # tase-sim ran on after the interpreter exited (no finalizer), its
+    # temporary directory with it
+    r = subprocess.run([sys.executable, "-c", SCRIPT, how], capture_output=True, text=True,
+                       timeout=60, env=dict(os.environ, TASE_SIM=tase_sim))
+    assert r.returncode == 0, r.stderr
+    out = r.stdout.split()
+    pid, where = int(out[0]), out[1]
+    try:
+        if how == "collected":
+            assert out[2] == "False", "tase-sim still runs after its Sim was collected"
+        assert _wait_gone(pid, 2.0), "tase-sim %d still runs after its interpreter exited" % pid
+        assert not os.path.exists(where)
+    finally:
+        if _running(pid):
+            os.kill(pid, 9)
+        shutil.rmtree(where, ignore_errors=True)
