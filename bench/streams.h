@@ -15,6 +15,9 @@
  *              repeated: one byte releases 31 frames
  *   heldnoise  00 FF 5A FF + 257 noise bytes without a 00, repeated: the
  *              scan walks what the failed candidate was holding
+ *   halfsum    60 noise bytes, 00 FF 5A FF + 64 syncs whose candidates
+ *              end half-way through what is left: long sums per judged
+ *              candidate (a review's worst case), repeated
  */
 #ifndef BENCH_STREAMS_H
 #define BENCH_STREAMS_H

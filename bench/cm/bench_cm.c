@@ -238,7 +238,7 @@ NOINLINE static void stack_push(const char *sname, size_t n)
 }
 
 static const char *const streams[] = {"telemetry", "badsize", "sync4", "syncrand", "noise",
-                                      "zeros",     "held255", "burst", "heldnoise"};
+                                      "zeros",     "held255", "burst", "heldnoise", "halfsum"};
 
 int main(void)
 {

@@ -292,10 +292,10 @@ static void gimbal_poll(uint32_t *worst_now, unsigned *worst_app)
 static void gimbal_service(uint32_t now, unsigned app)
 {
     static uint8_t script[4096];
-    static const char *const streams[] = {"held255", "syncrand"};
+    static const char *const streams[] = {"held255", "syncrand", "halfsum"};
     worst_t w = {0, ""};
     size_t i, s;
-    for (s = 0; s < 3u; s++) {
+    for (s = 0; s <= sizeof(streams) / sizeof(streams[0]); s++) {
         if (s == 0u) {
             for (i = 0; i + worst_setup_n <= sizeof(script); i += worst_setup_n) {
                 memcpy(&script[i], worst_setup, worst_setup_n);
@@ -486,7 +486,7 @@ static void host_service(void)
 {
     static uint8_t script[4096];
     static uint16_t coarse[sizeof(script) / 64u];
-    static const char *const streams[] = {"held255", "syncrand", "burst"};
+    static const char *const streams[] = {"held255", "syncrand", "burst", "halfsum"};
     worst_t w = {0, ""};
     size_t s, k, pass;
     for (s = 0; s < sizeof(streams) / sizeof(streams[0]); s++) {

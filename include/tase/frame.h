@@ -75,14 +75,16 @@
  * bytes at most the cap plus n bytes' worth (plus its callbacks):
  * docs/TIMING.md lists it per function, measured on Cortex-M4 and M0+ on
  * the adversarial streams of bench/ (on a Cortex-M4 -O2: about 850
- * instructions for one tase_rx_push(), 3,700 for a 16-byte
- * tase_rx_feed(), 12,000 for a 64-byte one). tase_rx_push() stores a
+ * instructions for one tase_rx_push(), 4,500 for a 16-byte
+ * tase_rx_feed(), 15,000 for a 64-byte one; these are the longest calls
+ * found, not proven bounds: docs/DESIGN.md). tase_rx_push() stores a
  * byte inside a frame with one test, a store and an add; the sync bytes,
  * the Size byte and the last byte of a valid frame (its checksum is two
  * bytes off the running sum) are handled beside it without the general
  * path. A buffer fed with tase_rx_feed() takes noise and the bytes of a
  * held candidate in bulk (memchr, memcpy, one checksum pass). On telemetry
- * a byte costs about as much as in a classic single-state parser; the
+ * a byte costs 1.2 times a minimal classic parser's on a Cortex-M4
+ * (less on an M0+: docs/DESIGN.md); the
  * worst streams measured (false syncs with random Sizes every 4 bytes)
  * cost about 95 Thumb instructions per byte through tase_rx_push() on a
  * Cortex-M4 (-O2) and 175 on an M0+ (-Os). docs/PERFORMANCE.md has the
