@@ -60,9 +60,12 @@ ssize_t write(int fd, const void *buf, size_t n)
 }
 
 /* glibc declares poll()'s array write-only (access attribute), so gcc
- * calls reading its fd "maybe uninitialized"; poll() reads it. */
+ * calls reading its fd "maybe uninitialized"; poll() reads it. (gcc's
+ * warning only: clang has no such group.) */
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 int poll(struct pollfd *fds, nfds_t nfds, int timeout)
 {
     int (*real)(struct pollfd *, nfds_t, int);
@@ -73,7 +76,9 @@ int poll(struct pollfd *fds, nfds_t nfds, int timeout)
     *(void **)&real = dlsym(RTLD_NEXT, "poll");
     return real(fds, nfds, timeout);
 }
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 typedef struct {
     int master, slave;
