@@ -542,8 +542,8 @@ def main():
           biggest("schema")))
     core_gap = m4["core"][0] - TARGET_CORE_FLASH
     p("- **Whole core flash, %d B against 4096 (%s).** By module (object file, everything "
-      "compiled in): %s. Framing (frame, frame_time) is the receiver above plus its time bound and the encoder; KLV (the MISB ST 0601 "
-      "metadata encoder, decoder and stream receiver) is the other large one; the schema is the ROM description of all 21 packets and their fields that the "
+      "compiled in): %s. Framing (frame, frame_time) is the receiver above plus its time bound and the encoder; KLV (the spec's KLV "
+      "metadata encoder, decoder and stream receiver; not MISB ST 0601, PROTOCOL-NOTES.md) is the other large one; the schema is the ROM description of all 21 packets and their fields that the "
       "codec, dispatcher and tools share." % (
           m4["core"][0], "met" if core_gap <= 0 else "+%d" % core_gap,
           ", ".join("%s %d" % (m, fl(m)) for m in sorted(CORE_MODULES, key=lambda x: -fl(x))

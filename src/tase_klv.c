@@ -237,13 +237,26 @@ int tase_klv_rx_stats_reset(tase_klv_rx_t *rx)
     return TASE_OK;
 }
 
-static void rx_drop(tase_klv_rx_t *rx, size_t k, int delivered)
+/* The scan decides buf[0..*s) as it goes: `offset` follows buf[*s], and
+ * the window is moved down once, when the scan stops (rx_keep()), not
+ * for every byte it passes (that made a stream of near-miss candidates
+ * cost a copy of the window per byte: 41,850 Cortex-M4 instructions for a
+ * 64-byte feed behind a held candidate, a review found). */
+static void rx_drop(tase_klv_rx_t *rx, size_t *s, size_t k, int delivered)
 {
-    (void)memmove(rx->buf, rx->buf + k, rx->len - k);
-    rx->len = (uint8_t)(rx->len - k);
+    *s += k;
     rx->offset += (uint32_t)k;
     if (!delivered) {
         rx->stats.bytes_discarded += (uint32_t)k;
+    }
+}
+
+/* The undecided bytes buf[s..len) to the front; `offset` is buf[0]'s again. */
+static void rx_keep(tase_klv_rx_t *rx, size_t s)
+{
+    if (s > 0u) {
+        (void)memmove(rx->buf, rx->buf + s, rx->len - s);
+        rx->len = (uint8_t)(rx->len - s);
     }
 }
 
@@ -271,22 +284,27 @@ typedef struct {
  * handler re-initialised the scanner (it must then be left alone). */
 static bool rx_scan(tase_klv_rx_t *rx, int final, klv_call_t *c)
 {
+    size_t s = 0; /* buf[0..s) decided by this scan */
     for (;;) {
-        const uint8_t *p = memchr(rx->buf, (int)KEY_FIRST, rx->len);
+        size_t avail = (size_t)rx->len - s;
+        const uint8_t *q = &rx->buf[s];
+        const uint8_t *p = (avail > 0u) ? memchr(q, (int)KEY_FIRST, avail) : NULL;
         size_t m;
         tase_klv_t k;
         int r;
-        rx_drop(rx, p == NULL ? rx->len : (size_t)(p - rx->buf), 0);
-        if (rx->len == 0u) {
-            return true;
+        rx_drop(rx, &s, p == NULL ? avail : (size_t)(p - q), 0);
+        avail = (size_t)rx->len - s;
+        q = &rx->buf[s];
+        if (avail == 0u) {
+            break;
         }
         /* Noise that merely starts with 0x06 is not worth an error. */
-        m = rx->len < TASE_KLV_KEY_LEN ? rx->len : TASE_KLV_KEY_LEN;
-        if (memcmp(rx->buf, klv_key, m) != 0) {
-            rx_drop(rx, 1u, 0);
+        m = avail < TASE_KLV_KEY_LEN ? avail : TASE_KLV_KEY_LEN;
+        if (memcmp(q, klv_key, m) != 0) {
+            rx_drop(rx, &s, 1u, 0);
             continue;
         }
-        r = tase_klv_decode(rx->buf, rx->len, &k);
+        r = tase_klv_decode(q, avail, &k);
         if (r > 0) {
             rx->stats.packets_ok++;
             if (c->delivered < INT_MAX) {
@@ -298,11 +316,11 @@ static bool rx_scan(tase_klv_rx_t *rx, int final, klv_call_t *c)
                     return false;
                 }
             }
-            rx_drop(rx, (size_t)r, 1);
+            rx_drop(rx, &s, (size_t)r, 1);
             continue;
         }
         if (r == TASE_ETRUNC && !final) {
-            return true;
+            break;
         }
         if (m == TASE_KLV_KEY_LEN) {
             rx_count(&rx->stats, r);
@@ -314,8 +332,10 @@ static bool rx_scan(tase_klv_rx_t *rx, int final, klv_call_t *c)
             }
         }
         /* Re-scan from the byte after the failed candidate's first byte. */
-        rx_drop(rx, 1u, 0);
+        rx_drop(rx, &s, 1u, 0);
     }
+    rx_keep(rx, s);
+    return true;
 }
 
 /* What feed and flush check (rx NULL, a call in progress, a held length

@@ -258,6 +258,32 @@ static void gimbal_setups(void)
             }
         }
     }
+    /* A review's input: the same frame when an earlier call left a held
+     * false candidate (00 FF 5A FF) with 8 copies of the frame inside it:
+     * the frame fails the candidate, and all 9 are applied and echoed. */
+    for (a = 0; a < 2u; a++) {
+        static uint8_t pre[4u + 8u * TASE_FRAME_MAX];
+        static const uint8_t sync4[4] = {0x00, 0xFF, 0x5A, 0xFF};
+        size_t n = 0, i;
+        memcpy(pre, sync4, sizeof(sync4));
+        n = sizeof(sync4);
+        for (i = 0; i < 8u; i++) {
+            memcpy(&pre[n], worst_setup, worst_setup_n);
+            n += worst_setup_n;
+        }
+        gimbal_snapshot(apps[a]);
+        restore_g(NULL);
+        (void)tase_gimbal_feed(&g, 0u, pre, n, 0u);
+        g_snap = g;
+        memcpy(grx_snap, grx, sizeof(grx));
+        memcpy(gfp_snap, gfp, sizeof(gfp));
+        memcpy(setup_frame, worst_setup, worst_setup_n);
+        setup_n = worst_setup_n;
+        worst_try(&wf, measure_exact(restore_g, c_gfeed, NULL),
+                  "the costliest single setup frame, after an earlier call left 00 FF 5A FF "
+                  "and 8 copies of it held (all 9 applied and echoed), %s",
+                  app_names[a]);
+    }
     worst_report("tase_gimbal_feed", &wf, ", the whole frame in one call: applied and echoed" PORT);
     worst_report("tase_gimbal_handle_frame", &wh, ": applied and echoed" PORT);
 }
@@ -475,6 +501,23 @@ static void host_replies(void)
                   a_typed ? "typed" : "raw");
         worst_try(&wh, hf.insns, "%s reply completing a pending %s request", hf.input,
                   a_typed ? "typed" : "raw");
+    }
+    /* A review's input: a typed GEOREFERENCE_DATA request pending, the
+     * receiver left with halfsum's first 320 bytes by an earlier call,
+     * then the reply (it still completes the request). */
+    {
+        static uint8_t pre[320];
+        a_typed = true;
+        cur_pkt = tase_schema_find(0x10u, 0x41u);
+        if (cur_pkt != NULL && prep_reply(cur_pkt)) {
+            size_t n = bench_stream("halfsum", pre, sizeof(pre)); /* one 320-byte period */
+            h = h_snap;
+            (void)tase_host_feed(&h, pre, n, NOW_MS);
+            h_snap = h;
+            worst_try(&wf, measure_exact(restore_h, c_hfeed, NULL),
+                      "GEOREFERENCE_DATA reply frame completing a pending typed request, after an "
+                      "earlier call fed halfsum's first 320 bytes");
+        }
     }
     worst_report("tase_host_feed", &wf, ", the whole frame in one call");
     worst_report("tase_host_handle_frame", &wh, "");

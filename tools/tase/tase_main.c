@@ -31,7 +31,8 @@ static const char usage_req[] =
                                     CLI_DEFAULT_RETRIES) "\n"
                                                          "  --json         print JSON lines (what "
                                                          "was sent "
-                                                         "\"dir\":\"in\", the answer \"out\")\n";
+                                                         "\"dir\":\"in\", the answer \"out\"; "
+                                                         "query: the answer only)\n";
 
 static const char usage_point[] =
     "usage: tase point PAN TILT [--stab on|off] LINK [--json]\n"
@@ -182,7 +183,8 @@ static const char usage_replay[] =
     "  --dir all   both (moves a gimbal); on CAN every recorded frame, whatever its ID\n"
     "Serial bytes go to a CAN interface as frames of their direction's ID, and the\n"
     "datalink bytes of CAN frames to a serial device; CAN FD, remote and error\n"
-    "frames are not sent. A bad record is reported and skipped (exit 4).\n";
+    "frames are not sent. A capture with a bad record is refused before anything is\n"
+    "sent (exit 4).\n";
 
 static const char usage_list[] = "usage: tase list\nLists every packet: group, type, "
                                  "direction, data length and field names.\n";
