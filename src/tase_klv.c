@@ -254,9 +254,13 @@ static void rx_drop(tase_klv_rx_t *rx, size_t *s, size_t k, int delivered)
 /* The undecided bytes buf[s..len) to the front; `offset` is buf[0]'s again. */
 static void rx_keep(tase_klv_rx_t *rx, size_t s)
 {
-    if (s > 0u) {
-        (void)memmove(rx->buf, rx->buf + s, rx->len - s);
+    if (s >= rx->len || s >= sizeof(rx->buf)) {
+        rx->len = 0u;
+    } else if (s > 0u) {
+        (void)memmove(rx->buf, &rx->buf[s], (size_t)rx->len - s);
         rx->len = (uint8_t)(rx->len - s);
+    } else {
+        /* nothing decided: the window stays as it is */
     }
 }
 
