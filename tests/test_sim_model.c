@@ -371,6 +371,33 @@ static void impulse_in_spoi_shifts_the_error_and_stays_in_spoi(void **state)
     near(m.pan, 90.0, 1e-3);
 }
 
+/* C14: an impulse (and the 0xD0 error rate) in SPOI is bounded by the
+ * axis's max rate, as the same packet is outside SPOI: 100 deg/s for 1 s
+ * with a 10 deg/s max rate shifts the error 10 deg, not 100. */
+static void impulse_in_spoi_is_bounded_by_the_max_rate(void **state)
+{
+    sim_model_t m;
+    sim_model_t out;
+    (void)state;
+    sim_model_init(&m);
+    m.axis_pan.max_rate = 10.0;
+    m.axis_tilt.max_rate = 10.0;
+    out = m;
+    point_east_down(&m);
+    assert_int_equal(sim_model_command(&m, 100.0, -100.0, 0xB0, 1.0), SIM_CMD_OK);
+    run(&m, 3.0);
+    assert_int_equal(m.mode, SIM_MODE_SPOI);
+    near(m.err_pan, 10.0, 1e-9);
+    near(m.err_tilt, -10.0, 1e-9);
+    assert_int_equal(sim_model_command(&m, 100.0, 0.0, 0xD0, 0.0), SIM_CMD_OK);
+    run(&m, 1.0);
+    near(m.err_pan, 20.0, 1e-6);
+    /* the same impulse outside SPOI: 10 deg */
+    assert_int_equal(sim_model_command(&out, 100.0, 0.0, 0xB0, 1.0), SIM_CMD_OK);
+    run(&out, 3.0);
+    near(out.pan, 10.0, 1e-3);
+}
+
 /* Item 3: tilt runs in the spec's -270..90, through -180, to the far edge
  * of the default no-go zone (120 = -240); a position target below -180 is
  * reached and reported as such. */
@@ -714,6 +741,7 @@ int main(void)
         cmocka_unit_test(camera_euler_combines_mount_and_axes),
         cmocka_unit_test(spoi_flags_carry_stabilisation_and_mode_only),
         cmocka_unit_test(impulse_in_spoi_shifts_the_error_and_stays_in_spoi),
+        cmocka_unit_test(impulse_in_spoi_is_bounded_by_the_max_rate),
         cmocka_unit_test(tilt_uses_the_spec_range_minus_270_to_90),
         cmocka_unit_test(link_port_follows_a2),
         cmocka_unit_test(rate_meter_measures_what_was_sent),

@@ -82,7 +82,7 @@ static const char *const not_deployed =
 static void nav_said(sim_t *s, uint32_t now, int *said, int rc, const char *what)
 {
     static const char *const how[] = {
-        "used", "ignored: NAV_SOURCE selects the gimbal's own GPS/INS", "ignored: Valid is 0",
+        "used", "ignored: NAV_SOURCE selects the gimbal's own GPS/INS", "ignored: Valid is not 1",
         "overwrote the gimbal's own attitude solution", "aided the gimbal's own heading"};
     if (rc != *said) {
         sim_log(s, now, "%s: %s", what, how[rc]);

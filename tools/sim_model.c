@@ -360,15 +360,18 @@ static void propagate(sim_pos_t *p, double dt)
 
 /* ---- motion ---- */
 
-/* The SPOI error advances by its rate and by an impulse in progress. */
+/* The SPOI error advances by its rate and by an impulse in progress,
+ * each bounded by the axis's max rate like every other rate command
+ * (PROTOCOL-NOTES C14: an impulse moves as far in SPOI as outside it; it
+ * moved ten times as far with a 10 deg/s max rate and 100 deg/s sent). */
 static void spoi_error_step(sim_model_t *m, double dt)
 {
     double idt = dt < m->err_imp_left ? dt : m->err_imp_left;
-    m->err_pan += m->err_rate_pan * dt;
-    m->err_tilt += m->err_rate_tilt * dt;
+    m->err_pan += clamp(m->err_rate_pan, m->axis_pan.max_rate) * dt;
+    m->err_tilt += clamp(m->err_rate_tilt, m->axis_tilt.max_rate) * dt;
     if (idt > 0.0) {
-        m->err_pan += m->err_imp_pan * idt;
-        m->err_tilt += m->err_imp_tilt * idt;
+        m->err_pan += clamp(m->err_imp_pan, m->axis_pan.max_rate) * idt;
+        m->err_tilt += clamp(m->err_imp_tilt, m->axis_tilt.max_rate) * idt;
         m->err_imp_left -= idt;
     }
 }

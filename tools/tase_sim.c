@@ -438,7 +438,9 @@ int main(int argc, char **argv)
     sim_model_nav_source(&s.m, nav.external_attitude != 0, nav.external_gps != 0);
 
     printf("tase-sim: simulated gimbal on %s%s", can ? "CAN interface " : "", path);
-    if (can == NULL) {
+    if (can_pty) {
+        printf(", the CAN link's rates and capacity"); /* no serial line: no baud */
+    } else if (can == NULL) {
         printf(", %lld baud", baud);
     }
     printf(", PACKET_RATE port %u", s.link + 1u);

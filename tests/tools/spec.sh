@@ -185,7 +185,7 @@ check "7: NAV_SOURCE external GPS: the last valid host GPS (10 N) is used, Valid
     test "$(json_int "$geo" lat)" = 36000000
 check "7: ... and the simulator says why" \
     eval 'grep -q "HOST_GPS_DATA: ignored: NAV_SOURCE selects the gimbal" "$dir/sim.log" &&
-          grep -q "HOST_GPS_DATA: ignored: Valid is 0" "$dir/sim.log"'
+          grep -q "HOST_GPS_DATA: ignored: Valid is not 1" "$dir/sim.log"'
 
 # ---- 10: reserved flag bits ----
 n=$(grep -c "HOST_ATTITUDE" "$dir/sim.log")
