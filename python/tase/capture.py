@@ -261,12 +261,16 @@ def _pcapng(f, head):
             yield index, linktype, usec, data, incl < orig
 
 
-def _records(f):
-    head = f.read(4)
-    if head == _SHB:
-        yield from _pcapng(f, head + f.read(4))
-    else:
-        yield from _pcap(f, head)
+def _records(f, path):
+    """The records of the open capture f; a CaptureError names `path`."""
+    try:
+        head = f.read(4)
+        if head == _SHB:
+            yield from _pcapng(f, head + f.read(4))
+        else:
+            yield from _pcap(f, head)
+    except CaptureError as e:
+        raise CaptureError("%s: %s" % (path, e)) from None
 
 
 def records(path):
@@ -274,10 +278,7 @@ def records(path):
     pcapng file. A file that is not one, or a damaged record or block, is a
     CaptureError naming the file (the records before it are given)."""
     with open(path, "rb") as f:
-        try:
-            yield from _records(f)
-        except CaptureError as e:
-            raise CaptureError("%s: %s" % (path, e)) from None
+        yield from _records(f, path)
 
 
 class CaptureWriter:
@@ -493,16 +494,10 @@ class CaptureLink:
             self._f.close()
             raise CaptureError("%s: not a capture tase can read (pcap or pcapng)" % path)
         self._cap = Capture(path, baud)
-        self._it = self._cap._packets(self._records())
+        self._it = self._cap._packets(_records(self._f, path))
         self._given = 0
         self._end = None  # None: more to come; True: the end; or the CaptureError that ended it
         self._closed = False
-
-    def _records(self):
-        try:
-            yield from _records(self._f)
-        except CaptureError as e:
-            raise CaptureError("%s: %s" % (self.path, e)) from None
 
     def __enter__(self):
         return self
