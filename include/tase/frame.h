@@ -423,8 +423,9 @@ uint32_t tase_rx_quiet_ms(const tase_rx_t *rx, uint32_t now_ms);
  * callback); TASE_EARG for rx NULL. O(1). */
 int tase_rx_stop(tase_rx_t *rx);
 
-/* Zero every counter, nothing else. Returns TASE_OK or TASE_EARG (rx
- * NULL). Allowed from inside the receiver's own callback. */
+/* Zero every counter, nothing else: the frames and the bytes that
+ * deliver them are the same as without the reset. Returns TASE_OK or
+ * TASE_EARG (rx NULL). Allowed from inside the receiver's own callback. */
 int tase_rx_stats_reset(tase_rx_t *rx);
 
 #ifdef __cplusplus
