@@ -197,6 +197,17 @@ size_t bench_stream(const char *name, uint8_t *buf, size_t cap)
     if (strcmp(name, "badsize") == 0) {
         return gen_telemetry(buf, cap, 1);
     }
+    if (strcmp(name, "synclong") == 0) {
+        /* syncs 4 bytes apart, each Size 0x5A..0x93 (about 9 in 100:
+         * 0xFF): a helper's hill-climb found the scan lags for good on
+         * such a stream, every judged candidate summed over a long
+         * stretch */
+        for (i = 0; i + 4u <= cap;) {
+            uint8_t r = rnd8();
+            i = put_sync(buf, i, (r < 24u) ? 0xFFu : (uint8_t)(0x5Au + r % 58u));
+        }
+        return i;
+    }
     if (strcmp(name, "sync4") == 0 || strcmp(name, "syncrand") == 0) {
         int r = strcmp(name, "syncrand") == 0;
         for (i = 0; i + 4u <= cap;) {

@@ -18,6 +18,9 @@
  *   halfsum    60 noise bytes, 00 FF 5A FF + 64 syncs whose candidates
  *              end half-way through what is left: long sums per judged
  *              candidate (a review's worst case), repeated
+ *   synclong   00 FF 5A then a Size of 0x5A..0x93 (about 9 in 100: 0xFF),
+ *              repeated: the scan never catches up, long sums (found by
+ *              a hill-climb: the worst sustained cost)
  */
 #ifndef BENCH_STREAMS_H
 #define BENCH_STREAMS_H

@@ -237,8 +237,9 @@ NOINLINE static void stack_push(const char *sname, size_t n)
     printf("stack tase_rx_push/%s %lu\n", sname, (unsigned long)((size_t)(sp - w) * 4u));
 }
 
-static const char *const streams[] = {"telemetry", "badsize", "sync4", "syncrand", "noise",
-                                      "zeros",     "held255", "burst", "heldnoise", "halfsum"};
+static const char *const streams[] = {"telemetry", "badsize", "sync4",   "syncrand",
+                                      "noise",     "zeros",   "held255", "burst",
+                                      "heldnoise", "halfsum", "synclong"};
 
 int main(void)
 {

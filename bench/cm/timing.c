@@ -227,8 +227,8 @@ static unsigned long worst_over_prefixes(measure_fn call, size_t upto, uint32_t 
     return best;
 }
 
-static const char *const rx_streams[] = {"held255", "burst",   "syncrand", "sync4",
-                                         "zeros",   "badsize", "heldnoise", "halfsum"};
+static const char *const rx_streams[] = {"held255", "burst",     "syncrand", "sync4",   "zeros",
+                                         "badsize", "heldnoise", "halfsum",  "synclong"};
 
 static void receiver(void)
 {

@@ -75,7 +75,7 @@
  * bytes at most the cap plus n bytes' worth (plus its callbacks):
  * docs/TIMING.md lists it per function, measured on Cortex-M4 and M0+ on
  * the adversarial streams of bench/ (on a Cortex-M4 -O2: about 850
- * instructions for one tase_rx_push(), 4,500 for a 16-byte
+ * instructions for one tase_rx_push(), 4,600 for a 16-byte
  * tase_rx_feed(), 15,000 for a 64-byte one; these are the longest calls
  * found, not proven bounds: docs/DESIGN.md). tase_rx_push() stores a
  * byte inside a frame with one test, a store and an add; the sync bytes,
@@ -85,10 +85,10 @@
  * held candidate in bulk (memchr, memcpy, one checksum pass). On telemetry
  * a byte costs 1.2 times a minimal classic parser's on a Cortex-M4
  * (less on an M0+: docs/DESIGN.md); the
- * worst streams measured (false syncs with random Sizes every 4 bytes)
- * cost about 95 Thumb instructions per byte through tase_rx_push() on a
- * Cortex-M4 (-O2) and 175 on an M0+ (-Os). docs/PERFORMANCE.md has the
- * numbers.
+ * worst streams measured (false syncs every 4 bytes whose Sizes keep the
+ * scan behind and make it sum long stretches) cost about 107 Thumb
+ * instructions per byte through tase_rx_push() on a Cortex-M4 (-O2) and
+ * 225 on an M0+ (-Os). docs/PERFORMANCE.md has the numbers.
  *
  * RAM. sizeof(tase_rx_t) is 360: the TASE_RX_WINDOW (300) window bytes (a
  * frame and the room a lagging scan needs), 28 of counters, 15 of the time
