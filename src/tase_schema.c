@@ -6,6 +6,7 @@
 #include "tase/schema.h"
 
 #include "tase/codec.h"
+#include "tase/flags.h"
 
 /* Field index bookkeeping: FIRST_x / END_x are the flat field indices of
  * packet x. Each marker rewinds the counter so it takes no slot. */
@@ -181,6 +182,21 @@ bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len)
 bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len)
 {
     return p != NULL && len == 0u && (p->flags & TASE_LEN_QUERY) != 0u;
+}
+
+uint8_t tase_schema_reserved_flags(const tase_packet_desc_t *p)
+{
+    uint8_t mask = 0u;
+    if (p != NULL) {
+        switch (p->id) {
+        case TASE_ID_CAMERA_CMD: mask = TASE_CAMERA_FLAGS_RESERVED; break;
+        case TASE_ID_HOST_SENSOR: mask = TASE_HOST_SENSOR_FLAGS_RESERVED; break;
+        case TASE_ID_HOST_ATTITUDE: mask = TASE_HOST_ATT_FLAGS_RESERVED; break;
+        case TASE_ID_SPOI_CMD: mask = TASE_SPOI_FLAGS_RESERVED; break;
+        default: break;
+        }
+    }
+    return mask;
 }
 
 bool tase_field_iter_begin(tase_field_iter_t *it, size_t len)

@@ -239,6 +239,40 @@ static void accepted_lengths_follow_the_spec_rules(void **state)
     assert_false(tase_schema_is_query(NULL, 0));
 }
 
+/* The flags bits the spec reserves in what goes to the gimbal, from the
+ * spec's tables by hand (4.1.3 bits 1-4, 4.2.3 bits 3-7, 4.2.4 bits 0-5,
+ * 4.3.2 "bits 1-7" to the gimbal); each lies in a 1-byte `flags` field of
+ * its packet. The tool and the Python link read them here (they kept a
+ * table each before). */
+static void reserved_flags_are_the_specs(void **state)
+{
+    size_t i;
+    (void)state;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        const char *name = tase_schema_packet_name(p);
+        unsigned want = 0;
+        unsigned got = tase_schema_reserved_flags(p);
+        if (strcmp(name, "CAMERA_CMD") == 0) {
+            want = 0x78;
+        } else if (strcmp(name, "HOST_SENSOR") == 0) {
+            want = 0x1F;
+        } else if (strcmp(name, "HOST_ATTITUDE") == 0) {
+            want = 0xFC;
+        } else if (strcmp(name, "SPOI_CMD") == 0) {
+            want = 0x7F;
+        }
+        assert_int_equal(got, want);
+        if (want != 0) {
+            int fi = tase_schema_field_index(p, "flags");
+            assert_true(fi >= 0);
+            assert_int_equal(TASE_FIELD_WIDTH(tase_schema_field(p, (size_t)fi)), 1u);
+            assert_true((p->flags & TASE_DIR_IN) != 0u);
+        }
+    }
+    assert_int_equal(tase_schema_reserved_flags(NULL), 0);
+}
+
 /* Table 22 read with row "14" as byte 13 and every later row one less:
  * transcribed by hand, not from the code. */
 static const char *const axis22 =
@@ -702,6 +736,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(schema_api_rejects_bad_arguments),
+        cmocka_unit_test(reserved_flags_are_the_specs),
         cmocka_unit_test(schema_matches_spec_transcription),
         cmocka_unit_test(fields_are_in_range_ordered_disjoint_and_cover_all_but_reserved),
         cmocka_unit_test(struct_members_match_field_width_sign_and_offset),

@@ -25,6 +25,7 @@ MEASURED(c_find, tase_schema_find(a_group, a_type))
 MEASURED(c_iter_find, tase_field_iter_find(&a_it, a_group, a_type, a_len))
 MEASURED(c_length_ok, tase_schema_length_ok(a_p, a_len))
 MEASURED(c_is_query, tase_schema_is_query(a_p, a_len))
+MEASURED(c_reserved, tase_schema_reserved_flags(a_p))
 MEASURED(c_iter_init, tase_field_iter_init(&a_it, a_p, a_len))
 MEASURED(c_iter_begin, tase_field_iter_begin(&a_it, a_len))
 MEASURED(c_short, tase_schema_short_(a_p, a_len))
@@ -89,7 +90,8 @@ static void lookups(void)
     static const uint16_t unknown[] = {0x2800u, 0x00FFu, 0x4808u, 0x1042u, 0x0844u, 0xFFFFu};
     static probe_t pr[] = {PROBE("tase_schema_find", c_find),
                            {"tase_field_iter_find", c_iter_find, ", at the table length", {0, ""}},
-                           PROBE("tase_schema_at", c_at)};
+                           PROBE("tase_schema_at", c_at),
+                           PROBE("tase_schema_reserved_flags", c_reserved)};
     static char id[16];
     size_t i;
     for (i = 0; i < TASE_PKT_COUNT + COUNT(unknown); i++) {
@@ -97,6 +99,7 @@ static void lookups(void)
         uint16_t pid = p != NULL ? p->id : unknown[i - TASE_PKT_COUNT];
         a_group = (uint8_t)TASE_ID_GROUP(pid);
         a_type = (uint8_t)TASE_ID_TYPE(pid);
+        a_p = p; /* NULL for the unknown ones */
         a_len = TASE_FIELD_ITER_TABLE_LEN;
         a_i = i;
         (void)snprintf(id, sizeof(id), "0x%02X/0x%02X", (unsigned)a_group, (unsigned)a_type);

@@ -103,6 +103,8 @@
 #define TASE_CAMERA_FLAG_BLACK_HOT TASE_BIT8(5)
 #define TASE_CAMERA_FLAG_STAB TASE_BIT8(6)
 #define TASE_CAMERA_FLAG_TITLE TASE_BIT8(7)
+/* Bits 1-4 are reserved ("set to zero"; tase_schema_reserved_flags()). */
+#define TASE_CAMERA_FLAGS_RESERVED TASE_MASK8(1, 4)
 
 /* ---- RETRACT_DEPLOY_CMD (4.1.6) --------------------------------------- */
 /* The `deploy` byte: non-zero deploys, zero retracts. The 3AX CAN move
@@ -134,11 +136,13 @@
 #define TASE_HOST_SENSOR_BIAS_CORRECTED TASE_BIT8(0)
 #define TASE_HOST_SENSOR_ACCEL_VALID TASE_BIT8(1)
 #define TASE_HOST_SENSOR_TAS_VALID TASE_BIT8(2)
+#define TASE_HOST_SENSOR_FLAGS_RESERVED TASE_MASK8(3, 7) /* "set to zero" */
 #define TASE_TAS_UNAVAILABLE 0xFFFFu
 
 /* ---- HOST_ATTITUDE flags (4.2.4) -------------------------------------- */
 #define TASE_HOST_ATT_AID_YAW TASE_BIT8(6)
 #define TASE_HOST_ATT_OVERWRITE TASE_BIT8(7)
+#define TASE_HOST_ATT_FLAGS_RESERVED TASE_MASK8(0, 5) /* "set to zero" */
 
 /* ---- SPOI_CMD flags (4.3.2) ------------------------------------------- */
 /* To the gimbal: bit 0 requests an echo, bits 1-7 zero. From the gimbal:
@@ -149,6 +153,7 @@
  * the same under both readings; reading bits 1-7 as the number would turn
  * a copied Mode byte (0xC2: stabilised, deployed, SPOI) into mode 66. */
 #define TASE_SPOI_ECHO TASE_BIT8(0)
+#define TASE_SPOI_FLAGS_RESERVED TASE_MASK8(1, 7) /* to the gimbal only */
 #define TASE_SPOI_STAB TASE_MODE_STAB
 #define TASE_SPOI_3AX_DEPLOYED TASE_MODE_3AX_DEPLOYED
 #define TASE_SPOI_3AX_RETRACTED TASE_MODE_3AX_RETRACTED

@@ -88,6 +88,7 @@ const tase_packet_desc_t *tase_schema_find(uint8_t group, uint8_t type);
 const char *tase_schema_packet_name(const tase_packet_desc_t *p);
 bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len);
 bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len);
+uint8_t tase_schema_reserved_flags(const tase_packet_desc_t *p);
 
 int tase_frame_build(uint8_t group, uint8_t type, const uint8_t *data, size_t len,
                      uint8_t *out, size_t cap);

@@ -205,7 +205,9 @@ class PacketType:
     """A packet of the spec, from the library's schema table: name, id,
     group, type, len (the table's data length), index (TASE_PKT_*),
     fields (in table order), to_gimbal / from_gimbal (direction),
-    has_query (a zero-length form), tail (CAMERA_PASS's free bytes)."""
+    has_query (a zero-length form), tail (CAMERA_PASS's free bytes),
+    reserved_flags (the bits of its flags field the spec reserves in what
+    is sent to the gimbal, as a mask; 0 for none)."""
 
     __slots__ = (
         "name",
@@ -221,6 +223,7 @@ class PacketType:
         "from_gimbal",
         "has_query",
         "tail",
+        "reserved_flags",
         "_desc",
     )
 
@@ -258,6 +261,7 @@ def _load_schema():
         t.from_gimbal = bool(d.flags & lib.TASE_DIR_OUT)
         t.has_query = bool(d.flags & lib.TASE_LEN_QUERY)
         t.tail = bool(d.flags & lib.TASE_LEN_TAIL)
+        t.reserved_flags = lib.tase_schema_reserved_flags(d)
         t.fields = []
         for k in range(d.nfields):
             if lib.py_field(i, k, d.len, out) != lib.TASE_OK:

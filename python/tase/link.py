@@ -315,16 +315,6 @@ _GIMBAL_CMD_FLAGS = {
 for _f in range(lib.TASE_GIMBAL_FLAGS_LEGACY_RATE, lib.TASE_GIMBAL_FLAGS_LEGACY_POSITION_STAB + 1):
     _GIMBAL_CMD_FLAGS[_f] = "legacy"
 
-# Flags fields of packets to the gimbal with bits the spec reserves ("set to
-# zero"), as `tase send` refuses them (mask, the bits in spec numbering).
-_RESERVED_FLAGS = {
-    "CAMERA_CMD": (0x78, "bits 1-4 (0x78), 4.1.3"),
-    "HOST_SENSOR": (0x1F, "bits 3-7 (0x1F), 4.2.3"),
-    "HOST_ATTITUDE": (0xFC, "bits 0-5 (0xFC), 4.2.4"),
-    "SPOI_CMD": (0x7F, "bits 1-7 (0x7F): to the gimbal only bit 0, 4.3.2"),
-}
-
-
 def _seconds(what, v):
     """A timeout in seconds: a number >= 0 (not NaN), else FieldError."""
     if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v) or v < 0:
@@ -422,13 +412,15 @@ class Link:
             raise FieldError(
                 "SYSTEM_VERSION is query-only: use query(\"SYSTEM_VERSION\"); not sent"
             )
-        bad = _RESERVED_FLAGS.get(t.name)
-        if bad is not None and not reserved and packet.size > 0:
+        bad = t.reserved_flags
+        if bad and not reserved and packet.size > 0:
             flags = packet.raw.get("flags")
-            if flags is not None and flags & bad[0]:
+            if flags is not None and flags & bad:
+                bits = [b for b in range(8) if bad & (0x80 >> b)]
                 raise FieldError(
-                    "%s flags=0x%02X sets reserved %s; not sent (send(..., reserved=True) "
-                    "sends it anyway, as tase send --raw)" % (t.name, flags, bad[1])
+                    "%s flags=0x%02X sets reserved bits %d-%d (0x%02X), which the spec says to "
+                    "set to zero; not sent (send(..., reserved=True) sends it anyway, as tase "
+                    "send --raw)" % (t.name, flags, bits[0], bits[-1], bad)
                 )
         if t.name == "GIMBAL_CMD" and packet.size > 0:
             flags = packet.raw["flags"]

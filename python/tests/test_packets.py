@@ -32,6 +32,9 @@ def test_schema_has_the_21_packets():
     assert cam["hfov"].keep == -1 and cam["focus"].keep == 0xFFFF
     ang = tase.packet_type("GIMBAL_ANGLE").by_name["pan"]
     assert (ang.unit, ang.scale, ang.signed, ang.width) == ("deg", 0.01, True, 2)
+    reserved = {t.name: t.reserved_flags for t in tase.PACKET_TYPES if t.reserved_flags}
+    assert reserved == {"CAMERA_CMD": 0x78, "HOST_SENSOR": 0x1F, "HOST_ATTITUDE": 0xFC,
+                        "SPOI_CMD": 0x7F}
 
 
 def _raw_strategy(t):

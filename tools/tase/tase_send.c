@@ -199,36 +199,34 @@ static size_t missing_list(const cli_fields_t *fs, unsigned n, char *buf, size_t
 
 /* ---- send ---- */
 
-/* Flags fields of In packets with bits the spec reserves ("set to zero"),
- * spec bit numbers (0 = MSB). */
-static const struct {
-    uint16_t id;
-    uint8_t reserved; /* mask */
-    const char *bits; /* in messages */
-} reserved_flags[] = {
-    {TASE_ID_CAMERA_CMD, TASE_MASK8(1, 4), "bits 1-4 (0x78), 4.1.3"},
-    {TASE_ID_HOST_SENSOR, TASE_MASK8(3, 7), "bits 3-7 (0x1F), 4.2.3"},
-    {TASE_ID_HOST_ATTITUDE, TASE_MASK8(0, 5), "bits 0-5 (0xFC), 4.2.4"},
-    {TASE_ID_SPOI_CMD, TASE_MASK8(1, 7), "bits 1-7 (0x7F): to the gimbal only bit 0, 4.3.2"},
-};
-
-/* Refuse (usage error, nothing sent) a flags value with a reserved bit. */
+/* Refuse (usage error, nothing sent) a flags value with a bit the spec
+ * reserves (tase_schema_reserved_flags(): a contiguous run of spec bits,
+ * 0 = MSB). */
 static void check_reserved_flags(const cli_fields_t *fs, unsigned nf)
 {
     const tase_packet_desc_t *p = fs->p;
     int fi = tase_schema_field_index(p, "flags");
-    size_t i;
-    if (fi < 0 || (unsigned)fi >= nf || !fs->given[fi]) {
+    unsigned mask = tase_schema_reserved_flags(p);
+    unsigned first = 0;
+    unsigned last;
+    long long v;
+    if (mask == 0u || fi < 0 || (unsigned)fi >= nf || !fs->given[fi]) {
         return;
     }
-    for (i = 0; i < sizeof(reserved_flags) / sizeof(reserved_flags[0]); i++) {
-        long long v = cli_fields_value(fs, (unsigned)fi);
-        if (reserved_flags[i].id == p->id && (v & reserved_flags[i].reserved) != 0) {
-            tk_usage_error("%s flags=0x%02llX sets reserved %s; nothing sent (--raw sends it "
-                           "anyway)",
-                           tase_schema_packet_name(p), v, reserved_flags[i].bits);
-        }
+    v = cli_fields_value(fs, (unsigned)fi);
+    if ((v & (long long)mask) == 0) {
+        return;
     }
+    while ((mask & (0x80u >> first)) == 0u) {
+        first++;
+    }
+    last = first;
+    while (last < 7u && (mask & (0x80u >> (last + 1u))) != 0u) {
+        last++;
+    }
+    tk_usage_error("%s flags=0x%02llX sets reserved bits %u-%u (0x%02X), which the spec says "
+                   "to set to zero; nothing sent (--raw sends it anyway)",
+                   tase_schema_packet_name(p), v, first, last, mask);
 }
 
 int cli_cmd_send(cli_args_t *a)
