@@ -75,8 +75,8 @@
  * bytes at most the cap plus n bytes' worth (plus its callbacks):
  * docs/TIMING.md lists it per function, measured on Cortex-M4 and M0+ on
  * the adversarial streams of bench/ (on a Cortex-M4 -O2: about 850
- * instructions for one tase_rx_push(), 4,600 for a 16-byte
- * tase_rx_feed(), 15,000 for a 64-byte one; these are the longest calls
+ * instructions for one tase_rx_push(), 4,400 for a 16-byte
+ * tase_rx_feed(), 14,500 for a 64-byte one; these are the longest calls
  * found, not proven bounds: docs/DESIGN.md). tase_rx_push() stores a
  * byte inside a frame with one test, a store and an add; the sync bytes,
  * the Size byte and the last byte of a valid frame (its checksum is two
@@ -86,7 +86,7 @@
  * a byte costs 1.2 times a minimal classic parser's on a Cortex-M4
  * (less on an M0+: docs/DESIGN.md); the
  * worst streams measured (false syncs every 4 bytes whose Sizes keep the
- * scan behind and make it sum long stretches) cost about 107 Thumb
+ * scan behind and make it sum long stretches) cost about 104 Thumb
  * instructions per byte through tase_rx_push() on a Cortex-M4 (-O2) and
  * 225 on an M0+ (-Os). docs/PERFORMANCE.md has the numbers.
  *
