@@ -46,12 +46,13 @@ int tase_rx_stats_reset(tase_rx_t *rx)
     if (rx == NULL) {
         return TASE_EARG;
     }
-    /* The scan's credit counts bytes since bank_at (src/tase_frame.c):
-     * moved with the count, so that a reset (from a callback too) changes
+    /* The scan's credit counts bytes since bank_at (src/tase_frame.c) and
+     * the time bound bytes since the last tick (tick_bytes): both move
+     * with the count, so that a reset (from a callback too) changes
      * nothing of when frames come out. */
     rx->bank_at = (uint16_t)(rx->bank_at - rx->stats.bytes_in);
+    rx->tick_bytes -= rx->stats.bytes_in;
     (void)memset(&rx->stats, 0, sizeof(rx->stats));
-    rx->tick_bytes = 0u; /* bytes fed from here on still count as activity */
     return TASE_OK;
 }
 

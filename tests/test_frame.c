@@ -1677,6 +1677,52 @@ static void a_stats_reset_does_not_move_the_frames(void **state)
     }
 }
 
+/* Found in review of the reset above: tase_rx_stats_reset() also set the
+ * time bound's count of the last tick to zero, so bytes fed after a tick
+ * and before the reset were no activity for the next tick, which judged a
+ * frame still arriving false (57,600 baud, 20 ms margin: 10 bytes at 0
+ * ms, 10 more at 19 ms, reset, tick at 21 ms: the frame was lost). */
+static int ticked_frames;
+
+static void count_ticked(void *user, const tase_frame_t *f)
+{
+    (void)user;
+    (void)f;
+    ticked_frames++;
+}
+
+static void a_stats_reset_between_ticks_keeps_the_frame(void **state)
+{
+    static const uint8_t d[20] = {0};
+    uint8_t fr[64];
+    int n;
+    int reset;
+    (void)state;
+    n = tase_frame_build(0x08, 0x41, d, sizeof d, fr, sizeof fr);
+    assert_int_equal(n, 28);
+    for (reset = 0; reset < 2; reset++) {
+        tase_rx_t rx;
+        int i;
+        ticked_frames = 0;
+        assert_int_equal(tase_rx_init(&rx), TASE_OK);
+        assert_int_equal(tase_rx_set_timing(&rx, 5760u, 0u), TASE_OK);
+        assert_true(tase_rx_tick(&rx, 0u, count_ticked, NULL) >= 0);
+        assert_true(tase_rx_feed(&rx, fr, 10, count_ticked, NULL) >= 0);
+        assert_true(tase_rx_tick(&rx, 0u, count_ticked, NULL) >= 0);
+        assert_true(tase_rx_feed(&rx, fr + 10, 10, count_ticked, NULL) >= 0);
+        if (reset) {
+            assert_int_equal(tase_rx_stats_reset(&rx), TASE_OK);
+        }
+        assert_true(tase_rx_tick(&rx, 21u, count_ticked, NULL) >= 0);
+        assert_true(tase_rx_feed(&rx, fr + 20, (size_t)n - 20u, count_ticked, NULL) >= 0);
+        for (i = 0; i < 10; i++) {
+            assert_true(tase_rx_tick(&rx, 22u + 100u * (uint32_t)i, count_ticked, NULL) >= 0);
+        }
+        assert_int_equal(ticked_frames, 1);
+        assert_int_equal(rx.stats.bytes_discarded, 0);
+    }
+}
+
 /* Found in review (also before the credit): a settling tick whose callback
  * stopped it, repeated as frame.h says, recomputed the quiet limit from
  * the stopped scan's position, found it not passed and only continued the
@@ -2185,6 +2231,7 @@ int main(void)
         cmocka_unit_test(a_lagging_scan_gives_the_same_frames_for_any_split),
         cmocka_unit_test(the_scans_credit_does_not_depend_on_the_split),
         cmocka_unit_test(a_stats_reset_does_not_move_the_frames),
+        cmocka_unit_test(a_stats_reset_between_ticks_keeps_the_frame),
         cmocka_unit_test(a_stopped_settling_tick_settles_when_repeated),
         cmocka_unit_test(a_receiver_re_initialised_in_its_callback_can_be_fed_there),
         cmocka_unit_test(sync_inside_a_delivered_frame_starts_nothing),

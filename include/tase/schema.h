@@ -154,11 +154,13 @@ bool tase_schema_length_ok(const tase_packet_desc_t *p, size_t len);
  * is a command, not a query. False when p is NULL. O(1). */
 bool tase_schema_is_query(const tase_packet_desc_t *p, size_t len);
 
-/* The bits of packet p's `flags` field that the spec reserves in what is
- * sent to the gimbal ("set to zero"), as a mask (tase/flags.h: CAMERA_CMD
- * TASE_CAMERA_FLAGS_RESERVED, HOST_SENSOR, HOST_ATTITUDE, SPOI_CMD); 0 for
- * every other packet and for p NULL. What `tase send` and the Python
- * Link refuse unless told to send it anyway. O(1). */
+/* The bits of packet p's `flags` field reserved in what is sent to the
+ * gimbal, as a mask (tase/flags.h): CAMERA_CMD, HOST_SENSOR and
+ * HOST_ATTITUDE bits the spec says to set to zero; SPOI_CMD bits 1-7, the
+ * Mode the gimbal fills in (to the gimbal only bit 0 means something:
+ * docs/PROTOCOL-NOTES.md P4). 0 for every other packet and for p NULL.
+ * What `tase send` and the Python Link refuse unless told to send it
+ * anyway. O(1). */
 uint8_t tase_schema_reserved_flags(const tase_packet_desc_t *p);
 
 /* ---- walking the fields of a packet ------------------------------------

@@ -315,6 +315,11 @@ _GIMBAL_CMD_FLAGS = {
 for _f in range(lib.TASE_GIMBAL_FLAGS_LEGACY_RATE, lib.TASE_GIMBAL_FLAGS_LEGACY_POSITION_STAB + 1):
     _GIMBAL_CMD_FLAGS[_f] = "legacy"
 
+# How to send anyway what _checked() refuses for reserved flag bits.
+_SEND_RESERVED = "send(..., reserved=True) sends it anyway, as tase send --raw"
+_QUERY_RESERVED = "send(..., reserved=True) sends it; the answer is then read with recv()"
+
+
 def _seconds(what, v):
     """A timeout in seconds: a number >= 0 (not NaN), else FieldError."""
     if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v) or v < 0:
@@ -395,7 +400,7 @@ class Link:
 
     # -- sending
 
-    def _checked(self, packet, reserved=False):
+    def _checked(self, packet, reserved=False, how=_SEND_RESERVED):
         if not isinstance(packet, Packet):
             raise TypeError("send() takes a tase.Packet, not %s" % type(packet).__name__)
         t = packet.packet_type
@@ -418,9 +423,8 @@ class Link:
             if flags is not None and flags & bad:
                 bits = [b for b in range(8) if bad & (0x80 >> b)]
                 raise FieldError(
-                    "%s flags=0x%02X sets reserved bits %d-%d (0x%02X), which the spec says to "
-                    "set to zero; not sent (send(..., reserved=True) sends it anyway, as tase "
-                    "send --raw)" % (t.name, flags, bits[0], bits[-1], bad)
+                    "%s flags=0x%02X sets reserved bits %d-%d (0x%02X); not sent (%s)"
+                    % (t.name, flags, bits[0], bits[-1], bad, how)
                 )
         if t.name == "GIMBAL_CMD" and packet.size > 0:
             flags = packet.raw["flags"]
@@ -469,7 +473,7 @@ class Link:
         if isinstance(what, Packet) and what.is_query and what.packet_type.has_query:
             req = what
         elif isinstance(what, Packet):
-            t = self._checked(what)
+            t = self._checked(what, how=_QUERY_RESERVED)
             echoed = t.group == 0x48 or (
                 t.name == "SPOI_CMD" and what.size > 0 and what.raw["flags"] & lib.TASE_SPOI_ECHO
             )

@@ -131,6 +131,11 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
                                        impulse_time=0)), tase.FieldError, "not echoed"),
         (lambda l: l.query(tase.Packet("SPOI_CMD", lat=0, lon=0, height=0, vnorth=0, veast=0,
                                        vdown=0, flags=0)), tase.FieldError, "not echoed"),
+        # query() has no reserved=: its refusal points to send() (a review)
+        (lambda l: l.query(tase.Packet("SPOI_CMD", lat=0, lon=0, height=0, vnorth=0, veast=0,
+                                       vdown=0, flags=0xFF)), tase.FieldError,
+         r"reserved bits 1-7 \(0x7F\); not sent \(send\(\.\.\., reserved=True\) sends it; "
+         r"the answer is then read with recv\(\)\)"),
     ],
 )
 def test_refused_input_sends_nothing(silent_pty, call, exc, text):

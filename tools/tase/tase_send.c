@@ -224,8 +224,8 @@ static void check_reserved_flags(const cli_fields_t *fs, unsigned nf)
     while (last < 7u && (mask & (0x80u >> (last + 1u))) != 0u) {
         last++;
     }
-    tk_usage_error("%s flags=0x%02llX sets reserved bits %u-%u (0x%02X), which the spec says "
-                   "to set to zero; nothing sent (--raw sends it anyway)",
+    tk_usage_error("%s flags=0x%02llX sets reserved bits %u-%u (0x%02X); nothing sent (--raw "
+                   "sends it anyway)",
                    tase_schema_packet_name(p), v, first, last, mask);
 }
 
