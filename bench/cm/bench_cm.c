@@ -18,7 +18,7 @@
  *     coarse count, +-39 instructions); pass 2 replays the stream and
  *     counts exactly every call whose coarse count is within 79 of the
  *     largest (no other call can be longer than the longest of those), the
- *     first MAX_EXACT of them.
+ *     first MAX_EXACT of them (longest.c, shared with search.c).
  *
  * Output lines (bench/bench.sh parses them):
  *   calibration INSNS                       (want 2000000)
@@ -32,6 +32,7 @@
 
 #include "../classic_rx.h"
 #include "../streams.h"
+#include "longest.h"
 #include "measure.h"
 #include "tase/frame.h"
 
@@ -64,7 +65,7 @@ static unsigned long since(uint32_t t0)
 
 /* ---- the calls measured: one signature, so one timing loop ----------- */
 
-typedef int (*call_fn)(const uint8_t *p, size_t n);
+typedef longest_call_fn call_fn;
 
 NOINLINE static int call_push(const uint8_t *p, size_t n)
 {
@@ -85,80 +86,17 @@ NOINLINE static int empty_call(const uint8_t *p, size_t n)
     return 0;
 }
 
-/* One call of the stream, from the receiver state before it. */
-typedef struct {
-    call_fn f;
-    const tase_rx_t *snap;
-    const uint8_t *p;
-    size_t n;
-} one_call_t;
-
-static void restore(void *ctx)
-{
-    rx = *((one_call_t *)ctx)->snap;
-}
-
-static void call_one(void *ctx)
-{
-    one_call_t *o = ctx;
-    (void)o->f(o->p, o->n);
-}
-
-/* Exact instruction count of f(p, n) from the receiver state `snap`: that
- * of tase_rx_push()/tase_rx_feed() plus the argument setup of a caller
- * (the wrappers above and call_one()). */
-static unsigned long exact(call_fn f, const tase_rx_t *snap, const uint8_t *p, size_t n)
-{
-    one_call_t o;
-    o.f = f;
-    o.snap = snap;
-    o.p = p;
-    o.n = n;
-    return measure_exact(restore, call_one, &o);
-}
-
 /* The longest single call of f over the first `bytes` of the stream, fed
- * `chunk` bytes per call (1 for push). */
+ * `chunk` bytes per call (1 for push): longest.c. */
 static void max_call(const char *name, const char *sname, call_fn f, size_t n, size_t chunk)
 {
-    static tase_rx_t snap;
-    size_t i, calls = 0, c, best_call = 0, cand = 0, done = 0;
-    uint16_t top = 0;
-    unsigned long best = 0;
+    longest_t r;
     if (n > MAXCALL_BYTES) {
         n = MAXCALL_BYTES;
     }
-    (void)tase_rx_init(&rx);
-    for (i = 0; i < n; i += chunk, calls++) {
-        size_t k = (n - i < chunk) ? n - i : chunk;
-        uint32_t t0 = ticks();
-        (void)f(&stream[i], k);
-        coarse[calls] = (uint16_t)(t0 - ticks());
-        if (coarse[calls] > top) {
-            top = coarse[calls];
-        }
-    }
-    (void)tase_rx_init(&rx);
-    for (i = 0, c = 0; i < n; i += chunk, c++) {
-        size_t k = (n - i < chunk) ? n - i : chunk;
-        if (coarse[c] + 1u >= top) {
-            cand++;
-            if (done < MAX_EXACT) {
-                unsigned long e;
-                snap = rx;
-                e = exact(f, &snap, &stream[i], k);
-                rx = snap;
-                done++;
-                if (e > best) {
-                    best = e;
-                    best_call = c;
-                }
-            }
-        }
-        (void)f(&stream[i], k);
-    }
-    printf("maxcall %s %s %lu %lu %lu %lu\n", name, sname, best, (unsigned long)best_call,
-           (unsigned long)done, (unsigned long)cand);
+    r = longest_call(&rx, f, stream, n, chunk, coarse, MAX_EXACT);
+    printf("maxcall %s %s %lu %lu %lu %lu\n", name, sname, r.insns, (unsigned long)r.call,
+           (unsigned long)r.exact, (unsigned long)r.candidates);
 }
 
 /* ---- whole-stream loops ---------------------------------------------- */

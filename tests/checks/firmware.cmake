@@ -13,3 +13,9 @@ endif()
 add_test(NAME footprint_report COMMAND ${PROJECT_SOURCE_DIR}/bench/footprint.sh
   --out ${CMAKE_BINARY_DIR}/FOOTPRINT.md --build ${CMAKE_BINARY_DIR}/footprint ${TASE_FOOTPRINT_SIM})
 set_tests_properties(footprint_report PROPERTIES LABELS check TIMEOUT 600)
+# The adversarial search of the receiver's worst calls (bench/search.sh) must
+# keep building and running: a short climb, whose best period must score the
+# same when measured again (exact counts).
+add_test(NAME bench_search COMMAND ${PROJECT_SOURCE_DIR}/bench/search.sh push --iters 30
+  --build ${CMAKE_BINARY_DIR}/search)
+set_tests_properties(bench_search PROPERTIES LABELS check TIMEOUT 300)
