@@ -206,8 +206,9 @@ class PacketType:
     group, type, len (the table's data length), index (TASE_PKT_*),
     fields (in table order), to_gimbal / from_gimbal (direction),
     has_query (a zero-length form), tail (CAMERA_PASS's free bytes),
-    reserved_flags (the bits of its flags field the spec reserves in what
-    is sent to the gimbal, as a mask; 0 for none)."""
+    reserved_flags (the bits of its flags field reserved in what is sent
+    to the gimbal, as a mask, from tase_schema_reserved_flags(); 0 for
+    none)."""
 
     __slots__ = (
         "name",
