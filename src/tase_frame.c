@@ -46,8 +46,9 @@
  * tase_rx_push() stores a byte inside a held candidate with one test
  * (len < end) and nothing saved but the return address; the sync and Size
  * bytes of a frame (push_other()), the last byte of a candidate
- * (push_last()) and every other byte (the general path, run()) are out of
- * line, and so are the bytes of a lagging scan (push_lag()). Every other
+ * (push_last()) and every other byte (push_body(): stored, then the scan
+ * on its credit, as run() does; a lagging scan's bytes go there) are out
+ * of line. Every other
  * path runs with `busy` set and `end` RX_BLOCKED, so that test fails while
  * a callback runs and a re-entrant call lands on the busy check.
  */
@@ -833,37 +834,24 @@ static int rx_check(const tase_rx_t *rx)
     return rx_sane(rx) ? TASE_OK : TASE_EARG;
 }
 
-/* tase_rx_push() for a byte the fast paths do not take, once rx has
- * passed its checks: the byte is stored and the scan goes on with its
- * credit, as run() does for each byte. */
+/* tase_rx_push() for every byte its fast paths do not take: the byte is
+ * stored and the scan goes on with its credit, as run() does for each
+ * byte. A lagging scan (`end` RX_BLOCKED outside a call) passes on the
+ * checks rx_sane() makes of that state; anything else goes through
+ * rx_check(), so a call from a callback or a corrupted instance gets its
+ * error. */
 RX_NOINLINE static int push_body(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
     rx_call_t c = {on_frame, user, 0u, NULL};
+    if (rx->end != RX_BLOCKED || rx->busy != 0u || rx->lag != 1u || rx->stop != 0u ||
+        rx->len > RX_CAP || rx->scan > rx->len) {
+        int r = rx_check(rx);
+        if (r != TASE_OK) {
+            return r;
+        }
+    }
     begin(rx);
     return finish(rx, &c, put(rx, &c, b) && scan_on(rx, &c, 0u));
-}
-
-/* tase_rx_push() for every byte its fast paths do not take: a call from
- * a callback or a corrupted instance (the error), or the general path. */
-RX_NOINLINE static int push_slow(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
-{
-    int r = rx_check(rx);
-    if (r != TASE_OK) {
-        return r;
-    }
-    return push_body(rx, b, on_frame, user);
-}
-
-/* tase_rx_push() for a byte while the scan lags (`end` RX_BLOCKED outside
- * a call): push_slow() with only the checks rx_sane() makes of that state
- * (anything else goes to push_slow(), which reports it). */
-RX_NOINLINE static int push_lag(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
-{
-    if (rx->busy != 0u || rx->lag != 1u || rx->stop != 0u || rx->len > RX_CAP ||
-        rx->scan > rx->len) {
-        return push_slow(rx, b, on_frame, user);
-    }
-    return push_body(rx, b, on_frame, user);
 }
 
 /* tase_rx_push() for the last byte of a held candidate that failed: the
@@ -933,10 +921,7 @@ RX_NOINLINE static int push_event(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t
     if (len == end && end != 0u && end < RX_CAP) {
         return push_last(rx, byte, on_frame, user);
     }
-    if (end == RX_BLOCKED) {
-        return push_lag(rx, byte, on_frame, user);
-    }
-    return push_slow(rx, byte, on_frame, user);
+    return push_body(rx, byte, on_frame, user);
 }
 
 /* tase_rx_push() for every byte that is not inside a held candidate: the
