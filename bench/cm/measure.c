@@ -4,7 +4,6 @@
 #define TIMER0_CTRL (*(volatile uint32_t *)0x40000000u)
 #define TIMER0_VALUE (*(volatile uint32_t *)0x40000004u)
 #define TIMER0_RELOAD (*(volatile uint32_t *)0x40000008u)
-#define INSN_PER_TICK 40u /* 1 ns per instruction, 25 MHz timer */
 #define EMPTY_INSNS 1u    /* measure_empty(): bx lr */
 
 void measure_start(void)
@@ -22,7 +21,7 @@ uint32_t measure_ticks(void)
 
 unsigned long measure_since(uint32_t t0)
 {
-    return (unsigned long)(t0 - measure_ticks()) * INSN_PER_TICK;
+    return (unsigned long)(t0 - measure_ticks()) * MEASURE_TICK_INSNS;
 }
 
 __attribute__((noinline, noipa)) static void measure_empty(void *ctx)

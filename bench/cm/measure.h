@@ -9,13 +9,18 @@
 
 #define MEASURE_REPS 200u
 
+/* Instructions per timer tick: measure_since() counts to this many (1 ns
+ * an instruction, a 25 MHz timer). */
+#define MEASURE_TICK_INSNS 40u
+
 /* Start the CMSDK timer (call once). */
 void measure_start(void);
 
-/* Timer value (counts down, 40 instructions per tick). */
+/* Timer value (counts down, MEASURE_TICK_INSNS instructions a tick). */
 uint32_t measure_ticks(void);
 
-/* Instructions since measure_ticks() returned t0, to 40. */
+/* Instructions since measure_ticks() returned t0, to a tick: how many
+ * ticks fall in the span depends on where it starts within one. */
 unsigned long measure_since(uint32_t t0);
 
 /* A step of a measurement, on a context. */

@@ -12,13 +12,17 @@
  * 16-byte tase_rx_feed(), 2 the longest 64-byte one (the longest call of
  * the SEARCH_EVAL bytes: coarse counts for all, exact for the few within a
  * tick of the largest), 3 the instructions of pushing all SEARCH_EVAL
- * bytes (the sustained cost, per byte once divided).
+ * bytes (the sustained cost, per byte once divided), to the timer's tick
+ * (MEASURE_TICK_INSNS): an exact count would take MEASURE_REPS runs of
+ * every call, and the tiled replay that reports the figure (bench_cm.c)
+ * spans 128 periods, where a tick is nothing.
  *
  * Output: "seed SCORE", a line per improvement ("step N SCORE at OFFSET")
  * and "best SCORE"; the best period goes to SEARCH_OUT (semihosting), to
  * be tiled again by whoever replays it. The best period is measured again
  * at the end: the program fails (exit 1) unless it scores the same, as
- * exact counts must.
+ * exact counts must (the sustained measure: within a tick, since the
+ * count of a span depends on where it starts within one).
  */
 #include <stdio.h>
 #include <string.h>
@@ -227,6 +231,7 @@ int main(void)
 {
     static uint8_t seed[SEARCH_EVAL];
     unsigned long best;
+    unsigned long again;
     unsigned long step;
     measure_start();
     if (bench_stream(SEARCH_SEED, seed, sizeof seed) < SEARCH_PERIOD) {
@@ -255,8 +260,13 @@ int main(void)
     save();
     printf("best %lu (%lu frames seen)\n", best, frames);
     (void)memcpy(period, kept, SEARCH_PERIOD);
-    if (score() != best) {
-        printf("search: the best period does not score %lu again\n", best);
+    again = score();
+#if SEARCH_MODE == 3
+    if (again + MEASURE_TICK_INSNS < best || again > best + MEASURE_TICK_INSNS) {
+#else
+    if (again != best) {
+#endif
+        printf("search: the best period does not score %lu again (%lu)\n", best, again);
         return 1;
     }
     return 0;
