@@ -570,6 +570,9 @@ static int telemetry_frame(tase_gimbal_t *g, unsigned port, uint16_t id, uint32_
     if (n < 0 || n > (int)TASE_GIMBAL_TELEMETRY_MAX) {
         return TASE_ERANGE;
     }
+    if (!tase_schema_length_ok(tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id)), (size_t)n)) {
+        return TASE_ELENGTH; /* a host would drop it as a wrong length */
+    }
     return tase_frame_build(TASE_ID_GROUP(id), TASE_ID_TYPE(id), frame + TASE_FRAME_HEADER,
                             (size_t)n, frame, sizeof g->tx_frame);
 }

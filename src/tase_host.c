@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "tase/codec.h"
+#include "tase/flags.h"
 #include "tase/port_io.h"
 
 enum { HOST_IDLE = 0, HOST_WAITING = 1, HOST_COMPLETE = 2 };
@@ -115,15 +116,43 @@ static int request_send(tase_host_t *h, uint8_t group, uint8_t type, size_t len,
     return TASE_OK;
 }
 
+/* A timeout the clock arithmetic can see expire: an elapsed time of 2^31
+ * ms or more reads as none (tase_port_elapsed_ms()). */
 static bool timeout_ok(uint32_t timeout_ms)
 {
-    return timeout_ms > 0u && timeout_ms <= 0x80000000u;
+    return timeout_ms > 0u && timeout_ms < 0x80000000u;
+}
+
+/* Whether the gimbal answers (group, type, data[0..len)) with a frame of
+ * the same group and type, so that a request may wait for it and re-send
+ * it: a zero-length query of a packet with a query form, and the packets
+ * it sends back (the setup packets' echo, RETRACT_DEPLOY_CMD when the move
+ * ends, CAMERA_PASS with the camera's bytes), SPOI_CMD only with its echo
+ * flag (4.3.2, data byte 18). TASE_ELENGTH for zero length without a
+ * query form (GYRO_ZERO_CMD is a command), TASE_EARG for a packet the
+ * gimbal does not answer (a re-send would repeat a command). A packet the
+ * schema does not know passes: nothing says it is not answered. */
+static int answered(uint8_t group, uint8_t type, const uint8_t *data, size_t len)
+{
+    const tase_packet_desc_t *p = tase_schema_find(group, type);
+    if (p == NULL) {
+        return TASE_OK;
+    }
+    if (len == 0u) {
+        return tase_schema_is_query(p, 0u) ? TASE_OK : TASE_ELENGTH;
+    }
+    if ((p->flags & TASE_DIR_BOTH) != TASE_DIR_BOTH ||
+        (p->id == TASE_ID_SPOI_CMD && (len <= 18u || (data[18] & TASE_SPOI_ECHO) == 0u))) {
+        return TASE_EARG;
+    }
+    return TASE_OK;
 }
 
 int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
                             size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
                             uint8_t retries, uint32_t now_ms)
 {
+    int r;
     if (h == NULL || (data == NULL && len > 0) || (reply == NULL && reply_cap > 0) ||
         !timeout_ok(timeout_ms)) {
         return TASE_EARG;
@@ -133,6 +162,10 @@ int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const u
     }
     if (h->state != HOST_IDLE) {
         return TASE_EBUSY;
+    }
+    r = answered(group, type, data, len);
+    if (r != TASE_OK) {
+        return r;
     }
     if (len > 0) {
         (void)memmove(h->req, data, len); /* data may be a former reply in h->req */
@@ -145,6 +178,7 @@ int tase_host_request_msg_start(tase_host_t *h, uint16_t id, const void *msg, vo
                                 uint32_t timeout_ms, uint8_t retries, uint32_t now_ms)
 {
     int n;
+    int r;
     if (h == NULL || !timeout_ok(timeout_ms)) {
         return TASE_EARG;
     }
@@ -157,6 +191,10 @@ int tase_host_request_msg_start(tase_host_t *h, uint16_t id, const void *msg, vo
                     : tase_packet_encode_data_len(id, NULL, 0u, h->req, sizeof h->req);
     if (n < 0) {
         return n;
+    }
+    r = answered(TASE_ID_GROUP(id), TASE_ID_TYPE(id), h->req, (size_t)n);
+    if (r != TASE_OK) {
+        return r;
     }
     h->typed = true;
     h->reply_msg = reply_msg;

@@ -98,11 +98,13 @@ static int app_fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_
     if (x->decline) {
         return -1;
     }
+    /* the packet's own length (6, 18, 63), the time in its first bytes */
+    memset(data, 0, cap);
     data[0] = (uint8_t)(now >> 24);
     data[1] = (uint8_t)(now >> 16);
     data[2] = (uint8_t)(now >> 8);
     data[3] = (uint8_t)now;
-    return 6;
+    return (int)tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id))->len;
 }
 
 static void app_other(void *user, unsigned port, const tase_frame_t *f)
@@ -1664,10 +1666,37 @@ static void telemetry_longer_than_its_room_is_skipped(void **state)
     free(x);
 }
 
+/* A length the packet does not have skips the slot: the role sent a
+ * 4-byte GIMBAL_ANGLE (6 bytes), counted it as telemetry sent, and every
+ * host dropped it as a wrong length. The packets' own lengths still go. */
+static int fill_short_angle(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
+                            uint32_t now)
+{
+    const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
+    (void)user;
+    (void)port;
+    (void)now;
+    memset(data, 0, cap);
+    return id == TASE_ID_GIMBAL_ANGLE ? 4 : (int)p->len;
+}
+
+static void telemetry_of_a_length_the_packet_does_not_have_is_skipped(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    (void)state;
+    x->g.app.fill_telemetry = fill_short_angle;
+    assert_int_equal(tase_gimbal_poll(&x->g, 1000), 2); /* GIMBAL_RATE, GEOREFERENCE_DATA */
+    assert_int_equal(x->g.stats.telemetry_skipped, 1u);
+    assert_int_equal(x->g.stats.telemetry_tx, 2u);
+    assert_int_equal(fake_frames_out(&x->port[0]), 2);
+    free(x);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(gimbal_api_rejects_bad_arguments),
+        cmocka_unit_test(telemetry_of_a_length_the_packet_does_not_have_is_skipped),
         cmocka_unit_test(a_zero_length_query_is_answered_with_the_defaults_on_its_port),
         cmocka_unit_test(a_setup_packet_is_applied_and_the_applied_bytes_echoed),
         cmocka_unit_test(a_refused_setup_echoes_the_settings_still_in_force),

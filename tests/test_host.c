@@ -12,6 +12,7 @@
 #include "fake_port.h"
 #include "fault_port.h"
 #include "tase/codec.h"
+#include "tase/flags.h"
 #include "tase/host.h"
 #include "tase/ids.h"
 #include "tase/port_io.h"
@@ -793,6 +794,91 @@ static void typed_request_errors_send_nothing_and_leave_the_host_idle(void **sta
     assert_int_equal(x->host.stats.requests, 0);
 }
 
+/* A retry sends the request again: only what the gimbal answers with the
+ * same group and type may be requested (a gyro zero or a gimbal command
+ * sent three times moved the gimbal three times). */
+static void requests_of_packets_the_gimbal_does_not_answer_send_nothing(void **state)
+{
+    fix_t *x = *state;
+    tase_gimbal_cmd_t cmd = {100, 0, 0, 0xB0, 0}; /* an impulse */
+    tase_spoi_cmd_t spoi;
+    tase_retract_deploy_cmd_t rd = {TASE_RETRACT};
+    tase_packet_msg_t m;
+    uint8_t data[TASE_DATA_MAX];
+    uint8_t reply[TASE_DATA_MAX];
+    int n;
+    memset(&spoi, 0, sizeof spoi);
+    memset(data, 0, sizeof data);
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_GYRO_ZERO_CMD, NULL, &m, 10, 2, 0),
+        TASE_ELENGTH);
+    assert_int_equal(tase_host_request_start(&x->host, 0x00, 0x40, NULL, 0, reply, 8, 10, 2, 0),
+                     TASE_ELENGTH);
+    assert_int_equal(tase_host_transact_msg(&x->host, TASE_ID_GYRO_ZERO_CMD, NULL, &m, 10, 2),
+                     TASE_ELENGTH);
+    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID_GIMBAL_CMD, &cmd, &m, 10, 2, 0),
+                     TASE_EARG);
+    n = tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &cmd, data, sizeof data);
+    assert_int_equal(n, 8);
+    assert_int_equal(
+        tase_host_request_start(&x->host, 0x00, 0x80, data, (size_t)n, reply, 8, 10, 2, 0),
+        TASE_EARG);
+    /* SPOI_CMD is echoed only when asked to be */
+    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID_SPOI_CMD, &spoi, &m, 10, 2, 0),
+                     TASE_EARG);
+    n = tase_packet_encode_data(TASE_ID_SPOI_CMD, &spoi, data, sizeof data);
+    assert_int_equal(n, 19);
+    assert_int_equal(
+        tase_host_request_start(&x->host, 0x10, 0x40, data, (size_t)n, reply, 8, 10, 2, 0),
+        TASE_EARG);
+    assert_int_equal(tase_host_request_start(&x->host, 0x10, 0x40, data, 18, reply, 8, 10, 2, 0),
+                     TASE_EARG);
+    /* host data and telemetry: the gimbal never sends them back */
+    assert_int_equal(tase_host_request_start(&x->host, 0x08, 0x41, data, 20, reply, 8, 10, 2, 0),
+                     TASE_EARG);
+    assert_int_equal(tase_host_request_start(&x->host, 0x08, 0x10, data, 6, reply, 8, 10, 2, 0),
+                     TASE_EARG);
+    assert_int_equal(x->port.nout, 0);
+    assert_int_equal(x->host.stats.requests, 0);
+    assert_false(tase_host_busy(&x->host));
+
+    /* what it answers still goes: SPOI_CMD with its echo flag, RETRACT_DEPLOY_CMD,
+     * a group/type the schema does not know */
+    spoi.flags = TASE_SPOI_ECHO;
+    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID_SPOI_CMD, &spoi, &m, 10, 2, 0),
+                     TASE_OK);
+    assert_int_equal(tase_host_cancel(&x->host), TASE_OK);
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_RETRACT_DEPLOY_CMD, &rd, &m, 10, 2, 0),
+        TASE_OK);
+    assert_int_equal(tase_host_cancel(&x->host), TASE_OK);
+    assert_int_equal(tase_host_request_start(&x->host, 0x28, 0x01, data, 3, reply, 8, 10, 2, 0),
+                     TASE_OK);
+    assert_int_equal(x->host.stats.requests, 3);
+}
+
+/* An elapsed time of 2^31 ms or more reads as none: a timeout of 2^31
+ * never expired (one attempt, TASE_EAGAIN for ever); it is refused now,
+ * and the longest accepted one expires. */
+static void a_timeout_of_2_to_the_31_is_refused_and_the_longest_expires(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[TASE_DATA_MAX];
+    tase_packet_msg_t m;
+    assert_int_equal(tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x00, reply, sizeof reply,
+                                           0x80000000u, 0, 0),
+                     TASE_EARG);
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_PACKET_RATE, NULL, &m, 0x80000000u, 0, 0),
+        TASE_EARG);
+    assert_int_equal(x->port.nout, 0);
+    assert_int_equal(tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x00, reply, sizeof reply,
+                                           0x7FFFFFFFu, 0, 5),
+                     TASE_OK);
+    assert_int_equal(tase_host_poll(&x->host, 5u + 0x7FFFFFFEu), TASE_EAGAIN);
+    assert_int_equal(tase_host_poll(&x->host, 5u + 0x7FFFFFFFu), TASE_ETIMEOUT);
+}
+
 static void transact_msg_decodes_the_scripted_gimbal_answer(void **state)
 {
     fix_t *x = *state;
@@ -993,6 +1079,10 @@ int main(void)
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(
             a_typed_reply_of_a_wrong_length_is_elength_and_writes_nothing, setup, teardown),
+        cmocka_unit_test_setup_teardown(requests_of_packets_the_gimbal_does_not_answer_send_nothing,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(a_timeout_of_2_to_the_31_is_refused_and_the_longest_expires,
+                                        setup, teardown),
         cmocka_unit_test_setup_teardown(typed_request_errors_send_nothing_and_leave_the_host_idle,
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(transact_msg_decodes_the_scripted_gimbal_answer, setup,

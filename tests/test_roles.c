@@ -37,7 +37,7 @@ static const uint8_t spoi_now[19] = {0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0
 
 static int fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap, uint32_t now)
 {
-    size_t len = id == TASE_ID_GIMBAL_ANGLE ? 6u : id == TASE_ID_GIMBAL_RATE ? 22u : 40u;
+    size_t len = id == TASE_ID_GIMBAL_ANGLE ? 6u : id == TASE_ID_GIMBAL_RATE ? 18u : 63u;
     (void)user;
     (void)port;
     assert_true(cap >= len);

@@ -200,8 +200,9 @@ typedef struct {
      * _GEOREFERENCE_DATA) is due on `port`: write its data into
      * data[0..cap) (cap is TASE_GIMBAL_TELEMETRY_MAX, 63: GEOREFERENCE_DATA's
      * length, the longest) and return the length, or a negative value to
-     * skip this slot (stats.telemetry_skipped); a length over cap skips it
-     * too. NULL: nothing is sent. */
+     * skip this slot (stats.telemetry_skipped); a length over cap or not
+     * the packet's (6, 18, 63: a host drops a wrong length) skips it too.
+     * NULL: nothing is sent. */
     int (*fill_telemetry)(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
                           uint32_t now_ms);
     /* Every other valid frame received on `port`. */

@@ -9,7 +9,8 @@
  *    struct with tase_host_send_msg(), or as data bytes with
  *    tase_host_send();
  *  - run ONE request at a time: send a frame (a zero-length query, or a
- *    setup packet / SPOI command whose echo confirms it) and wait for the
+ *    setup packet / SPOI command whose echo confirms it; never a packet
+ *    the gimbal does not answer, which a retry would repeat) and wait for the
  *    gimbal's frame of the same group and type, re-sending the request
  *    after `timeout_ms` up to `retries` times. A typed request
  *    (tase_host_request_msg_start(), tase_host_transact_msg()) decodes
@@ -61,8 +62,8 @@
  * clock read before the request started and passed in afterwards, or a
  * clock that stepped back) makes that difference 2^31 or more: it counts
  * as no time elapsed, never as an expired timeout. Samples must therefore
- * be less than 2^31 ms (24.8 days) apart, which timeout_ms <= 2^31
- * guarantees for a host that is polled.
+ * be less than 2^31 ms (24.8 days) apart: timeout_ms is under 2^31, and
+ * timeout_ms plus the longest gap between two polls must be too.
  *
  * TWO WAYS TO USE IT
  *  - Firmware main loop (never blocks):
@@ -165,13 +166,24 @@ int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg);
  * reply's data will be copied into reply[0..reply_cap) (reply may be NULL
  * when reply_cap is 0: only the length is reported). The data is copied;
  * `reply` must stay valid until the request completes or is cancelled.
+ * Only what the gimbal answers with a frame of the same group and type
+ * can be requested (a retry sends it again): a zero-length query of a
+ * packet with a query form, a setup packet, RETRACT_DEPLOY_CMD (echoed
+ * when the move ends), CAMERA_PASS (the camera's bytes come back),
+ * SPOI_CMD with TASE_SPOI_ECHO set, or a group/type the schema does not
+ * know. Send the others with tase_host_send() / tase_host_send_msg().
  * Returns TASE_OK (first attempt sent), or
  *   TASE_EARG     h NULL, data NULL with len > 0, reply NULL with
- *                 reply_cap > 0, timeout_ms 0 or > 2^31;
+ *                 reply_cap > 0, timeout_ms 0 or >= 2^31; a packet the
+ *                 gimbal does not answer (GIMBAL_CMD, CAMERA_CMD, the
+ *                 host's data, telemetry, SPOI_CMD without its echo flag);
+ *   TASE_ELENGTH  len 0 for a known packet without a query form
+ *                 (GYRO_ZERO_CMD: a command, never sent as a request);
  *   TASE_ETOOLONG len > 253;
- *   TASE_EBUSY    a request is pending (it is left untouched);
+ *   TASE_EBUSY    a request is pending (it is left untouched; checked
+ *                 before what the request is);
  *   a port error  the first attempt could not be sent (no request pending).
- * O(len). */
+ * Nothing is sent on an error. O(len). */
 int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
                             size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
                             uint8_t retries, uint32_t now_ms);
@@ -185,13 +197,16 @@ int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const u
  * with TASE_ELENGTH (reply_msg untouched). A decoded CAMERA_PASS points
  * into the host instance, valid until the next request starts. reply_msg
  * must stay valid until the request completes or is cancelled.
+ * The packets that can be requested are tase_host_request_start()'s.
  * Returns TASE_OK (first attempt sent), or
- *   TASE_EARG     h NULL, timeout_ms 0 or > 2^31; or from the codec:
- *                 a CAMERA_PASS tail NULL with len > 0;
+ *   TASE_EARG     h NULL, timeout_ms 0 or >= 2^31; a packet the gimbal
+ *                 does not answer (as tase_host_request_start()); or from
+ *                 the codec: a CAMERA_PASS tail NULL with len > 0;
  *   TASE_EBUSY    a request is pending (checked before the packet is
  *                 encoded; the pending one is left untouched);
  *   TASE_EUNKNOWN id is not in the schema;
- *   TASE_ELENGTH  msg NULL for a packet without a query form;
+ *   TASE_ELENGTH  msg NULL for a packet without a query form (and
+ *                 GYRO_ZERO_CMD, which has no data: a command);
  *   TASE_ETOOLONG CAMERA_PASS tail over 249 bytes;
  *   a port error  the first attempt could not be sent (no request pending).
  * O(length). */

@@ -489,9 +489,9 @@ class Link:
         t = req.packet_type
         timeout = self.timeout if timeout is None else timeout
         retries = self.retries if retries is None else retries
-        if not 0 < timeout <= 2**31 / 1000 or not 0 <= retries <= 255:
-            raise FieldError("timeout must be > 0 s and retries 0..255")
-        ms = max(1, int(round(timeout * 1000)))
+        if not 0 < timeout < 2**31 / 1000 or not 0 <= retries <= 255:
+            raise FieldError("timeout must be > 0 s and under 2^31 ms, retries 0..255")
+        ms = min(max(1, int(round(timeout * 1000))), 2**31 - 1)
         data = req.payload
         r = self._call(
             lib.tase_host_transact,
