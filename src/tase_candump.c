@@ -111,7 +111,8 @@ static bool read_ifname(cursor_t *c, char *name)
 }
 
 /* Identifier up to '#'. Returns TASE_OK, TASE_EFORMAT or TASE_EUNSUPPORTED
- * (error frame). */
+ * (an error frame: its data is read as a classic frame's, and the line
+ * must end after it like any other). */
 static int read_id(cursor_t *c, uint32_t *id, bool *extended)
 {
     uint32_t v = 0;
@@ -149,39 +150,95 @@ static int read_id(cursor_t *c, uint32_t *id, bool *extended)
     return TASE_OK;
 }
 
-static int read_data(cursor_t *c, uint8_t *data, uint8_t *dlc)
+/* Data bytes as pairs of hex digits, '.' allowed between two, at most
+ * `max` (into data when it is not NULL). Returns the count, or -1. */
+static int read_hex_bytes(cursor_t *c, uint8_t *data, unsigned max)
 {
-    uint8_t n = 0;
-    int ch = peek(c);
-    if (ch == '#' || ch == 'R' || ch == 'r') {
-        return TASE_EUNSUPPORTED; /* CAN FD or remote frame */
-    }
+    unsigned n = 0;
     for (;;) {
         int hi = hexval(peek(c));
         int lo;
         if (hi < 0) {
-            break;
+            return (int)n;
         }
         c->i++;
         lo = hexval(peek(c));
-        if (lo < 0 || n == TASE_CAN_DLC_MAX) {
-            return TASE_EFORMAT;
+        if (lo < 0 || n == max) {
+            return -1;
         }
         c->i++;
-        data[n] = (uint8_t)(((unsigned)hi << 4) | (unsigned)lo);
+        if (data != NULL) {
+            data[n] = (uint8_t)(((unsigned)hi << 4) | (unsigned)lo);
+        }
         n++;
         /* A '.' separates bytes; it may not end the data. */
         if (peek(c) == '.') {
             c->i++;
             if (hexval(peek(c)) < 0) {
-                return TASE_EFORMAT;
+                return -1;
             }
         }
     }
-    if (peek(c) == '_') {
-        return TASE_EUNSUPPORTED; /* raw DLC 9..15 of a classic frame */
+}
+
+/* The raw DLC suffix of a classic frame with 8 data bytes: '_' and one
+ * hex digit 9..F. Whether one is there: true, or false with *bad set when
+ * a '_' begins a malformed one. */
+static bool read_raw_dlc(cursor_t *c, unsigned n, bool *bad)
+{
+    int d;
+    if (peek(c) != '_') {
+        return false;
     }
-    *dlc = n;
+    c->i++;
+    d = hexval(peek(c));
+    if (n != TASE_CAN_DLC_MAX || d < 9) {
+        *bad = true;
+        return false;
+    }
+    c->i++;
+    return true;
+}
+
+/* After the '#': the frame's data. Returns TASE_OK, TASE_EFORMAT, or
+ * TASE_EUNSUPPORTED for a well-formed frame this library cannot
+ * represent (the caller still checks that the line ends after it): a
+ * remote frame (R, an optional length digit 0..8, a raw DLC after 8), a
+ * CAN FD frame ('#', a flags digit, up to 64 bytes) or a classic frame
+ * with a raw DLC. */
+static int read_data(cursor_t *c, uint8_t *data, uint8_t *dlc)
+{
+    int n;
+    bool bad = false;
+    if (peek(c) == '#') {
+        c->i++;
+        if (hexval(peek(c)) < 0) {
+            return TASE_EFORMAT;
+        }
+        c->i++;
+        return read_hex_bytes(c, NULL, 64u) < 0 ? TASE_EFORMAT : TASE_EUNSUPPORTED;
+    }
+    if (peek(c) == 'R') {
+        unsigned len = 0;
+        c->i++;
+        if (peek(c) >= '0' && peek(c) <= '8') {
+            len = (unsigned)(peek(c) - '0');
+            c->i++;
+        }
+        (void)read_raw_dlc(c, len, &bad);
+        return bad ? TASE_EFORMAT : TASE_EUNSUPPORTED;
+    }
+    n = read_hex_bytes(c, data, TASE_CAN_DLC_MAX);
+    if (n < 0) {
+        return TASE_EFORMAT;
+    }
+    if (read_raw_dlc(c, (unsigned)n, &bad)) {
+        return TASE_EUNSUPPORTED;
+    }
+    if (bad) {
+        return TASE_EFORMAT;
+    }
+    *dlc = (uint8_t)n;
     return TASE_OK;
 }
 
@@ -219,14 +276,16 @@ int tase_candump_parse(const char *line, size_t len, tase_candump_rec_t *rec)
         return TASE_EFORMAT;
     }
     rc = read_id(&c, &r.frame.id, &r.frame.extended);
-    if (rc == TASE_OK) {
-        rc = read_data(&c, r.frame.data, &r.frame.dlc);
+    if (rc != TASE_EFORMAT) {
+        /* an error frame's data is a classic frame's */
+        int d = read_data(&c, r.frame.data, &r.frame.dlc);
+        rc = (d == TASE_OK) ? rc : d;
+    }
+    if (rc == TASE_EFORMAT || !at_line_end(&c)) {
+        return TASE_EFORMAT;
     }
     if (rc != TASE_OK) {
         return rc;
-    }
-    if (!at_line_end(&c)) {
-        return TASE_EFORMAT;
     }
     *rec = r;
     return TASE_OK;

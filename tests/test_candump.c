@@ -91,6 +91,53 @@ static void frames_we_cannot_represent_are_unsupported(void **state)
     assert_int_equal(parse("(1.000000) vcan0 123##100", &r), TASE_EUNSUPPORTED);
     assert_int_equal(parse("(1.000000) vcan0 20000080#0000000000000000", &r), TASE_EUNSUPPORTED);
     assert_int_equal(parse("(1.000000) vcan0 123#1122334455667788_E", &r), TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 123#R5", &r), TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 12345678#R8_9 R", &r), TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 123##0", &r), TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 12345678##3AA.BB.CC", &r), TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 123#11.22.33.44.55.66.77.88_F\r\n", &r),
+                     TASE_EUNSUPPORTED);
+}
+
+/* Only a well-formed line of those kinds is unsupported: a corrupted one
+ * is not a log line (they were all "unsupported", so `tase decode
+ * --candump` skipped corrupt lines on the datalink IDs without a word). */
+static void malformed_unsupported_forms_are_format_errors(void **state)
+{
+    static const char *const bad[] = {
+        "(1.000000) vcan0 123#Rgarbage!!",
+        "(1.000000) vcan0 123#rubbish",
+        "(1.000000) vcan0 11000000#R9",
+        "(1.000000) vcan0 11000000#R3_9",
+        "(1.000000) vcan0 11000000#R8_3",
+        "(1.000000) vcan0 123##",
+        "(1.000000) vcan0 123##ZZZZ not fd",
+        "(1.000000) vcan0 11000000##1AA.",
+        "(1.000000) vcan0 123#11_E",
+        "(1.000000) vcan0 123#1122334455667788_Zjunk",
+        "(1.000000) vcan0 123#1122334455667788_E junk",
+        "(1.000000) vcan0 20000080#this is not hex",
+        "(1.000000) vcan0 20000080#001122334455667788",
+    };
+    char fd[256];
+    size_t i;
+    tase_candump_rec_t r;
+    tase_candump_rec_t before;
+    (void)state;
+    memset(&r, 0x5A, sizeof r);
+    before = r;
+    for (i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        assert_int_equal(parse(bad[i], &r), TASE_EFORMAT);
+    }
+    /* CAN FD carries at most 64 bytes */
+    strcpy(fd, "(1.000000) vcan0 123##1");
+    for (i = 0; i < 65; i++) {
+        strcat(fd, "AB");
+    }
+    assert_int_equal(parse(fd, &r), TASE_EFORMAT);
+    fd[strlen(fd) - 2] = '\0';
+    assert_int_equal(parse(fd, &r), TASE_EUNSUPPORTED);
+    assert_memory_equal(&r, &before, sizeof r);
 }
 
 static void format_writes_candump_style_lines(void **state)
@@ -262,6 +309,7 @@ int main(void)
         cmocka_unit_test(standard_and_empty_frames_parse),
         cmocka_unit_test(malformed_lines_are_rejected_and_leave_output_alone),
         cmocka_unit_test(frames_we_cannot_represent_are_unsupported),
+        cmocka_unit_test(malformed_unsupported_forms_are_format_errors),
         cmocka_unit_test(format_writes_candump_style_lines),
         cmocka_unit_test(format_needs_room_and_valid_records),
         cmocka_unit_test(longest_line_fits_the_documented_maximum_and_round_trips),

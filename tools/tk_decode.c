@@ -36,7 +36,7 @@ tk_stream_t *tk_dec_stream(tk_dec_t *d, const char *iface, const char *dir)
     strncpy(s->iface, iface, sizeof(s->iface) - 1u);
     s->dir = dir;
     (void)tase_rx_init(&s->rx);
-    (void)tase_rx_set_timing(&s->rx, d->serial_rate, 0u);
+    (void)tase_rx_set_timing(&s->rx, d->serial_rate, d->margin_ms);
     return s;
 }
 
@@ -112,8 +112,12 @@ static void begin(tk_dec_t *d, tk_stream_t *s, const tk_time_t *time)
 
 void tk_dec_tick(tk_dec_t *d, tk_stream_t *s, uint32_t now_ms)
 {
+    uint32_t discarded = s->rx.stats.bytes_discarded;
     begin(d, s, s->timed ? &s->last : NULL);
     (void)tase_rx_tick(&s->rx, now_ms, on_frame, d);
+    if (s->rx.stats.bytes_discarded != discarded) {
+        d->n.paused++; /* the pause settled what was held */
+    }
     account(d, s);
     flush_out(d);
 }
@@ -175,7 +179,7 @@ bool tk_dec_can(tk_dec_t *d, const char *iface, const tase_can_frame_t *f, const
     if (s == NULL) {
         return false;
     }
-    (void)tase_rx_set_timing(&s->rx, TASE_SOCKETCAN_BYTES_PER_S, 0u);
+    (void)tase_rx_set_timing(&s->rx, TASE_SOCKETCAN_BYTES_PER_S, d->margin_ms);
     tk_dec_bytes(d, s, f->data, (size_t)n, time);
     return true;
 }
@@ -205,6 +209,9 @@ void tk_dec_summary(const tk_dec_t *d, FILE *out, const char *extra)
     if (n->can_frames != 0u) {
         fprintf(out, ", %llu CAN frames (%llu not datalink)", (unsigned long long)n->can_frames,
                 (unsigned long long)n->can_other);
+    }
+    if (n->paused != 0u) {
+        fprintf(out, ", %llu held frames cut short by a pause", (unsigned long long)n->paused);
     }
     fprintf(out, "%s\n", extra);
 }

@@ -303,6 +303,8 @@ typedef struct {
     uint64_t discarded;       /* bytes not part of any valid frame */
     uint64_t can_frames;      /* CAN frames seen */
     uint64_t can_other;       /* of them: not datalink frames (other IDs) */
+    uint64_t paused;          /* held candidates settled by a pause longer
+                                 than the quiet limit (bytes discarded) */
 } tk_counts_t;
 
 typedef struct {
@@ -314,9 +316,12 @@ typedef struct {
      * capture's record times: a gap in them settles a held candidate as
      * the live receiver did); otherwise the caller ticks (tk_dec_tick()).
      * serial_rate is a serial stream's byte rate (CAN streams: the
-     * SocketCAN port's). Set both before the first stream is made. */
+     * SocketCAN port's), margin_ms the time bound's margin (0: the
+     * library's, TASE_RX_QUIET_MS). Set them before the first stream is
+     * made. */
     bool by_time;
     uint32_t serial_rate;
+    uint16_t margin_ms;
     tk_counts_t n;
     size_t nstreams;
     tk_stream_t stream[TK_STREAMS_MAX];

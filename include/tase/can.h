@@ -13,8 +13,21 @@
  * keeping their order (the spec requires it) and simply feeds each
  * payload to an ordinary datalink receiver (tase_rx_t), which finds the
  * 00 FF 5A frames in the byte stream exactly as on a UART. A lost CAN
- * frame costs the datalink frame it belonged to (checksum error, counted)
- * and nothing more.
+ * frame costs the datalink frame it belonged to and nothing more: counted
+ * as a checksum error when a later CAN frame of it arrived (its candidate
+ * fails), only in bytes_discarded when its first CAN frame was lost (the
+ * rest has no sync: noise).
+ *
+ * PAUSES. The receiver's time bound (tase/frame.h, TIME BOUND) applies to
+ * the reassembled bytes as to a UART's: a candidate that sees no byte for
+ * its quiet limit is judged false, and the limit is at least the margin,
+ * TASE_RX_QUIET_MS (20 ms). A sender that pauses longer between the CAN
+ * frames of one packet (frames sent one at a time by hand with cansend,
+ * or by a scheduler that sends one per slow cycle) has its packets cut
+ * short, counted only in bytes_discarded. Such a link needs a larger
+ * margin on its receiver: tase_rx_set_timing(&h.rx,
+ * TASE_SOCKETCAN_BYTES_PER_S, 250) after tase_host_init() (the gimbal
+ * role: on each rx it was given); `tase decode --candump` takes --margin.
  *
  * ROLES. A node is either the host (autopilot: sends 0x11000000, listens
  * to 0x10000000) or the gimbal (sends 0x10000000, listens to 0x11000000;

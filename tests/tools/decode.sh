@@ -33,4 +33,25 @@ printf '\x00\xff\x5a\x16\x00\x42\x01\x08\x00\x00\x00\xff\x5a\x0a\x00\x80\x23\x28
 if [ "$(wc -l <"$out")" -ne 1 ] || ! grep -q '^{"offset":0,.*"name":"CAMERA_PASS"' "$out"; then
     echo "tase decode of a CAMERA_PASS carrying a GIMBAL_CMD frame:"; cat "$out"; exit 1
 fi
-echo "decode: serial, candump and KLV captures match their expected JSON; a frame inside a CAMERA_PASS is data"
+# A packet whose CAN frames come 30 ms apart (cansend, a slow scheduler): the
+# time bound cuts it short at 20 ms, and says so; --margin 100 waits for it.
+gap=$(mktemp)
+python3 - "$gap" <<'PY'
+import sys
+f = bytes([0x00, 0xFF, 0x5A, 0x08, 0x08, 0x10, 0x03, 0xE8, 0xFE, 0x0C, 0, 0])
+f += (sum(f) & 0xFFFF).to_bytes(2, "big")
+with open(sys.argv[1], "w") as o:
+    o.write("(1700000000.000100) can0 10000000#%s\n" % f[:8].hex().upper())
+    o.write("(1700000000.030100) can0 10000000#%s\n" % f[8:].hex().upper())
+PY
+rc=0
+"$TASE" decode --candump --stats "$gap" >"$out" 2>"$gap.err" || rc=$?
+if [ "$rc" -ne 4 ] || [ -s "$out" ] || ! grep -q "1 held frames cut short by a pause" "$gap.err" ||
+    ! grep -q "cut short by pauses longer than the quiet limit; --margin MS" "$gap.err"; then
+    echo "tase decode --candump of frames 30 ms apart: exit $rc"; cat "$out" "$gap.err"; exit 1
+fi
+"$TASE" decode --candump --margin 100 "$gap" >"$out"
+grep -q '^{"offset":0,"time":1700000000.030100,"dir":"out","interface":"can0",.*"name":"GIMBAL_ANGLE"' "$out" ||
+    { echo "tase decode --candump --margin 100:"; cat "$out"; exit 1; }
+rm -f "$gap" "$gap.err"
+echo "decode: serial, candump and KLV captures match their expected JSON; a frame inside a CAMERA_PASS is data; --margin waits for paced CAN frames"

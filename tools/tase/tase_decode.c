@@ -29,6 +29,10 @@ static const char *input_guess(const cli_input_t *in, const tk_dec_t *d, bool ca
     if (!candump && cli_input_is_text(in)) {
         return ": it is text, not a raw serial capture";
     }
+    if (d->n.paused > 0u) {
+        return " (frames were cut short by pauses longer than the quiet limit; --margin MS "
+               "waits longer)";
+    }
     if (d->n.checksum_errors > 0u) {
         return " (candidate frames were found, each with a bad checksum)";
     }
@@ -184,6 +188,7 @@ int cli_cmd_decode(cli_args_t *a)
     unsigned long bad = 0;
     long baud = CLI_DEFAULT_BAUD;
     bool baud_given = false;
+    uint16_t margin = 0;
     cli_input_t in;
     static tk_dec_t d;
     tk_fmt_t fmt = {true, false, true};
@@ -197,6 +202,8 @@ int cli_cmd_decode(cli_args_t *a)
             candump = true;
         } else if (cli_opt(a, "--stats", false, &v)) {
             stats = true;
+        } else if (cli_opt(a, "--margin", true, &v)) {
+            margin = (uint16_t)cli_int_opt_value("--margin", v, 1, 65535);
         } else if (path == NULL && cli_is_arg(a, false)) {
             path = a->argv[a->i++];
         } else {
@@ -210,6 +217,7 @@ int cli_cmd_decode(cli_args_t *a)
      * ends a held candidate as it did on the live line, at --baud */
     d.by_time = true;
     d.serial_rate = TASE_UART_BYTES_PER_S((uint32_t)baud);
+    d.margin_ms = margin;
     if (candump) {
         cli_input_check_baud(&in, baud_given, " or a serial capture");
         bad = decode_candump(&in, &d);

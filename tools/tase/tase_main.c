@@ -126,7 +126,7 @@ static const char usage_query[] =
         CLI_DEFAULT_RETRIES) ") more attempts are made.\n";
 
 static const char usage_decode[] =
-    "usage: tase decode [FILE|-] [--candump] [--stats] [--baud N]\n"
+    "usage: tase decode [FILE|-] [--candump] [--stats] [--baud N] [--margin MS]\n"
     "Decodes a capture of 'tase record' (pcap or pcapng; each object carries\n"
     "\"time\" and \"dir\"; a bad record is reported with its number, exit 4) or a\n"
     "raw serial byte capture (default: standard input; a live pty or\n"
@@ -143,8 +143,10 @@ static const char usage_decode[] =
     "settings given back at exit; SIGINT/SIGTERM/SIGHUP end it (exit 0), a hang-up\n"
     "is an error (exit 1). As a live receiver does, a candidate frame the line\n"
     "went quiet on is judged false after its remaining bytes' time at the line's\n"
-    "rate (a capture's: --baud; CAN: 1 Mbit/s), at least 20 ms: on a device by\n"
-    "the clock, in a capture or candump log by the gaps in the record times.\n";
+    "rate (a capture's: --baud; CAN: 1 Mbit/s), at least 20 ms (--margin MS: at\n"
+    "least MS, 1..65535, for a sender that pauses inside a packet, such as CAN\n"
+    "frames sent one at a time): on a device by the clock, in a capture or candump\n"
+    "log by the gaps in the record times. --stats counts the frames so cut short.\n";
 
 static const char usage_klv[] =
     "usage: tase klv [FILE|-] [--baud N]\n"
