@@ -22,8 +22,11 @@
  *      tase_packet_decode_iter(): one call into the schema per frame), and
  *      the handler gets the frame and the typed struct (tase/codec.h; NULL for
  *      GYRO_ZERO_CMD). A query (tase_schema_is_query()) arrives as a
- *      zeroed struct with frame->len == 0; a 1-byte CAMERA_CMD has
- *      frame->len == 1.
+ *      zeroed struct with frame->len == 0: test frame->len before acting
+ *      on a SPOI_CMD (the only query a gimbal application gets: its
+ *      zeroed struct reads as a point at 0 deg N, 0 deg E, which must not
+ *      be pointed at); a 1-byte CAMERA_CMD has frame->len == 1 (the
+ *      fields it omits decode to their "do not change" values).
  *   4. Known packet, accepted length, no typed handler: the default
  *      handler gets the frame (not counted), so a default handler alone
  *      sees every frame.

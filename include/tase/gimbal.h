@@ -53,7 +53,8 @@
  *     [TASE_PKT_RETRACT_DEPLOY_CMD] = on_retract, ...
  * and every frame the role does not answer itself goes through it: a
  * GIMBAL_CMD arrives in on_gimbal_cmd as a decoded tase_gimbal_cmd_t, a
- * zero-length query as a zeroed struct with frame->len 0, a wrong length
+ * zero-length query as a zeroed struct with frame->len 0 (a SPOI_CMD
+ * handler tests it: that struct is no point to aim at), a wrong length
  * at the dispatcher's error hook, the rest at its default handler.
  * tase_gimbal_frame_port() tells a handler which port the frame came in
  * on. The setups stay the role's (they never reach the dispatcher).
