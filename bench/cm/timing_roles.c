@@ -458,19 +458,20 @@ MEASURED(c_htransact_msg, tase_host_transact_msg(&h, cur_pkt->id, &full_msg, &re
  * is the packet's longest frame. */
 static bool prep_reply(const tase_packet_desc_t *p)
 {
+    int r;
     if (!prep_full_frame(p) || cur_len == 0u) {
         return false; /* a zero-length frame is never a reply */
     }
     host_snapshot();
     h = h_snap;
     if (a_typed) {
-        (void)tase_host_request_msg_start(&h, p->id, &full_msg, &reply_msg, 100u, 3u, NOW_MS);
+        r = tase_host_request_msg_start(&h, p->id, &full_msg, &reply_msg, 100u, 3u, NOW_MS);
     } else {
-        (void)tase_host_request_start(&h, pkt_f.group, pkt_f.type, NULL, 0u, reply, sizeof(reply),
-                                      100u, 3u, NOW_MS);
+        r = tase_host_request_start(&h, pkt_f.group, pkt_f.type, pkt_f.data, cur_len, reply,
+                                    sizeof(reply), 100u, 3u, NOW_MS);
     }
     h_snap = h;
-    return true;
+    return r == TASE_OK; /* what the gimbal does not answer cannot be requested */
 }
 
 /* A transaction whose reply (cur_pkt's longest frame) the port has
@@ -502,21 +503,22 @@ static void host_replies(void)
         worst_try(&wh, hf.insns, "%s reply completing a pending %s request", hf.input,
                   a_typed ? "typed" : "raw");
     }
-    /* A review's input: a typed GEOREFERENCE_DATA request pending, the
-     * receiver left with halfsum's first 320 bytes by an earlier call,
-     * then the reply (it still completes the request). */
+    /* A review's input: a typed request pending, the receiver left with
+     * halfsum's first 320 bytes by an earlier call, then the reply (it
+     * still completes the request): the longest reply, CAMERA_PASS (the
+     * review's GEOREFERENCE_DATA can no longer be requested). */
     {
         static uint8_t pre[320];
         a_typed = true;
-        cur_pkt = tase_schema_find(0x10u, 0x41u);
+        cur_pkt = tase_schema_find(0x00u, 0x42u);
         if (cur_pkt != NULL && prep_reply(cur_pkt)) {
             size_t n = bench_stream("halfsum", pre, sizeof(pre)); /* one 320-byte period */
             h = h_snap;
             (void)tase_host_feed(&h, pre, n, NOW_MS);
             h_snap = h;
             worst_try(&wf, measure_exact(restore_h, c_hfeed, NULL),
-                      "GEOREFERENCE_DATA reply frame completing a pending typed request, after an "
-                      "earlier call fed halfsum's first 320 bytes");
+                      "CAMERA_PASS reply frame (253 data bytes) completing a pending typed request, "
+                      "after an earlier call fed halfsum's first 320 bytes");
         }
     }
     worst_report("tase_host_feed", &wf, ", the whole frame in one call");
