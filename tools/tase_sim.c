@@ -316,8 +316,28 @@ int main(int argc, char **argv)
     tk_prog = "tase-sim";
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
-        /* a value that starts with "--" is the next option: missing */
-        bool more = i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0;
+        /* --opt=VALUE takes any value, as in tase (docs/TOOLS.md); otherwise
+         * a value that starts with "--" is the next option: missing */
+        char name[16];
+        const char *eq = strchr(a, '=');
+        const char *val = NULL;
+        bool with_value;
+        if (strncmp(a, "--", 2) == 0 && eq != NULL && (size_t)(eq - a) < sizeof(name)) {
+            memcpy(name, a, (size_t)(eq - a));
+            name[eq - a] = '\0';
+            val = eq + 1;
+            a = name;
+            if (strcmp(a, "--quiet") == 0 || strcmp(a, "--can-pty") == 0 ||
+                strcmp(a, "--help") == 0 || strcmp(a, "--version") == 0) {
+                tk_usage_error("option %s takes no value", a);
+            }
+        }
+        with_value = strcmp(a, "--link") == 0 || strcmp(a, "--can") == 0 ||
+                     strcmp(a, "--klv-link") == 0 || strcmp(a, "--baud") == 0 ||
+                     strcmp(a, "--seconds") == 0;
+        if (with_value && val == NULL && i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0) {
+            val = argv[++i];
+        }
         /* each option with a value at most once */
         if ((strcmp(a, "--link") == 0 && link != NULL) ||
             (strcmp(a, "--can") == 0 && can != NULL) ||
@@ -338,26 +358,24 @@ int main(int argc, char **argv)
             s.quiet = true;
         } else if (strcmp(a, "--can-pty") == 0) {
             can_pty = true;
-        } else if (strcmp(a, "--link") == 0 && more) {
-            link = argv[++i];
-        } else if (strcmp(a, "--can") == 0 && more) {
-            can = argv[++i];
-        } else if (strcmp(a, "--klv-link") == 0 && more) {
-            klv_link = argv[++i];
-        } else if (strcmp(a, "--baud") == 0 && more) {
-            if (tk_parse_int(argv[++i], 1, 4000000, &baud, NULL) != TK_NUM_OK ||
+        } else if (with_value && (val == NULL || val[0] == '\0')) {
+            tk_usage_error("option %s needs a value", a);
+        } else if (strcmp(a, "--link") == 0) {
+            link = val;
+        } else if (strcmp(a, "--can") == 0) {
+            can = val;
+        } else if (strcmp(a, "--klv-link") == 0) {
+            klv_link = val;
+        } else if (strcmp(a, "--baud") == 0) {
+            if (tk_parse_int(val, 1, 4000000, &baud, NULL) != TK_NUM_OK ||
                 !tase_posix_uart_baud_supported((uint32_t)baud)) {
-                tk_usage_error("bad --baud value '%s' (a standard serial rate)", argv[i]);
+                tk_usage_error("bad --baud value '%s' (a standard serial rate)", val);
             }
             baud_given = true;
-        } else if (strcmp(a, "--seconds") == 0 && more) {
-            if (tk_parse_seconds(argv[++i], &seconds) != 0 || seconds <= 0.0) {
-                tk_usage_error("bad --seconds value '%s'", argv[i]);
+        } else if (strcmp(a, "--seconds") == 0) {
+            if (tk_parse_seconds(val, &seconds) != 0 || seconds <= 0.0) {
+                tk_usage_error("bad --seconds value '%s'", val);
             }
-        } else if (a[0] == '-' && (strcmp(a, "--link") == 0 || strcmp(a, "--can") == 0 ||
-                                   strcmp(a, "--klv-link") == 0 || strcmp(a, "--seconds") == 0 ||
-                                   strcmp(a, "--baud") == 0)) {
-            tk_usage_error("option %s needs a value", a);
         } else {
             tk_usage_error("unknown argument '%s' (see --help)", a);
         }

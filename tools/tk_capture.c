@@ -92,7 +92,10 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
     pcap_t *p = pcap_open_dead_with_tstamp_precision(linktype, snaplen, PCAP_TSTAMP_PRECISION_NANO);
     pcap_dumper_t *d;
     struct stat st;
-    bool existed = stat(path, &st) == 0;
+    /* the path itself, not what a symlink names: a rename onto a symlink
+     * replaces the link (`-o /dev/stdout` into a file, as root, turned
+     * /dev/stdout into a regular file) */
+    bool existed = lstat(path, &st) == 0;
     if (p == NULL) {
         tk_die("cannot start a capture: out of memory");
     }
@@ -103,8 +106,8 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
         trim_partial_record(path);
     }
     /* a temporary file and a rename only for a regular file (or a new
-     * one): a device, a FIFO or /dev/stdout is written in place, never
-     * replaced by a rename */
+     * one): a device, a FIFO, a symlink (/dev/stdout) is written in place
+     * (through the link), never replaced by a rename */
     if (!append && (existed ? S_ISREG(st.st_mode) : errno == ENOENT)) {
         int k = snprintf(w->tmp, sizeof(w->tmp), "%s.partial-%ld", path, (long)getpid());
         if (k < 0 || (size_t)k >= sizeof(w->tmp)) {

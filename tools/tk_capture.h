@@ -181,13 +181,16 @@ typedef struct {
     double speed;
     unsigned long records; /* in the capture (tk_cap_check() counted them) */
 } tk_replay_opts_t;
+/* A wait between two records (at --speed) that tk_cap_check() warns of. */
+#define TK_REPLAY_LONG_WAIT_S 60.0
 unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o);
 /* The check replay makes before sending anything: read every record of r
  * (dies, naming the record, on a file cut inside a record header), warn
  * about each bad record and return their count, and count in *backward
  * the records (of those o selects) stamped earlier than the one before,
  * warning about the first three (replay sends them right after it and
- * keeps the gaps after them). */
+ * keeps the gaps after them); the first three waits of
+ * TK_REPLAY_LONG_WAIT_S or more are warned of too. */
 unsigned long tk_cap_check(tk_cap_reader_t *r, const tk_replay_opts_t *o, unsigned long *backward);
 
 #endif /* TASE_TOOLS_TK_CAPTURE_H */

@@ -73,14 +73,16 @@ static void on_frame(void *user, const tase_frame_t *f)
     const tk_stream_t *s = d->cur;
     const tase_packet_desc_t *p = tk_schema_find(f->group, f->type);
     tk_meta_t m;
-    if (d->limit != 0u && d->n.frames >= d->limit) {
-        return;
-    }
+    /* every frame is counted (the summary adds up to the bytes read); those
+     * past the limit are not printed */
     d->n.frames++;
     if (p == NULL) {
         d->n.unknown++;
     } else if (!tase_schema_length_ok(p, f->len)) {
         d->n.bad_length++;
+    }
+    if (d->limit != 0u && d->n.frames > d->limit) {
+        return;
     }
     m.offset = tk_offset64(d->base64, d->base32, f->offset);
     m.time = frame_time(s, m.offset + f->len + TASE_FRAME_OVERHEAD, d->time);
@@ -209,6 +211,10 @@ void tk_dec_summary(const tk_dec_t *d, FILE *out, const char *extra)
     if (n->can_frames != 0u) {
         fprintf(out, ", %llu CAN frames (%llu not datalink)", (unsigned long long)n->can_frames,
                 (unsigned long long)n->can_other);
+    }
+    if (d->limit != 0u && n->frames > d->limit) {
+        fprintf(out, ", %llu frames past --count not printed",
+                (unsigned long long)(n->frames - d->limit));
     }
     if (n->paused != 0u) {
         fprintf(out, ", %llu held frames cut short by a pause", (unsigned long long)n->paused);

@@ -9,6 +9,7 @@
 #include <poll.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/uio.h>
 #include <time.h>
 #include <unistd.h>
@@ -23,24 +24,44 @@
 
 /* ---- recording ---- */
 
+/* Where the status lines go: standard output, unless the capture itself
+ * goes there (`-o /dev/stdout` into a pipe): then standard error, so the
+ * pcap stream stays a capture. */
+static FILE *status_out(const char *path)
+{
+    struct stat sp, so;
+    if (stat(path, &sp) == 0 && fstat(STDOUT_FILENO, &so) == 0 && sp.st_dev == so.st_dev &&
+        sp.st_ino == so.st_ino) {
+        return stderr;
+    }
+    return stdout;
+}
+
 static void print_recorded(const tk_cap_writer_t *w, unsigned long bytes, const char *what)
 {
-    printf("recorded %lu record%s (%lu %s) to %s\n", w->records, w->records == 1 ? "" : "s", bytes,
-           what, w->path);
+    FILE *out = status_out(w->path);
+    fprintf(out, "recorded %lu record%s (%lu %s) to %s\n", w->records, w->records == 1 ? "" : "s",
+            bytes, what, w->path);
+    if (out == stdout) {
+        tk_stdout_flush();
+    }
 }
 
 /* Said before the capture is created: output that fails (a closed pipe,
  * /dev/full) ends the run before any file exists. */
 static void print_recording(const char *path, const char *what, const char *tap_in, double seconds)
 {
-    printf("recording %s%s%s to %s ", what, tap_in != NULL ? " and " : "",
-           tap_in != NULL ? tap_in : "", path);
+    FILE *out = status_out(path);
+    fprintf(out, "recording %s%s%s to %s ", what, tap_in != NULL ? " and " : "",
+            tap_in != NULL ? tap_in : "", path);
     if (seconds > 0.0) {
-        printf("for %g s\n", seconds);
+        fprintf(out, "for %g s\n", seconds);
     } else {
-        printf("until interrupted (Ctrl-C)\n");
+        fprintf(out, "until interrupted (Ctrl-C)\n");
     }
-    tk_stdout_flush();
+    if (out == stdout) {
+        tk_stdout_flush();
+    }
 }
 
 static int ms_left(double t_end)
@@ -112,7 +133,6 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *path, const char *dev,
     }
     tk_cap_close(w);
     print_recorded(w, bytes, "bytes");
-    tk_stdout_flush();
     if (failed != 0) {
         tk_die("cannot read %s: %s", failed_dev == 0 ? dev : tap_in,
                tk_link_error(&links[failed_dev], failed));
@@ -334,7 +354,7 @@ unsigned long tk_cap_check(tk_cap_reader_t *r, const tk_replay_opts_t *o, unsign
     tk_cap_rec_t rec;
     tk_time_t last = {0, 0};
     bool any = false;
-    unsigned long bad = 0, last_index = 0;
+    unsigned long bad = 0, last_index = 0, long_waits = 0;
     char why[160];
     int rc;
     memset(&rp, 0, sizeof(rp));
@@ -355,6 +375,16 @@ unsigned long tk_cap_check(tk_cap_reader_t *r, const tk_replay_opts_t *o, unsign
                 tk_warn("%s: record %lu is %.6f s earlier than record %lu (a clock step?): "
                         "replayed right after it",
                         r->path, rec.index, -time_diff(&last, &rec.t), last_index);
+            }
+        } else if (any && o->speed > 0.0 &&
+                   time_diff(&last, &rec.t) / o->speed >= TK_REPLAY_LONG_WAIT_S) {
+            /* a silence that long, or a clock step forward: replay keeps
+             * the timing, so say that it will wait */
+            if (++long_waits <= 3u) {
+                tk_warn("%s: record %lu comes %.0f s after record %lu (a clock step?): replay "
+                        "waits %.0f s for it (--speed 0 does not wait; Ctrl-C stops)",
+                        r->path, rec.index, time_diff(&last, &rec.t), last_index,
+                        time_diff(&last, &rec.t) / o->speed);
             }
         }
         last = rec.t;

@@ -310,7 +310,7 @@ typedef struct {
 typedef struct {
     tk_fmt_t fmt;
     FILE *out;
-    uint64_t limit; /* stop printing after this many frames, 0 none */
+    uint64_t limit; /* print no frame after this many (they are counted), 0 none */
     /* The receivers' time bound (tase/frame.h, TIME BOUND): with by_time,
      * the times given to tk_dec_bytes()/tk_dec_can() are the clock (a
      * capture's record times: a gap in them settles a held candidate as

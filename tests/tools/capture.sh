@@ -306,6 +306,26 @@ check "record killed with SIGKILL: the previous capture is unchanged, the partia
     eval 'cmp -s "$dir/tele.pcap" "$dir/tele.copy" && ls "$dir"/tele.pcap.partial-* >/dev/null 2>&1'
 rm -f "$dir"/tele.pcap.partial-*
 
+# ---- a capture to standard output or through a symlink ----
+# The status lines went into the pcap stream (`-o /dev/stdout | decode`:
+# "it is text"), `-o -` made a file named "-", and a symlink was replaced
+# by a regular file (as root, `-o /dev/stdout >FILE` replaced /dev/stdout).
+( cd "$dir" && "$TASE" record --serial "$dir/gimbal" -o - --seconds 0.6 2>"$dir/dash.err" |
+    "$TASE" decode - >"$dir/dash.json" )
+check "record -o - | decode -: packets decoded, status on stderr, no file named '-'" \
+    eval 'grep -q "GIMBAL_ANGLE" "$dir/dash.json" && grep -q "^recorded" "$dir/dash.err" &&
+          [ ! -e "$dir/-" ]'
+"$TASE" record --serial "$dir/gimbal" -o /dev/stdout --seconds 0.6 2>/dev/null | cat >"$dir/pipe.pcap"
+"$TASE" decode "$dir/pipe.pcap" >"$dir/pipe.json" 2>/dev/null
+check "record -o /dev/stdout into a pipe: a capture that decodes" \
+    grep -q '"dir":"out".*GIMBAL_ANGLE' "$dir/pipe.json"
+: >"$dir/target.pcap"
+ln -s "$dir/target.pcap" "$dir/link.pcap"
+"$TASE" record --serial "$dir/gimbal" -o "$dir/link.pcap" --seconds 0.6 >/dev/null 2>&1
+check "record -o SYMLINK: the link stays a link, its target holds the capture" \
+    eval '[ -L "$dir/link.pcap" ] && "$TASE" decode "$dir/target.pcap" >"$dir/link.json" &&
+          grep -q GIMBAL_ANGLE "$dir/link.json"'
+
 # ---- the recorded device goes away: record stops (it spun at 75% CPU) ----
 "$TASE" record --serial "$dir/gimbal" -o "$dir/gone.pcap" >"$dir/gone.out" 2>"$dir/gone.err" &
 rp=$!
@@ -393,6 +413,29 @@ t_back=$(sed -n 's/^replayed 4 of 4 records (56 bytes) to .* in \([0-9.]*\) s$/\
 check "replay across a clock stepped back: warned, the later gaps kept (${t_back:-?} s; 1.0 s of gaps, was 0.7)" \
     eval 'grep -q "record 3 is 0.300000 s earlier than record 2" "$dir/backrx.out" &&
           awk -v t="${t_back:-0}" "BEGIN { exit !(t >= 0.95 && t < 1.0 + $tol) }"'
+
+# A forward step (or a damaged seconds field) made replay wait silently for
+# it (80 years in the review's file): warned before anything is sent now
+"${TASE_PYTHON:-python3}" - "$dir/jump.pcap" <<'PY'
+import struct, sys
+rec = lambda sec, data: struct.pack("<IIII", sec, 0, len(data), len(data)) + data
+ga = bytes([0, 0x00, 0xFF, 0x5A, 0x08, 0x08, 0x10, 0, 0, 0, 0, 0, 0, 0x01, 0x79])
+with open(sys.argv[1], "wb") as f:
+    f.write(struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 147))
+    f.write(rec(1700000000, ga) + rec(1700003600, ga))
+PY
+"$TASE" replay "$dir/jump.pcap" --serial "$dir/A" --dir out >"$dir/jump.out" 2>&1 &
+rp=$!
+wait_for "$dir/jump.out" "record 2 comes 3600 s after record 1"
+kill -INT $rp
+wait $rp
+rc=$?
+check "replay of a 3600 s gap: warned before waiting, Ctrl-C ends it (exit $rc: $(head -1 "$dir/jump.out"))" \
+    eval 'grep -q "record 2 comes 3600 s after record 1 (a clock step?): replay waits 3600 s" "$dir/jump.out" &&
+          [ $rc = 130 ]'
+"$TASE" replay "$dir/jump.pcap" --serial "$dir/A" --dir out --speed 0 >"$dir/jump0.out" 2>&1
+check "... --speed 0 sends both at once, without the warning" \
+    eval '! grep -q "comes 3600 s" "$dir/jump0.out" && grep -q "^replayed 2 of 2" "$dir/jump0.out"'
 
 # A two-line tap: the gimbal's line into A (recorded on B), the host's line
 # into C (recorded on D with --tap-in), both replayed at once.

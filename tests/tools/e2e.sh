@@ -265,6 +265,19 @@ check "monitor of bytes without a frame: exit $rc, the summary and a hint ($(tr 
 t=$("$TASE" monitor "${L[@]}" --count 3 --units 2>/dev/null)
 check "monitor prints readable lines with units" grep -q '^GIMBAL_ANGLE pan=[-0-9]* ([-0-9.]* deg) ' <<<"$t"
 
+# monitor --count N counts every frame of the bytes it read: the summary
+# said 1 frame, 0 of 111 bytes discarded, for a read that held 3 frames
+"$TASE" send PACKET_RATE angle_2=255 rate_2=255 geo_ref_2=255 "${L[@]}" >/dev/null
+sleep 0.3
+rm -f "$dir/cnt.pcap"
+"$TASE" monitor "${L[@]}" --count 1 --record "$dir/cnt.pcap" >"$dir/cnt.out" 2>"$dir/cnt.err"
+nf=$(sed -n 's/^tase: summary: \([0-9]*\) frames.*/\1/p' "$dir/cnt.err")
+nc=$("$TASE" decode "$dir/cnt.pcap" 2>/dev/null | grep -c '"dir":"out"')
+check "monitor --count 1: 1 printed, the summary counts the $nc frames read ($(grep summary "$dir/cnt.err" | cut -c16-))" \
+    eval '[ "$(grep -c . "$dir/cnt.out")" = 1 ] && [ "$nf" = "$nc" ] &&
+          { [ "$nc" = 1 ] || grep -q ", $((nc - 1)) frames past --count not printed" "$dir/cnt.err"; }'
+"$TASE" send PACKET_RATE angle_2=20 rate_2=5 geo_ref_2=2 "${L[@]}" >/dev/null
+
 # ---- output errors ----
 expect_error "monitor > /dev/full" 1 "cannot write to standard output" \
     sh -c 'exec "$0" monitor --serial "$1" --count 3 >/dev/full' "$TASE" "$dir/gimbal"
@@ -376,6 +389,13 @@ check "... and the link still leads to the first simulator" \
     eval '"$TASE" query SYSTEM_VERSION "${L[@]}" >/dev/null'
 expect_error "--klv-link equal to --link refused" 2 "--klv-link must differ from --link" \
     "$SIM" --link "$dir/x" --klv-link "$dir/./x" --seconds 1
+# --opt=VALUE, as tase takes it (docs/TOOLS.md): it was "unknown argument"
+"$SIM" --link="$dir/eq" --seconds=0.3 --baud=9600 --quiet >"$dir/eq.log" 2>&1
+rc=$?
+check "tase-sim --link=PATH --seconds=S --baud=N: exit $rc, $(head -c 80 "$dir/eq.log")" \
+    eval '[ $rc -eq 0 ] && grep -q "9600 baud" "$dir/eq.log" && [ ! -e "$dir/eq" ]'
+expect_error "tase-sim --quiet=1 refused" 2 "option --quiet takes no value" "$SIM" --quiet=1
+expect_error "tase-sim --link= refused" 2 "option --link needs a value" "$SIM" --link=
 "$SIM" --link "$dir/hup" --klv-link "$dir/hupk" --seconds 30 >"$dir/hup.log" 2>&1 &
 hpid=$!
 for _ in $(seq 100); do [ -L "$dir/hupk" ] && break; sleep 0.05; done

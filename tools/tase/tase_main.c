@@ -162,7 +162,8 @@ static const char usage_klv[] =
 static const char usage_record[] =
     "usage: tase record (--serial DEV [--tap-in DEV2] [--baud N] | --can IFACE) -o FILE\n"
     "                   [--seconds S]\n"
-    "Records what arrives to the pcap capture FILE (replaced), with a timestamp per\n"
+    "Records what arrives to the pcap capture FILE (replaced; - or a FIFO, device or\n"
+    "symlink is written in place, - being standard output), with a timestamp per\n"
     "received chunk, until interrupted (Ctrl-C, SIGTERM, SIGHUP: exit 0) or S seconds\n"
     "have passed.\n"
     "  --serial DEV   one record per read, byte-exact, as sent by the gimbal\n"

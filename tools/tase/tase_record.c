@@ -43,6 +43,14 @@ int cli_cmd_record(cli_args_t *a)
     if (out == NULL) {
         tk_usage_error("record needs an output file: -o FILE");
     }
+    if (strcmp(out, "-") == 0) {
+        out = "/dev/stdout"; /* as `-` is standard input to decode and replay */
+    }
+    if (strcmp(out, "/dev/stdout") == 0 && isatty(STDOUT_FILENO)) {
+        tk_usage_error("-o %s is a terminal: a capture is binary (redirect it, or pipe it to "
+                       "'tase decode -')",
+                       out);
+    }
     if ((lo.serial != NULL) == (lo.can != NULL)) {
         tk_usage_error("give either --serial DEV or --can IFACE");
     }
