@@ -699,6 +699,39 @@ static void assert_termios_equal(const struct termios *a, const struct termios *
     assert_int_equal(cfgetospeed(a), cfgetospeed(b));
 }
 
+/* Another program's TIOCEXCL without our lock: root got past it, changed
+ * the device's settings under that program, and its close cleared the
+ * flag, so the program lost its exclusive access. Busy now, flag kept. */
+static void another_programs_tiocexcl_is_busy_and_left_alone(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a;
+    struct termios before, after;
+    int excl = -1;
+    (void)state;
+
+    pty_open(&p);
+    if (ioctl(p.slave, TIOCGEXCL, &excl) != 0 && getenv("TASE_TEST_EMULATOR") != NULL) {
+        print_message("SKIPPED: %s cannot read the exclusive-mode flag\n",
+                      getenv("TASE_TEST_EMULATOR"));
+        pty_close(&p);
+        skip();
+    }
+    assert_int_equal(ioctl(p.slave, TIOCEXCL), 0); /* the other program's */
+    assert_int_equal(tcgetattr(p.slave, &before), 0);
+    a.fd = 99;
+    /* as root the kernel lets the open() through; as anybody else it is
+     * its EBUSY: the same answer either way */
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 9600), TASE_EBUSY);
+    assert_int_equal(a.fd, -1);
+    assert_int_equal(ioctl(p.slave, TIOCGEXCL, &excl), 0);
+    assert_int_equal(excl, 1);
+    assert_int_equal(tcgetattr(p.slave, &after), 0);
+    assert_termios_equal(&before, &after);
+    pty_close(&p);
+}
+
+
 /* A line set up the way a user's terminal program might leave it. */
 static void make_cooked(int fd, struct termios *t)
 {
@@ -779,6 +812,7 @@ int main(void)
         cmocka_unit_test(bad_arguments_are_rejected),
         cmocka_unit_test(a_second_open_of_the_device_is_ebusy_until_the_first_closes),
         cmocka_unit_test(the_kernel_refuses_other_opens_while_the_port_is_open),
+        cmocka_unit_test(another_programs_tiocexcl_is_busy_and_left_alone),
         cmocka_unit_test(close_gives_the_device_back_with_the_settings_it_had),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -186,6 +186,47 @@ static void frames_of_other_ids_are_ignored(void **state)
     close_pair(&p);
 }
 
+/* A read drained every frame queued ahead of its bytes, whatever its
+ * timeout: a flood of frames with nothing for the caller (other nodes,
+ * error frames, 3AX status) held read(timeout 0) for hundreds of ms. It
+ * looks at its deadline every 64 such frames now: read(0) returns 0 after
+ * 64 of them, and the bytes behind them come with later reads, none lost. */
+static void a_flood_of_frames_with_nothing_for_the_caller_ends_at_the_deadline(void **state)
+{
+    pair_t p;
+    uint8_t b[16];
+    size_t got = 0;
+    unsigned i;
+    int n;
+    static const uint8_t x[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    for (i = 0; i < 150u; i++) {
+        peer_send(&p, 0x11000000u | CAN_EFF_FLAG, x, 8); /* the host's own direction */
+    }
+    peer_send(&p, 0x10000000u | CAN_EFF_FLAG, x + 2, 3);
+    assert_int_equal(tase_socketcan_read(&p.s, b, sizeof(b), 0), 0);
+    assert_int_equal(p.s.stats.frames_ignored, 64);
+    for (i = 0; i < 3u && got == 0u; i++) {
+        n = tase_socketcan_read(&p.s, b, sizeof(b), 0);
+        assert_true(n >= 0);
+        got = (size_t)n;
+    }
+    assert_int_equal(got, 3);
+    assert_memory_equal(b, x + 2, 3);
+    assert_int_equal(p.s.stats.frames_ignored, 150);
+    close_pair(&p);
+
+    /* the gimbal's 3AX status frames, kept for recv_frame() */
+    open_pair(&p, TASE_CAN_ROLE_GIMBAL);
+    for (i = 0; i < 100u; i++) {
+        peer_send(&p, 0x12020000u | CAN_EFF_FLAG, x, 2);
+    }
+    assert_int_equal(tase_socketcan_read(&p.s, b, sizeof(b), 0), 0);
+    assert_int_equal(p.s.stats.frames_rx, 64);
+    close_pair(&p);
+}
+
 static void threeax_move_goes_out_and_status_comes_back(void **state)
 {
     pair_t p;
@@ -711,6 +752,7 @@ int main(void)
         cmocka_unit_test(gimbal_reads_a_max_packet_in_one_call),
         cmocka_unit_test(host_reads_a_max_packet_three_bytes_at_a_time),
         cmocka_unit_test(frames_of_other_ids_are_ignored),
+        cmocka_unit_test(a_flood_of_frames_with_nothing_for_the_caller_ends_at_the_deadline),
         cmocka_unit_test(threeax_move_goes_out_and_status_comes_back),
         cmocka_unit_test(full_queue_is_reported_never_dropped),
         cmocka_unit_test(write_retries_while_the_peer_drains),

@@ -54,7 +54,9 @@
  *  tase_port_elapsed_ms() in port_io.h.
  *
  *  ERRORS are negative TASE_E* codes (tase/common.h); TASE_EARG for a NULL
- *  or closed context, a NULL buffer, or a count above INT32_MAX.
+ *  or closed context, a NULL buffer, or a write count the int result
+ *  cannot hold. A read's cap above that is refused (SocketCAN) or read as
+ *  that many (POSIX UART, bare metal): each port's header says which.
  *
  * tests/fault_port.h wraps any port and injects short writes, interrupted
  * and refused calls, stalls, hang-ups, clock jumps and stale clock samples;

@@ -175,6 +175,17 @@ static int take_exclusive(tase_posix_uart_t *u, int fd)
     if (r != 0) {
         return errno == EWOULDBLOCK ? TASE_EBUSY : TASE_EIO;
     }
+#ifdef TIOCGEXCL
+    {
+        /* Another program's TIOCEXCL without a lock: the kernel lets only
+         * root past it, and clearing it at close would take the other
+         * program's exclusivity away. */
+        int held = 0;
+        if (ioctl(fd, TIOCGEXCL, &held) == 0 && held != 0) {
+            return TASE_EBUSY; /* the lock goes with the descriptor */
+        }
+    }
+#endif
 #ifdef TIOCEXCL
     /* Best effort: the lock above already keeps our own programs apart. */
     u->excl = ioctl(fd, TIOCEXCL) == 0;

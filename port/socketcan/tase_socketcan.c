@@ -19,6 +19,9 @@
 #include <linux/can/raw.h>
 
 #define RETRY_SLEEP_MS 1u
+/* Frames with nothing for the caller taken between two looks at the clock
+ * (skip_ends()). */
+#define SKIP_BATCH 64u
 
 #ifndef CAN_ERR_CNT
 #define CAN_ERR_CNT 0x00000200U /* Linux 5.19+: error counters in data[6..7] */
@@ -494,18 +497,32 @@ static int take_record(tase_socketcan_t *s, ssize_t n, const can_record_t *cf, t
     return 0;
 }
 
-/* Next data frame from the socket within timeout_ms: 1, 0 or TASE_EIO;
- * *ns is the frame's kernel receive time. */
-static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint32_t timeout_ms)
+/* A frame that gives the caller nothing was taken: true when the call is
+ * to end as if its wait ran out (the deadline has passed, checked every
+ * SKIP_BATCH such frames), so that a flood of them (error frames, other
+ * nodes, 3AX status) cannot hold a read past its timeout: at most
+ * SKIP_BATCH - 1 more are handled after it. */
+static bool skip_ends(uint32_t deadline, unsigned *skipped)
+{
+    *skipped += 1u;
+    return *skipped % SKIP_BATCH == 0u && remaining(deadline) == 0u;
+}
+
+/* Next data frame from the socket by `deadline`: 1, 0 or TASE_EIO; *ns is
+ * the frame's kernel receive time. */
+static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint32_t deadline,
+                    unsigned *skipped)
 {
     can_record_t cf;
-    uint32_t deadline = deadline_in(timeout_ms);
     for (;;) {
         ssize_t n = recv_record(s->fd, &cf, ns);
         if (n >= 0) {
             int rc = take_record(s, n, &cf, f);
             if (rc != 0) {
                 return rc;
+            }
+            if (skip_ends(deadline, skipped)) {
+                return 0;
             }
             continue;
         }
@@ -527,15 +544,18 @@ static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint
 }
 
 /* Next frame the role's filter passes (software copy of the kernel's). */
-static int recv_wanted(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint32_t timeout_ms)
+static int recv_wanted(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint32_t deadline,
+                       unsigned *skipped)
 {
-    uint32_t deadline = deadline_in(timeout_ms);
     for (;;) {
-        int rc = raw_recv(s, f, ns, remaining(deadline));
+        int rc = raw_recv(s, f, ns, deadline, skipped);
         if (rc <= 0 || role_wants(s->role, f)) {
             return rc;
         }
         s->stats.frames_ignored++;
+        if (skip_ends(deadline, skipped)) {
+            return 0;
+        }
     }
 }
 
@@ -574,6 +594,7 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
     uint32_t deadline;
     uint64_t ns;
     size_t got;
+    unsigned skipped = 0;
     if (!usable(s) || buf == NULL || cap > (size_t)0x7FFFFFFF) {
         return TASE_EARG;
     }
@@ -581,7 +602,7 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
     got = take_pending(s, buf, cap);
     /* Once some bytes are in hand, only drain what is already queued. */
     while (got < cap) {
-        int rc = recv_wanted(s, &f, &ns, got > 0u ? 0u : remaining(deadline));
+        int rc = recv_wanted(s, &f, &ns, got > 0u ? deadline_in(0u) : deadline, &skipped);
         if (rc < 0) {
             return got > 0u ? (int)got : rc;
         }
@@ -599,6 +620,9 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
             side_push(s, &f, ns);
         } else {
             s->stats.bad_frames++;
+        }
+        if (rc <= 0 && skip_ends(deadline, &skipped)) {
+            break; /* a frame with no bytes for the caller */
         }
     }
     return (int)got;
@@ -618,7 +642,8 @@ int tase_socketcan_recv_frame(tase_socketcan_t *s, tase_can_frame_t *f, uint32_t
     }
     {
         uint64_t ns;
-        int rc = recv_wanted(s, f, &ns, timeout_ms);
+        unsigned skipped = 0;
+        int rc = recv_wanted(s, f, &ns, deadline_in(timeout_ms), &skipped);
         if (rc == 1) {
             s->rx_ns = ns;
         }

@@ -36,7 +36,8 @@
  *          deadline). The hook's longest block is this port's write
  *          bound W (tase/port.h): n bytes at the line rate. Returns n,
  *          or TASE_EARG (ctx NULL or not initialised, data NULL with
- *          n > 0, n > INT32_MAX; the hook is not called).
+ *          n > 0, n > INT_MAX, the largest int result: INT32_MAX on a
+ *          32-bit core; the hook is not called).
  *  read    takes what the ring holds; if empty, waits until bytes arrive
  *          or timeout_ms passes on hooks->millis() (wrap- and stale-safe),
  *          spinning if idle is NULL, else sleeping race-free:
@@ -52,7 +53,7 @@
  *          irq_off/irq_on.) Sleeping ends on any interrupt; the timeout
  *          needs one that ticks, e.g. SysTick. Returns the count (0:
  *          timeout), or TASE_EARG (ctx NULL or not initialised, buf NULL,
- *          cap 0).
+ *          cap 0). A cap above INT_MAX reads at most INT_MAX bytes.
  *  now_ms  hooks->millis(hw) (a SysTick millisecond counter); 0 for ctx
  *          NULL or not initialised.
  */

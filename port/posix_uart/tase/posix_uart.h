@@ -8,8 +8,12 @@
  * device, in this or another process, fails with TASE_EBUSY, "device
  * busy: in use by another program"), plus the kernel's TIOCEXCL, which
  * makes any further open() of the device fail with EBUSY for everybody
- * but root. Two readers of one serial line would each get a random half
- * of the byte stream; this makes that impossible by accident.
+ * but root. A device whose TIOCEXCL another program set without the lock
+ * is busy as well, for root too (read with TIOCGEXCL, Linux 3.8 and
+ * later), and its flag is left alone: root's open used to succeed and its
+ * close cleared the other program's flag. Two readers of one serial line
+ * would each get a random half of the byte stream; this makes that
+ * impossible by accident.
  * TASE_POSIX_UART_SHARED (tase_posix_uart_open_flags()) opens without
  * either. Both end when the device is closed. When the process exits
  * without closing it, the lock ends with it, but the kernel keeps the

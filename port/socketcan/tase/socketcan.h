@@ -42,7 +42,10 @@
  *
  * LONGEST BLOCK (the port contract of tase/port.h): write() and
  * send_frame() tx_timeout_ms in total; read() and recv_frame() timeout_ms
- * in total. A signal (EINTR) never ends a wait early or makes it fail: the
+ * in total, and then at most 63 more frames handled that carry nothing
+ * for the caller (a flood of other nodes' frames, error frames or 3AX
+ * status is looked through 64 at a time, the clock read between: read()
+ * with timeout 0 takes at most 64 such frames and returns 0). A signal (EINTR) never ends a wait early or makes it fail: the
  * wait resumes with the time left.
  *
  * BUS HEALTH. open() (and adopt() with TASE_SOCKETCAN_SET_FILTER) asks the
