@@ -731,7 +731,6 @@ static void another_programs_tiocexcl_is_busy_and_left_alone(void **state)
     pty_close(&p);
 }
 
-
 /* A line set up the way a user's terminal program might leave it. */
 static void make_cooked(int fd, struct termios *t)
 {
