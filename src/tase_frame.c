@@ -932,7 +932,7 @@ RX_NOINLINE static int push_other(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t
     }
     /* One tail call through a pointer: gcc compiles two tail calls here
      * with five registers saved and the arguments moved (a lagging scan's
-     * byte, bench's synclong: 103.1 -> 101.8 M4 instructions a byte). */
+     * byte, bench's synclong: 103.1 -> 100.8 M4 instructions a byte). */
     return ((len == end && end != 0u && end < RX_CAP) ? push_last : push_body)(rx, byte, on_frame,
                                                                                user);
 }

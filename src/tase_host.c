@@ -123,26 +123,27 @@ static bool timeout_ok(uint32_t timeout_ms)
     return timeout_ms > 0u && timeout_ms < 0x80000000u;
 }
 
-/* Whether the gimbal answers (group, type, data[0..len)) with a frame of
- * the same group and type, so that a request may wait for it and re-send
- * it: a zero-length query of a packet with a query form, and the packets
- * it sends back (the setup packets' echo, RETRACT_DEPLOY_CMD when the move
- * ends, CAMERA_PASS with the camera's bytes), SPOI_CMD only with its echo
- * flag (4.3.2, data byte 18). TASE_ELENGTH for zero length without a
- * query form (GYRO_ZERO_CMD is a command), TASE_EARG for a packet the
- * gimbal does not answer (a re-send would repeat a command). A packet the
- * schema does not know passes: nothing says it is not answered. */
-static int answered(uint8_t group, uint8_t type, const uint8_t *data, size_t len)
+/* Whether the gimbal answers packet p (NULL: unknown to the schema),
+ * sent with data or without, with a frame of the same group and type, so
+ * that a request may wait for it and re-send it: a zero-length query of a
+ * packet with a query form, and the packets it sends back (the setup
+ * packets' echo, RETRACT_DEPLOY_CMD when the move ends, CAMERA_PASS with
+ * the camera's bytes), SPOI_CMD only with its echo flag (4.3.2: spoi_flags,
+ * its data byte 18). TASE_ELENGTH for zero length without a query form
+ * (GYRO_ZERO_CMD is a command), TASE_EARG for a packet the gimbal does not
+ * answer (a re-send would repeat a command). A packet the schema does not
+ * know passes: nothing says it is not answered. Decided before anything
+ * is written to h->req, which may hold a typed CAMERA_PASS reply. */
+static int answered(const tase_packet_desc_t *p, bool with_data, unsigned spoi_flags)
 {
-    const tase_packet_desc_t *p = tase_schema_find(group, type);
     if (p == NULL) {
         return TASE_OK;
     }
-    if (len == 0u) {
+    if (!with_data) {
         return tase_schema_is_query(p, 0u) ? TASE_OK : TASE_ELENGTH;
     }
     if ((p->flags & TASE_DIR_BOTH) != TASE_DIR_BOTH ||
-        (p->id == TASE_ID_SPOI_CMD && (len <= 18u || (data[18] & TASE_SPOI_ECHO) == 0u))) {
+        (p->id == TASE_ID_SPOI_CMD && (spoi_flags & TASE_SPOI_ECHO) == 0u)) {
         return TASE_EARG;
     }
     return TASE_OK;
@@ -163,7 +164,7 @@ int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const u
     if (h->state != HOST_IDLE) {
         return TASE_EBUSY;
     }
-    r = answered(group, type, data, len);
+    r = answered(tase_schema_find(group, type), len > 0u, len > 18u ? data[18] : 0u);
     if (r != TASE_OK) {
         return r;
     }
@@ -185,16 +186,23 @@ int tase_host_request_msg_start(tase_host_t *h, uint16_t id, const void *msg, vo
     if (h->state != HOST_IDLE) {
         return TASE_EBUSY;
     }
+    {
+        /* with data unless msg is NULL or the packet has none (GYRO_ZERO) */
+        const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
+        r = answered(p, msg != NULL && p != NULL && p->len > 0u,
+                     (msg != NULL && id == TASE_ID_SPOI_CMD) ? ((const tase_spoi_cmd_t *)msg)->flags
+                                                             : 0u);
+        if (r != TASE_OK) {
+            return r;
+        }
+    }
     /* The request's data goes where re-sends take it from; the reply will
-     * land in the same buffer once no re-send is due any more. */
+     * land in the same buffer once no re-send is due any more. The codec
+     * checks everything before it writes: an error leaves h->req as it was. */
     n = msg != NULL ? tase_packet_encode_data(id, msg, h->req, sizeof h->req)
                     : tase_packet_encode_data_len(id, NULL, 0u, h->req, sizeof h->req);
     if (n < 0) {
         return n;
-    }
-    r = answered(TASE_ID_GROUP(id), TASE_ID_TYPE(id), h->req, (size_t)n);
-    if (r != TASE_OK) {
-        return r;
     }
     h->typed = true;
     h->reply_msg = reply_msg;

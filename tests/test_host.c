@@ -921,6 +921,22 @@ static void a_typed_camera_pass_reply_stays_readable_after_the_poll(void **state
     /* more traffic does not move it: it lives in the host until the next request */
     feed_frame(x, 0x00, 0x42, rates, 7, 6);
     assert_memory_equal(back.data, "\x90\x50\xFF", 3);
+    /* nor does a request that is refused (it encoded its packet over the
+     * reply before the check: 7A BC 01 read there after this GIMBAL_CMD) */
+    {
+        tase_gimbal_cmd_t cmd = {0x7ABC, 0x0102, 0x0304, 0xB0, 0x05};
+        tase_spoi_cmd_t spoi;
+        tase_packet_msg_t m;
+        memset(&spoi, 0x7A, sizeof spoi);
+        spoi.flags = 0; /* no echo asked */
+        assert_int_equal(
+            tase_host_request_msg_start(&x->host, TASE_ID_GIMBAL_CMD, &cmd, &m, 100, 0, 7),
+            TASE_EARG);
+        assert_int_equal(
+            tase_host_request_msg_start(&x->host, TASE_ID_SPOI_CMD, &spoi, &m, 100, 0, 7),
+            TASE_EARG);
+        assert_memory_equal(back.data, "\x90\x50\xFF", 3);
+    }
 }
 
 /* ---- clock edges ----------------------------------------------------- */

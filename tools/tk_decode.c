@@ -114,11 +114,21 @@ static void begin(tk_dec_t *d, tk_stream_t *s, const tk_time_t *time)
 
 void tk_dec_tick(tk_dec_t *d, tk_stream_t *s, uint32_t now_ms)
 {
-    uint32_t discarded = s->rx.stats.bytes_discarded;
+    /* A tick with no byte since the last one, after a held candidate's
+     * whole quiet limit (the last tick saw one held, the scan caught up),
+     * settles it: a candidate cut short by the pause. (A tick also goes on
+     * with a lagging scan, which discards bytes without any pause.) */
+    bool cut = s->ticked && s->rx.stats.bytes_in == s->tick_bytes && s->tick_left != 0u &&
+               s->tick_left != UINT32_MAX && (uint32_t)(now_ms - s->tick_at) < 0x80000000u &&
+               now_ms - s->tick_at >= s->tick_left;
     begin(d, s, s->timed ? &s->last : NULL);
     (void)tase_rx_tick(&s->rx, now_ms, on_frame, d);
-    if (s->rx.stats.bytes_discarded != discarded) {
-        d->n.paused++; /* the pause settled what was held */
+    s->ticked = true;
+    s->tick_at = now_ms;
+    s->tick_bytes = s->rx.stats.bytes_in;
+    s->tick_left = tase_rx_quiet_ms(&s->rx, now_ms);
+    if (cut && s->tick_left == UINT32_MAX) {
+        d->n.paused++; /* settled: the receiver holds nothing now */
     }
     account(d, s);
     flush_out(d);

@@ -290,6 +290,12 @@ typedef struct {
         tk_time_t time;
     } hist[TK_HIST];
     size_t hnext, hcount;
+    /* At the last tick: its time, rx.stats.bytes_in, and the quiet limit
+     * left then (tase_rx_quiet_ms(): a held candidate's, or 0 / UINT32_MAX
+     * for a lagging scan / nothing held), to tell a tick that cut a held
+     * candidate short from one that only went on with the scan. */
+    uint32_t tick_at, tick_bytes, tick_left;
+    bool ticked;
     tase_rx_t rx;
 } tk_stream_t;
 
@@ -303,8 +309,8 @@ typedef struct {
     uint64_t discarded;       /* bytes not part of any valid frame */
     uint64_t can_frames;      /* CAN frames seen */
     uint64_t can_other;       /* of them: not datalink frames (other IDs) */
-    uint64_t paused;          /* held candidates settled by a pause longer
-                                 than the quiet limit (bytes discarded) */
+    uint64_t paused;          /* held candidates cut short by a pause
+                                 longer than their quiet limit */
 } tk_counts_t;
 
 typedef struct {

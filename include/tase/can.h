@@ -13,10 +13,12 @@
  * keeping their order (the spec requires it) and simply feeds each
  * payload to an ordinary datalink receiver (tase_rx_t), which finds the
  * 00 FF 5A frames in the byte stream exactly as on a UART. A lost CAN
- * frame costs the datalink frame it belonged to and nothing more: counted
- * as a checksum error when a later CAN frame of it arrived (its candidate
- * fails), only in bytes_discarded when its first CAN frame was lost (the
- * rest has no sync: noise).
+ * frame costs the datalink frame it belonged to and nothing more. It is
+ * counted as a checksum error when the next packet's bytes complete the
+ * short candidate before the line goes quiet for its quiet limit (PAUSES
+ * below); otherwise the time bound settles the candidate and it counts
+ * only in bytes_discarded, as it does when the packet's first CAN frame
+ * was the one lost (the rest has no sync: noise).
  *
  * PAUSES. The receiver's time bound (tase/frame.h, TIME BOUND) applies to
  * the reassembled bytes as to a UART's: a candidate that sees no byte for

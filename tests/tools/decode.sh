@@ -53,5 +53,41 @@ fi
 "$TASE" decode --candump --margin 100 "$gap" >"$out"
 grep -q '^{"offset":0,"time":1700000000.030100,"dir":"out","interface":"can0",.*"name":"GIMBAL_ANGLE"' "$out" ||
     { echo "tase decode --candump --margin 100:"; cat "$out"; exit 1; }
-rm -f "$gap" "$gap.err"
+# Only a pause cuts a frame short: false syncs 1 ms apart (a lagging scan
+# discards bytes at every tick) counted 42 "cut short" and hinted --margin;
+# a GIMBAL_RATE missing its middle CAN frame is cut short by a 100 ms pause
+# before the next packet, not by a 5 ms one (there it fails its checksum).
+python3 - "$gap" <<'PY'
+import random, sys
+rng = random.Random(7)
+with open(sys.argv[1], "w") as o:
+    for i in range(400):
+        d = [0x00, 0xFF, 0x5A, rng.randint(0x5A, 0x93), 0x00, 0xFF, 0x5A, rng.randint(0x5A, 0x93)]
+        o.write("(%d.%06d) can0 10000000#%s\n" % (1700000000 + i // 1000, (i % 1000) * 1000,
+                                                   bytes(d).hex().upper()))
+for period in (5, 100):
+    f = bytes([0x00, 0xFF, 0x5A, 0x14, 0x08, 0x40] + [0] * 18)
+    f += (sum(f) & 0xFFFF).to_bytes(2, "big")
+    us = 0
+    with open("%s.%d" % (sys.argv[1], period), "w") as o:
+        for p in range(4):
+            for c in range(0, len(f), 8):
+                if not (p == 1 and c == 8):
+                    o.write("(%d.%06d) can0 10000000#%s\n" % (1700000000 + us // 1000000, us % 1000000,
+                                                               f[c:c + 8].hex().upper()))
+                us += 1000
+            us += period * 1000
+PY
+rc=0
+"$TASE" decode --candump --stats "$gap" >"$out" 2>"$gap.err" || rc=$?
+if [ "$rc" -ne 4 ] || grep -q "cut short" "$gap.err" || ! grep -q "each with a bad checksum" "$gap.err"; then
+    echo "tase decode --candump of false syncs 1 ms apart: exit $rc"; cat "$gap.err"; exit 1
+fi
+"$TASE" decode --candump --stats "$gap.5" >"$out" 2>"$gap.err"
+grep -q "3 frames .* 1 checksum errors" "$gap.err" && ! grep -q "cut short" "$gap.err" ||
+    { echo "a lost middle CAN frame, packets 5 ms apart:"; cat "$gap.err"; exit 1; }
+"$TASE" decode --candump --stats "$gap.100" >"$out" 2>"$gap.err"
+grep -q "3 frames .* 0 checksum errors.*, 1 held frames cut short by a pause" "$gap.err" ||
+    { echo "a lost middle CAN frame, packets 100 ms apart:"; cat "$gap.err"; exit 1; }
+rm -f "$gap" "$gap.err" "$gap.5" "$gap.100"
 echo "decode: serial, candump and KLV captures match their expected JSON; a frame inside a CAMERA_PASS is data; --margin waits for paced CAN frames"
