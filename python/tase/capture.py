@@ -34,7 +34,8 @@ MAGICS = (
 
 
 class CaptureError(Error, ValueError):
-    """A file that is not a capture tase can read."""
+    """A file that is not a capture tase can read, or one that cannot be
+    written (a full disk)."""
 
 
 # libpcap's bounds (sf-pcap.c, sf-pcapng.c): a record longer than any
@@ -285,41 +286,89 @@ class CaptureWriter:
     """Write a serial capture as `tase record` does: nanosecond pcap, link
     type 147, one record per read or write (a direction byte, 0 from the
     gimbal, 1 to it, then the bytes). An existing file is appended to when
-    it is such a capture (as `--record`), else refused; a new one is
-    created. Every record is flushed."""
+    it is such a capture (as `--record`), else refused; a record a full
+    disk cut short at its end is cut off first (as `--record` does: the
+    next session would be unreadable behind it); a new one is created.
+    Every record is flushed. A write that fails (a full disk) is a
+    CaptureError, the file left ending with its last whole record."""
 
     _HEADER = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, LINKTYPE_SERIAL)
 
     def __init__(self, path):
         self.path = path
         self.records = 0
-        if os.path.exists(path) and os.path.getsize(path) > 0:
-            with open(path, "rb") as f:
-                head = f.read(24)
-            if head != self._HEADER:
-                raise CaptureError(
-                    "%s: not a nanosecond serial capture of tase record: not appending" % path
-                )
-            self.f = open(path, "ab")
-        else:
-            self.f = open(path, "wb")
-            self.f.write(self._HEADER)
-            self.f.flush()
+        self.f = None
+        created = False
+        try:
+            if os.path.exists(path) and os.path.getsize(path) > 0:
+                with open(path, "rb") as f:
+                    head = f.read(24)
+                if head != self._HEADER:
+                    raise CaptureError(
+                        "%s: not a nanosecond serial capture of tase record: not appending" % path
+                    )
+                self.f = open(path, "r+b", buffering=0)
+                self.good = self._whole_records_end()
+                self.f.truncate(self.good)
+                self.f.seek(self.good)
+            else:
+                created = not os.path.exists(path)
+                self.f = open(path, "wb", buffering=0)  # no buffer to write later
+                self.good = 0
+                self._write(self._HEADER)
+        except (OSError, CaptureError) as e:
+            if self.f is not None:
+                self.f.close()
+            if created:
+                try:  # a file this call made goes again (as tase record's)
+                    os.unlink(path)
+                except OSError:
+                    pass
+            if isinstance(e, CaptureError):
+                raise
+            raise CaptureError("cannot write capture %s: %s" % (path, e.strerror or e)) from e
+
+    def _whole_records_end(self):
+        """Where the last whole record of the open file ends."""
+        size = os.fstat(self.f.fileno()).st_size
+        pos = 24
+        while pos + 16 <= size:
+            self.f.seek(pos + 8)
+            n = struct.unpack("<I", self.f.read(4))[0]
+            if pos + 16 + n > size:
+                break
+            pos += 16 + n
+        return pos
+
+    def _write(self, buf):
+        try:
+            view = memoryview(buf)
+            while view:
+                view = view[self.f.write(view) :]
+        except OSError as e:
+            try:  # what did go out of this record is cut off again
+                self.f.truncate(self.good)
+            except (OSError, ValueError):
+                pass
+            raise CaptureError("cannot write capture %s: %s" % (self.path, e.strerror or e)) from e
+        self.good += len(buf)
 
     def put(self, dir, data, t_ns=None):
         """One record: dir 0 (bytes from the gimbal) or 1 (to it)."""
         t = time.time_ns() if t_ns is None else t_ns
         for i in range(0, len(data), 4096):
             chunk = bytes((dir,)) + bytes(data[i : i + 4096])
-            self.f.write(
+            self._write(
                 struct.pack("<IIII", t // 1000000000, t % 1000000000, len(chunk), len(chunk))
                 + chunk
             )
             self.records += 1
-        self.f.flush()
 
     def close(self):
-        self.f.close()
+        try:
+            self.f.close()
+        except OSError as e:
+            raise CaptureError("cannot write capture %s: %s" % (self.path, e.strerror or e)) from e
 
 
 class _Stream:

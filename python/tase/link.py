@@ -17,7 +17,9 @@ import math
 import os
 import re
 import select
+import threading
 import time
+import warnings
 import weakref
 
 from ._core import (
@@ -98,30 +100,52 @@ def connect(url, *, timeout=0.5, retries=2, record=None):
 
 
 class _Recorder:
-    """A transport that records what passes through it."""
+    """A transport that records what passes through it. A capture that
+    cannot be written (a full disk) stops the recording, not the link: the
+    bytes went out or came in all the same, and an error there would tell
+    the caller a command was not sent when it was (as `tase --record`:
+    a warning, the command goes on). Link.record_error says why."""
 
     def __init__(self, inner, writer):
         self.inner = inner
         self.w = writer
+        self.failed = None
         self.name = inner.name
         self.bytes_per_s = inner.bytes_per_s
 
+    def _put(self, dir, data):
+        if self.w is None:
+            return
+        try:
+            self.w.put(dir, data)
+        except Error as e:
+            self.failed = e
+            w, self.w = self.w, None
+            try:
+                w.close()
+            except Error:
+                pass
+            warnings.warn("%s; recording stopped, the link goes on" % e, RuntimeWarning, 3)
+
     def write(self, data):
         n = self.inner.write(data)
-        self.w.put(1, data[:n])
+        if n > 0:
+            self._put(1, data[:n])
         return n
 
     def read(self, cap, timeout_s):
         data = self.inner.read(cap, timeout_s)
         if data:
-            self.w.put(0, data)
+            self._put(0, data)
         return data
 
     def close(self):
         try:
             self.inner.close()
         finally:
-            self.w.close()
+            if self.w is not None:
+                w, self.w = self.w, None
+                w.close()
 
 
 # ---- transports: bytes in and out -------------------------------------------
@@ -171,8 +195,10 @@ class _SerialTransport:
 
     def read(self, cap, timeout_s):
         try:
-            r, _, _ = select.select([self.fd], [], [], timeout_s)
-            if not r:
+            p = select.poll()
+            p.register(self.fd, select.POLLIN)
+            ev = p.poll(max(0, math.ceil(timeout_s * 1000)))
+            if not ev:
                 return b""
             data = os.read(self.fd, cap)
         except BlockingIOError:
@@ -183,9 +209,13 @@ class _SerialTransport:
                 lib.TASE_EIO,
             ) from e
         if not data:
-            raise LinkError(
-                "cannot read %s: the device went away or hung up" % self.name, lib.TASE_EIO
-            )
+            # readable and no byte: a hang-up only when poll() said so; else
+            # another reader of the device took them first
+            if ev[0][1] & (select.POLLHUP | select.POLLERR | select.POLLNVAL):
+                raise LinkError(
+                    "cannot read %s: the device went away or hung up" % self.name, lib.TASE_EIO
+                )
+            return b""
         return data
 
     def close(self):
@@ -268,10 +298,19 @@ class _CanTransport:
 # ---- the port callbacks of the C host role -----------------------------------
 
 
+def _closed_meanwhile(link):
+    """close() from another thread during a call: the call ends at its
+    next read or write (the device stays open until it has)."""
+    if link._closed:
+        link._exc = Error("%s: the link was closed" % link.url)
+        return True
+    return False
+
+
 @ffi.def_extern()
 def py_port_write(ctx, data, n):
     link = ffi.from_handle(ctx)()
-    if link is None:
+    if link is None or _closed_meanwhile(link):
         return lib.TASE_EIO
     try:
         return link._t.write(ffi.buffer(data, n)[:])
@@ -283,7 +322,7 @@ def py_port_write(ctx, data, n):
 @ffi.def_extern()
 def py_port_read(ctx, buf, cap, timeout_ms):
     link = ffi.from_handle(ctx)()
-    if link is None:
+    if link is None or _closed_meanwhile(link):
         return lib.TASE_EIO
     try:
         data = link._t.read(cap, timeout_ms / 1000.0)
@@ -321,9 +360,15 @@ _QUERY_RESERVED = "send(..., reserved=True) sends it; the answer is then read wi
 
 
 def _seconds(what, v):
-    """A timeout in seconds: a number >= 0 (not NaN), else FieldError."""
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v) or v < 0:
-        raise FieldError("%s: %r is not a number of seconds >= 0" % (what, v))
+    """A timeout in seconds: a finite number >= 0 (under 2^31 ms, what the
+    C side's clock arithmetic can see expire), else FieldError."""
+    if (
+        isinstance(v, bool)
+        or not isinstance(v, (int, float))
+        or not math.isfinite(v)
+        or not 0 <= v < 2**31 / 1000
+    ):
+        raise FieldError("%s: %r is not a number of seconds >= 0 (and under 2^31 ms)" % (what, v))
     return v
 
 
@@ -347,6 +392,14 @@ class Link:
         self._base = 0
         self._queue = collections.deque()
         self._closed = False
+        # Threads: a Link's calls run one at a time (_call_lock), and a
+        # close() from another thread during a call leaves the device open
+        # until that call has ended (it ends at its next read or write), so
+        # its descriptor cannot be reused meanwhile by another link.
+        self._call_lock = threading.RLock()
+        self._state_lock = threading.Lock()
+        self._calls = 0
+        self._t_open = True
         _check(
             lib.py_host_init(self._host, self._handle, transport.bytes_per_s, self._ctx), url
         )
@@ -362,8 +415,16 @@ class Link:
         return False
 
     def close(self):
-        if not self._closed:
+        """Close the link (also from another thread: a call in progress
+        there then ends with an Error, and the device is closed when it
+        has)."""
+        with self._state_lock:
+            if self._closed:
+                return
             self._closed = True
+            shut = self._calls == 0 and self._t_open
+            self._t_open = self._t_open and not shut
+        if shut:
             self._t.close()
 
     def __del__(self):
@@ -378,9 +439,24 @@ class Link:
             raise Error("%s: the link is closed" % self.url)
 
     def _call(self, fn, *args):
-        """Run a host call that may receive; collect the frames it passed
-        on (telemetry, other answers) into the queue; raise what the
-        transport raised."""
+        """Run a host call that may receive (one at a time, whatever the
+        thread); collect the frames it passed on (telemetry, other answers)
+        into the queue; raise what the transport raised."""
+        with self._call_lock:
+            with self._state_lock:
+                self._live()
+                self._calls += 1
+            try:
+                return self._call_locked(fn, *args)
+            finally:
+                with self._state_lock:
+                    self._calls -= 1
+                    shut = self._closed and self._calls == 0 and self._t_open
+                    self._t_open = self._t_open and not shut
+                if shut:
+                    self._t.close()
+
+    def _call_locked(self, fn, *args):
         self._exc = None
         lib.py_host_begin(self._host, self._sink.s, self._base)
         before = self._host.rx.stats.bytes_in
@@ -551,6 +627,13 @@ class Link:
         raise TimeoutError_("%s: no packet within %s s" % (self.url, timeout), lib.TASE_ETIMEOUT)
 
     @property
+    def record_error(self):
+        """Why the recording of connect(record=...) stopped (a CaptureError,
+        e.g. a full disk; a RuntimeWarning said so then), or None while it
+        runs or when there is none. The link goes on without it."""
+        return getattr(self._t, "failed", None)
+
+    @property
     def stats(self):
         """Counters of the host role and its receiver (32-bit, as the
         library keeps them)."""
@@ -611,6 +694,9 @@ class Link:
         """SPOI_CMD (`tase spoi`): degrees WGS-84, metres; no velocity. With
         wait the echo is requested and returned, and its position compared
         (Error if it differs); else the packet sent is returned."""
+        for name, v in (("latitude", lat), ("longitude", lon), ("height", height)):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise FieldError("spoi: %s %r is not a number: nothing sent" % (name, v))
         if not -90 <= lat <= 90 or not -180 <= lon <= 180:
             raise FieldError("spoi: latitude %r / longitude %r out of range" % (lat, lon))
         p = Packet(
@@ -636,6 +722,8 @@ class Link:
         return echo
 
     def _retract_deploy(self, deploy, wait):
+        if wait is not None:
+            _seconds("%s: wait" % ("deploy" if deploy else "retract"), wait)  # before sending
         p = Packet("RETRACT_DEPLOY_CMD", deploy=lib.TASE_DEPLOY if deploy else lib.TASE_RETRACT)
         self.send(p)
         if wait is None:

@@ -124,6 +124,15 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
         (lambda l: l.send(tase.Packet("SPOI_CMD", lat=0, lon=0, height=0, vnorth=0, veast=0,
                                       vdown=0, flags=0x7F)), tase.FieldError, "reserved bits 1-7"),
         (lambda l: l.recv(float("nan")), tase.FieldError, "seconds"),
+        # a review: wait= was checked after RETRACT_DEPLOY_CMD went out (the
+        # mechanism moved, the caller was told nothing was sent)
+        (lambda l: l.retract(wait=-1), tase.FieldError, "retract: wait"),
+        (lambda l: l.deploy(wait=float("nan")), tase.FieldError, "deploy: wait"),
+        (lambda l: l.retract(wait="5"), tase.FieldError, "retract: wait"),
+        # an OverflowError from deep inside, and a TypeError from a comparison
+        (lambda l: list(l.packets(timeout=float("inf"))), tase.FieldError, "seconds"),
+        (lambda l: l.spoi("45", 0, 0), tase.FieldError, "latitude '45' is not a number"),
+        (lambda l: l.spoi(0, 0, None), tase.FieldError, "height None is not a number"),
         (lambda l: l.camera("D"), tase.FieldError, "A, B or C"),
         (lambda l: l.camera(hfov=0), tase.FieldError, "0.01..327.67"),
         (lambda l: l.spoi(91, 0, 0), tase.FieldError, "out of range"),
@@ -186,6 +195,109 @@ def test_packets_stops_at_close(silent_pty):
     link.close()
     with pytest.raises(tase.Error, match="closed"):
         next(gen)
+
+
+def test_close_from_another_thread_ends_the_call_and_keeps_the_device(silent_pty):
+    # A query waiting in a thread kept using the closed link's descriptor
+    # number: a second link opened meanwhile got it, and the first link's
+    # retry (a setting) went to that other device. The call ends with an
+    # Error now, and the device stays open until it has.
+    url, master = silent_pty
+    link = tase.connect(url)
+    got = []
+
+    def worker():
+        try:
+            link.query("PACKET_RATE", timeout=0.3, retries=5)
+        except tase.Error as e:
+            got.append(e)
+
+    t = threading.Thread(target=worker)
+    t.start()
+    time.sleep(0.1)
+    t0 = time.monotonic()
+    link.close()
+    fd = link._t.fd
+    os.fstat(fd)  # still open: the call has not ended yet
+    t.join(5)
+    assert not t.is_alive() and time.monotonic() - t0 < 1.0
+    assert len(got) == 1 and "the link was closed" in str(got[0])
+    with pytest.raises(OSError):
+        os.fstat(fd)  # closed once the call ended
+    # one attempt went out, no retry after the close
+    assert len(tase.decode(_drain(master))) == 1
+
+
+def test_a_reader_thread_and_queries_share_a_link(tase_sim):
+    # Both threads read the device at once: the one that found its bytes
+    # taken read 0 bytes and called it a hang-up ("the device went away").
+    # A Link's calls run one at a time now.
+    with tase.sim.start() as sim, tase.connect(sim.url) as link:
+        errors = []
+        seen = []
+
+        def reader():
+            try:
+                for p in link.packets(timeout=2):
+                    seen.append(p.name)
+            except tase.Error as e:
+                errors.append(e)
+
+        t = threading.Thread(target=reader)
+        t.start()
+        for _ in range(20):
+            assert link.query("PACKET_RATE").name == "PACKET_RATE"
+        t.join(5)
+        assert not errors and "GIMBAL_ANGLE" in seen
+
+
+def _sink_full(link, after):
+    """Make the recording's file fail with ENOSPC after `after` writes."""
+    w = link._t.w
+    real = w.f
+
+    class Full:
+        def __init__(self):
+            self.n = 0
+
+        def write(self, b):
+            self.n += 1
+            if self.n > after:
+                real.write(bytes(b)[:5])  # a record cut short, then the error
+                raise OSError(28, "No space left on device")
+            return real.write(b)
+
+        def __getattr__(self, name):
+            return getattr(real, name)
+
+    w.f = Full()
+
+
+def test_a_full_disk_stops_the_recording_not_the_link(silent_pty, tmp_path):
+    # point() raised LinkError ("went away") while the command went out, so
+    # a script retrying on LinkError sent it again; the cut record made the
+    # next session appended to the file unreadable.
+    url, master = silent_pty
+    cap = str(tmp_path / "s.pcap")
+    with tase.connect(url, record=cap) as link:
+        link.point(1, 2)
+        _sink_full(link, 0)
+        with pytest.warns(RuntimeWarning, match="No space left on device; recording stopped"):
+            link.point(3, 4)
+        link.point(5, 6)
+        assert isinstance(link.record_error, tase.capture.CaptureError)
+    sent = tase.decode(_drain(master))
+    assert [p.raw["pan"] for p in sent] == [100, 300, 500]
+    assert [p.raw["pan"] for _, p in tase.read_capture(cap)] == [100]
+    # a record cut at the end (by a full disk) is cut off before appending
+    with open(cap, "ab") as f:
+        f.write(b"\x01\x02\x03")
+    with tase.connect(url, record=cap) as link:
+        link.point(7, 8)
+    assert [p.raw["pan"] for _, p in tase.read_capture(cap)] == [100, 700]
+    # a capture that cannot even be created: a CaptureError (was an OSError)
+    with pytest.raises(tase.capture.CaptureError, match="No space left on device"):
+        tase.connect(url, record="/dev/full")
 
 
 def test_send_to_a_gimbal_that_stopped_reading_ends(silent_pty):
