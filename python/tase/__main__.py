@@ -32,8 +32,20 @@ def main(argv=None):
             with open(a.file, "rb") as f:
                 head = f.read(4)
             if head[:4] in tase.capture.MAGICS:
-                for _, pkt in tase.read_capture(a.file):
+                cap = tase.capture.Capture(a.file)
+                for _, pkt in cap:
                     print(pkt.json())
+                # as `tase decode`: each bad record said, the rest decoded, exit 4
+                for index, why in cap.bad:
+                    print("tase: %s: record %d skipped: %s" % (a.file, index, why), file=sys.stderr)
+                if cap.bad:
+                    n = len(cap.bad)
+                    print(
+                        "tase: %s: %d bad record%s (the rest was decoded)"
+                        % (a.file, n, "" if n == 1 else "s"),
+                        file=sys.stderr,
+                    )
+                    return 4
             else:
                 with open(a.file, "rb") as f:
                     for pkt in tase.decode(f.read()):

@@ -506,9 +506,13 @@ def read_capture(path, baud=57600):
     `tase decode FILE` prints them (same packets, order, offsets, times);
     `baud`: the serial line's rate, for the receivers' time bound (as
     decode's --baud). time is Unix seconds (packet.time_us exact). A file
-    that is not a pcap or pcapng capture, or a damaged record or block in
-    it, is a CaptureError naming the file and the block, raised when the
-    iteration reaches it (`tase decode` fails on those too)."""
+    that is not a pcap or pcapng capture, or a damaged block in it (its
+    structure), is a CaptureError naming the file and the block, raised
+    when the iteration reaches it (`tase decode` fails on those too). A
+    record whose contents are bad (a direction byte other than 0 or 1, no
+    bytes, cut by the snapshot length) is skipped, as `tase decode` skips
+    it (warning, exit 4): iterate over `Capture(path, baud)` instead to
+    find them in its `.bad` afterwards."""
     return iter(Capture(path, baud))
 
 

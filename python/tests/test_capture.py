@@ -79,6 +79,23 @@ def test_module_decode_equals_tase_decode(recorded):
     assert r.stdout.splitlines() == lines
 
 
+def test_module_decode_of_bad_records_is_tase_decode(recorded, tase_cli, tmp_path):
+    # a record with direction byte 0x81 was skipped without a word, exit 0;
+    # `tase decode` says so and exits 4
+    cap, _ = recorded
+    data = bytearray(open(cap, "rb").read())
+    data[24 + 16] = 0x81  # the first record's direction byte
+    bad = tmp_path / "bad.pcap"
+    bad.write_bytes(bytes(data))
+    c = subprocess.run([tase_cli, "decode", str(bad)], capture_output=True, text=True, timeout=30)
+    p = subprocess.run([sys.executable, "-m", "tase", "decode", str(bad)],
+                       capture_output=True, text=True, timeout=60)
+    assert c.returncode == 4 and p.returncode == 4, (c.stderr, p.stderr)
+    assert p.stdout == c.stdout
+    assert "record 1 skipped: bad direction byte 0x81" in p.stderr
+    assert "1 bad record (the rest was decoded)" in p.stderr
+
+
 def test_link_records_a_capture_tase_decode_reads(sim, tase_cli, tmp_path):
     cap = str(tmp_path / "py.pcap")
     with tase.connect(sim.url, record=cap) as link:
