@@ -12,7 +12,7 @@ import os
 import struct
 import time
 
-from ._core import Decoder, Error, LinkError, TimeoutError_, _with_meta, ffi, lib
+from ._core import Decoder, Error, FieldError, LinkError, TimeoutError_, _with_meta, ffi, lib
 
 __all__ = ["read_capture", "records", "CaptureLink", "CaptureWriter"]
 
@@ -410,6 +410,9 @@ class Capture:
     with new receivers (the counters are those of the last one)."""
 
     def __init__(self, path, baud=57600):
+        if isinstance(baud, bool) or not isinstance(baud, int) or not 10 <= baud <= 4000000:
+            # an OverflowError / TypeError from deep inside, or 0 taken
+            raise FieldError("baud %r is not a serial line rate (10..4000000)" % (baud,))
         self.path = path
         self.rate = baud // 10
         self.bad = []

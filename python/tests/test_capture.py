@@ -96,6 +96,13 @@ def test_module_decode_of_bad_records_is_tase_decode(recorded, tase_cli, tmp_pat
     assert "1 bad record (the rest was decoded)" in p.stderr
 
 
+@pytest.mark.parametrize("baud", [0, -9600, 2**70, "57600", float("nan"), True])
+def test_read_capture_refuses_a_bad_baud(recorded, baud):
+    cap, _ = recorded
+    with pytest.raises(tase.FieldError, match="not a serial line rate"):
+        list(tase.read_capture(cap, baud=baud))
+
+
 def test_link_records_a_capture_tase_decode_reads(sim, tase_cli, tmp_path):
     cap = str(tmp_path / "py.pcap")
     with tase.connect(sim.url, record=cap) as link:
