@@ -179,7 +179,6 @@ int tase_host_request_msg_start(tase_host_t *h, uint16_t id, const void *msg, vo
                                 uint32_t timeout_ms, uint8_t retries, uint32_t now_ms)
 {
     int n;
-    int r;
     if (h == NULL || !timeout_ok(timeout_ms)) {
         return TASE_EARG;
     }
@@ -189,9 +188,9 @@ int tase_host_request_msg_start(tase_host_t *h, uint16_t id, const void *msg, vo
     {
         /* with data unless msg is NULL or the packet has none (GYRO_ZERO) */
         const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
-        r = answered(p, msg != NULL && p != NULL && p->len > 0u,
-                     (msg != NULL && id == TASE_ID_SPOI_CMD) ? ((const tase_spoi_cmd_t *)msg)->flags
-                                                             : 0u);
+        int r = answered(
+            p, msg != NULL && p != NULL && p->len > 0u,
+            (msg != NULL && id == TASE_ID_SPOI_CMD) ? ((const tase_spoi_cmd_t *)msg)->flags : 0u);
         if (r != TASE_OK) {
             return r;
         }
