@@ -395,7 +395,7 @@ class Packet(tuple):
         for what, v in (("group", group), ("type", type)):
             if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 0xFF:
                 raise FieldError("from_data: %s %r is not 0..255" % (what, v))
-        data = bytes(data)
+        data = _bytes("from_data", data)
         if len(data) > lib.TASE_DATA_MAX:
             raise FieldError(
                 "from_data: %d data bytes, a frame carries at most %d"
@@ -597,12 +597,20 @@ def _with_meta(p, time_us, dir):
     return _new_tuple(Packet, (p[_KEY], p[_OFF], p[_BUF], time_us, dir))
 
 
+def _bytes(what, data):
+    """data as bytes: a bytes-like object (bytes(5) would be five zero
+    bytes, and a str has no one encoding: both a TypeError)."""
+    if isinstance(data, (int, str)):
+        raise TypeError("%s takes bytes, not %s" % (what, type(data).__name__))
+    return bytes(data)
+
+
 def _make(t, raw, length, data):
     """Build packet type t from wire integers (by name) through the codec."""
-    if length is None or length == t.len:
+    if length is None or (length == t.len and not isinstance(length, bool)):
         n = None
     else:
-        if not isinstance(length, int) or not t.length_ok(length):
+        if isinstance(length, bool) or not isinstance(length, int) or not t.length_ok(length):
             raise FieldError("%s: %r is not an accepted data length" % (t.name, length))
         n = length
     for k in raw:
@@ -652,7 +660,7 @@ def _make(t, raw, length, data):
     if data and not t.tail:
         raise FieldError("%s carries no data bytes" % t.name)
     if t.tail:
-        data = bytes(data)
+        data = _bytes("%s data" % t.name, data)
     enc = ffi.new("int64_t[]", vals or [0])
     out = ffi.new("uint8_t[]", lib.TASE_FRAME_MAX)
     bad = ffi.new("int *")
@@ -867,7 +875,7 @@ class Decoder:
         return self._sink
 
     def feed(self, data, time_us=None):
-        data = bytes(data)
+        data = _bytes("feed", data)
         sink = self._sink_for(len(data))
         sink.s.base64 = self.bytes
         _check(lib.py_rx_feed(self.rx, data, len(data), sink.s), "feed")

@@ -207,3 +207,24 @@ def test_a_short_form_never_drops_a_given_field():
     with pytest.raises(tase.FieldError, match="not hfov"):
         short.replace(hfov=5)
     assert short.replace(camera=2).raw == {"camera": 2}
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        # bytes(5) is five zero bytes: an integer was taken as that
+        lambda: tase.Packet.from_data(1, 0, 5),
+        lambda: tase.Decoder().feed(5),
+        lambda: tase.Packet("CAMERA_PASS", camera=1, baud=0, data=3),
+        lambda: tase.Packet.from_data(1, 0, "abc"),
+    ],
+)
+def test_an_integer_or_str_is_not_bytes(call):
+    with pytest.raises(TypeError, match="takes bytes"):
+        call()
+
+
+def test_a_bool_is_not_a_length():
+    # length=True was taken as 1
+    with pytest.raises(tase.FieldError, match="not an accepted data length"):
+        tase.Packet("CAMERA_CMD", raw={"camera": 0}, length=True)
