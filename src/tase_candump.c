@@ -182,22 +182,19 @@ static int read_hex_bytes(cursor_t *c, uint8_t *data, unsigned max)
 }
 
 /* The raw DLC suffix of a classic frame with 8 data bytes: '_' and one
- * hex digit 9..F. Whether one is there: true, or false with *bad set when
- * a '_' begins a malformed one. */
-static bool read_raw_dlc(cursor_t *c, unsigned n, bool *bad)
+ * hex digit 9..F. Returns 1 (one is there), 0 (none) or -1 (a '_' that
+ * begins a malformed one). */
+static int read_raw_dlc(cursor_t *c, unsigned n)
 {
-    int d;
     if (peek(c) != '_') {
-        return false;
+        return 0;
     }
     c->i++;
-    d = hexval(peek(c));
-    if (n != TASE_CAN_DLC_MAX || d < 9) {
-        *bad = true;
-        return false;
+    if (n != TASE_CAN_DLC_MAX || hexval(peek(c)) < 9) {
+        return -1;
     }
     c->i++;
-    return true;
+    return 1;
 }
 
 /* After the '#': the frame's data. Returns TASE_OK, TASE_EFORMAT, or
@@ -209,7 +206,7 @@ static bool read_raw_dlc(cursor_t *c, unsigned n, bool *bad)
 static int read_data(cursor_t *c, uint8_t *data, uint8_t *dlc)
 {
     int n;
-    bool bad = false;
+    int raw;
     if (peek(c) == '#') {
         c->i++;
         if (hexval(peek(c)) < 0) {
@@ -225,18 +222,15 @@ static int read_data(cursor_t *c, uint8_t *data, uint8_t *dlc)
             len = (unsigned)(peek(c) - '0');
             c->i++;
         }
-        (void)read_raw_dlc(c, len, &bad);
-        return bad ? TASE_EFORMAT : TASE_EUNSUPPORTED;
+        return read_raw_dlc(c, len) < 0 ? TASE_EFORMAT : TASE_EUNSUPPORTED;
     }
     n = read_hex_bytes(c, data, TASE_CAN_DLC_MAX);
     if (n < 0) {
         return TASE_EFORMAT;
     }
-    if (read_raw_dlc(c, (unsigned)n, &bad)) {
-        return TASE_EUNSUPPORTED;
-    }
-    if (bad) {
-        return TASE_EFORMAT;
+    raw = read_raw_dlc(c, (unsigned)n);
+    if (raw != 0) {
+        return raw > 0 ? TASE_EUNSUPPORTED : TASE_EFORMAT;
     }
     *dlc = (uint8_t)n;
     return TASE_OK;

@@ -794,6 +794,20 @@ static void typed_request_errors_send_nothing_and_leave_the_host_idle(void **sta
     assert_int_equal(x->host.stats.requests, 0);
 }
 
+/* Packet id from msg refused with `want`, typed and as its data bytes
+ * (n of them), nothing sent. */
+static void refused_both_ways(fix_t *x, uint16_t id, const void *msg, size_t n, int want)
+{
+    tase_packet_msg_t m;
+    uint8_t data[TASE_DATA_MAX];
+    uint8_t reply[8];
+    assert_int_equal(tase_host_request_msg_start(&x->host, id, msg, &m, 10, 2, 0), want);
+    assert_int_equal(tase_packet_encode_data(id, msg, data, sizeof data), (int)n);
+    assert_int_equal(tase_host_request_start(&x->host, TASE_ID_GROUP(id), TASE_ID_TYPE(id), data, n,
+                                             reply, sizeof reply, 10, 2, 0),
+                     want);
+}
+
 /* A retry sends the request again: only what the gimbal answers with the
  * same group and type may be requested (a gyro zero or a gimbal command
  * sent three times moved the gimbal three times). */
@@ -806,7 +820,6 @@ static void requests_of_packets_the_gimbal_does_not_answer_send_nothing(void **s
     tase_packet_msg_t m;
     uint8_t data[TASE_DATA_MAX];
     uint8_t reply[TASE_DATA_MAX];
-    int n;
     memset(&spoi, 0, sizeof spoi);
     memset(data, 0, sizeof data);
     assert_int_equal(
@@ -816,21 +829,9 @@ static void requests_of_packets_the_gimbal_does_not_answer_send_nothing(void **s
                      TASE_ELENGTH);
     assert_int_equal(tase_host_transact_msg(&x->host, TASE_ID_GYRO_ZERO_CMD, NULL, &m, 10, 2),
                      TASE_ELENGTH);
-    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID_GIMBAL_CMD, &cmd, &m, 10, 2, 0),
-                     TASE_EARG);
-    n = tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &cmd, data, sizeof data);
-    assert_int_equal(n, 8);
-    assert_int_equal(
-        tase_host_request_start(&x->host, 0x00, 0x80, data, (size_t)n, reply, 8, 10, 2, 0),
-        TASE_EARG);
+    refused_both_ways(x, TASE_ID_GIMBAL_CMD, &cmd, 8, TASE_EARG);
     /* SPOI_CMD is echoed only when asked to be */
-    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID_SPOI_CMD, &spoi, &m, 10, 2, 0),
-                     TASE_EARG);
-    n = tase_packet_encode_data(TASE_ID_SPOI_CMD, &spoi, data, sizeof data);
-    assert_int_equal(n, 19);
-    assert_int_equal(
-        tase_host_request_start(&x->host, 0x10, 0x40, data, (size_t)n, reply, 8, 10, 2, 0),
-        TASE_EARG);
+    refused_both_ways(x, TASE_ID_SPOI_CMD, &spoi, 19, TASE_EARG);
     assert_int_equal(tase_host_request_start(&x->host, 0x10, 0x40, data, 18, reply, 8, 10, 2, 0),
                      TASE_EARG);
     /* host data and telemetry: the gimbal never sends them back */

@@ -602,7 +602,10 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
     got = take_pending(s, buf, cap);
     /* Once some bytes are in hand, only drain what is already queued. */
     while (got < cap) {
-        int rc = recv_wanted(s, &f, &ns, got > 0u ? deadline_in(0u) : deadline, &skipped);
+        /* bytes in hand: what is queued only, now (also for the frames
+         * skipped below) */
+        uint32_t until = got > 0u ? deadline_in(0u) : deadline;
+        int rc = recv_wanted(s, &f, &ns, until, &skipped);
         if (rc < 0) {
             return got > 0u ? (int)got : rc;
         }
@@ -621,7 +624,7 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
         } else {
             s->stats.bad_frames++;
         }
-        if (rc <= 0 && skip_ends(deadline, &skipped)) {
+        if (rc <= 0 && skip_ends(until, &skipped)) {
             break; /* a frame with no bytes for the caller */
         }
     }

@@ -282,6 +282,11 @@ def records(path):
         yield from _records(f, path)
 
 
+def _write_error(path, e):
+    """The CaptureError of an OSError writing the capture `path`."""
+    return CaptureError("cannot write capture %s: %s" % (path, e.strerror or e))
+
+
 class CaptureWriter:
     """Write a serial capture as `tase record` does: nanosecond pcap, link
     type 147, one record per read or write (a direction byte, 0 from the
@@ -326,7 +331,7 @@ class CaptureWriter:
                     pass
             if isinstance(e, CaptureError):
                 raise
-            raise CaptureError("cannot write capture %s: %s" % (path, e.strerror or e)) from e
+            raise _write_error(path, e) from e
 
     def _whole_records_end(self):
         """Where the last whole record of the open file ends."""
@@ -350,7 +355,7 @@ class CaptureWriter:
                 self.f.truncate(self.good)
             except (OSError, ValueError):
                 pass
-            raise CaptureError("cannot write capture %s: %s" % (self.path, e.strerror or e)) from e
+            raise _write_error(self.path, e) from e
         self.good += len(buf)
 
     def put(self, dir, data, t_ns=None):
@@ -368,7 +373,7 @@ class CaptureWriter:
         try:
             self.f.close()
         except OSError as e:
-            raise CaptureError("cannot write capture %s: %s" % (self.path, e.strerror or e)) from e
+            raise _write_error(self.path, e) from e
 
 
 class _Stream:

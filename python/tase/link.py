@@ -120,9 +120,8 @@ class _Recorder:
             self.w.put(dir, data)
         except Error as e:
             self.failed = e
-            w, self.w = self.w, None
             try:
-                w.close()
+                self._stop()
             except Error:
                 pass
             warnings.warn("%s; recording stopped, the link goes on" % e, RuntimeWarning, 3)
@@ -139,13 +138,17 @@ class _Recorder:
             self._put(0, data)
         return data
 
+    def _stop(self):
+        """Close the capture (once)."""
+        w, self.w = self.w, None
+        if w is not None:
+            w.close()
+
     def close(self):
         try:
             self.inner.close()
         finally:
-            if self.w is not None:
-                w, self.w = self.w, None
-                w.close()
+            self._stop()
 
 
 # ---- transports: bytes in and out -------------------------------------------
@@ -422,10 +425,17 @@ class Link:
             if self._closed:
                 return
             self._closed = True
-            shut = self._calls == 0 and self._t_open
-            self._t_open = self._t_open and not shut
+            shut = self._shut_now()
         if shut:
             self._t.close()
+
+    def _shut_now(self):
+        """With _state_lock held: whether the device is to be closed now
+        (the link is closed and no call is left in it); marks it closed."""
+        shut = self._closed and self._calls == 0 and self._t_open
+        if shut:
+            self._t_open = False
+        return shut
 
     def __del__(self):
         if not getattr(self, "_closed", True):
@@ -451,8 +461,7 @@ class Link:
             finally:
                 with self._state_lock:
                     self._calls -= 1
-                    shut = self._closed and self._calls == 0 and self._t_open
-                    self._t_open = self._t_open and not shut
+                    shut = self._shut_now()
                 if shut:
                     self._t.close()
 
