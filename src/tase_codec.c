@@ -14,6 +14,12 @@
 #include <string.h>
 
 #include "tase_codec_private.h"
+#include "tase/flags.h"
+
+/* SPOI_CMD's latitude and longitude limits (90 and 180 degrees) in
+ * milli-arcseconds, its wire unit. */
+#define SPOI_LAT_MAX_MAS 324000000
+#define SPOI_LON_MAX_MAS 648000000
 
 static void member_store(void *dst, unsigned w, uint64_t v)
 {
@@ -300,4 +306,56 @@ int tase_packet_decode(const tase_frame_t *f, void *msg)
         return TASE_EARG;
     }
     return decode_find(f->group, f->type, f->data, f->len, msg);
+}
+
+int tase_command_check(uint16_t id, const void *msg)
+{
+    if (msg == NULL) {
+        return TASE_EARG;
+    }
+    if (id == TASE_ID_GIMBAL_CMD) {
+        const tase_gimbal_cmd_t *c = msg;
+        bool position;
+        switch (c->flags) {
+        case TASE_GIMBAL_FLAGS_LEGACY_POSITION:
+        case TASE_GIMBAL_FLAGS_LEGACY_POSITION_STAB:
+        case TASE_GIMBAL_FLAGS_POSITION:
+        case TASE_GIMBAL_FLAGS_POSITION_STAB: position = true; break;
+        case TASE_GIMBAL_FLAGS_LEGACY_RATE:
+        case TASE_GIMBAL_FLAGS_LEGACY_RATE_STAB:
+        case TASE_GIMBAL_FLAGS_RATE:
+        case TASE_GIMBAL_FLAGS_RATE_STAB:
+        case TASE_GIMBAL_FLAGS_IMPULSE:
+        case TASE_GIMBAL_FLAGS_IMPULSE_STAB:
+        case TASE_GIMBAL_FLAGS_SPOI_ERROR:
+        case TASE_GIMBAL_FLAGS_SPOI_ERROR_RATE: position = false; break;
+        default: return TASE_ERANGE; /* not a mode of table 5 */
+        }
+        if (position && (c->pan < TASE_PAN_MIN_CDEG || c->pan > TASE_PAN_MAX_CDEG ||
+                         c->tilt < TASE_TILT_MIN_CDEG || c->tilt > TASE_TILT_MAX_CDEG)) {
+            return TASE_ERANGE;
+        }
+    } else if (id == TASE_ID_SPOI_CMD) {
+        const tase_spoi_cmd_t *c = msg;
+        if (c->lat < -SPOI_LAT_MAX_MAS || c->lat > SPOI_LAT_MAX_MAS || c->lon < -SPOI_LON_MAX_MAS ||
+            c->lon > SPOI_LON_MAX_MAS) {
+            return TASE_ERANGE;
+        }
+    } else {
+        /* no other packet moves the gimbal on a value the wire can carry */
+    }
+    return TASE_OK;
+}
+
+int tase_command_check_data(uint16_t id, const uint8_t *data, size_t len)
+{
+    tase_gimbal_cmd_t gimbal_cmd;
+    tase_spoi_cmd_t spoi_cmd;
+    void *m = (id == TASE_ID_GIMBAL_CMD) ? (void *)&gimbal_cmd : (void *)&spoi_cmd;
+    int r;
+    if ((id != TASE_ID_GIMBAL_CMD && id != TASE_ID_SPOI_CMD) || len == 0u) {
+        return TASE_OK;
+    }
+    r = tase_packet_decode_data(id, data, len, m);
+    return (r < 0) ? r : tase_command_check(id, m);
 }

@@ -75,16 +75,28 @@ static int host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t 
 
 int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len)
 {
+    int r;
     if (h == NULL) {
         return TASE_EARG;
     }
-    return host_send(h, group, type, data, len);
+    /* the port's argument checks first (as tase_port_send_frame() makes them) */
+    if (data == NULL && len > 0u) {
+        return TASE_EARG;
+    }
+    if (len > TASE_DATA_MAX) {
+        return TASE_ETOOLONG;
+    }
+    r = tase_command_check_data(TASE_ID(group, type), data, len);
+    return (r != TASE_OK) ? r : host_send(h, group, type, data, len);
 }
 
 int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg)
 {
     if (h == NULL) {
         return TASE_EARG;
+    }
+    if (msg != NULL && tase_command_check(id, msg) != TASE_OK) {
+        return TASE_ERANGE;
     }
     return tase_port_count_tx(tase_port_send_msg(&h->port, id, msg), &h->stats.frames_tx,
                               &h->stats.tx_errors);
@@ -125,25 +137,34 @@ static bool timeout_ok(uint32_t timeout_ms)
 
 /* Whether the gimbal answers packet p (NULL: unknown to the schema),
  * sent with data or without, with a frame of the same group and type, so
- * that a request may wait for it and re-send it: a zero-length query of a
- * packet with a query form, and the packets it sends back (the setup
- * packets' echo, RETRACT_DEPLOY_CMD when the move ends, CAMERA_PASS with
- * the camera's bytes), SPOI_CMD only with its echo flag (4.3.2: spoi_flags,
- * its data byte 18). TASE_ELENGTH for zero length without a query form
- * (GYRO_ZERO_CMD is a command), TASE_EARG for a packet the gimbal does not
- * answer (a re-send would repeat a command). A packet the schema does not
- * know passes: nothing says it is not answered. Decided before anything
- * is written to h->req, which may hold a typed CAMERA_PASS reply. */
-static int answered(const tase_packet_desc_t *p, bool with_data, unsigned spoi_flags)
+ * that a request may wait for it, and whether it may be re-sent: a
+ * zero-length query of a packet with a query form, and the packets it
+ * sends back (the setup packets' echo, RETRACT_DEPLOY_CMD when the move
+ * ends, CAMERA_PASS with the camera's bytes), SPOI_CMD only with its echo
+ * flag (4.3.2: spoi_flags, its data byte 18). TASE_ELENGTH for zero length
+ * without a query form (GYRO_ZERO_CMD is a command), TASE_EARG for a
+ * packet the gimbal does not answer (a re-send would repeat a command). A
+ * re-send (retries > 0) repeats the packet, so only what sets absolute
+ * values may have one: a query, a setup packet, SPOI_CMD; not
+ * RETRACT_DEPLOY_CMD (its echo comes when the move ends, later than any
+ * timeout may say), CAMERA_PASS (camera bytes, often relative commands)
+ * or a packet the schema does not know (nothing says what a repeat does),
+ * which are TASE_EARG with retries. Decided before anything is written to
+ * h->req, which may hold a typed CAMERA_PASS reply. */
+static int answered(const tase_packet_desc_t *p, bool with_data, unsigned spoi_flags,
+                    uint8_t retries)
 {
     if (p == NULL) {
-        return TASE_OK;
+        return (retries == 0u) ? TASE_OK : TASE_EARG;
     }
     if (!with_data) {
         return tase_schema_is_query(p, 0u) ? TASE_OK : TASE_ELENGTH;
     }
     if ((p->flags & TASE_DIR_BOTH) != TASE_DIR_BOTH ||
         (p->id == TASE_ID_SPOI_CMD && (spoi_flags & TASE_SPOI_ECHO) == 0u)) {
+        return TASE_EARG;
+    }
+    if (retries > 0u && TASE_ID_GROUP(p->id) != TASE_GROUP_SETUP && p->id != TASE_ID_SPOI_CMD) {
         return TASE_EARG;
     }
     return TASE_OK;
@@ -164,7 +185,10 @@ int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const u
     if (h->state != HOST_IDLE) {
         return TASE_EBUSY;
     }
-    r = answered(tase_schema_find(group, type), len > 0u, len > 18u ? data[18] : 0u);
+    r = answered(tase_schema_find(group, type), len > 0u, len > 18u ? data[18] : 0u, retries);
+    if (r == TASE_OK) {
+        r = tase_command_check_data(TASE_ID(group, type), data, len);
+    }
     if (r != TASE_OK) {
         return r;
     }
@@ -190,7 +214,11 @@ int tase_host_request_msg_start(tase_host_t *h, uint16_t id, const void *msg, vo
         const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
         int r = answered(
             p, msg != NULL && p != NULL && p->len > 0u,
-            (msg != NULL && id == TASE_ID_SPOI_CMD) ? ((const tase_spoi_cmd_t *)msg)->flags : 0u);
+            (msg != NULL && id == TASE_ID_SPOI_CMD) ? ((const tase_spoi_cmd_t *)msg)->flags : 0u,
+            retries);
+        if (r == TASE_OK && msg != NULL) {
+            r = tase_command_check(id, msg);
+        }
         if (r != TASE_OK) {
             return r;
         }

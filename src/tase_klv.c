@@ -136,6 +136,11 @@ static int read_ber(const uint8_t *in, size_t n, uint32_t *value, size_t *set_st
             if (n <= pos) {
                 return TASE_ETRUNC;
             }
+            if (i + 1u < octets && in[pos] != 0u) {
+                /* at least 256 whatever follows: never 69 or 70, decided
+                 * now (TASE_ETRUNC means a valid packet may still follow) */
+                return TASE_ELENGTH;
+            }
             v = (v << 8) | in[pos];
             pos++;
         }
@@ -349,14 +354,14 @@ static bool rx_scan(tase_klv_rx_t *rx, int final, klv_call_t *c)
 static int rx_begin(tase_klv_rx_t *rx, tase_klv_handler_t on_packet,
                     tase_klv_error_handler_t on_error, void *user, klv_call_t *c)
 {
-    if (rx == NULL) {
+    /* the held length first: a corrupted or never initialised scanner is
+     * TASE_EARG even when its `busy` byte happens to be set (TASE_EBUSY
+     * would have a caller retry for ever) */
+    if (rx == NULL || rx->len > TASE_KLV_PACKET_MAX) {
         return TASE_EARG;
     }
     if (rx->busy != 0u) {
         return TASE_EBUSY;
-    }
-    if (rx->len > TASE_KLV_PACKET_MAX) {
-        return TASE_EARG;
     }
     c->on_packet = on_packet;
     c->on_error = on_error;

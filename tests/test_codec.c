@@ -634,6 +634,81 @@ static void data_only_codec_rejects_bad_arguments(void **state)
     assert_int_equal(msg.packet_rate.angle_1, 0); /* zeroed */
 }
 
+/* tase_command_check(): the twelve flags values of table 5 pass, the
+ * other 244 are TASE_ERANGE; a position command must lie within pan
+ * -180..180 and tilt -270..90 degrees (a rate, impulse or SPOI error
+ * takes the wire's range); SPOI_CMD within 90 / 180 degrees. The table
+ * and the limits are written out here from the spec, not from the code. */
+static void command_check_takes_what_the_spec_defines_and_nothing_else(void **state)
+{
+    static const unsigned modes[] = {0x00, 0x01, 0x02, 0x03, 0x10, 0x90,
+                                     0x20, 0xA0, 0x30, 0xB0, 0xC0, 0xD0};
+    static const unsigned positions[] = {0x01, 0x03, 0x20, 0xA0};
+    tase_gimbal_cmd_t c;
+    tase_spoi_cmd_t sp;
+    uint8_t data[TASE_DATA_MAX];
+    unsigned f;
+    size_t i;
+    (void)state;
+    memset(&c, 0, sizeof c);
+    for (f = 0; f < 256u; f++) {
+        int want = TASE_ERANGE;
+        for (i = 0; i < sizeof modes / sizeof modes[0]; i++) {
+            if (modes[i] == f) {
+                want = TASE_OK;
+            }
+        }
+        c.flags = (uint8_t)f;
+        assert_int_equal(tase_command_check(TASE_ID_GIMBAL_CMD, &c), want);
+        assert_int_equal(tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &c, data, sizeof data), 8);
+        assert_int_equal(tase_command_check_data(TASE_ID_GIMBAL_CMD, data, 8), want);
+    }
+    for (i = 0; i < sizeof positions / sizeof positions[0]; i++) {
+        static const int16_t pans[][2] = {{-18000, 1}, {18000, 1}, {-18001, 0},
+                                          {18001, 0},  {32767, 0}, {-32768, 0}};
+        static const int16_t tilts[][2] = {{-27000, 1}, {9000, 1}, {-27001, 0}, {9001, 0}};
+        size_t k;
+        c.flags = (uint8_t)positions[i];
+        c.tilt = 0;
+        for (k = 0; k < sizeof pans / sizeof pans[0]; k++) {
+            c.pan = pans[k][0];
+            assert_int_equal(tase_command_check(TASE_ID_GIMBAL_CMD, &c),
+                             pans[k][1] ? TASE_OK : TASE_ERANGE);
+        }
+        c.pan = 0;
+        for (k = 0; k < sizeof tilts / sizeof tilts[0]; k++) {
+            c.tilt = tilts[k][0];
+            assert_int_equal(tase_command_check(TASE_ID_GIMBAL_CMD, &c),
+                             tilts[k][1] ? TASE_OK : TASE_ERANGE);
+        }
+    }
+    c.pan = 32767;
+    c.tilt = -32768;
+    c.flags = TASE_GIMBAL_FLAGS_RATE_STAB;
+    assert_int_equal(tase_command_check(TASE_ID_GIMBAL_CMD, &c), TASE_OK);
+    c.flags = TASE_GIMBAL_FLAGS_IMPULSE;
+    assert_int_equal(tase_command_check(TASE_ID_GIMBAL_CMD, &c), TASE_OK);
+
+    memset(&sp, 0, sizeof sp);
+    sp.lat = 324000000; /* 90 degrees in milli-arcseconds */
+    sp.lon = -648000000;
+    assert_int_equal(tase_command_check(TASE_ID_SPOI_CMD, &sp), TASE_OK);
+    sp.lat = -324000001;
+    assert_int_equal(tase_command_check(TASE_ID_SPOI_CMD, &sp), TASE_ERANGE);
+    sp.lat = 0;
+    sp.lon = 648000001;
+    assert_int_equal(tase_command_check(TASE_ID_SPOI_CMD, &sp), TASE_ERANGE);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_SPOI_CMD, &sp, data, sizeof data), 19);
+    assert_int_equal(tase_command_check_data(TASE_ID_SPOI_CMD, data, 19), TASE_ERANGE);
+    /* a query, other packets, wrong lengths and NULL */
+    assert_int_equal(tase_command_check_data(TASE_ID_SPOI_CMD, NULL, 0), TASE_OK);
+    assert_int_equal(tase_command_check_data(TASE_ID_SPOI_CMD, data, 18), TASE_ELENGTH);
+    assert_int_equal(tase_command_check_data(TASE_ID_GIMBAL_CMD, NULL, 8), TASE_EARG);
+    assert_int_equal(tase_command_check_data(TASE_ID_PACKET_RATE, data, 3), TASE_OK);
+    assert_int_equal(tase_command_check(TASE_ID_GIMBAL_CMD, NULL), TASE_EARG);
+    assert_int_equal(tase_command_check(TASE_ID_PACKET_RATE, &sp), TASE_OK);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -652,6 +727,7 @@ int main(void)
         cmocka_unit_test(camera_pass_carries_249_bytes_and_may_be_encoded_in_place),
         cmocka_unit_test(data_only_codec_matches_the_frame_codec_for_every_packet),
         cmocka_unit_test(data_only_codec_rejects_bad_arguments),
+        cmocka_unit_test(command_check_takes_what_the_spec_defines_and_nothing_else),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -322,7 +322,7 @@ static void a_port_that_refuses_the_request_leaves_the_host_idle(void **state)
                      TASE_EDOWN);
     assert_false(tase_host_busy(&x->host));
     assert_int_equal(x->host.stats.tx_errors, 1);
-    assert_int_equal(tase_host_send(&x->host, 0, 0x80, rates, 8), TASE_EDOWN);
+    assert_int_equal(tase_host_send(&x->host, 0x48, 0x00, rates, 16), TASE_EDOWN);
     /* A refused retry still uses up its attempt. */
     x->port.write_result = 0;
     assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 100, 1, 0),
@@ -656,7 +656,7 @@ static void host_api_rejects_bad_arguments(void **state)
 static void send_msg_writes_the_frame_the_codec_builds(void **state)
 {
     fix_t *x = *state;
-    tase_gimbal_cmd_t cmd = {-12345, 4500, 0, 0x21, 7};
+    tase_gimbal_cmd_t cmd = {-12345, 4500, 0, 0xA0, 7};
     tase_camera_pass_t cp = {1, 8, 3, (const uint8_t *)"abc"};
     uint8_t want[TASE_FRAME_MAX];
     int n;
@@ -843,19 +843,116 @@ static void requests_of_packets_the_gimbal_does_not_answer_send_nothing(void **s
     assert_int_equal(x->host.stats.requests, 0);
     assert_false(tase_host_busy(&x->host));
 
-    /* what it answers still goes: SPOI_CMD with its echo flag, RETRACT_DEPLOY_CMD,
-     * a group/type the schema does not know */
+    /* what it answers still goes: SPOI_CMD with its echo flag (re-sent on
+     * a timeout), RETRACT_DEPLOY_CMD and a group/type the schema does not
+     * know (without retries: next test) */
     spoi.flags = TASE_SPOI_ECHO;
     assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID_SPOI_CMD, &spoi, &m, 10, 2, 0),
                      TASE_OK);
     assert_int_equal(tase_host_cancel(&x->host), TASE_OK);
     assert_int_equal(
-        tase_host_request_msg_start(&x->host, TASE_ID_RETRACT_DEPLOY_CMD, &rd, &m, 10, 2, 0),
+        tase_host_request_msg_start(&x->host, TASE_ID_RETRACT_DEPLOY_CMD, &rd, &m, 10, 0, 0),
         TASE_OK);
     assert_int_equal(tase_host_cancel(&x->host), TASE_OK);
-    assert_int_equal(tase_host_request_start(&x->host, 0x28, 0x01, data, 3, reply, 8, 10, 2, 0),
+    assert_int_equal(tase_host_request_start(&x->host, 0x28, 0x01, data, 3, reply, 8, 10, 0, 0),
                      TASE_OK);
     assert_int_equal(x->host.stats.requests, 3);
+}
+
+/* A retry repeats the packet. RETRACT_DEPLOY_CMD's echo comes when the move
+ * ends (a review: with a 500 ms timeout it went out three times during one
+ * move), CAMERA_PASS carries camera bytes (a relative zoom went out three
+ * times) and nothing says what a packet the schema does not know does
+ * twice: these may be requested only without retries. */
+static void requests_a_retry_would_repeat_need_retries_0(void **state)
+{
+    fix_t *x = *state;
+    tase_retract_deploy_cmd_t rd = {TASE_DEPLOY};
+    tase_camera_pass_t pass = {0, 0, 3, (const uint8_t *)"\x81\x01\x04"};
+    tase_packet_msg_t m;
+    uint8_t data[3] = {1, 2, 3};
+    uint8_t reply[8];
+    refused_both_ways(x, TASE_ID_RETRACT_DEPLOY_CMD, &rd, 2, TASE_EARG);
+    refused_both_ways(x, TASE_ID_CAMERA_PASS, &pass, 7, TASE_EARG);
+    assert_int_equal(tase_host_request_start(&x->host, 0x28, 0x01, data, 3, reply, 8, 10, 1, 0),
+                     TASE_EARG);
+    assert_int_equal(tase_host_request_start(&x->host, 0x00, 0x99, data, 3, reply, 8, 10, 1, 0),
+                     TASE_EARG);
+    assert_int_equal(tase_host_transact(&x->host, 0x00, 0x99, data, 3, reply, 8, 10, 2), TASE_EARG);
+    assert_int_equal(x->port.nout, 0);
+    assert_int_equal(x->host.stats.requests, 0);
+    /* without retries they go, once, and time out once */
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_CAMERA_PASS, &pass, &m, 10, 0, 0), TASE_OK);
+    assert_int_equal(tase_host_poll(&x->host, 10), TASE_ETIMEOUT);
+    assert_int_equal(fake_frames_out(&x->port), 1);
+    /* a setup packet's echo and a query may still be re-sent */
+    assert_int_equal(tase_host_request_start(&x->host, 0x48, 0x00, rates, 16, reply, 8, 10, 2, 0),
+                     TASE_OK);
+    assert_int_equal(tase_host_cancel(&x->host), TASE_OK);
+}
+
+/* Nothing moves on a value the spec gives no meaning: a GIMBAL_CMD whose
+ * flags are not a mode of table 5 (0x55 went out and the simulator took it
+ * for a rate), a position beyond the axes' ranges (pan 200 degrees), a
+ * SPOI_CMD beyond 90 degrees of latitude or 180 of longitude; typed, as
+ * data bytes and as a request, nothing sent, no port error counted. */
+static void motion_commands_the_spec_does_not_define_are_not_sent(void **state)
+{
+    fix_t *x = *state;
+    static const tase_gimbal_cmd_t bad_cmds[] = {
+        {0, 0, 0, 0x55, 0},
+        {0, 0, 0, 0x04, 0},
+        {0, 0, 0, 0xE0, 0},
+        {18001, 0, 0, TASE_GIMBAL_FLAGS_POSITION, 0},
+        {-18001, 0, 0, TASE_GIMBAL_FLAGS_POSITION_STAB, 0},
+        {0, 9001, 0, TASE_GIMBAL_FLAGS_LEGACY_POSITION, 0},
+        {0, -27001, 0, TASE_GIMBAL_FLAGS_LEGACY_POSITION_STAB, 0},
+    };
+    static const tase_gimbal_cmd_t good_cmds[] = {
+        {18000, 9000, 0, TASE_GIMBAL_FLAGS_POSITION, 0},
+        {-18000, -27000, 0, TASE_GIMBAL_FLAGS_POSITION_STAB, 0},
+        {32767, -32768, 0, TASE_GIMBAL_FLAGS_RATE_STAB, 0}, /* a rate: the wire's range */
+        {32767, 32767, 0, TASE_GIMBAL_FLAGS_SPOI_ERROR, 0},
+    };
+    tase_spoi_cmd_t spoi;
+    tase_packet_msg_t m;
+    uint8_t data[TASE_DATA_MAX];
+    uint8_t reply[8];
+    size_t i;
+    for (i = 0; i < sizeof bad_cmds / sizeof bad_cmds[0]; i++) {
+        assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_GIMBAL_CMD, &bad_cmds[i]),
+                         TASE_ERANGE);
+        assert_int_equal(
+            tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &bad_cmds[i], data, sizeof data), 8);
+        assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, data, 8), TASE_ERANGE);
+    }
+    /* a GIMBAL_CMD of a wrong length is not sent either */
+    assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, data, 7), TASE_ELENGTH);
+    memset(&spoi, 0, sizeof spoi);
+    spoi.flags = TASE_SPOI_ECHO;
+    spoi.lat = 324000001;
+    assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_SPOI_CMD, &spoi), TASE_ERANGE);
+    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID_SPOI_CMD, &spoi, &m, 10, 0, 0),
+                     TASE_ERANGE);
+    spoi.lat = 0;
+    spoi.lon = -648000001;
+    assert_int_equal(tase_packet_encode_data(TASE_ID_SPOI_CMD, &spoi, data, sizeof data), 19);
+    assert_int_equal(tase_host_send(&x->host, 0x10, 0x40, data, 19), TASE_ERANGE);
+    assert_int_equal(tase_host_request_start(&x->host, 0x10, 0x40, data, 19, reply, 8, 10, 0, 0),
+                     TASE_ERANGE);
+    assert_int_equal(x->port.nout, 0);
+    assert_int_equal(x->host.stats.tx_errors, 0);
+    assert_false(tase_host_busy(&x->host));
+    /* the ends of the ranges go */
+    for (i = 0; i < sizeof good_cmds / sizeof good_cmds[0]; i++) {
+        assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_GIMBAL_CMD, &good_cmds[i]), 16);
+    }
+    spoi.lat = -324000000;
+    spoi.lon = 648000000;
+    assert_int_equal(tase_host_send_msg(&x->host, TASE_ID_SPOI_CMD, &spoi), 27);
+    assert_int_equal(tase_host_send(&x->host, 0x10, 0x40, NULL, 0), 8); /* a query */
+    assert_int_equal(fake_frames_out(&x->port), 6);
 }
 
 /* An elapsed time of 2^31 ms or more reads as none: a timeout of 2^31
@@ -1096,6 +1193,10 @@ int main(void)
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(
             a_typed_reply_of_a_wrong_length_is_elength_and_writes_nothing, setup, teardown),
+        cmocka_unit_test_setup_teardown(requests_a_retry_would_repeat_need_retries_0, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(motion_commands_the_spec_does_not_define_are_not_sent,
+                                        setup, teardown),
         cmocka_unit_test_setup_teardown(requests_of_packets_the_gimbal_does_not_answer_send_nothing,
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(a_timeout_of_2_to_the_31_is_refused_and_the_longest_expires,

@@ -238,6 +238,35 @@ static void long_form_ber_length_is_accepted_and_counted(void **state)
     assert_decode_fails(p, 91, TASE_ELENGTH);
 }
 
+/* TASE_ETRUNC means exactly "a valid packet may still follow": a long
+ * form whose octets already make 256 or more (82 FF: at least 0xFF00) was
+ * ETRUNC until its last octet came (a review). */
+static void long_form_lengths_of_256_or_more_are_elength_at_once(void **state)
+{
+    uint8_t p[21];
+    (void)state;
+    memcpy(p, hand_packet, 16);
+    p[16] = 0x82;
+    p[17] = 0xFF;
+    assert_decode_fails(p, 18, TASE_ELENGTH);
+    p[17] = 0x00;
+    assert_decode_fails(p, 18, TASE_ETRUNC); /* 0x00xx may be 0x0046 */
+    p[16] = 0x84;
+    p[17] = 0x01;
+    assert_decode_fails(p, 18, TASE_ELENGTH);
+    p[17] = 0x00;
+    p[18] = 0x00;
+    p[19] = 0x00;
+    assert_decode_fails(p, 20, TASE_ETRUNC);
+    p[19] = 0x01;
+    assert_decode_fails(p, 20, TASE_ELENGTH);
+    /* the last octet alone decides as before: 84 00 00 00 FF is ELENGTH
+     * once that octet is in */
+    p[19] = 0x00;
+    p[20] = 0xFF;
+    assert_decode_fails(p, 21, TASE_ELENGTH);
+}
+
 static void indefinite_and_overlong_ber_forms_are_malformed(void **state)
 {
     uint8_t p[87];
@@ -650,6 +679,11 @@ static void scanner_rejects_bad_arguments_and_resets_counters(void **state)
     assert_int_equal(tase_klv_rx_stats_reset(&rx), TASE_OK);
     assert_int_equal(rx.stats.packets_ok, 0);
     assert_int_equal(rx.stats.bytes_in, 0);
+    /* a never initialised (here all 0xFF) scanner is TASE_EARG: it was
+     * TASE_EBUSY, which has a caller retry for ever (a review) */
+    memset(&rx, 0xFF, sizeof rx);
+    assert_int_equal(tase_klv_rx_feed(&rx, hand_packet, 87, NULL, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_klv_rx_flush(&rx, NULL, NULL, NULL), TASE_EARG);
 }
 
 /* ---- scanner re-entrancy (issue 12) ----------------------------------- */
@@ -1002,6 +1036,7 @@ int main(void)
         cmocka_unit_test(declared_lengths_69_and_70_are_both_accepted),
         cmocka_unit_test(other_declared_lengths_are_rejected),
         cmocka_unit_test(long_form_ber_length_is_accepted_and_counted),
+        cmocka_unit_test(long_form_lengths_of_256_or_more_are_elength_at_once),
         cmocka_unit_test(indefinite_and_overlong_ber_forms_are_malformed),
         cmocka_unit_test(bad_checksum_is_rejected),
         cmocka_unit_test(checksum_covers_exactly_the_items_before_it),

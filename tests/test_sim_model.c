@@ -720,6 +720,20 @@ static void spoi_geometry_matches_an_independent_wgs84_reference(void **state)
     assert_true(worst_tilt <= 1e-6);
 }
 
+/* A review: held up for 5 s, tase-sim sent the KLV packets it had missed
+ * 5 ms apart when it went on (the next due time only ever moved one period
+ * on). */
+static void a_stalled_periodic_output_resumes_without_a_burst(void **state)
+{
+    (void)state;
+    assert_int_equal(sim_next_due(1000u, 1003u, 900u), 1900u); /* on time */
+    assert_int_equal(sim_next_due(1000u, 1899u, 900u), 1900u); /* late, in its period */
+    assert_int_equal(sim_next_due(1000u, 1900u, 900u), 2800u); /* a whole period late */
+    assert_int_equal(sim_next_due(1000u, 6000u, 900u), 6900u); /* a 5 s stall */
+    assert_int_equal(sim_next_due(0xFFFFFF00u, 0xFFFFFF10u, 900u), 0x284u); /* the wrap */
+    assert_int_equal(sim_next_due(0xFFFFFF00u, 0x1000u, 900u), 0x1384u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -751,6 +765,7 @@ int main(void)
         cmocka_unit_test(a_removed_camera_is_gone_from_every_report),
         cmocka_unit_test(retracted_gimbal_holds_still_until_deployed),
         cmocka_unit_test(spoi_geometry_matches_an_independent_wgs84_reference),
+        cmocka_unit_test(a_stalled_periodic_output_resumes_without_a_burst),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

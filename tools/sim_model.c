@@ -521,3 +521,9 @@ unsigned sim_rate_hz(const sim_rate_meter_t *r, uint32_t now_ms)
     hz = floor(hz + 0.5);
     return hz > 255.0 ? 255u : (unsigned)hz;
 }
+
+uint32_t sim_next_due(uint32_t due, uint32_t now_ms, uint32_t period_ms)
+{
+    uint32_t next = due + period_ms;
+    return ((int32_t)(now_ms - next) >= 0) ? now_ms + period_ms : next;
+}

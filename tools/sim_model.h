@@ -257,4 +257,10 @@ void sim_rate_note(sim_rate_meter_t *r, uint32_t now_ms);
  * packet, 1000 / (its time - the reset time); 0 with none. */
 unsigned sim_rate_hz(const sim_rate_meter_t *r, uint32_t now_ms);
 
+/* A periodic output's next due time after the one due at `due` went out
+ * at now_ms: one period later, or, when that has passed too (the
+ * simulator was held up: stopped, a loaded machine), one period from now:
+ * never a burst of the outputs missed meanwhile. Modulo 2^32. */
+uint32_t sim_next_due(uint32_t due, uint32_t now_ms, uint32_t period_ms);
+
 #endif /* TASE_TOOLS_SIM_MODEL_H */

@@ -512,7 +512,7 @@ int main(int argc, char **argv)
              * serial line would, so a reader that opens later gets fresh data */
             (void)tk_pty_drop_unread(klv_slave);
             send_klv(&s, &klv_port);
-            next_klv += KLV_PERIOD_MS;
+            next_klv = sim_next_due(next_klv, now, KLV_PERIOD_MS); /* no burst after a stall */
         }
     }
     /* only links that still point at our ptys */

@@ -232,10 +232,22 @@ void tk_stdout_buffered(void)
     (void)setvbuf(stdout, NULL, _IOFBF, 1u << 16);
 }
 
+/* The first failed write's errno that tk_stdout_flush_soft() saw (its
+ * error stays on stdout for tk_stdout_flush() to report). */
+static int stdout_errno;
+
+void tk_stdout_flush_soft(void)
+{
+    if (fflush(stdout) != 0 && stdout_errno == 0) {
+        stdout_errno = (errno != 0) ? errno : EIO;
+    }
+}
+
 void tk_stdout_flush(void)
 {
     if (fflush(stdout) != 0 || ferror(stdout)) {
-        int e = errno;
+        int e = (stdout_errno != 0) ? stdout_errno : errno;
+        stdout_errno = 0;
         clearerr(stdout);
         if (sent_what != NULL) {
             /* the packet went out: say so, also to a closed pipe, with a

@@ -109,6 +109,11 @@ void tk_stdout_buffered(void);
  * killed by SIGPIPE do (links closed first). After tk_mark_sent() both
  * exit TK_EXIT_SENT naming the packet sent. */
 void tk_stdout_flush(void);
+/* Flush standard output now, as far as it goes: a failure is kept (on
+ * stdout and its errno) for the next tk_stdout_flush() to report, so a
+ * command that waits after printing (for an echo) finishes its wait and
+ * exits with the code of what happened on the link. */
+void tk_stdout_flush_soft(void);
 
 /* ---- signals ---- */
 

@@ -398,6 +398,31 @@ int tase_packet_decode_desc(const tase_packet_desc_t *p, const uint8_t *data, si
  * NULL or bound to no packet. O(length). */
 int tase_packet_decode_iter(tase_field_iter_t *it, const uint8_t *data, void *msg);
 
+/* ---- commands that move the gimbal ------------------------------------ */
+
+/* Whether a command that moves the gimbal is one the spec defines, so that
+ * nothing moves on a value the spec gives no meaning (the host role checks
+ * every GIMBAL_CMD and SPOI_CMD it sends with it: tase/host.h):
+ *   GIMBAL_CMD  flags must be one of the twelve values of the spec's
+ *               table 5 (4.1.1, the four legacy ones included), and a
+ *               position command (flags 0x01, 0x03, 0x20, 0xA0) must lie
+ *               in the axes' ranges (TASE_PAN_*_CDEG, TASE_TILT_*_CDEG in
+ *               tase/units.h: pan -180..180, tilt -270..90 degrees);
+ *   SPOI_CMD    lat within -90..90 and lon within -180..180 degrees
+ *               (+-324,000,000 and +-648,000,000 milli-arcseconds).
+ * Every other packet passes (its ranges are the wire's). Reserved flag
+ * bits are not checked here (tase_schema_reserved_flags()).
+ * Returns TASE_OK, TASE_ERANGE (a value above), or TASE_EARG (msg NULL).
+ * O(1), no side effects. */
+int tase_command_check(uint16_t id, const void *msg);
+
+/* tase_command_check() of the data bytes data[0..len) of packet `id`: a
+ * GIMBAL_CMD or SPOI_CMD with data is decoded (tase_packet_decode_data():
+ * TASE_ELENGTH for a length the packet does not accept, TASE_EARG for data
+ * NULL) and checked; a zero-length frame (a query) and any other packet
+ * give TASE_OK. O(1). */
+int tase_command_check_data(uint16_t id, const uint8_t *data, size_t len);
+
 #ifdef __cplusplus
 }
 #endif

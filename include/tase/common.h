@@ -105,6 +105,22 @@ extern "C" {
  * not link the strings. Reentrant, ISR-safe. */
 const char *tase_strerror(int err);
 
+/* Axis angle ranges of the spec (4.3.3, GEOREFERENCE_DATA bytes 56-59):
+ * pan "from -180 to 180", tilt "from -270 to 90" degrees. Tilt covers a
+ * whole turn from -270 to 90: the default tilt no-go zone (4.4.3: centre
+ * 90, range 60) forbids 60..90 and -270..-240 of it. The host role
+ * (tase_command_check(), tase/codec.h), the tools and the simulator check
+ * commands and report angles in these ranges; TASE_*_CDEG are the same in
+ * 1/100 degree, as on the wire. */
+#define TASE_PAN_MIN_DEG (-180.0)
+#define TASE_PAN_MAX_DEG 180.0
+#define TASE_TILT_MIN_DEG (-270.0)
+#define TASE_TILT_MAX_DEG 90.0
+#define TASE_PAN_MIN_CDEG (-18000)
+#define TASE_PAN_MAX_CDEG 18000
+#define TASE_TILT_MIN_CDEG (-27000)
+#define TASE_TILT_MAX_CDEG 9000
+
 #ifdef __cplusplus
 }
 #endif

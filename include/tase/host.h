@@ -143,18 +143,25 @@ typedef struct {
 int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on_frame, void *user);
 
 /* Send one frame now (a command, host data, anything; a request may be
- * pending meanwhile). Returns the frame length, or TASE_EARG (h NULL,
- * data NULL with len > 0), TASE_ETOOLONG (len > 253), or a port error
- * from tase_port_write_all() (port_io.h). O(len). */
+ * pending meanwhile). A GIMBAL_CMD or SPOI_CMD with data must be one the
+ * spec defines (tase_command_check_data(), tase/codec.h: a flags value of
+ * table 5, a position within the axes' ranges, a SPOI within 90/180
+ * degrees, the packet's length): nothing moves on a value the spec gives
+ * no meaning. Returns the frame length, or TASE_EARG (h NULL, data NULL
+ * with len > 0), TASE_ETOOLONG (len > 253), TASE_ERANGE / TASE_ELENGTH
+ * (such a GIMBAL_CMD or SPOI_CMD), all checked before anything is sent,
+ * or a port error from tase_port_write_all() (port_io.h). O(len). */
 int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len);
 
 /* Send packet `id` (TASE_ID_*) from its typed struct msg (tase/codec.h)
  * now; msg NULL sends the zero-length form (GYRO_ZERO_CMD, or a query
  * whose answer then goes to on_frame). Returns the frame length, or
  * TASE_EARG (h NULL, or a CAMERA_PASS tail NULL with len > 0),
- * TASE_EUNKNOWN (id not in the schema), TASE_ELENGTH (msg NULL for a
- * packet without a zero-length form), TASE_ETOOLONG (CAMERA_PASS tail
- * over 249 bytes), all checked before anything is sent, or a port error
+ * TASE_ERANGE (a GIMBAL_CMD or SPOI_CMD tase_command_check() refuses, as
+ * tase_host_send()), TASE_EUNKNOWN (id not in the schema), TASE_ELENGTH
+ * (msg NULL for a packet without a zero-length form), TASE_ETOOLONG
+ * (CAMERA_PASS tail over 249 bytes), all checked before anything is
+ * sent, or a port error
  * from tase_port_write_all(). msg must not change until the call returns;
  * stack: tase_port_send_msg() (port_io.h).
  * O(length). */
@@ -172,13 +179,21 @@ int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg);
  * when the move ends), CAMERA_PASS (the camera's bytes come back),
  * SPOI_CMD with TASE_SPOI_ECHO set, or a group/type the schema does not
  * know. Send the others with tase_host_send() / tase_host_send_msg().
+ * A retry repeats the packet, so retries > 0 only for what sets absolute
+ * values (a query, a setup packet, SPOI_CMD); RETRACT_DEPLOY_CMD (its echo
+ * comes when the move ends, later than a timeout may say), CAMERA_PASS
+ * (camera bytes, often relative commands) and unknown packets (nothing
+ * says what a repeat does) need retries 0.
  * Returns TASE_OK (first attempt sent), or
  *   TASE_EARG     h NULL, data NULL with len > 0, reply NULL with
  *                 reply_cap > 0, timeout_ms 0 or >= 2^31; a packet the
  *                 gimbal does not answer (GIMBAL_CMD, CAMERA_CMD, the
  *                 host's data, telemetry, SPOI_CMD without its echo flag);
+ *                 retries > 0 for a packet that needs 0 (above);
+ *   TASE_ERANGE   a SPOI_CMD tase_command_check_data() refuses;
  *   TASE_ELENGTH  len 0 for a known packet without a query form
- *                 (GYRO_ZERO_CMD: a command, never sent as a request);
+ *                 (GYRO_ZERO_CMD: a command, never sent as a request), a
+ *                 SPOI_CMD of a length it does not accept;
  *   TASE_ETOOLONG len > 253;
  *   TASE_EBUSY    a request is pending (it is left untouched; checked
  *                 before what the request is);

@@ -29,7 +29,8 @@
  *   - The 16 key bytes must match exactly              else TASE_EFORMAT.
  *   - The length is read as BER: short form, or long form with 1..4 length
  *     octets (0x81 0x46 ...); indefinite (0x80) or longer forms give
- *     TASE_EFORMAT; a value other than 69 or 70 gives TASE_ELENGTH.
+ *     TASE_EFORMAT; a value other than 69 or 70 gives TASE_ELENGTH (as
+ *     soon as a long form's octets make it 256 or more).
  *   - Items are parsed one by one. A tag outside 1..15 is TASE_EUNKNOWN.
  *     Tags must appear exactly once each, in order 1..15: a repeated,
  *     missing or out-of-order tag shows up as "tag k where k-th was

@@ -9,7 +9,8 @@
  *   1/300 m/s^2 (HOST_SENSOR accel)     tase_units_accel_to_mps2 / mps2_to_accel
  *   0.1 PDOP                            tase_units_pdop_to_raw / raw_to_pdop
  *
- * and the axes' angle ranges (TASE_PAN_*, TASE_TILT_*, below).
+ * and the axes' angle ranges (TASE_PAN_*, TASE_TILT_*: tase/common.h,
+ * which this header includes).
  *
  * To-wire conversions round to the nearest integer, halves away from zero
  * (2.5 -> 3, -2.5 -> -3), then SATURATE to the field's range (a value
@@ -36,20 +37,7 @@
 extern "C" {
 #endif
 
-/* Axis angle ranges of the spec (4.3.3, GEOREFERENCE_DATA bytes 56-59):
- * pan "from -180 to 180", tilt "from -270 to 90" degrees. Tilt covers a
- * whole turn from -270 to 90: the default tilt no-go zone (4.4.3: centre
- * 90, range 60) forbids 60..90 and -270..-240 of it. Tools and simulators
- * check commands and report angles in these ranges; TASE_*_CDEG are the
- * same in 1/100 degree, as on the wire. */
-#define TASE_PAN_MIN_DEG (-180.0)
-#define TASE_PAN_MAX_DEG 180.0
-#define TASE_TILT_MIN_DEG (-270.0)
-#define TASE_TILT_MAX_DEG 90.0
-#define TASE_PAN_MIN_CDEG (-18000)
-#define TASE_PAN_MAX_CDEG 18000
-#define TASE_TILT_MIN_CDEG (-27000)
-#define TASE_TILT_MAX_CDEG 9000
+/* The axes' angle ranges (TASE_PAN_*, TASE_TILT_*) are in tase/common.h. */
 
 /* Round half away from zero and clamp to [lo, hi]; NaN -> 0. Exact for
  * every |v| < 2^52 except values within one ulp below a .5 boundary. */

@@ -40,10 +40,13 @@ def session(url, out):
         else:
             raise SystemExit("the gimbal did not reach pan 30, tilt -10 within 5 s")
 
-        # a slow pan to the left for one second, then stop
+        # a slow pan to the left for one second, then stop (in a finally:
+        # an exception or Ctrl-C must not leave the gimbal turning)
         link.rate(-20, 0)
-        telemetry = list(link.packets(timeout=1.0))
-        link.rate(0, 0)
+        try:
+            telemetry = list(link.packets(timeout=1.0))
+        finally:
+            link.rate(0, 0)
         angles = [p for p in telemetry if p.name == "GIMBAL_ANGLE"]
         print("%d packets in 1 s, %d GIMBAL_ANGLE" % (len(telemetry), len(angles)))
         with open(os.path.join(out, "telemetry.jsonl"), "w") as f:

@@ -179,6 +179,16 @@ class Field:
                 ),
                 lib.TASE_ERANGE,
             )
+        if r == self.keep or r == self.none:
+            # e.g. AXIS_SETTING pan_max_rate 1275 deg/s is raw 0xFF: "do not
+            # change", which a gimbal reads as no value at all
+            raise FieldError(
+                "%s %s: %s %s is raw %d, the wire's \"%s\" code, not a value "
+                "(leave the field out, or give it in raw=, to send that code)"
+                % (pkt, self.name, value, self.label, r,
+                   "do not change" if r == self.keep else "unavailable"),
+                lib.TASE_ERANGE,
+            )
         return r
 
     def _check(self, value, pkt):

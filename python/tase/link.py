@@ -362,6 +362,14 @@ _SEND_RESERVED = "send(..., reserved=True) sends it anyway, as tase send --raw"
 _QUERY_RESERVED = "send(..., reserved=True) sends it; the answer is then read with recv()"
 
 
+def _stab(what, v):
+    """stab= of point()/rate(): True or False only (a string such as
+    "off" is true in Python, and stabilised is not what it asked for)."""
+    if not isinstance(v, bool):
+        raise FieldError("%s: stab must be True or False, not %r: nothing sent" % (what, v))
+    return v
+
+
 def _seconds(what, v):
     """A timeout in seconds: a finite number >= 0 (under 2^31 ms, what the
     C side's clock arithmetic can see expire), else FieldError."""
@@ -520,11 +528,28 @@ class Link:
                 )
         return t
 
+    def _request_opts(self, timeout, retries):
+        """A request's timeout (s) and retries, the link's defaults for None;
+        FieldError unless a number in (0, 2^31 ms) and an int 0..255."""
+        timeout = self.timeout if timeout is None else timeout
+        retries = self.retries if retries is None else retries
+        if (
+            isinstance(timeout, bool)
+            or not isinstance(timeout, (int, float))
+            or isinstance(retries, bool)
+            or not isinstance(retries, int)
+            or not 0 < timeout < 2**31 / 1000
+            or not 0 <= retries <= 255
+        ):
+            raise FieldError("timeout must be > 0 s and under 2^31 ms, retries 0..255")
+        return timeout, retries
+
     def send(self, packet, reserved=False):
         """Send one packet to the gimbal now (no answer awaited). Packets
         the gimbal sends, unknown ones, wrong lengths, a full-length
         SYSTEM_VERSION (query-only), GIMBAL_CMD flags outside the spec's
-        table 5 and flags with bits the spec reserves (CAMERA_CMD,
+        table 5, a position or SPOI outside the spec's ranges (the host
+        role's tase_command_check()) and flags with bits the spec reserves (CAMERA_CMD,
         HOST_SENSOR, HOST_ATTITUDE, SPOI_CMD; reserved=True sends those
         anyway) are refused (FieldError), nothing sent, as `tase send`."""
         self._live()
@@ -572,10 +597,7 @@ class Link:
         else:
             raise TypeError("query() takes a packet name or a tase.Packet, not %s" % type(what).__name__)
         t = req.packet_type
-        timeout = self.timeout if timeout is None else timeout
-        retries = self.retries if retries is None else retries
-        if not 0 < timeout < 2**31 / 1000 or not 0 <= retries <= 255:
-            raise FieldError("timeout must be > 0 s and under 2^31 ms, retries 0..255")
+        timeout, retries = self._request_opts(timeout, retries)
         ms = min(max(1, int(round(timeout * 1000))), 2**31 - 1)
         data = req.payload
         r = self._call(
@@ -682,7 +704,7 @@ class Link:
                 raise FieldError(
                     "point: %s %r is not a number in %g..%g degrees" % (name, v, lo / 100, hi / 100)
                 )
-        flags = lib.TASE_GIMBAL_FLAGS_POSITION_STAB if stab else lib.TASE_GIMBAL_FLAGS_POSITION
+        flags = lib.TASE_GIMBAL_FLAGS_POSITION_STAB if _stab("point", stab) else lib.TASE_GIMBAL_FLAGS_POSITION
         return self.send(_gimbal_cmd(pan, tilt, flags))
 
     def rate(self, pan_rate, tilt_rate, stab=True):
@@ -696,7 +718,7 @@ class Link:
                 raise FieldError(
                     "rate: %s %r is not a number in -327.68..327.67 deg/s" % (name, v)
                 )
-        flags = lib.TASE_GIMBAL_FLAGS_RATE_STAB if stab else lib.TASE_GIMBAL_FLAGS_RATE
+        flags = lib.TASE_GIMBAL_FLAGS_RATE_STAB if _stab("rate", stab) else lib.TASE_GIMBAL_FLAGS_RATE
         return self.send(_gimbal_cmd(pan_rate, tilt_rate, flags))
 
     def spoi(self, lat, lon, height, wait=True, timeout=None, retries=None):
@@ -732,7 +754,10 @@ class Link:
 
     def _retract_deploy(self, deploy, wait):
         if wait is not None:
-            _seconds("%s: wait" % ("deploy" if deploy else "retract"), wait)  # before sending
+            # before sending; 0 s would send and then time out at once
+            what = "%s: wait" % ("deploy" if deploy else "retract")
+            if _seconds(what, wait) == 0:
+                raise FieldError("%s: 0 is no time to wait (None: do not wait); nothing sent" % what)
         p = Packet("RETRACT_DEPLOY_CMD", deploy=lib.TASE_DEPLOY if deploy else lib.TASE_RETRACT)
         self.send(p)
         if wait is None:
@@ -768,6 +793,7 @@ class Link:
         the gimbal's SYSTEM_VERSION: a camera it does not have is refused,
         nothing sent), hfov in degrees (0.01..327.67) or zoom ratio
         (1..327.68); every other field "do not change"."""
+        self._request_opts(timeout, retries)  # checked even when no query is made
         if hfov is not None and zoom is not None:
             raise FieldError("camera: hfov or zoom, not both")
         cam = None

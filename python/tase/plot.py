@@ -6,9 +6,19 @@ from .capture import read_capture
 
 __all__ = ["series", "plot_capture"]
 
-# GIMBAL_CMD flags (tase/flags.h): the kind is bits 4-5 (1 rate, 2 position)
-_KIND_RATE = 0x10
-_KIND_POSITION = 0x20
+# GIMBAL_CMD flags (spec table 5, tase/flags.h): the drawn kind of each
+# value; impulse and SPOI error commands (and values outside the table)
+# are not drawn and leave the command in force as it was.
+_DRAWN = {
+    0x00: "_rate",  # legacy rate
+    0x02: "_rate",  # legacy rate, stabilised
+    0x10: "_rate",
+    0x90: "_rate",
+    0x01: "",  # legacy position
+    0x03: "",  # legacy position, stabilised
+    0x20: "",
+    0xA0: "",
+}
 
 
 def series(path, baud=57600):
@@ -16,8 +26,10 @@ def series(path, baud=57600):
     seconds from the first packet. Reported: GIMBAL_ANGLE pan/tilt (deg)
     and GIMBAL_RATE pan_rate/tilt_rate (deg/s). Commanded (GIMBAL_CMD sent
     to the gimbal): pan_cmd/tilt_cmd (deg) while position commands are in
-    force and pan_rate_cmd/tilt_rate_cmd (deg/s) while rate commands are,
-    each value held until the next command (NaN between: no line drawn)."""
+    force and pan_rate_cmd/tilt_rate_cmd (deg/s) while rate commands are
+    (the legacy flags values included), each value held until the next
+    command (NaN between: no line drawn); impulse and SPOI error commands
+    change neither."""
     out = {}
     t0 = None
     last = None
@@ -55,12 +67,13 @@ def series(path, baud=57600):
             add("tilt_rate", t, f["tilt_rate"])
         elif p.name == "GIMBAL_CMD" and p.dir == "in":
             r = p.raw
-            kind = {_KIND_POSITION: "", _KIND_RATE: "_rate"}.get(r["flags"] & 0x30)
+            kind = _DRAWN.get(r["flags"])
+            if kind is None:
+                continue  # the gimbal keeps the position or rate command it had
             hold(t, end=kind != mode)
             mode = kind
-            if kind is not None:
-                add("pan" + kind + "_cmd", t, r["pan"] / 100.0)
-                add("tilt" + kind + "_cmd", t, r["tilt"] / 100.0)
+            add("pan" + kind + "_cmd", t, r["pan"] / 100.0)
+            add("tilt" + kind + "_cmd", t, r["tilt"] / 100.0)
     if last is not None:
         hold(last)
     return out

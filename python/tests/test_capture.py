@@ -71,6 +71,33 @@ def test_plot_commanded_vs_reported(recorded, tmp_path):
     assert len(s["pan"][0]) > 5 and len(s["pan_rate"][0]) > 5
 
 
+def test_plot_draws_only_position_and_rate_commands(tmp_path):
+    # a review: the kind was read as flags & 0x30, so a SPOI error rate
+    # (0xD0) drew a rate command that never was and ended the position
+    # curve, and the legacy position values (0x01, 0x03) were dropped
+    cap = str(tmp_path / "cmds.pcap")
+
+    def cmd(pan, tilt, flags):
+        return tase.encode(tase.Packet("GIMBAL_CMD", raw={"pan": pan, "tilt": tilt, "roll": 0,
+                                                          "flags": flags, "impulse_time": 0}))
+
+    w = tase.capture.CaptureWriter(cap)
+    for i, (pan, tilt, flags) in enumerate([(1000, 2000, 0xA0), (500, 500, 0xD0),
+                                            (300, 300, 0x30), (-1500, 100, 0x01),
+                                            (700, -700, 0x02), (900, 900, 0x55)]):
+        w.put(1, cmd(pan, tilt, flags), t_ns=(i + 1) * 10**9)
+    w.close()
+    s = tase.plot.series(cap)
+    assert sorted(s) == ["pan_cmd", "pan_rate_cmd", "tilt_cmd", "tilt_rate_cmd"]
+    ts, vs = s["pan_cmd"]
+    # 10 held through the SPOI error and the impulse, then the legacy position -15
+    assert [v for v in vs if v == v] == [10.0, 10.0, -15.0, -15.0]
+    assert ts[1] == 3.0 and ts[2] == 3.0  # held to the legacy command, no break
+    assert s["pan_rate_cmd"][1][0] == 7.0 and s["tilt_rate_cmd"][1][0] == -7.0
+    # 0x55 is not a command the gimbal takes: the rate stays in force to the end
+    assert s["pan_rate_cmd"][0][-1] == 5.0 and s["pan_rate_cmd"][1][-1] == 7.0
+
+
 def test_module_decode_equals_tase_decode(recorded):
     cap, lines = recorded
     r = subprocess.run([sys.executable, "-m", "tase", "decode", cap],
@@ -139,6 +166,44 @@ def test_bench_script_of_the_docs_runs_against_tase_sim(tase_sim, tmp_path):
     assert "on target at pan" in r.stdout
     assert (tmp_path / "session.png").stat().st_size > 1000
     assert len(list(tase.read_capture(str(tmp_path / "session.pcap")))) > 20
+
+
+def test_bench_script_interrupted_while_turning_stops_the_gimbal(sim, tmp_path):
+    # a review: Ctrl-C during the script's one second of rate(-20, 0) left
+    # the gimbal turning (the stop was not in a finally)
+    import signal
+    import time
+
+    from conftest import ROOT
+
+    cap = tmp_path / "session.pcap"
+    proc = subprocess.Popen([sys.executable, os.path.join(ROOT, "python", "examples",
+                                                          "bench_session.py"), sim.url,
+                             "-o", str(tmp_path)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+
+    def commands():
+        if not cap.exists():
+            return []
+        try:
+            return [p.raw for _, p in tase.read_capture(str(cap))
+                    if p.name == "GIMBAL_CMD" and p.dir == "in"]
+        except ValueError:
+            return []  # a record still being written
+
+    try:
+        t_end = time.monotonic() + 60
+        while not any(c["pan"] == -2000 for c in commands()):  # turning now
+            assert proc.poll() is None and time.monotonic() < t_end, proc.communicate()
+            time.sleep(0.02)
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode != 0  # interrupted, not finished
+    last = commands()[-1]
+    assert (last["pan"], last["tilt"], last["flags"]) == (0, 0, 0x90)
 
 
 def test_capture_link_is_a_stream(recorded):

@@ -140,6 +140,25 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
                                        impulse_time=0)), tase.FieldError, "not echoed"),
         (lambda l: l.query(tase.Packet("SPOI_CMD", lat=0, lon=0, height=0, vnorth=0, veast=0,
                                        vdown=0, flags=0)), tase.FieldError, "not echoed"),
+        # a review: stab="off" is true in Python and went out stabilised
+        (lambda l: l.point(1, 1, stab="off"), tase.FieldError, "stab must be True or False"),
+        (lambda l: l.rate(0, 0, stab=None), tase.FieldError, "stab must be True or False"),
+        # wait=0 sent the retract, then timed out at once (`tase retract --wait 0` is refused)
+        (lambda l: l.retract(wait=0), tase.FieldError, "0 is no time to wait"),
+        # retries=True was taken for 1, and checked only when a query was made
+        (lambda l: l.camera(hfov=10, retries=True), tase.FieldError, "retries 0..255"),
+        (lambda l: l.query("PACKET_RATE", timeout=True), tase.FieldError, "timeout must be"),
+        # the general send path takes the verbs' ranges too (the C host role
+        # refuses them): a SPOI beyond the pole and a position beyond the axes went out
+        (lambda l: l.send(tase.Packet("SPOI_CMD", lat=100, lon=0, height=0, vnorth=0, veast=0,
+                                      vdown=0, flags=0)), tase.FieldError, "out of range"),
+        (lambda l: l.send(tase.Packet("SPOI_CMD", lat=0, lon=-180.5, height=0, vnorth=0,
+                                      veast=0, vdown=0, flags=0)), tase.FieldError, "out of range"),
+        (lambda l: l.send(tase.Packet("GIMBAL_CMD", pan=20000, tilt=0, roll=0, flags=0x20,
+                                      impulse_time=0)), tase.FieldError, "out of range"),
+        # an engineering value that lands on the wire's "do not change" code
+        (lambda l: l.send(tase.Packet("AXIS_SETTING", pan_max_rate=1275)), tase.FieldError,
+         r"pan_max_rate: 1275 .* is raw 255, the wire's \"do not change\" code"),
         # query() has no reserved=: its refusal points to send() (a review)
         (lambda l: l.query(tase.Packet("SPOI_CMD", lat=0, lon=0, height=0, vnorth=0, veast=0,
                                        vdown=0, flags=0xFF)), tase.FieldError,

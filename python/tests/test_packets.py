@@ -58,8 +58,17 @@ def test_round_trip_every_packet_type(t, data):
     got = tase.decode(frame)
     assert got == [p]
     assert got[0].raw == raw and got[0].name == t.name and got[0].offset == 0
-    # engineering values convert back to the same wire integers
-    assert tase.Packet(t.name, data=tail, **p.fields) == p
+    # engineering values convert back to the same wire integers; a "do not
+    # change" / "unavailable" code is no value and is refused in engineering
+    # units (AXIS_SETTING pan_max_rate=1275 deg/s was raw 0xFF): given raw
+    codes = {
+        f.name for f in t.fields if f.unit is not None and raw.get(f.name) in (f.keep, f.none)
+    }
+    eng = {k: v for k, v in p.fields.items() if k not in codes}
+    assert tase.Packet(t.name, data=tail, raw={k: raw[k] for k in codes}, **eng) == p
+    for k in codes:
+        with pytest.raises(tase.FieldError, match="code, not a value"):
+            tase.Packet(t.name, data=tail, raw={c: raw[c] for c in codes if c != k}, **p.fields)
 
 
 def test_engineering_values_and_repr():

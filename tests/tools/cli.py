@@ -144,6 +144,19 @@ expect("GIMBAL_CMD without flags is refused even with --zero",
 expect("GIMBAL_CMD flags outside table 5 refused",
        ["send", "GIMBAL_CMD", "pan=0", "tilt=0", "flags=0x55", "--zero"] + L, 2,
        "not a mode of the spec's table 5")
+# a review: `tase send` put out a position beyond the axes (pan 200 degrees,
+# refused by `tase point`) and a SPOI beyond the poles
+expect("GIMBAL_CMD position beyond pan 180 refused",
+       ["send", "GIMBAL_CMD", "pan=20000", "tilt=0", "flags=0x20", "--zero"] + L, 2,
+       r"GIMBAL_CMD position outside pan -180\.\.180 / tilt -270\.\.90 degrees.*nothing sent")
+expect("GIMBAL_CMD legacy position below tilt -270 refused",
+       ["send", "GIMBAL_CMD", "pan=0", "tilt=-27001", "flags=0x03", "--zero"] + L, 2,
+       "GIMBAL_CMD position outside")
+expect("GIMBAL_CMD rate takes the wire's range", ["send", "GIMBAL_CMD", "pan=20000", "tilt=0",
+       "flags=0x90", "--zero"] + L, 1, "cannot open serial device")
+expect("SPOI_CMD beyond 90 degrees of latitude refused",
+       ["send", "SPOI_CMD", "lat=324000001", "--zero"] + L, 2,
+       r"SPOI_CMD lat/lon outside -90\.\.90 / -180\.\.180 degrees")
 expect("--no-wait setup packet needs every field",
        ["send", "PACKET_RATE", "angle_1=20", "--no-wait"] + L, 2, "needs every field with --no-wait")
 expect("point: out-of-range angle states the range", ["point", "200", "0"] + L, 2,
@@ -198,6 +211,20 @@ expect("tase-sim --link given twice is refused",
 expect("record --tap-in the same line as --serial: a usage error, not 'busy'",
        ["record", "--serial", "/dev/null", "--tap-in", "/dev/./null", "-o", os.path.join(TMP, "t.pcap")],
        2, "--tap-in must be the other line of the tap, not --serial's /dev/null")
+# a review: these were taken and ignored (or, for "1", taken as camera B)
+expect("--baud with --can is refused", ["point", "1", "1", "--can", "vcan0", "--baud", "9600"], 2,
+       "--baud is a serial link's rate")
+expect("record: --baud with --can is refused",
+       ["record", "--can", "vcan0", "--baud", "9600", "-o", "/tmp/never.pcap"], 2,
+       "--baud is a serial link's rate")
+expect("point awaits no answer: --timeout refused", ["point", "1", "1", "--timeout", "5"] + L, 2,
+       "awaits no answer: --timeout and --retries do not apply")
+expect("rate awaits no answer: --retries refused", ["rate", "0", "0", "--retries=1"] + L, 2,
+       "awaits no answer")
+expect("camera takes A, B or C, not a wire index", ["camera", "1"] + L, 2,
+       r"bad camera '1' \(A, B or C\)")
+expect("camera still takes request options", ["camera", "b", "--timeout", "5"] + L, 1,
+       "cannot open serial device")
 expect("tase-sim --can-pty is not for --baud",
        [SIM, "--can-pty", "--baud", "9600", "--seconds", "1"], 2,
        "--can-pty is a pseudo-terminal at CAN's capacity: not with --baud")
@@ -320,6 +347,21 @@ for args in (["decode", noisy], ["list"], ["--help"], ["klv", os.path.join(os.pa
     ok("tase %s > /dev/full fails with a message" % args[0],
        rc == 1 and "cannot write to standard output" in err, "exit %d %s" % (rc, err))
 
+# a review: `deploy --wait` exited 5 ("sent and confirmed") the moment its
+# "sent" line failed to write, without waiting: it waits, and a gimbal that
+# never echoes is a timeout (exit 1, the packet named as sent)
+m, sl = os.openpty()
+tty.setraw(m)
+t0 = time.time()
+with open("/dev/full", "wb") as full:
+    rc, _, err = run(["deploy", "--wait", "0.5", "--serial", os.ttyname(sl)], stdout=full)
+waited = time.time() - t0
+os.close(m)
+os.close(sl)
+ok("deploy --wait > /dev/full waits for the echo: a silent line is a timeout (exit 1)",
+   rc == 1 and waited >= 0.5 and "timeout: no RETRACT_DEPLOY_CMD echo" in err
+   and "(RETRACT_DEPLOY_CMD was sent)" in err, "exit %d after %.2f s: %s" % (rc, waited, err))
+
 # (more output than a pipe holds, so the write must meet the closed end)
 big = write("dense.bin", b"".join(angle(i, -i) for i in range(20000)))
 p = subprocess.Popen(VG + [TASE, "decode", big], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -394,6 +436,22 @@ first = json.loads(open(os.path.join(os.path.dirname(noisy), "klv_noisy.jsonl"))
 got = live(["klv"], klv[first["offset"]:first["offset"] + 87], "klv")
 ok("tase klv on a live input prints a packet while the writer is still open",
    b'"fields":{"utc":' in got, repr(got[:200]))
+# lat/lon units print every raw step (180 / 2^32 and 360 / 2^32 degrees):
+# they were printed to 1e-7 degrees, and adjacent values read the same (a review)
+pk = bytearray(klv[first["offset"]:first["offset"] + 87])
+two = b""
+for lat, lon in ((1000000000, -7), (1000000001, -8)):
+    pk[29:33] = lat.to_bytes(4, "big", signed=True)  # key 16, length 1, utc item 10, tag+len 2
+    pk[35:39] = lon.to_bytes(4, "big", signed=True)
+    pk[85:87] = (sum(pk[17:83]) & 0xFFFF).to_bytes(2, "big")  # the 66 set bytes before item 15
+    two += bytes(pk)
+rc, out, err = run(["klv", write("klv_steps.bin", two)])
+u = [json.loads(l)["units"] for l in out.splitlines()]
+ok("tase klv: adjacent raw lat and lon give different lat_deg / lon_deg",
+   rc == 0 and len(u) == 2 and u[0]["lat_deg"] != u[1]["lat_deg"]
+   and u[0]["lon_deg"] != u[1]["lon_deg"]
+   and abs(u[1]["lat_deg"] - 1000000001 * 180 / 2**32) < 1e-9
+   and abs(u[1]["lon_deg"] + 8 * 360 / 2**32) < 1e-9, out + err)
 got = live(["decode"], angle(7, 8), "decode")
 ok("tase decode on a live input prints a packet while the writer is still open",
    b'"pan":7,' in got, repr(got[:200]))

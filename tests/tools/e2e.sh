@@ -253,6 +253,26 @@ check "KLV output: $nk packets in 2.5 s (about one per 900 ms)" eval '[ $nk -ge 
 check "KLV packet carries the simulated pan (90 deg = raw 16384)" \
     grep -q '"pan":1638[3-5],' <<<"$k"
 
+# a review: held up for 4.5 s (SIGSTOP), tase-sim sent the five packets it
+# missed 5 ms apart when it went on; one packet, then one per 900 ms again
+# (the packets' UTC is the simulator's clock when it sent them)
+timeout 6.5 "$TASE" klv "$dir/klv" >"$dir/klv2.txt" 2>/dev/null &
+kpid=$!
+sleep 0.5
+kill -STOP $sim_pid
+sleep 4.5
+kill -CONT $sim_pid
+wait $kpid
+gaps=$(sed -n 's/.*"utc":\([0-9]*\),.*/\1/p' "$dir/klv2.txt" |
+       awk 'NR > 1 { printf "%d ", ($1 - last) / 1000 } { last = $1 }')
+# all_at_least "N N ..." MIN: some numbers, each >= MIN
+all_at_least() {
+    [ -n "$1" ] || return 1
+    for g in $1; do [ "$g" -ge "$2" ] || return 1; done
+}
+check "KLV after a 4.5 s stall: no burst of the missed packets (gaps ms: $gaps)" \
+    all_at_least "$gaps" 500
+
 # ---- monitor on a line that carries no TASE frame (the KLV pty) ----
 "$TASE" monitor --serial "$dir/klv" --seconds 1.2 >"$dir/out" 2>"$dir/mon.err"
 rc=$?

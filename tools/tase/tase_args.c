@@ -100,8 +100,12 @@ bool cli_baud_opt(cli_args_t *a, long *baud)
 
 bool cli_link_opt(cli_args_t *a, cli_link_opts_t *l)
 {
+    if (cli_baud_opt(a, &l->baud)) {
+        l->baud_given = true;
+        return true;
+    }
     return cli_opt(a, "--serial", true, &l->serial) || cli_opt(a, "--can", true, &l->can) ||
-           cli_opt(a, "--record", true, &l->record) || cli_baud_opt(a, &l->baud);
+           cli_opt(a, "--record", true, &l->record);
 }
 
 long long cli_int_opt_value(const char *name, const char *v, long long min, long long max)

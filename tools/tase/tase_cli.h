@@ -54,6 +54,7 @@ typedef struct {
     const char *serial;
     const char *can;
     long baud;
+    bool baud_given;    /* --baud was given (a serial link's option only) */
     const char *record; /* --record FILE, or NULL */
 } cli_link_opts_t;
 
@@ -101,6 +102,8 @@ typedef struct {
 
 /* Usage error unless exactly one of --serial and --can is given (and no
  * --record with --can). */
+/* Usage error: --baud given with --can. */
+void cli_check_link_baud(const cli_link_opts_t *lo);
 void cli_check_link_opts(const cli_link_opts_t *lo);
 void cli_session_open(cli_session_t *s, const cli_link_opts_t *lo, tase_rx_handler_t on_frame,
                       void *user);

@@ -293,7 +293,7 @@ static void print_klv(void *user, uint32_t offset, const tase_klv_t *k)
            (unsigned)k->pan, (int)k->tilt, (unsigned)k->heading, (int)k->pitch, (int)k->roll,
            (int)k->vnorth, (int)k->veast, (unsigned)k->hfov, (unsigned)k->vfov,
            (unsigned)k->gps_status);
-    printf("\"units\":{\"utc_s\":%.6f,\"lat_deg\":%.7f,\"lon_deg\":%.7f,\"alt_m\":%.2f,"
+    printf("\"units\":{\"utc_s\":%.6f,\"lat_deg\":%.9f,\"lon_deg\":%.9f,\"alt_m\":%.2f,"
            "\"pan_deg\":%.3f,\"tilt_deg\":%.3f,\"heading_deg\":%.3f,\"pitch_deg\":%.4f,"
            "\"roll_deg\":%.4f,\"vnorth_mps\":%.3f,\"veast_mps\":%.3f,\"hfov_deg\":%.3f,"
            "\"vfov_deg\":%.3f,\"gps_fix\":%u,\"gps_antenna\":%u}}\n",

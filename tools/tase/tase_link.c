@@ -7,6 +7,15 @@
 #include "tase_cli.h"
 #include "tk_capture.h"
 
+void cli_check_link_baud(const cli_link_opts_t *lo)
+{
+    if (lo->baud_given && lo->can != NULL) {
+        tk_usage_error("--baud is a serial link's rate; a CAN interface has its own bit rate "
+                       "(ip link set %s type can bitrate ...)",
+                       lo->can);
+    }
+}
+
 void cli_check_link_opts(const cli_link_opts_t *lo)
 {
     if (lo->serial != NULL && lo->can != NULL) {
@@ -15,6 +24,7 @@ void cli_check_link_opts(const cli_link_opts_t *lo)
     if (lo->serial == NULL && lo->can == NULL) {
         tk_usage_error("no link given: use --serial DEV or --can IFACE");
     }
+    cli_check_link_baud(lo);
     if (lo->record != NULL && lo->can != NULL) {
         tk_usage_error("--record records serial links; on CAN run 'tase record --can %s -o FILE' "
                        "beside this command",
@@ -199,7 +209,7 @@ void cli_send_fields(cli_session_t *s, const cli_fields_t *fs, size_t len, const
 
 int cli_cmd_monitor(cli_args_t *a)
 {
-    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, NULL};
+    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, false, NULL};
     tk_fmt_t fmt = {false, false, false};
     double seconds = 0.0, t_end;
     long long limit = 0;

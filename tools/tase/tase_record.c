@@ -10,7 +10,7 @@
 
 int cli_cmd_record(cli_args_t *a)
 {
-    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, NULL};
+    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, false, NULL};
     const char *out = NULL, *tap_in = NULL, *v;
     double seconds = 0.0;
     tk_cap_writer_t w;
@@ -54,6 +54,7 @@ int cli_cmd_record(cli_args_t *a)
     if ((lo.serial != NULL) == (lo.can != NULL)) {
         tk_usage_error("give either --serial DEV or --can IFACE");
     }
+    cli_check_link_baud(&lo);
     if (tap_in != NULL && lo.serial == NULL) {
         tk_usage_error("--tap-in is the second line of a serial tap: it needs --serial");
     }
@@ -81,7 +82,7 @@ int cli_cmd_record(cli_args_t *a)
 
 int cli_cmd_replay(cli_args_t *a)
 {
-    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, NULL};
+    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, false, NULL};
     tk_replay_opts_t ro;
     const char *path = NULL, *v;
     static uint8_t head[CLI_READ_CHUNK];
@@ -127,6 +128,7 @@ int cli_cmd_replay(cli_args_t *a)
     if ((lo.serial != NULL) == (lo.can != NULL)) {
         tk_usage_error("give either --serial DEV or --can IFACE");
     }
+    cli_check_link_baud(&lo);
     if (ro.dirs == 0) {
         tk_usage_error("replay needs --dir: out = the gimbal's side, to exercise a host (its "
                        "echoes are commands to a gimbal); in = the host's commands (moves a "

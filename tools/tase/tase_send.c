@@ -3,6 +3,7 @@
  * the gimbal's settings, or refused), and `list`, the table they read. */
 #include <string.h>
 
+#include "tase/codec.h"
 #include "tase/flags.h"
 #include "tase_cli.h"
 
@@ -231,7 +232,7 @@ static void check_reserved_flags(const cli_fields_t *fs, unsigned nf)
 
 int cli_cmd_send(cli_args_t *a)
 {
-    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, NULL};
+    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, false, NULL};
     cli_send_opts_t o = {
         false, false, false, -1, {CLI_DEFAULT_TIMEOUT_MS, CLI_DEFAULT_RETRIES, false}};
     const char *name = NULL, *v;
@@ -325,6 +326,15 @@ int cli_cmd_send(cli_args_t *a)
                            name, setup ? " with --no-wait (nothing is queried)" : "", missing);
         }
     }
+    if (tase_command_check_data(p->id, fs.data, len) == TASE_ERANGE) {
+        /* the flags were checked above: a value beyond the spec's ranges
+         * (tase_command_check(); the library would refuse it too) */
+        tk_usage_error("%s", p->id == TASE_ID_GIMBAL_CMD
+                                 ? "GIMBAL_CMD position outside pan -180..180 / tilt -270..90 "
+                                   "degrees (pan/tilt in 1/100 degree); nothing sent"
+                                 : "SPOI_CMD lat/lon outside -90..90 / -180..180 degrees "
+                                   "(milli-arcseconds); nothing sent");
+    }
     if (setup && !o.no_wait && o.len < 0 && (p->flags & TASE_LEN_SHORT) != 0u) {
         /* a packet of two layouts (AXIS_SETTING, PROTOCOL-NOTES S2): the
          * query's answer tells which one this gimbal uses, even when
@@ -375,7 +385,7 @@ int cli_cmd_send(cli_args_t *a)
 
 int cli_cmd_query(cli_args_t *a)
 {
-    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, NULL};
+    cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, false, NULL};
     cli_req_opts_t r = {CLI_DEFAULT_TIMEOUT_MS, CLI_DEFAULT_RETRIES, false};
     const char *name = NULL;
     const tase_packet_desc_t *p;

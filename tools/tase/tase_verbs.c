@@ -78,6 +78,12 @@ static void verb_parse(cli_args_t *a, verb_args_t *v, size_t max_pos, const char
     v->r.retries = CLI_DEFAULT_RETRIES;
     while (a->i < a->argc) {
         const char *x;
+        if (strstr(which, "req") == NULL &&
+            (cli_opt(a, "--timeout", true, &x) || cli_opt(a, "--retries", true, &x))) {
+            /* taken and ignored, it looked as if the verb waited for something */
+            tk_usage_error("this command awaits no answer: --timeout and --retries do not "
+                           "apply (see --help)");
+        }
         if (cli_common_opt(a) || cli_link_opt(a, &v->lo) || cli_req_opt(a, &v->r)) {
             continue;
         }
@@ -187,7 +193,9 @@ int cli_cmd_rate(cli_args_t *a)
 
 static int camera_index(const char *s)
 {
-    static const char *const names[] = {"A", "B", "C", "a", "b", "c", "0", "1", "2"};
+    /* the letters only: "1" was taken for camera B (0-based, as on the
+     * wire), which no help text said */
+    static const char *const names[] = {"A", "B", "C", "a", "b", "c"};
     size_t i;
     for (i = 0; i < sizeof(names) / sizeof(names[0]); i++) {
         if (strcmp(s, names[i]) == 0) {
@@ -235,7 +243,7 @@ int cli_cmd_camera(cli_args_t *a)
     long long hfov = 0;
     size_t len;
     char what[96];
-    verb_parse(a, &v, 1, "hfov zoom");
+    verb_parse(a, &v, 1, "hfov zoom req");
     cli_check_link_opts(&v.lo);
     if (v.npos == 1) {
         cam = camera_index(v.pos[0]);
@@ -330,7 +338,9 @@ static int retract_deploy(cli_args_t *a, bool deploy)
     cli_session_open(&s, &v.lo, on_rd_frame, &e);
     cli_send_frame(&s, p, data, sizeof(data));
     cli_print_packet(p, data, sizeof(data), v.r.json, "in", "sent");
-    tk_stdout_flush();
+    /* shown before the wait; a failing output is reported after it (exit
+     * 5 once confirmed, 1 on a timeout: "sent" alone is not "confirmed") */
+    tk_stdout_flush_soft();
     t_end = tk_now_s() + wait;
     while (wait > 0.0 && !e.seen && tk_now_s() < t_end) {
         tk_exit_if_signalled();
@@ -368,7 +378,7 @@ int cli_cmd_spoi(cli_args_t *a)
     cli_fields_t fs;
     cli_session_t s;
     long long lat, lon, height;
-    verb_parse(a, &v, 3, "no-wait");
+    verb_parse(a, &v, 3, "no-wait req");
     need_args(&v, 3, "LAT LON HEIGHT (degrees, degrees, metres)");
     lat = cli_scaled_arg("latitude", v.pos[0], -90.0, 90.0, "deg", 3600000u);
     lon = cli_scaled_arg("longitude", v.pos[1], -180.0, 180.0, "deg", 3600000u);
