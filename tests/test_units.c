@@ -64,12 +64,67 @@ static void from_wire_applies_the_spec_scales(void **state)
                 1.0 / 3600000.0);
 }
 
+/* A review: a NaN pan became 0 and went out as a position command; 400
+ * degrees became 327.67. The checked forms give TASE_ERANGE for NaN, the
+ * infinities and anything that rounds beyond the field, *out untouched,
+ * and round like the saturating ones everywhere else. */
+static void checked_to_wire_refuses_what_the_field_cannot_carry(void **state)
+{
+    int16_t i16 = 7;
+    uint16_t u16 = 7;
+    int32_t i32 = 7;
+    uint8_t u8 = 7;
+    double v;
+    (void)state;
+    assert_int_equal(tase_units_deg_to_cdeg_checked(NAN, &i16), TASE_ERANGE);
+    assert_int_equal(tase_units_deg_to_cdeg_checked(INFINITY, &i16), TASE_ERANGE);
+    assert_int_equal(tase_units_deg_to_cdeg_checked(400.0, &i16), TASE_ERANGE);
+    assert_int_equal(tase_units_deg_to_cdeg_checked(327.675, &i16), TASE_ERANGE);
+    assert_int_equal(tase_units_deg_to_cdeg_checked(-327.685, &i16), TASE_ERANGE);
+    assert_int_equal(i16, 7);
+    assert_int_equal(tase_units_deg_to_cdeg_checked(327.67, &i16), TASE_OK);
+    assert_int_equal(i16, 32767);
+    assert_int_equal(tase_units_deg_to_cdeg_checked(-327.68, &i16), TASE_OK);
+    assert_int_equal(i16, -32768);
+    assert_int_equal(tase_units_deg_to_cdeg_checked(-0.025, &i16), TASE_OK);
+    assert_int_equal(i16, -3);
+    assert_int_equal(tase_units_deg_to_cdeg_u16_checked(-0.01, &u16), TASE_ERANGE);
+    assert_int_equal(tase_units_deg_to_cdeg_u16_checked(-0.004, &u16), TASE_OK);
+    assert_int_equal(u16, 0);
+    assert_int_equal(tase_units_deg_to_cdeg_u16_checked(655.35, &u16), TASE_OK);
+    assert_int_equal(u16, 65535);
+    assert_int_equal(tase_units_deg_to_mas_checked(NAN, &i32), TASE_ERANGE);
+    assert_int_equal(tase_units_deg_to_mas_checked(1000.0, &i32), TASE_ERANGE);
+    assert_int_equal(tase_units_deg_to_mas_checked(-122.5, &i32), TASE_OK);
+    assert_true(i32 == -441000000);
+    assert_int_equal(tase_units_m_to_cm_checked(-INFINITY, &i32), TASE_ERANGE);
+    assert_int_equal(tase_units_m_to_cm_checked(1e12, &i32), TASE_ERANGE);
+    assert_true(i32 == -441000000);
+    assert_int_equal(tase_units_m_to_cm_checked(10.255, &i32), TASE_OK);
+    assert_true(i32 == tase_units_m_to_cm(10.255));
+    assert_int_equal(tase_units_mps_to_cmps_checked(NAN, &i16), TASE_ERANGE);
+    assert_int_equal(tase_units_mps2_to_accel_checked(110.0, &i16), TASE_ERANGE);
+    assert_int_equal(tase_units_mps2_to_accel_checked(9.80665, &i16), TASE_OK);
+    assert_int_equal(i16, 2942);
+    assert_int_equal(tase_units_pdop_to_raw_checked(-0.1, &u8), TASE_ERANGE);
+    assert_int_equal(tase_units_pdop_to_raw_checked(25.55, &u8), TASE_ERANGE);
+    assert_int_equal(u8, 7);
+    assert_int_equal(tase_units_pdop_to_raw_checked(1.25, &u8), TASE_OK);
+    assert_int_equal(u8, 13);
+    /* inside the range the two forms agree */
+    for (v = -327.0; v <= 327.0; v += 0.123) {
+        assert_int_equal(tase_units_deg_to_cdeg_checked(v, &i16), TASE_OK);
+        assert_int_equal(i16, tase_units_deg_to_cdeg(v));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(to_wire_rounds_half_away_from_zero),
         cmocka_unit_test(to_wire_saturates_at_field_limits_and_maps_nan_to_zero),
         cmocka_unit_test(from_wire_applies_the_spec_scales),
+        cmocka_unit_test(checked_to_wire_refuses_what_the_field_cannot_carry),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -94,14 +94,20 @@ void flight_attitude(const flight_state_t *s, uint32_t t_ms, uint8_t sample_rate
     a->sample_rate = sample_rate;
 }
 
-void flight_spoi(const flight_plan_t *p, float north_m, float east_m, float height_m, uint8_t flags,
-                 tase_spoi_cmd_t *c)
+int flight_spoi(const flight_plan_t *p, float north_m, float east_m, float height_m, uint8_t flags,
+                tase_spoi_cmd_t *c)
 {
+    int r;
     memset(c, 0, sizeof(*c));
-    c->lat = tase_units_deg_to_mas(lat_of(p, north_m));
-    c->lon = tase_units_deg_to_mas(lon_of(p, east_m));
-    c->height = tase_units_m_to_cm((double)height_m);
     c->flags = flags;
+    r = tase_units_deg_to_mas_checked(lat_of(p, north_m), &c->lat);
+    if (r == TASE_OK) {
+        r = tase_units_deg_to_mas_checked(lon_of(p, east_m), &c->lon);
+    }
+    if (r == TASE_OK) {
+        r = tase_units_m_to_cm_checked((double)height_m, &c->height);
+    }
+    return r;
 }
 
 void flight_offset(const flight_plan_t *p, int32_t lat_mas, int32_t lon_mas, float *north_m,

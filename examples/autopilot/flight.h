@@ -48,9 +48,11 @@ void flight_attitude(const flight_state_t *s, uint32_t t_ms, uint8_t sample_rate
                      tase_host_attitude_t *a);
 
 /* A point north_m/east_m from the centre at height_m, as a SPOI_CMD with
- * zero velocity and the given flags. */
-void flight_spoi(const flight_plan_t *p, float north_m, float east_m, float height_m, uint8_t flags,
-                 tase_spoi_cmd_t *c);
+ * zero velocity and the given flags. A command: converted with the checked
+ * forms of tase/units.h, so a position the wire cannot carry is
+ * TASE_ERANGE (c then incomplete: not to be sent), never a saturated one. */
+int flight_spoi(const flight_plan_t *p, float north_m, float east_m, float height_m, uint8_t flags,
+                tase_spoi_cmd_t *c);
 
 /* North/east metres of a wire position from the centre. */
 void flight_offset(const flight_plan_t *p, int32_t lat_mas, int32_t lon_mas, float *north_m,

@@ -403,8 +403,12 @@ static void run_step(mission_t *m)
         return;
     case STEP_WARMUP:
         if (m->now - m->step_at >= WARMUP_MS) {
-            flight_spoi(&plan, SPOI_NORTH_M, SPOI_EAST_M, SPOI_HEIGHT_M, (uint8_t)TASE_SPOI_ECHO,
-                        &m->spoi_req);
+            int r = flight_spoi(&plan, SPOI_NORTH_M, SPOI_EAST_M, SPOI_HEIGHT_M,
+                                (uint8_t)TASE_SPOI_ECHO, &m->spoi_req);
+            if (r != TASE_OK) {
+                abort_mission(m, "SPOI_CMD position", r); /* nothing sent */
+                return;
+            }
             /* From here on a GEOREFERENCE may reflect the command (it is
              * sent on the next pass): none counts as "before" any more. */
             m->spoi_at = m->now;

@@ -34,7 +34,13 @@
  * MATCHING. The pending request completes on the first received frame
  * with the request's group and type and at least one data byte (a
  * zero-length frame is a query, never an answer: this keeps a loop-back or
- * our own query echoed by a half-duplex line from completing it). Any
+ * our own query echoed by a half-duplex line from completing it). A frame
+ * WITH data echoed by such a line cannot be told from the gimbal's answer:
+ * a setup packet, SPOI_CMD and RETRACT_DEPLOY_CMD come back byte for byte
+ * as the gimbal's echo would, and complete the request (a retract then
+ * "completes" at once). Use a line that does not echo what it sends; a
+ * host that receives packets only a host sends (GIMBAL_CMD, HOST_SENSOR,
+ * ...) or its own zero-length queries is on one that does. Any
  * such frame counts, including a late echo of an earlier attempt that
  * arrives after a retry was sent: the gimbal's answer always carries its
  * current settings, so any of them is a valid answer. A frame of another

@@ -14,7 +14,9 @@
  *
  * To-wire conversions round to the nearest integer, halves away from zero
  * (2.5 -> 3, -2.5 -> -3), then SATURATE to the field's range (a value
- * beyond it gives the nearest representable one); NaN gives 0. Mind
+ * beyond it gives the nearest representable one); NaN gives 0. For what
+ * is sent as a command use the *_checked forms (end of this header):
+ * the same rounding, TASE_ERANGE instead of a saturated value or 0. Mind
  * reserved values at the ends of a range: e.g. HFOV -1 and TAS 0xFFFF
  * mean "no change"/"unavailable", so clamp before converting if a real
  * value could land there. The rounding is of the double given: 1.005 is
@@ -139,6 +141,90 @@ static inline double tase_units_raw_to_pdop(uint8_t raw)
 static inline uint8_t tase_units_pdop_to_raw(double pdop)
 {
     return tase_units_sat_u8(pdop * 10.0);
+}
+
+/* ---- checked to-wire conversions: for what is sent as a command --------
+ * The same rounding (half away from zero), but a value the field cannot
+ * carry is an error instead of a neighbour: NaN, an infinity, or a value
+ * that rounds beyond the field's range gives TASE_ERANGE and leaves *out
+ * untouched (a saturating conversion would turn a NaN pan into 0, a
+ * position command the gimbal then obeys). TASE_OK and *out otherwise. out
+ * must not be NULL. The fields' meanings (a position's axis range, a "do
+ * not change" code such as HFOV -1) are the caller's to respect:
+ * tase_command_check() (tase/codec.h) checks the commands that move. */
+static inline int tase_units_round_checked(double v, double lo, double hi, double *out)
+{
+    if (!(v > lo - 0.5 && v < hi + 0.5)) {
+        return TASE_ERANGE; /* NaN fails every comparison */
+    }
+    *out = v >= 0.0 ? v + 0.5 : v - 0.5; /* the caller's cast truncates toward zero */
+    return TASE_OK;
+}
+/* The checked rounding into each wire type (as tase_units_sat_*). */
+static inline int tase_units_checked_i16(double v, int16_t *out)
+{
+    double r = 0.0;
+    int e = tase_units_round_checked(v, -32768.0, 32767.0, &r);
+    if (e == TASE_OK) {
+        *out = TASE_CAST_(int16_t, r);
+    }
+    return e;
+}
+static inline int tase_units_checked_u16(double v, uint16_t *out)
+{
+    double r = 0.0;
+    int e = tase_units_round_checked(v, 0.0, 65535.0, &r);
+    if (e == TASE_OK) {
+        *out = TASE_CAST_(uint16_t, r);
+    }
+    return e;
+}
+static inline int tase_units_checked_i32(double v, int32_t *out)
+{
+    double r = 0.0;
+    int e = tase_units_round_checked(v, -2147483648.0, 2147483647.0, &r);
+    if (e == TASE_OK) {
+        *out = TASE_CAST_(int32_t, r);
+    }
+    return e;
+}
+static inline int tase_units_checked_u8(double v, uint8_t *out)
+{
+    double r = 0.0;
+    int e = tase_units_round_checked(v, 0.0, 255.0, &r);
+    if (e == TASE_OK) {
+        *out = TASE_CAST_(uint8_t, r);
+    }
+    return e;
+}
+
+static inline int tase_units_deg_to_cdeg_checked(double deg, int16_t *cdeg)
+{
+    return tase_units_checked_i16(deg * 100.0, cdeg);
+}
+static inline int tase_units_deg_to_cdeg_u16_checked(double deg, uint16_t *cdeg)
+{
+    return tase_units_checked_u16(deg * 100.0, cdeg);
+}
+static inline int tase_units_deg_to_mas_checked(double deg, int32_t *mas)
+{
+    return tase_units_checked_i32(deg * 3600000.0, mas);
+}
+static inline int tase_units_m_to_cm_checked(double m, int32_t *cm)
+{
+    return tase_units_checked_i32(m * 100.0, cm);
+}
+static inline int tase_units_mps_to_cmps_checked(double mps, int16_t *cmps)
+{
+    return tase_units_checked_i16(mps * 100.0, cmps);
+}
+static inline int tase_units_mps2_to_accel_checked(double mps2, int16_t *accel)
+{
+    return tase_units_checked_i16(mps2 * 300.0, accel);
+}
+static inline int tase_units_pdop_to_raw_checked(double pdop, uint8_t *raw)
+{
+    return tase_units_checked_u8(pdop * 10.0, raw);
 }
 
 #ifdef __cplusplus
