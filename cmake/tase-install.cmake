@@ -63,6 +63,15 @@ foreach(dir LIBDIR INCLUDEDIR)
   endif()
 endforeach()
 set(TASE_PC_PREFIX "@TASE_PC_PREFIX@") # second stage, at install time
+# A prefix other than /usr is written relative to the .pc file's own place
+# (${pcfiledir}, which pkg-config sets), so that an installed tree moved or
+# copied elsewhere still points at its own headers and libraries, not at
+# the old place; /usr (the Debian packages) keeps its absolute paths, which
+# pkg-config leaves out of the flags as the system's.
+set(TASE_PC_UP "")
+if(NOT IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}")
+  string(REGEX REPLACE "[^/]+" ".." TASE_PC_UP "${CMAKE_INSTALL_LIBDIR}/pkgconfig")
+endif()
 foreach(lib ${TASE_LIBS})
   if(lib STREQUAL "tase")
     set(TASE_PC_NAME tase)
@@ -79,6 +88,9 @@ foreach(lib ${TASE_LIBS})
   configure_file(${PROJECT_SOURCE_DIR}/cmake/tase.pc.in ${stage} @ONLY)
   install(CODE "
     set(TASE_PC_PREFIX \"\${CMAKE_INSTALL_PREFIX}\")
+    if(NOT TASE_PC_PREFIX STREQUAL \"/usr\" AND NOT \"${TASE_PC_UP}\" STREQUAL \"\")
+      set(TASE_PC_PREFIX \"\\\${pcfiledir}/${TASE_PC_UP}\")
+    endif()
     configure_file(\"${stage}\" \"${PROJECT_BINARY_DIR}/pkgconfig/install/${TASE_PC_NAME}.pc\" @ONLY)
     file(INSTALL DESTINATION \"${TASE_PC_DEST}\" TYPE FILE
          FILES \"${PROJECT_BINARY_DIR}/pkgconfig/install/${TASE_PC_NAME}.pc\")"

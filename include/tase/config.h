@@ -53,7 +53,7 @@
  * Headers of one release used with the library of another (a stale copy
  * in /usr/local/include, an old libtase-dev) would describe instances of
  * another size than the library fills: 0.1.0's tase_rx_t is 328 bytes on
- * x86-64, 0.2.0's 296, 0.3.0's 356. So every function that initialises an instance the
+ * x86-64, 0.2.0's 296, 0.3.0's 360. So every function that initialises an instance the
  * application allocates and the library fills links under a name that
  * carries the headers' ABI level (TASE_ABI_LEVEL, tase/version.h): the
  * call tase_rx_init(&rx) links to tase_rx_init_abi3, and a library of

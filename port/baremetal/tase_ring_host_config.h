@@ -4,5 +4,9 @@
  * -Watomic-implicit-seq-cst is quiet). See tase/ring.h, "the hook". */
 #ifndef TASE_RING_HOST_CONFIG_H
 #define TASE_RING_HOST_CONFIG_H
+/* Only when nothing defined it: the library's configuration header
+ * (TASE_CONFIG_HEADER, included before this through tase/ring.h) wins. */
+#ifndef TASE_RING_BARRIER
 #define TASE_RING_BARRIER() __atomic_thread_fence(__ATOMIC_SEQ_CST)
+#endif
 #endif

@@ -117,4 +117,16 @@ v=$(cd / && PYTHONPATH="$root/usr/lib/python3/dist-packages" /usr/bin/python3 -c
 [[ $v == "$version $root/usr/lib/python3/dist-packages/tase/__init__.py" ]] ||
     tase_fail "python3-tase: import tase gave '$v'"
 echo "   python3-tase: import tase: $v"
+# Another prefix: where that python3 looks (/usr/local/lib/python3.X/
+# dist-packages); it went to PREFIX/lib/python3/dist-packages, which python3
+# searches only under /usr.
+rm -rf "$out/stage"
+DESTDIR="$out/stage" cmake --install "$out/build" --prefix /usr/local --component python >/dev/null
+pyv=$(/usr/bin/python3 -c 'import sys; print("%d.%d" % sys.version_info[:2])')
+site="/usr/local/lib/python$pyv/dist-packages"
+[ -f "$out/stage$site/tase/__init__.py" ] ||
+    tase_fail "prefix /usr/local: the Python package is not in $site ($(cd "$out/stage" && find . -name __init__.py))"
+/usr/bin/python3 -c "import sys; sys.exit(0 if '$site' in sys.path else 1)" ||
+    tase_fail "$site is not on /usr/bin/python3's path"
+echo "   prefix /usr/local: the Python package goes to $site, on python3's path"
 tase_step "packages: built, checked, unpacked and used"

@@ -56,16 +56,18 @@
  * CMSIS, or a C11 atomic_thread_fence(memory_order_seq_cst)), on the
  * command line, in the library's configuration header (TASE_CONFIG_HEADER,
  * tase/config.h) or in a header named by -DTASE_RING_CONFIG='"file.h"'
- * that tase_ring.c includes first. The ring
+ * that tase_ring.c includes after tase/ring.h (so after the configuration
+ * header, whose definition the hosted build's own header leaves alone).
+ * The ring
  * calls it between writing data and publishing `head`, between reading
  * `head` and reading data, between reading data and publishing `tail`, and
  * between reading `tail` and overwriting a slot. Its default is empty,
  * correct for the single-core case above and free of compiler extensions.
  * With caches and DMA, the ring memory must also be non-cacheable or
  * maintained by the port (not the ring's business). The hosted build in
- * this repository defines the hook as __sync_synchronize() (in
- * tase_ring_host_config.h) because its test runs the producer on another
- * CPU core.
+ * this repository defines the hook as a sequentially consistent fence (in
+ * tase_ring_host_config.h, unless the configuration header defined it)
+ * because its test runs the producer on another CPU core.
  *
  * COST: put is O(1) (a few loads/stores: ISR-friendly); get is O(n).
  */
