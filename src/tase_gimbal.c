@@ -36,6 +36,10 @@ typedef char
 static const uint8_t setup_len[TASE_GIMBAL_SETUP_TYPES] = {16u, 2u, 23u, 42u, 2u, 3u, 6u, 16u};
 static const uint8_t setup_off[TASE_GIMBAL_SETUP_TYPES] = {0u, 16u, 18u, 41u, 83u, 85u, 88u, 94u};
 
+/* How far ahead of the clock a stream's next slot can be: a whole period
+ * of a 1-per-second stream. */
+#define SCHED_AHEAD_MAX_MS 1000u
+
 /* Slot k's offset from t0. k < rate <= 255 keeps the product small. */
 static uint32_t slot_ms(uint32_t k, uint32_t rate)
 {
@@ -83,18 +87,26 @@ static void pace_port(tase_gimbal_t *g, unsigned p)
     }
 }
 
+/* Restart the streams whose rate changed (all: every stream) and the
+ * pacing of their ports only: a PACKET_RATE that changes nothing on a port
+ * leaves its pacing alone (re-sent every 200 ms, it restarted every port
+ * with a full budget and the ports sent far beyond their capacity). */
 static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
 {
     unsigned p;
     unsigned s;
     for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
+        bool changed = all;
         for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
             uint8_t rate = g->setup[setup_off[SETUP_PACKET_RATE] + p * RATE_BYTES_PER_PORT + s];
             if (all || rate != g->sched[p][s].rate) {
                 sched_start(&g->sched[p][s], rate, now_ms);
+                changed = true;
             }
         }
-        pace_port(g, p);
+        if (changed) {
+            pace_port(g, p);
+        }
     }
 }
 
@@ -589,8 +601,20 @@ static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_
     uint16_t id = stream_id[stream];
     int n;
     int sent = 0;
+    uint32_t due;
 
-    if (s->rate == 0 || !reached(now_ms, s->t0 + slot_ms(s->k, s->rate))) {
+    if (s->rate == 0) {
+        return 0;
+    }
+    due = s->t0 + slot_ms(s->k, s->rate);
+    if (!reached(now_ms, due)) {
+        if (due - now_ms > SCHED_AHEAD_MAX_MS) {
+            /* Never more than a second ahead in step with the clock: it
+             * stepped back, or polls came 2^31 ms or more apart (the late
+             * slot reads as one far ahead). Start over from now instead of
+             * waiting (up to 24.8 days) for that time. */
+            sched_start(s, s->rate, now_ms);
+        }
         return 0;
     }
     if (*failed) {

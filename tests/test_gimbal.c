@@ -1362,6 +1362,65 @@ static void capacity_is_per_port_and_checks_its_arguments(void **state)
     free(x);
 }
 
+/* A review: each accepted PACKET_RATE restarted the pacing of every port
+ * with a full budget, even when no rate changed, so a host re-sending the
+ * same setting every 200 ms (its retries do) made every port send far
+ * beyond its capacity (port 2, which received nothing, at 1,121 B/s of a
+ * 720 B/s budget) and the transmit queue grew for ever. */
+static void a_repeated_packet_rate_keeps_every_port_within_its_capacity(void **state)
+{
+    static const unsigned frame_len[NSTREAM] = {14u, 26u, 71u}; /* data + 8 */
+    fix_t *x = make(0, 3, true);
+    uint8_t rates[16];
+    uint32_t budget = 960u * TASE_GIMBAL_TELEMETRY_SHARE / 100u;
+    uint32_t t;
+    unsigned p, s;
+    (void)state;
+    memset(rates, 0, sizeof rates);
+    for (p = 0; p < 3; p++) {
+        assert_int_equal(tase_gimbal_set_capacity(&x->g, p, 960u), TASE_OK); /* 9600 baud */
+        x->port[p].discard = 1;
+        for (s = 0; s < NSTREAM; s++) {
+            rates[p * 5 + s] = 255u;
+        }
+    }
+    for (t = 0; t <= 10000u; t++) {
+        if (t % 200u == 0u) {
+            feed(x, 0, 0x48, 0x00, rates, sizeof rates, t); /* the same setting again */
+        }
+        tase_gimbal_poll(&x->g, t);
+    }
+    for (p = 0; p < 3; p++) {
+        uint32_t bytes = 0;
+        for (s = 0; s < NSTREAM; s++) {
+            bytes += x->count[p][s] * frame_len[s];
+        }
+        /* 10 s at the budget, and a frame of each stream of slack */
+        assert_true(bytes <= 10u * budget + 14u + 26u + 71u);
+        assert_true(bytes >= 9u * budget); /* and it does use its share */
+    }
+    free(x);
+}
+
+/* A review: after the clock stepped back 5 s, or a poll came 2^31 ms or
+ * more after the last, the next slot read as one far ahead and nothing was
+ * sent until then (up to 24.8 days). The streams restart from now. */
+static void a_clock_step_back_or_a_2_31_gap_restarts_the_streams(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    uint32_t t0;
+    (void)state;
+    run(x, 0, 1000, 0);
+    assert_int_equal(x->count[0][0], 10);
+    t0 = 1000u - 5000u; /* the clock went back 5 s (modulo 2^32) */
+    run(x, t0, 1000, 0);
+    assert_true(x->count[0][0] >= 19u && x->count[0][0] <= 20u); /* 9..10 more, not 0 */
+    t0 = t0 + 1000u + 0x80000000u + 5000u; /* then no poll for 2^31 ms and 5 s */
+    run(x, t0, 1000, 0);
+    assert_true(x->count[0][0] >= 28u && x->count[0][0] <= 30u);
+    free(x);
+}
+
 /* Every write stalls its whole bound: a poll with three frames due tries
  * one and leaves the other two (before, it tried each 64 times). */
 static void a_stuck_port_costs_one_frame_bound_per_poll(void **state)
@@ -1727,6 +1786,8 @@ int main(void)
         cmocka_unit_test(init_refuses_both_forms_of_a_callback),
         cmocka_unit_test(an_echo_gets_through_an_over_rate_schedule_within_the_host_timeout),
         cmocka_unit_test(capacity_is_per_port_and_checks_its_arguments),
+        cmocka_unit_test(a_repeated_packet_rate_keeps_every_port_within_its_capacity),
+        cmocka_unit_test(a_clock_step_back_or_a_2_31_gap_restarts_the_streams),
         cmocka_unit_test(a_stuck_port_costs_one_frame_bound_per_poll),
         cmocka_unit_test(the_gimbal_keeps_its_bounds_under_random_faults),
         cmocka_unit_test(commands_reach_the_dispatcher_typed_with_their_port),

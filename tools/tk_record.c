@@ -295,7 +295,7 @@ static void send_bytes(replay_t *rp, const uint8_t *d, size_t n, unsigned dir)
         tase_can_frame_t f;
         (void)tase_can_split_init(
             &s, dir == TK_CAP_FROM_GIMBAL ? TASE_CAN_ROLE_GIMBAL : TASE_CAN_ROLE_HOST, d, n);
-        while (tase_can_split_next(&s, &f) == TASE_OK) {
+        while (tase_can_split_next(&s, &f) > 0) { /* the frame's dlc; 0 when done */
             send_frame(rp, &f);
         }
     } else {

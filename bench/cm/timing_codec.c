@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "tase/dispatch.h"
+#include "tase/flags.h"
 #include "tase/frame.h"
 #include "timing.h"
 
@@ -65,6 +66,34 @@ NOINLINE static void c_dispatch(void *ctx)
     tase_dispatch_frame(&disp, &pkt_f);
 }
 
+/* The commands tase_command_check() judges, set to pass every check (the
+ * longest path: a position command in range, a SPOI in range); every other
+ * packet at its full form. cmd_data: the same as data bytes. */
+static uint8_t cmd_data[TASE_DATA_MAX];
+static size_t cmd_len;
+
+static bool prep_cmd(const tase_packet_desc_t *p)
+{
+    int n;
+    if (!prep_full_frame(p)) {
+        return false;
+    }
+    if (p->id == TASE_ID_GIMBAL_CMD) {
+        full_msg.gimbal_cmd.flags = TASE_GIMBAL_FLAGS_POSITION_STAB;
+        full_msg.gimbal_cmd.pan = TASE_PAN_MAX_CDEG;
+        full_msg.gimbal_cmd.tilt = TASE_TILT_MIN_CDEG;
+    } else if (p->id == TASE_ID_SPOI_CMD) {
+        full_msg.spoi_cmd.lat = 324000000;
+        full_msg.spoi_cmd.lon = -648000000;
+    }
+    n = tase_packet_encode_data(p->id, &full_msg, cmd_data, sizeof(cmd_data));
+    cmd_len = n > 0 ? (size_t)n : 0u;
+    return n >= 0;
+}
+
+MEASURED(c_command_check, tase_command_check(cur_pkt->id, &full_msg))
+MEASURED(c_command_check_data, tase_command_check_data(cur_pkt->id, cmd_data, cmd_len))
+
 MEASURED(c_dispatch_init, tase_dispatch_init(&disp, handlers, on_other, NULL, NULL, &stats))
 
 MEASURED(c_frame_encode,
@@ -96,6 +125,9 @@ void timing_codec(void)
     codec_one("tase_packet_decode_desc", prep_full, c_decode_desc, "");
     codec_one("tase_packet_decode_iter", prep_full, c_decode_iter, ", walk bound at that length");
     codec_one("tase_dispatch_frame", prep_full, c_dispatch, ", trivial handler");
+    codec_one("tase_command_check", prep_cmd, c_command_check, ", a command that passes");
+    codec_one("tase_command_check_data", prep_cmd, c_command_check_data,
+              ", a command that passes (decoded first)");
     report("tase_dispatch_init", measure_plain(c_dispatch_init),
            "handler table, default handler and stats given");
     memset(camera_bytes, 0x5A, sizeof(camera_bytes));

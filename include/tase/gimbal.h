@@ -93,7 +93,11 @@
  * tase_gimbal_poll(); if the poll came so late that further slots have
  * passed too, they are skipped (counted in stats.slots_skipped), never
  * sent as a burst. Poll at least once per shortest period (every few ms)
- * and every slot is sent, within the poll interval of its due time.
+ * and every slot is sent, within the poll interval of its due time. A
+ * next slot more than a second ahead of now_ms (the clock stepped back,
+ * or polls came 2^31 ms or more apart) re-anchors its stream at now_ms,
+ * as a rate change does, instead of waiting for that time; the slots of
+ * such a gap are not counted.
  *
  * PRIORITY AND CAPACITY. Setup echoes, query answers and the
  * application's own sends are written before the call that received the
@@ -130,7 +134,10 @@
  * its receive buffer empty (see there).
  *
  * LONGEST BLOCK. Each frame write blocks at most the port's frame bound
- * (port_io.h: TASE_PORT_WRITE_TIMEOUT_MS + the port's W). A port whose
+ * (port_io.h: TASE_PORT_WRITE_TIMEOUT_MS + the port's W; an answer or
+ * tase_gimbal_send() goes in 16-byte pieces, so a port that takes every
+ * piece whole but blocks W in each call blocks W per piece: up to 17 W for
+ * the longest frame, 2 W for a 24-byte PACKET_RATE echo). A port whose
  * write fails gets no further telemetry in the same poll (its remaining
  * due slots count in stats.slots_after_tx_error), so a stuck port costs
  * tase_gimbal_poll() one frame bound, not one per due stream: a poll
@@ -315,8 +322,9 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
 
 /* Hand over one frame received on `port` some other way (e.g. CAN
  * reassembly). Returns TASE_OK or TASE_EARG (g, frame or frame->data
- * NULL, port >= 3; nothing counted). A setup frame for an absent port is
- * counted but not answered. O(len). */
+ * NULL, port >= 3; nothing counted). A setup frame for an absent port (no
+ * ops: nothing could answer it) is counted in stats.frames_rx only:
+ * neither applied nor answered, whatever its length (no bad_length). O(len). */
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
                              uint32_t now_ms);
 

@@ -368,6 +368,13 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     grep ' 11000000#' /tmp/recorded.txt > /tmp/recorded.in
     check "replay --can --dir in: only the $(wc -l < /tmp/recorded.in) frames sent to the gimbal ($(cat /tmp/replay.out))" \
         eval 'cmp -s /tmp/recorded.in /tmp/replayed.txt || { diff /tmp/recorded.in /tmp/replayed.txt | head; false; }'
+    # A serial capture replayed onto CAN: cut into frames of each record's
+    # direction's ID (it sent nothing: the loop took the frames' dlc for an
+    # error code)
+    cp /data/serial.pcap /tmp/tools.pcap
+    replay_seen /tmp/replay-serial.log --dir all --speed 0
+    check "replay --can of a serial capture: the frames of each direction's ID ($(cat /tmp/replay.out))" \
+        eval 'cmp -s /data/serial.expect /tmp/replayed.txt || { diff /data/serial.expect /tmp/replayed.txt | head; false; }'
     [ $nfail -eq 0 ] || fail "$nfail bench tool check(s) over vcan0 failed"
 else
     step "bench tools over vcan0: SKIPPED (tase and tase-sim are not built)"

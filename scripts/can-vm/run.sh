@@ -101,6 +101,30 @@ if [ -n "$tase" ]; then
     done
     cp "$tase" "$root/bin/tase"
     cp "$tase_sim" "$root/bin/tase-sim"
+    # A serial capture (a GIMBAL_CMD to the gimbal, a GIMBAL_ANGLE from it)
+    # for `tase replay --can`, and the CAN frames the spec makes of it
+    # (5.1: 0x11000000 to the gimbal, 0x10000000 from it, 8 bytes a frame),
+    # written here independently of the library.
+    python3 - "$root/data" <<'PY'
+import os, struct, sys
+d = sys.argv[1]
+os.makedirs(d, exist_ok=True)
+def frame(g, t, data):
+    b = bytes([0x00, 0xFF, 0x5A, len(data) + 2, g, t]) + bytes(data)
+    s = sum(b) & 0xFFFF
+    return b + bytes([s >> 8, s & 0xFF])
+cmd = frame(0x00, 0x80, [0x0B, 0xB8, 0xFA, 0x24, 0, 0, 0xA0, 0])
+ang = frame(0x08, 0x10, [0x03, 0xE8, 0xFE, 0x0C, 0, 0])
+with open(os.path.join(d, "serial.pcap"), "wb") as f:
+    f.write(struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 147))
+    for i, (to_gimbal, fr) in enumerate([(1, cmd), (0, ang)]):
+        rec = bytes([to_gimbal]) + fr
+        f.write(struct.pack("<IIII", 1700000000, i * 1000000, len(rec), len(rec)) + rec)
+with open(os.path.join(d, "serial.expect"), "w") as f:
+    for can_id, fr in (("11000000", cmd), ("10000000", ang)):
+        for k in range(0, len(fr), 8):
+            f.write("vcan0 %s#%s\n" % (can_id, fr[k:k + 8].hex().upper()))
+PY
 fi
 cp "$here/init.sh" "$root/init"
 chmod +x "$root/init"
