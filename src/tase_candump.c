@@ -150,14 +150,20 @@ static int read_id(cursor_t *c, uint32_t *id, bool *extended)
     return TASE_OK;
 }
 
-/* Data bytes as pairs of hex digits, '.' allowed between two, at most
- * `max` (into data when it is not NULL). Returns the count, or -1. */
+/* Data bytes as pairs of hex digits, at most `max` (into data when it is
+ * not NULL), each after an optional '.' (as canplayer reads them: a
+ * separator before any byte, the first too, and one at the end). Returns
+ * the count, or -1. */
 static int read_hex_bytes(cursor_t *c, uint8_t *data, unsigned max)
 {
     unsigned n = 0;
     for (;;) {
-        int hi = hexval(peek(c));
+        int hi;
         int lo;
+        if (peek(c) == '.') {
+            c->i++;
+        }
+        hi = hexval(peek(c));
         if (hi < 0) {
             return (int)n;
         }
@@ -171,13 +177,6 @@ static int read_hex_bytes(cursor_t *c, uint8_t *data, unsigned max)
             data[n] = (uint8_t)(((unsigned)hi << 4) | (unsigned)lo);
         }
         n++;
-        /* A '.' separates bytes; it may not end the data. */
-        if (peek(c) == '.') {
-            c->i++;
-            if (hexval(peek(c)) < 0) {
-                return -1;
-            }
-        }
     }
 }
 
@@ -200,9 +199,10 @@ static int read_raw_dlc(cursor_t *c, unsigned n)
 /* After the '#': the frame's data. Returns TASE_OK, TASE_EFORMAT, or
  * TASE_EUNSUPPORTED for a well-formed frame this library cannot
  * represent (the caller still checks that the line ends after it): a
- * remote frame (R, an optional length digit 0..8, a raw DLC after 8), a
- * CAN FD frame ('#', a flags digit, up to 64 bytes) or a classic frame
- * with a raw DLC. */
+ * remote frame (R or r, an optional length digit 0..8, a raw DLC after 8)
+ * or a CAN FD frame ('#', a flags digit, up to 64 bytes). A classic frame
+ * of 8 bytes with a raw DLC 9..F is those 8 bytes (classic CAN carries 8
+ * for any DLC above 8; the SocketCAN port receives it so). */
 static int read_data(cursor_t *c, uint8_t *data, uint8_t *dlc)
 {
     int n;
@@ -215,7 +215,7 @@ static int read_data(cursor_t *c, uint8_t *data, uint8_t *dlc)
         c->i++;
         return read_hex_bytes(c, NULL, 64u) < 0 ? TASE_EFORMAT : TASE_EUNSUPPORTED;
     }
-    if (peek(c) == 'R') {
+    if (peek(c) == 'R' || peek(c) == 'r') {
         unsigned len = 0;
         c->i++;
         if (peek(c) >= '0' && peek(c) <= '8') {
@@ -229,8 +229,8 @@ static int read_data(cursor_t *c, uint8_t *data, uint8_t *dlc)
         return TASE_EFORMAT;
     }
     raw = read_raw_dlc(c, (unsigned)n);
-    if (raw != 0) {
-        return raw > 0 ? TASE_EUNSUPPORTED : TASE_EFORMAT;
+    if (raw < 0) {
+        return TASE_EFORMAT;
     }
     *dlc = (uint8_t)n;
     return TASE_OK;

@@ -61,7 +61,7 @@ static void malformed_lines_are_rejected_and_leave_output_alone(void **state)
         "(1700000000.123456) vcan0 123#0",                  /* odd nibble */
         "(1700000000.123456) vcan0 123#0G",                 /* not hex */
         "(1700000000.123456) vcan0 123#001122334455667788", /* 9 bytes */
-        "(1700000000.123456) vcan0 123#00.",                /* dangling dot */
+        "(1700000000.123456) vcan0 123#00..",               /* two dots */
         "(1700000000.123456) vcan0 123#00 junk",            /* trailing text */
         "(1700000000.123456) vcan0 C0000000#00",            /* flag bits 30/31 */
         "(1700000000.123456) averyveryverylongname 123#00", /* name > 15 */
@@ -90,13 +90,37 @@ static void frames_we_cannot_represent_are_unsupported(void **state)
     assert_int_equal(parse("(1.000000) vcan0 123#R", &r), TASE_EUNSUPPORTED);
     assert_int_equal(parse("(1.000000) vcan0 123##100", &r), TASE_EUNSUPPORTED);
     assert_int_equal(parse("(1.000000) vcan0 20000080#0000000000000000", &r), TASE_EUNSUPPORTED);
-    assert_int_equal(parse("(1.000000) vcan0 123#1122334455667788_E", &r), TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 123#r", &r), TASE_EUNSUPPORTED); /* as canplayer */
     assert_int_equal(parse("(1.000000) vcan0 123#R5", &r), TASE_EUNSUPPORTED);
     assert_int_equal(parse("(1.000000) vcan0 12345678#R8_9 R", &r), TASE_EUNSUPPORTED);
     assert_int_equal(parse("(1.000000) vcan0 123##0", &r), TASE_EUNSUPPORTED);
     assert_int_equal(parse("(1.000000) vcan0 12345678##3AA.BB.CC", &r), TASE_EUNSUPPORTED);
-    assert_int_equal(parse("(1.000000) vcan0 123#11.22.33.44.55.66.77.88_F\r\n", &r),
-                     TASE_EUNSUPPORTED);
+    assert_int_equal(parse("(1.000000) vcan0 11000000##1AA.", &r), TASE_EUNSUPPORTED);
+}
+
+/* Classic CAN carries 8 bytes for any DLC above 8, and the SocketCAN port
+ * receives such a frame as its 8 bytes; candump logs it with `_9`..`_F`.
+ * Those lines were skipped as unsupported, so `tase decode --candump` lost
+ * a packet `tase monitor --can` had received (a review). canplayer also
+ * takes a '.' before the first byte and after the last. */
+static void raw_dlc_frames_are_their_8_bytes_and_dots_separate_as_canplayer(void **state)
+{
+    static const uint8_t want[8] = {0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77, 0x88};
+    tase_candump_rec_t r;
+    (void)state;
+    assert_int_equal(parse("(1.000000) vcan0 123#1122334455667788_E", &r), TASE_OK);
+    assert_int_equal(r.frame.dlc, 8);
+    assert_memory_equal(r.frame.data, want, 8);
+    assert_int_equal(parse("(1.000000) vcan0 10000000#11.22.33.44.55.66.77.88_F\r\n", &r),
+                     TASE_OK);
+    assert_int_equal(r.frame.dlc, 8);
+    assert_true(r.frame.extended);
+    assert_memory_equal(r.frame.data, want, 8);
+    assert_int_equal(parse("(1.000000) vcan0 123#.1122", &r), TASE_OK);
+    assert_int_equal(r.frame.dlc, 2);
+    assert_int_equal(parse("(1.000000) vcan0 123#11.22.", &r), TASE_OK);
+    assert_int_equal(r.frame.dlc, 2);
+    assert_int_equal(r.frame.data[1], 0x22);
 }
 
 /* Only a well-formed line of those kinds is unsupported: a corrupted one
@@ -112,7 +136,6 @@ static void malformed_unsupported_forms_are_format_errors(void **state)
         "(1.000000) vcan0 11000000#R8_3",
         "(1.000000) vcan0 123##",
         "(1.000000) vcan0 123##ZZZZ not fd",
-        "(1.000000) vcan0 11000000##1AA.",
         "(1.000000) vcan0 123#11_E",
         "(1.000000) vcan0 123#1122334455667788_Zjunk",
         "(1.000000) vcan0 123#1122334455667788_E junk",
@@ -309,6 +332,7 @@ int main(void)
         cmocka_unit_test(standard_and_empty_frames_parse),
         cmocka_unit_test(malformed_lines_are_rejected_and_leave_output_alone),
         cmocka_unit_test(frames_we_cannot_represent_are_unsupported),
+        cmocka_unit_test(raw_dlc_frames_are_their_8_bytes_and_dots_separate_as_canplayer),
         cmocka_unit_test(malformed_unsupported_forms_are_format_errors),
         cmocka_unit_test(format_writes_candump_style_lines),
         cmocka_unit_test(format_needs_room_and_valid_records),

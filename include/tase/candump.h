@@ -8,17 +8,21 @@
  *     (1700000000.123456) vcan0 11000000#00FF5A0808100001
  *
  *   - timestamp: seconds, '.', exactly six digits of microseconds;
- *   - interface name: 1..15 printable characters, no spaces;
+ *   - interface name: 1..15 printable ASCII characters, no spaces (a
+ *     name with other bytes, which Linux allows, is TASE_EFORMAT);
  *   - identifier: 3 hex digits for a standard frame (<= 7FF), 8 for an
  *     extended one (<= 1FFFFFFF); then '#' and 0..8 data bytes as pairs
  *     of hex digits (the writer uses upper case; the reader takes either,
- *     and '.' between bytes as cansend/canplayer do).
+ *     and a '.' before any byte and one at the end, as canplayer does);
+ *     after 8 bytes an optional raw DLC `_9`..`_F` (classic CAN carries 8
+ *     bytes for any DLC above 8: read as those 8 bytes, as the SocketCAN
+ *     port receives such a frame).
  *
  * The reader accepts fields separated by runs of spaces/tabs, a trailing
  * "\n" or "\r\n", and an optional trailing direction flag "T" or "R"
  * (later can-utils with -x). Valid can-utils lines this library cannot
- * represent (remote frames `123#R`, CAN FD `123##1...`, error frames, whose
- * 8-digit identifier has bit 29 set, raw DLC suffix `_X`) give
+ * represent (remote frames `123#R` or `123#r`, CAN FD `123##1...`, error
+ * frames, whose 8-digit identifier has bit 29 set) give
  * TASE_EUNSUPPORTED, so a replay can count and skip them; anything else
  * that does not match gives TASE_EFORMAT.
  */
@@ -50,7 +54,7 @@ typedef struct {
  *   TASE_EFORMAT       not a log line (bad timestamp, name, identifier,
  *                      odd or non-hex data, more than 8 bytes, trailing
  *                      text, empty line);
- *   TASE_EUNSUPPORTED  a remote, CAN FD, error or raw-DLC frame.
+ *   TASE_EUNSUPPORTED  a remote, CAN FD or error frame.
  * rec is untouched on error. O(len), reentrant, ISR-safe. */
 int tase_candump_parse(const char *line, size_t len, tase_candump_rec_t *rec);
 

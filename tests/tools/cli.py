@@ -339,6 +339,21 @@ ok("decode --stats prints the counters on stderr",
    rc == 0 and re.search(r"summary: 12 frames \(1 unknown, 1 wrong length\), 1 checksum errors, "
                          r"1 bad sizes, \d+ of \d+ bytes discarded", err) is not None, err)
 
+# candump logs (a review): a classic frame logged with a raw DLC (_9.._F)
+# is its 8 bytes, as the SocketCAN port receives it live (it was skipped:
+# the packet lost offline); canplayer's lower-case remote and leading dot
+# are valid lines; a time beyond 2^63 s was printed negative
+ga = angle(1000, -500)
+log = ("(1700000000.000000) can0 10000000#%s_9\n(1700000000.000100) can0 10000000#r\n"
+       "(1700000000.000200) can0 10000000#.%s\n" % (ga[:8].hex().upper(), ga[8:].hex().upper()))
+rc, out, err = run(["decode", "--candump", write("rawdlc.log", log)])
+ok("decode --candump: a raw-DLC frame is its 8 bytes; #r and #. are can-utils lines",
+   rc == 0 and '"name":"GIMBAL_ANGLE"' in out and err == "", "exit %d %s %s" % (rc, out, err))
+rc, out, err = run(["decode", "--candump", write("bigtime.log",
+                    "(18446744073709551615.000001) can0 10000000#%s\n" % ga[:8].hex())])
+ok("decode --candump: a time of 2^63 s or more is a bad line, never a negative time",
+   rc == 4 and "2^63" in err and "-" not in out, "exit %d %s %s" % (rc, out, err))
+
 # ---- output errors ----
 for args in (["decode", noisy], ["list"], ["--help"], ["klv", os.path.join(os.path.dirname(noisy),
                                                                       "klv_noisy.bin")]):

@@ -140,6 +140,11 @@ static void candump_line(candump_t *c, const char *line, size_t len, bool overlo
                                   : ""));
         return;
     }
+    if (rec.sec > (uint64_t)INT64_MAX) {
+        /* printed as a negative time before (the tools' times are signed) */
+        candump_bad(c, " (a time of 2^63 s or more)");
+        return;
+    }
     t.sec = (int64_t)rec.sec;
     t.usec = rec.usec;
     if (!tk_dec_can(c->d, rec.ifname, &rec.frame, &t)) {

@@ -77,7 +77,13 @@ local tase_serial = Proto("tase_serial", "TASE serial capture")
 tase.prefs.baud = Pref.uint("Serial line baud rate", 57600,
     "The rate of the captured serial line (as tase decode --baud): a pending candidate frame "
         .. "is judged false after a gap longer than its remaining bytes' time at this rate, "
-        .. "at least 20 ms")
+        .. "at least the quiet margin")
+-- The least gap that ends a pending candidate: `tase decode --margin`'s
+-- (can.h PAUSES: a CAN link whose frames come further apart needs more).
+-- tshark: -o tase.margin:250.
+tase.prefs.margin = Pref.uint("Quiet margin (ms)", 20,
+    "The least gap, in milliseconds, after which a pending candidate frame is judged false "
+        .. "(as tase decode --margin MS; default 20, the receiver's)")
 
 -- BEGIN GENERATED (tools/wireshark/schema_lua.c; do not edit by hand)
 -- {group, type, name, data length, flags,
@@ -344,8 +350,8 @@ end
 -- pending candidate, or a partial sync at its end) is judged false, as at
 -- the end of the capture, when the next packet of the stream comes more
 -- than its quiet limit after the previous one: the time its remaining
--- bytes need at the line's rate, at least QUIET_MS.
-local QUIET_MS = 20
+-- bytes need at the line's rate, at least the margin preference (20 ms
+-- unless set, as tase decode's --margin).
 local FRAME_MAX = 261
 
 -- A packet time (seconds, a double) in whole milliseconds, as `tase
@@ -370,7 +376,7 @@ local function quiet_limit(st, rate)
         end
         if left == nil then return nil end
     end
-    return math.max(math.floor((left * 1000 + rate - 1) / rate), QUIET_MS)
+    return math.max(math.floor((left * 1000 + rate - 1) / rate), tase.prefs.margin)
 end
 
 -- First pass: append packet `num`'s bytes (arrived at `ts` on a line of
@@ -538,8 +544,24 @@ local function dissect_3ax(tvb, pinfo, tree, id)
     end
 end
 
+-- A CAN FD frame on our IDs: not the datalink (classic CAN only, CAN.md),
+-- as the library and `tase decode` skip it (its bytes went into the
+-- stream: a packet around it was lost). More than 8 bytes is FD; an FD
+-- frame of 8 or fewer is told by its flags field (Wireshark 4.0:
+-- canfd.flags.brs), which exists only where the pass has a protocol tree:
+-- tshark -2 needs -R frame for that in its first pass (as for several
+-- capture interfaces, above).
+local ok_fd, f_canfd_brs = pcall(Field.new, "canfd.flags.brs")
+
+local function is_fd(tvb)
+    return tvb:len() > 8 or (ok_fd and f_canfd_brs() ~= nil)
+end
+
 function tase.dissector(tvb, pinfo, tree)
     local id = pinfo.match_uint -- the CAN ID it was registered for
+    if is_fd(tvb) then
+        return 0
+    end
     if id == ID_3AX_MOVE or id == ID_3AX_STATUS then
         dissect_3ax(tvb, pinfo, tree, id)
         return tvb:len()
