@@ -111,8 +111,7 @@ static void raw_dlc_frames_are_their_8_bytes_and_dots_separate_as_canplayer(void
     assert_int_equal(parse("(1.000000) vcan0 123#1122334455667788_E", &r), TASE_OK);
     assert_int_equal(r.frame.dlc, 8);
     assert_memory_equal(r.frame.data, want, 8);
-    assert_int_equal(parse("(1.000000) vcan0 10000000#11.22.33.44.55.66.77.88_F\r\n", &r),
-                     TASE_OK);
+    assert_int_equal(parse("(1.000000) vcan0 10000000#11.22.33.44.55.66.77.88_F\r\n", &r), TASE_OK);
     assert_int_equal(r.frame.dlc, 8);
     assert_true(r.frame.extended);
     assert_memory_equal(r.frame.data, want, 8);
