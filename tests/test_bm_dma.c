@@ -202,6 +202,87 @@ static void a_lap_is_reported_and_loses_only_what_was_overwritten(void **state)
     assert_int_equal(rd.stats.overruns, 1);
 }
 
+/* The DMA as hardware runs it: its index is its whole count modulo the
+ * size, also past 2^32 (a 64-bit count here); the stream repeats a
+ * 256-byte period of sixteen 16-byte frames. */
+typedef struct {
+    uint8_t *buf;
+    uint32_t size;
+    uint64_t total;
+    const uint8_t *s;
+} dma64_t;
+
+static void dma64_write(dma64_t *d, uint32_t n)
+{
+    uint32_t i;
+    for (i = 0; i < n; i++) {
+        d->buf[(d->total + i) % d->size] = d->s[(d->total + i) % 256u];
+    }
+    d->total += n;
+}
+
+/* Polls of 40 bytes, `polls` of them: the frames delivered. */
+static unsigned dma64_run(dma64_t *d, tase_bm_dma_t *rd, tase_rx_t *rx, log_t *got, unsigned polls)
+{
+    unsigned k, frames = 0;
+    for (k = 0; k < polls; k++) {
+        int r;
+        dma64_write(d, 40);
+        r = tase_bm_dma_poll(rd, (uint32_t)d->total, k, rx, on_frame, got);
+        assert_true(r >= 0);
+        frames += (unsigned)r;
+    }
+    return frames;
+}
+
+/* A review, at a buffer size that does not divide 2^32 (100): a reader
+ * 2^31 bytes or more behind took the sample for a stale one and read
+ * nothing, uncounted, for another 2^31 bytes; and after the count wrapped
+ * at 2^32 an overrun resumed at `written % size`, which is no longer the
+ * DMA's index: the reader stayed at the wrong place for good (599 of 1000
+ * frames). */
+static void overruns_far_behind_and_past_2_32_resume_at_the_dmas_index(void **state)
+{
+    static uint8_t period[256];
+    static uint8_t buf[100];
+    static log_t got;
+    uint8_t d[8] = {0};
+    dma64_t dma = {buf, sizeof buf, 0, period};
+    tase_bm_dma_t rd;
+    tase_rx_t rx;
+    unsigned i, frames;
+    (void)state;
+    for (i = 0; i < 16u; i++) {
+        d[0] = (uint8_t)i;
+        assert_int_equal(tase_frame_build(0x08, (uint8_t)i, d, 8, &period[16u * i], 16), 16);
+    }
+    got.n = 0;
+    (void)tase_rx_init(&rx);
+    assert_int_equal(tase_bm_dma_init(&rd, buf, sizeof buf), TASE_OK);
+    /* the DMA ran on alone for 2^32 - 1000 bytes (more than 2^31) */
+    dma.total = 0x100000000u - 1000u - 300u;
+    dma64_write(&dma, 300);
+    assert_true(tase_bm_dma_poll(&rd, (uint32_t)dma.total, 0, &rx, on_frame, &got) >= 0);
+    assert_int_equal(rd.stats.overruns, 1);
+    assert_true(rd.stats.lost_bytes == 0x100000000u - 1000u);
+    frames = dma64_run(&dma, &rd, &rx, &got, 50); /* 2,000 bytes: across 2^32 */
+    assert_true(frames >= 2000u / 16u - 2u);
+    assert_true(dma.total > 0x100000000u);
+    /* an overrun after the wrap: the reader resumes at the DMA's index */
+    dma64_write(&dma, 350);
+    assert_true(tase_bm_dma_poll(&rd, (uint32_t)dma.total, 60, &rx, on_frame, &got) >= 0);
+    assert_int_equal(rd.stats.overruns, 2);
+    frames = dma64_run(&dma, &rd, &rx, &got, 100); /* 4,000 bytes */
+    assert_true(frames >= 4000u / 16u - 2u);
+    assert_int_equal(rd.stats.overruns, 2);
+    /* and every frame delivered is one of the stream's (data[0] = type) */
+    for (i = 0; i < got.n; i++) {
+        assert_int_equal(got.f[i].group, 0x08);
+        assert_int_equal(got.f[i].len, 8);
+        assert_int_equal(got.f[i].sum, got.f[i].type);
+    }
+}
+
 /* The time bound: noise then a frame, then nothing: the frame comes out
  * by the tick of a later empty poll. */
 static void an_empty_poll_ticks_the_time_bound(void **state)
@@ -282,6 +363,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(any_split_gives_the_frames_of_one_feed),
         cmocka_unit_test(a_lap_is_reported_and_loses_only_what_was_overwritten),
+        cmocka_unit_test(overruns_far_behind_and_past_2_32_resume_at_the_dmas_index),
         cmocka_unit_test(an_empty_poll_ticks_the_time_bound),
         cmocka_unit_test(bad_arguments_and_a_busy_receiver_read_nothing),
     };

@@ -427,6 +427,45 @@ static void a_write_to_a_master_whose_peer_closed_fails_with_eio_at_once(void **
     pty_close(&p);
 }
 
+/* Closes the pty master after 100 ms (the peer hangs up). */
+static void *late_hangup(void *arg)
+{
+    int *fd = arg;
+    struct timespec ts = {0, 100L * 1000000L};
+    nanosleep(&ts, NULL);
+    close(*fd);
+    *fd = -1;
+    return NULL;
+}
+
+/* A review: a write the slave side was making when the master hung up
+ * returned TASE_EIO although part of it had gone into the queue before
+ * (port.h: never drop bytes silently); the POLLHUP path already returned
+ * the count. The count comes back; the next call is TASE_EIO. */
+static void a_hang_up_in_the_middle_of_a_write_returns_what_went_out(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a;
+    tase_port_t pa;
+    static uint8_t big[1 << 20];
+    pthread_t th;
+    int n;
+    (void)state;
+
+    pty_open(&p);
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 57600), TASE_OK);
+    pa = tase_posix_uart_port(&a);
+    a.write_timeout_ms = 1000;
+    assert_int_equal(pthread_create(&th, NULL, late_hangup, &p.master), 0);
+    n = pa.ops->write(pa.ctx, big, sizeof big);
+    assert_int_equal(pthread_join(th, NULL), 0);
+    assert_true(n > 0); /* the bytes the queue took before the hang-up */
+    assert_true(n < (int)sizeof big);
+    assert_int_equal(pa.ops->write(pa.ctx, big, 16), TASE_EIO);
+    tase_posix_uart_close(&a);
+    pty_close(&p);
+}
+
 /* EINTR is resumed with the time left (port.h): a storm of signals cannot
  * hold read() or write() past their bounds (they retried for as long as
  * the storm lasted). */
@@ -805,6 +844,7 @@ int main(void)
         cmocka_unit_test(a_write_to_a_master_whose_peer_closed_fails_with_eio_at_once),
         cmocka_unit_test(a_storm_of_signals_does_not_hold_a_call_past_its_bound),
         cmocka_unit_test(a_write_of_nothing_returns_zero),
+        cmocka_unit_test(a_hang_up_in_the_middle_of_a_write_returns_what_went_out),
         cmocka_unit_test(a_hung_up_line_reads_as_eio),
         cmocka_unit_test(a_hung_up_line_reads_as_eio_also_without_waiting),
         cmocka_unit_test(the_clock_is_monotonic_milliseconds),

@@ -65,7 +65,7 @@ void worst_try(worst_t *w, unsigned long insns, const char *fmt, ...)
 
 void worst_report(const char *fn, const worst_t *w, const char *how)
 {
-    static char line[320];
+    static char line[448];
     (void)snprintf(line, sizeof(line), "%s%s", w->input, how);
     report(fn, w->insns, line);
 }

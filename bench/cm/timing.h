@@ -45,7 +45,7 @@ unsigned long measure_plain(measure_fn call);
 /* The worst count seen so far over several inputs, and which input. */
 typedef struct {
     unsigned long insns;
-    char input[224];
+    char input[320];
 } worst_t;
 
 /* Keep insns and the input described by fmt when it is the worst yet. */

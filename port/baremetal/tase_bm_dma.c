@@ -50,16 +50,23 @@ int tase_bm_dma_poll(tase_bm_dma_t *d, uint32_t written, uint32_t now_ms, tase_r
     }
     frames = r; /* the probe may finish a scan the last call left pending */
     fresh = written - d->read;
-    if (fresh >= 0x80000000u) {
-        fresh = 0; /* a stale sample: the DMA cannot run backwards */
+    if (fresh > d->size && (uint32_t)(d->read - written) <= d->size) {
+        /* A stale sample (at most a lap behind what was read: the DMA
+         * cannot run backwards). A lag beyond that is an overrun below: 2^31
+         * bytes or more behind read as "stale" and nothing was read for
+         * another 2^31 bytes. */
+        fresh = 0;
     }
     if (fresh > d->size) {
         /* Lapped: the buffer mixes two laps. Lose it all, settle what the
-         * receiver holds (the gap cuts any candidate), resume at the DMA. */
+         * receiver holds (the gap cuts any candidate), resume at the DMA:
+         * `fresh` bytes on from where the reader is (written % size is the
+         * DMA's index only while the count has not wrapped at 2^32, unless
+         * the size divides 2^32: the reader landed elsewhere for good). */
         d->stats.overruns++;
         d->stats.lost_bytes += fresh;
         d->read = written;
-        d->pos = written % d->size;
+        d->pos = (d->pos + fresh % d->size) % d->size;
         r = tase_rx_flush(rx, on_frame, user);
         frames += r > 0 ? r : 0;
         fresh = 0;

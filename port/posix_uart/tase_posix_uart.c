@@ -359,7 +359,9 @@ static int uart_write(void *ctx, const uint8_t *data, size_t n)
             continue;
         }
         if (w < 0 && !intr && !would_block(errno)) {
-            return TASE_EIO;
+            /* a hang-up after part of it went out: that part is counted
+             * (port.h: never drop bytes silently); the next call says EIO */
+            return done > 0 ? (int)done : TASE_EIO;
         }
         /* Full (or interrupted): wait for room within the bound. A signal
          * resumes with the time left, so a storm of them cannot hold the

@@ -42,6 +42,14 @@
  * DMA's position. Exactly `size` new bytes is not an overrun (the reader
  * takes the whole buffer), but is the last safe moment: poll well within
  * a buffer's time (256 bytes at 115200 baud: 22 ms).
+ * The count is of the bytes written when `written` was sampled: bytes the
+ * DMA writes while the call runs (on_frame runs inside it: a gimbal
+ * writing its echo at line rate) must not reach the part not yet fed, or
+ * they are fed in place of the old ones (a frame lost, one given twice,
+ * nothing counted). Keep fresh bytes + the bytes that arrive during the
+ * call within `size`: poll when the buffer is at most half full, or make
+ * the buffer twice what one poll takes plus what the callbacks' time
+ * brings in.
  *
  * TIME BOUND. After feeding, tase_rx_tick(rx, now_ms, ...) runs (the
  * receiver's time bound, tase/frame.h TIME BOUND): call this on every
@@ -50,7 +58,7 @@
  *
  * CONTEXT: one context per instance (the main loop, or the one interrupt
  * that polls); on_frame runs inside tase_bm_dma_poll(). No heap, no
- * globals; one 32-bit remainder on an overrun, no other division.
+ * globals; two 32-bit remainders on an overrun, no other division.
  * O(bytes fed) per call plus the receiver's costs.
  */
 #ifndef TASE_BM_DMA_H
@@ -91,8 +99,10 @@ int tase_bm_dma_init(tase_bm_dma_t *d, const uint8_t *buf, uint32_t size);
  * of frames delivered (by the feed, an overrun's flush and the tick), or
  * TASE_EARG (d, rx NULL or d not initialised; nothing read), or the
  * receiver's error (TASE_EBUSY when called from rx's own callback:
- * nothing read, call again later). `written` going backwards by less
- * than 2^31 (a stale sample) reads nothing. */
+ * nothing read, call again later). `written` going backwards by at most
+ * `size` (a stale sample) reads nothing; more than `size` ahead, however
+ * far (the count wraps at 2^32: 2^31 or more behind is far ahead), is an
+ * overrun. */
 int tase_bm_dma_poll(tase_bm_dma_t *d, uint32_t written, uint32_t now_ms, tase_rx_t *rx,
                      tase_rx_handler_t on_frame, void *user);
 
