@@ -407,7 +407,7 @@ int tase_packet_decode_iter(tase_field_iter_t *it, const uint8_t *data, void *ms
  *               table 5 (4.1.1, the four legacy ones included), and a
  *               position command (flags 0x01, 0x03, 0x20, 0xA0) must lie
  *               in the axes' ranges (TASE_PAN_*_CDEG, TASE_TILT_*_CDEG in
- *               tase/units.h: pan -180..180, tilt -270..90 degrees);
+ *               tase/common.h: pan -180..180, tilt -270..90 degrees);
  *   SPOI_CMD    lat within -90..90 and lon within -180..180 degrees
  *               (+-324,000,000 and +-648,000,000 milli-arcseconds).
  * Every other packet passes (its ranges are the wire's). Reserved flag

@@ -86,9 +86,10 @@
  * a byte costs 1.2 times a minimal classic parser's on a Cortex-M4
  * (less on an M0+: docs/DESIGN.md); the
  * worst streams measured (false syncs every 4 bytes whose Sizes keep the
- * scan behind and make it sum long stretches) cost about 104 Thumb
- * instructions per byte through tase_rx_push() on a Cortex-M4 (-O2) and
- * 225 on an M0+ (-Os). docs/PERFORMANCE.md has the numbers.
+ * scan behind and make it sum long stretches) cost about 101 Thumb
+ * instructions per byte through tase_rx_push() on a Cortex-M4 (-O2; the
+ * adversarial search of bench/search.sh finds 104..106) and 224 on an M0+
+ * (-Os). docs/PERFORMANCE.md has the numbers.
  *
  * RAM. sizeof(tase_rx_t) is 360: the TASE_RX_WINDOW (300) window bytes (a
  * frame and the room a lagging scan needs), 28 of counters, 15 of the time

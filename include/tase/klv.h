@@ -59,9 +59,10 @@
  *
  * RAM: sizeof(tase_klv_rx_t) <= TASE_KLV_RX_SIZE_BUDGET (132 bytes: the
  * 91-byte window, 8 counters, the offset, the length and a busy flag,
- * padded; no pointers, so the same on 32- and 64-bit). Stack: about 200
- * bytes for feed -> scan -> decode on Cortex-M4 -Os (gcc -fstack-usage:
- * 40 + 72 + 72), of which one tase_klv_t (40 bytes).
+ * padded; no pointers, so the same on 32- and 64-bit). Stack: about 210
+ * bytes for feed -> scan -> decode -> checksum on Cortex-M4 -Os (212 in
+ * docs/FOOTPRINT.md, from gcc -fstack-usage), of which one tase_klv_t
+ * (40 bytes).
  *
  * UNITS. The raw fields are what travels on the wire; tase_klv_*_deg() and
  * friends convert them with the corrected scale factors (the spec prints

@@ -51,7 +51,7 @@ def session(url, out):
         print("%d packets in 1 s, %d GIMBAL_ANGLE" % (len(telemetry), len(angles)))
         with open(os.path.join(out, "telemetry.jsonl"), "w") as f:
             for p in telemetry:
-                f.write(p.json(units=True) + "\n")  # the same JSON as `tase monitor --json --units`
+                f.write(p.json(units=True) + "\n")  # `tase monitor --json --units --time`'s, + "dir"
         print("link statistics:", link.stats)
 
     tase.plot.plot_capture(capture, os.path.join(out, "session.png"))

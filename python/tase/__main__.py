@@ -31,10 +31,12 @@ def main(argv=None):
         elif a.cmd == "decode":
             with open(a.file, "rb") as f:
                 head = f.read(4)
+            n = 0
             if head[:4] in tase.capture.MAGICS:
                 cap = tase.capture.Capture(a.file)
                 for _, pkt in cap:
                     print(pkt.json())
+                    n += 1
                 # as `tase decode`: each bad record said, the rest decoded, exit 4
                 for index, why in cap.bad:
                     print("tase: %s: record %d skipped: %s" % (a.file, index, why), file=sys.stderr)
@@ -46,10 +48,23 @@ def main(argv=None):
                         file=sys.stderr,
                     )
                     return 4
+                if n == 0 and cap.records > 0:
+                    print("tase: no TASE packet found in %s" % a.file, file=sys.stderr)
+                    return 4
             else:
                 with open(a.file, "rb") as f:
-                    for pkt in tase.decode(f.read()):
-                        print(pkt.json())
+                    data = f.read()
+                for pkt in tase.decode(data):
+                    print(pkt.json())
+                    n += 1
+                if n == 0 and data:
+                    # as `tase decode`: bytes but no packet is exit 4
+                    print(
+                        "tase: no TASE packet found in %s (not a capture of a TASE serial line?)"
+                        % a.file,
+                        file=sys.stderr,
+                    )
+                    return 4
     except (tase.Error, OSError, ValueError) as e:
         print("tase: %s" % e, file=sys.stderr)
         return 1

@@ -153,6 +153,9 @@ class Field:
         (never saturated: nothing is sent on a guess)."""
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise FieldError("%s %s: not a number: %r" % (pkt, self.name, value))
+        if isinstance(value, int) and abs(value) > 2**64:
+            # far outside any field (a float of it raised OverflowError)
+            raise FieldError("%s %s: %d is out of range" % (pkt, self.name, value), lib.TASE_ERANGE)
         if self.unit is None:
             if isinstance(value, float):
                 if not value.is_integer():
@@ -583,8 +586,16 @@ class Packet(tuple):
         if t.is_query(self.size):
             return "Packet.query(%r)" % t.name
         args = ["%r" % t.name]
+        codes = {}
+        raw = self.raw
+        for f in t.fields:
+            if f.unit is not None and raw.get(f.name) in (f.keep, f.none):
+                codes[f.name] = raw[f.name]  # a code, not a value: given raw
         for k, v in self.fields.items():
-            args.append("%s=%r" % (k, v))
+            if k not in codes:
+                args.append("%s=%r" % (k, v))
+        if codes:
+            args.append("raw=%r" % codes)
         if t.tail:
             args.append("data=%r" % self.data)
         if self.size != t.len and not t.tail:
@@ -620,7 +631,12 @@ def _make(t, raw, length, data):
     if length is None or (length == t.len and not isinstance(length, bool)):
         n = None
     else:
-        if isinstance(length, bool) or not isinstance(length, int) or not t.length_ok(length):
+        if (
+            isinstance(length, bool)
+            or not isinstance(length, int)
+            or not 0 <= length <= lib.TASE_DATA_MAX
+            or not t.length_ok(length)
+        ):
             raise FieldError("%s: %r is not an accepted data length" % (t.name, length))
         n = length
     for k in raw:

@@ -59,7 +59,10 @@ def _pcap(f, head):
     rest = f.read(20)
     if len(rest) < 20:
         raise CaptureError("pcap header cut short")
-    linktype = struct.unpack(e + "HHiIII", rest)[5] & 0x0FFFFFFF
+    snaplen, linktype = struct.unpack(e + "HHiIII", rest)[4:6]
+    linktype &= 0x0FFFFFFF
+    if snaplen == 0 or snaplen > _MAX_SNAPLEN:
+        snaplen = _MAX_SNAPLEN  # libpcap's adjustment
     index = 0
     while True:
         h = f.read(16)
@@ -77,8 +80,12 @@ def _pcap(f, head):
         index += 1
         if len(data) < incl:
             raise CaptureError("record %d: cut short" % index)
+        if incl > snaplen:
+            # as libpcap: read, but given up to the snapshot length only, so
+            # the record is cut (tase decode skips it; this gave it whole)
+            data = data[:snaplen]
         usec = frac // 1000 if nano else frac
-        yield index, linktype, sec * 1000000 + usec, data, incl < orig
+        yield index, linktype, sec * 1000000 + usec, data, len(data) < orig
 
 
 class _Block:
@@ -157,11 +164,15 @@ def _pcapng(f, head):
     index = 0
     e = None  # the byte order of the sections, from the first one's magic
     ifaces = []
+    idb_seen = False
     while True:
         where = "after record %d: " % index
         h = head if head is not None else f.read(8)
         head = None
         if not h:
+            if not idb_seen:
+                # libpcap opens no such file (tase decode: exit 1)
+                raise CaptureError("the capture file has no Interface Description Blocks")
             return
         if len(h) < 8:
             raise CaptureError("%struncated pcapng dump file: a block header cut short" % where)
@@ -236,6 +247,7 @@ def _pcapng(f, head):
                 snaplen = _MAX_SNAPLEN  # libpcap's adjustment
             res, offset = _idb_options(blk)
             ifaces.append((linktype, snaplen, res, offset))
+            idb_seen = True
         elif btype in (6, 3):  # enhanced / simple packet
             if btype == 6:
                 iface, hi, lo, incl, orig = blk.unpack("IIIII")
@@ -300,6 +312,7 @@ class CaptureWriter:
     _HEADER = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, LINKTYPE_SERIAL)
 
     def __init__(self, path):
+        path = _path_arg("a capture", path)
         self.path = path
         self.records = 0
         self.f = None
@@ -315,10 +328,16 @@ class CaptureWriter:
                 self.f = open(path, "r+b", buffering=0)
                 self.good = self._whole_records_end()
                 self.f.truncate(self.good)
-                self.f.seek(self.good)
+                self.f.close()
+                # appended to (O_APPEND), each record in one write: another
+                # writer's records (tase --record, a second link) go between
+                # ours, never over them (a seek to our own end overwrote them)
+                self.f = None
+                self.f = open(path, "ab", buffering=0)
             else:
                 created = not os.path.exists(path)
-                self.f = open(path, "wb", buffering=0)  # no buffer to write later
+                # appended to as well (O_APPEND: see above); no buffer to write later
+                self.f = open(path, "ab", buffering=0)
                 self.good = 0
                 self._write(self._HEADER)
         except (OSError, CaptureError) as e:
@@ -356,7 +375,8 @@ class CaptureWriter:
             except (OSError, ValueError):
                 pass
             raise _write_error(self.path, e) from e
-        self.good += len(buf)
+        # the end of the file after this record (others may append too)
+        self.good = os.fstat(self.f.fileno()).st_size
 
     def put(self, dir, data, t_ns=None):
         """One record: dir 0 (bytes from the gimbal) or 1 (to it)."""
@@ -408,6 +428,16 @@ class _Stream:
         return self._timed(self.dec.flush(), self.last)
 
 
+
+def _path_arg(what, path):
+    """A file path (str, bytes, os.PathLike); an int would be taken for an
+    open file descriptor (record=3 wrote the capture onto the link's own
+    line), so anything else is a TypeError."""
+    if isinstance(path, bool) or not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError("%s is a file path, not %s" % (what, type(path).__name__))
+    return os.fsdecode(path)
+
+
 class Capture:
     """Iterate over (time, packet) of a capture; .bad lists the malformed
     records skipped ((index, reason)), .records the records read, .stats
@@ -418,7 +448,7 @@ class Capture:
         if isinstance(baud, bool) or not isinstance(baud, int) or not 10 <= baud <= 4000000:
             # an OverflowError / TypeError from deep inside, or 0 taken
             raise FieldError("baud %r is not a serial line rate (10..4000000)" % (baud,))
-        self.path = path
+        self.path = _path_arg("a capture", path)
         self.rate = baud // 10
         self.bad = []
         self.streams = {}

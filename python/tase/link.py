@@ -16,6 +16,7 @@ import errno
 import math
 import os
 import re
+import sys
 import select
 import threading
 import time
@@ -42,7 +43,9 @@ from ._core import (
 __all__ = ["connect", "Link", "parse_url"]
 
 DEFAULT_BAUD = 57600
-_SERIAL_URL = re.compile(r"^serial:(?P<dev>[^:]+)(?::(?P<baud>[0-9]+))?$")
+# the device may hold ':' (/dev/serial/by-path/pci-0000:00:14.0-usb-0:2:1.0-port0):
+# a baud is the digits after the last one
+_SERIAL_URL = re.compile(r"^serial:(?P<dev>.+?)(?::(?P<baud>[0-9]+))?$")
 _BAUDS = (9600, 19200, 38400, 57600, 115200, 230400, 460800, 921600)
 
 
@@ -75,6 +78,7 @@ def connect(url, *, timeout=0.5, retries=2, record=None):
     what is written as sent to the gimbal, what is read as sent by it).
     Use as a context manager: the link is closed on exit."""
     scheme, target, baud = parse_url(url)
+    _request_opts(timeout, retries)  # refused here, not at the first query
     if record is not None and scheme != "serial":
         raise FieldError(
             "record: only a serial link's session can be recorded here (on CAN run "
@@ -110,6 +114,7 @@ class _Recorder:
         self.inner = inner
         self.w = writer
         self.failed = None
+        self.warning = None
         self.name = inner.name
         self.bytes_per_s = inner.bytes_per_s
 
@@ -124,7 +129,10 @@ class _Recorder:
                 self._stop()
             except Error:
                 pass
-            warnings.warn("%s; recording stopped, the link goes on" % e, RuntimeWarning, 3)
+            # warned when the call returns (Link._call_locked), not here in
+            # the port callback: under -W error the warning raised here was
+            # taken for the port's failure (a sent command reported as not)
+            self.warning = "%s; recording stopped, the link goes on" % e
 
     def write(self, data):
         n = self.inner.write(data)
@@ -310,38 +318,68 @@ def _closed_meanwhile(link):
     return False
 
 
+# Every line of a callback is inside its try: cffi prints and drops an
+# exception that leaves one (a Ctrl-C there was lost, with the bytes read).
+
+
 @ffi.def_extern()
 def py_port_write(ctx, data, n):
-    link = ffi.from_handle(ctx)()
-    if link is None or _closed_meanwhile(link):
-        return lib.TASE_EIO
+    link = None
     try:
+        link = ffi.from_handle(ctx)()
+        if link is None or _closed_meanwhile(link):
+            return lib.TASE_EIO
         return link._t.write(ffi.buffer(data, n)[:])
     except BaseException as e:  # noqa: B902 - handed back to the caller
-        link._exc = e
+        if link is not None:
+            link._exc = e
         return lib.TASE_EIO
+
+
+# A read waits in slices of this many seconds, so that close() from
+# another thread ends a call waiting for an answer that does not come (it
+# waited out the whole timeout).
+_READ_SLICE_S = 0.2
 
 
 @ffi.def_extern()
 def py_port_read(ctx, buf, cap, timeout_ms):
-    link = ffi.from_handle(ctx)()
-    if link is None or _closed_meanwhile(link):
-        return lib.TASE_EIO
+    link = None
     try:
-        data = link._t.read(cap, timeout_ms / 1000.0)
+        link = ffi.from_handle(ctx)()
+        if link is None or _closed_meanwhile(link):
+            return lib.TASE_EIO
+        deadline = time.monotonic() + timeout_ms / 1000.0
+        while True:
+            left = deadline - time.monotonic()
+            data = link._t.read(cap, max(0.0, min(left, _READ_SLICE_S)))
+            if data or left <= _READ_SLICE_S:
+                break
+            if _closed_meanwhile(link):
+                return lib.TASE_EIO
+        if data:
+            ffi.memmove(buf, data, len(data))
+            # the frames these bytes complete arrived now (tase monitor --time)
+            link._sink.s.now = _now_us()
+        return len(data)
     except BaseException as e:  # noqa: B902
-        link._exc = e
+        if link is not None:
+            link._exc = e
         return lib.TASE_EIO
-    if data:
-        ffi.memmove(buf, data, len(data))
-        # the frames these bytes complete arrived now (tase monitor --time)
-        link._sink.s.now = _now_us()
-    return len(data)
 
 
 @ffi.def_extern()
 def py_port_now(ctx):
-    return int(time.monotonic() * 1000) & 0xFFFFFFFF
+    try:
+        return int(time.monotonic() * 1000) & 0xFFFFFFFF
+    except BaseException as e:  # noqa: B902
+        try:
+            link = ffi.from_handle(ctx)()
+            if link is not None:
+                link._exc = e
+        except BaseException:  # noqa: B902
+            pass
+        return 0
 
 
 _GIMBAL_CMD_FLAGS = {
@@ -360,6 +398,37 @@ for _f in range(lib.TASE_GIMBAL_FLAGS_LEGACY_RATE, lib.TASE_GIMBAL_FLAGS_LEGACY_
 # How to send anyway what _checked() refuses for reserved flag bits.
 _SEND_RESERVED = "send(..., reserved=True) sends it anyway, as tase send --raw"
 _QUERY_RESERVED = "send(..., reserved=True) sends it; the answer is then read with recv()"
+
+
+def _request_opts(timeout, retries):
+    """A request's timeout (s) and retries: FieldError unless a number in
+    (0, 2^31 ms) and an int 0..255."""
+    if (
+        isinstance(timeout, bool)
+        or not isinstance(timeout, (int, float))
+        or isinstance(retries, bool)
+        or not isinstance(retries, int)
+        or not 0 < timeout < 2**31 / 1000
+        or not 0 <= retries <= 255
+    ):
+        raise FieldError("timeout must be > 0 s and under 2^31 ms, retries 0..255")
+    return timeout, retries
+
+
+def _warn_at_caller(msg):
+    """A RuntimeWarning at the first frame outside this package."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    f, level = sys._getframe(1), 1
+    while f is not None and os.path.dirname(os.path.abspath(f.f_code.co_filename)) == here:
+        f, level = f.f_back, level + 1
+    warnings.warn(msg, RuntimeWarning, level + 1)
+
+
+def _flag(what, v):
+    """A True/False option (a string such as "no" is true in Python)."""
+    if not isinstance(v, bool):
+        raise FieldError("%s must be True or False, not %r: nothing sent" % (what, v))
+    return v
 
 
 def _stab(what, v):
@@ -484,6 +553,10 @@ class Link:
             got = self._sink.take(None, "out")
             if got:
                 self._queue.extend(got)
+        w = getattr(self._t, "warning", None)
+        if w is not None:
+            self._t.warning = None
+            _warn_at_caller(w)
         if self._exc is not None:
             e, self._exc = self._exc, None
             if isinstance(e, Error) or not isinstance(e, Exception):
@@ -529,20 +602,10 @@ class Link:
         return t
 
     def _request_opts(self, timeout, retries):
-        """A request's timeout (s) and retries, the link's defaults for None;
-        FieldError unless a number in (0, 2^31 ms) and an int 0..255."""
-        timeout = self.timeout if timeout is None else timeout
-        retries = self.retries if retries is None else retries
-        if (
-            isinstance(timeout, bool)
-            or not isinstance(timeout, (int, float))
-            or isinstance(retries, bool)
-            or not isinstance(retries, int)
-            or not 0 < timeout < 2**31 / 1000
-            or not 0 <= retries <= 255
-        ):
-            raise FieldError("timeout must be > 0 s and under 2^31 ms, retries 0..255")
-        return timeout, retries
+        """A request's timeout (s) and retries, the link's defaults for None."""
+        return _request_opts(
+            self.timeout if timeout is None else timeout, self.retries if retries is None else retries
+        )
 
     def send(self, packet, reserved=False):
         """Send one packet to the gimbal now (no answer awaited). Packets
@@ -553,7 +616,7 @@ class Link:
         HOST_SENSOR, HOST_ATTITUDE, SPOI_CMD; reserved=True sends those
         anyway) are refused (FieldError), nothing sent, as `tase send`."""
         self._live()
-        self._checked(packet, reserved)
+        self._checked(packet, _flag("send: reserved", reserved))
         data = packet.payload
         r = self._call(lib.tase_host_send, self._host, packet.group, packet.type, data, len(data))
         if r < 0:
@@ -632,6 +695,8 @@ class Link:
         self._live()
         if timeout is not None:
             _seconds("packets: timeout", timeout)
+        if count is not None and (isinstance(count, bool) or not isinstance(count, int) or count < 0):
+            raise FieldError("packets: count %r is not a number of packets (an int >= 0)" % (count,))
         deadline = None if timeout is None else time.monotonic() + timeout
         given = 0
         looked = False
@@ -647,7 +712,17 @@ class Link:
             # at least one look at the port, also with timeout 0 (a poll)
             ms = 0 if wait <= 0 else max(1, min(int(wait * 1000), 200))
             looked = True
-            r = self._call(lib.tase_host_service, self._host, ms)
+            if ms == 0:
+                # a poll does not wait for another thread's call (recv(0)
+                # waited seconds behind a query)
+                if not self._call_lock.acquire(blocking=False):
+                    continue
+                try:
+                    r = self._call(lib.tase_host_service, self._host, ms)
+                finally:
+                    self._call_lock.release()
+            else:
+                r = self._call(lib.tase_host_service, self._host, ms)
             if r < 0:
                 raise error(r, "%s: receive" % self.url)
 
@@ -725,6 +800,7 @@ class Link:
         """SPOI_CMD (`tase spoi`): degrees WGS-84, metres; no velocity. With
         wait the echo is requested and returned, and its position compared
         (Error if it differs); else the packet sent is returned."""
+        _flag("spoi: wait", wait)
         for name, v in (("latitude", lat), ("longitude", lon), ("height", height)):
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                 raise FieldError("spoi: %s %r is not a number: nothing sent" % (name, v))

@@ -159,6 +159,12 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
         # an engineering value that lands on the wire's "do not change" code
         (lambda l: l.send(tase.Packet("AXIS_SETTING", pan_max_rate=1275)), tase.FieldError,
          r"pan_max_rate: 1275 .* is raw 255, the wire's \"do not change\" code"),
+        # a review: "no" is true in Python: reserved bits went out, the echo
+        # flag was set and awaited
+        (lambda l: l.send(tase.Packet("CAMERA_CMD", camera=0, raw={"flags": 0x88}),
+                          reserved="no"), tase.FieldError, "reserved must be True or False"),
+        (lambda l: l.spoi(2, 2, 2, wait="no"), tase.FieldError, "wait must be True or False"),
+        (lambda l: list(l.packets(timeout=0.1, count=2.5)), tase.FieldError, "count 2.5"),
         # query() has no reserved=: its refusal points to send() (a review)
         (lambda l: l.query(tase.Packet("SPOI_CMD", lat=0, lon=0, height=0, vnorth=0, veast=0,
                                        vdown=0, flags=0xFF)), tase.FieldError,
@@ -317,6 +323,95 @@ def test_a_full_disk_stops_the_recording_not_the_link(silent_pty, tmp_path):
     # a capture that cannot even be created: a CaptureError (was an OSError)
     with pytest.raises(tase.capture.CaptureError, match="No space left on device"):
         tase.connect(url, record="/dev/full")
+
+
+def test_a_full_disk_under_w_error_does_not_say_the_command_failed(silent_pty, tmp_path):
+    # a review: the RuntimeWarning was raised inside the port callback under
+    # -W error, which made the write fail: LinkError for a command that
+    # went out. The warning comes when the call returns, at the caller.
+    import warnings
+
+    url, master = silent_pty
+    with tase.connect(url, record=str(tmp_path / "s.pcap")) as link:
+        _sink_full(link, 0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with pytest.raises(RuntimeWarning, match="recording stopped, the link goes on"):
+                link.point(3, 4)
+        assert isinstance(link.record_error, tase.capture.CaptureError)
+        link.point(5, 6)
+    assert [p.raw["pan"] for p in tase.decode(_drain(master))] == [300, 500]
+
+
+def test_the_recording_warning_names_the_callers_line(silent_pty, tmp_path):
+    url, master = silent_pty
+    with tase.connect(url, record=str(tmp_path / "s.pcap")) as link:
+        _sink_full(link, 0)
+        with pytest.warns(RuntimeWarning) as rec:
+            link.point(3, 4)
+    assert rec[0].filename == __file__  # not a line inside the package
+
+
+@pytest.mark.parametrize("record", [3, True, 3.5])
+def test_record_takes_a_path_not_a_descriptor(silent_pty, record):
+    # a review: record=3 (the link's own pty) wrote the capture onto the
+    # gimbal's line (the command went out twice); record=True onto stdout
+    url, master = silent_pty
+    with pytest.raises(TypeError, match="is a file path"):
+        tase.connect(url, record=record)
+    assert _drain(master, 0.05) == b""
+
+
+def test_close_from_another_thread_ends_a_query_waiting_for_its_answer(silent_pty):
+    # a review: with no retry due, the query waited its whole timeout (5 s)
+    # after close(); reads wait in slices now and see the close
+    url, master = silent_pty
+    link = tase.connect(url)
+    got = []
+
+    def worker():
+        try:
+            link.query("PACKET_RATE", timeout=5, retries=0)
+        except tase.Error as e:
+            got.append(e)
+
+    t = threading.Thread(target=worker)
+    t.start()
+    time.sleep(0.2)
+    t0 = time.monotonic()
+    link.close()
+    t.join(5)
+    assert not t.is_alive() and time.monotonic() - t0 < 1.0
+    assert len(got) == 1 and "the link was closed" in str(got[0])
+
+
+def test_recv_0_does_not_wait_for_another_threads_call(silent_pty):
+    # a review: recv(0) waited 2.9 s behind a query of another thread
+    url, master = silent_pty
+    with tase.connect(url) as link:
+        t = threading.Thread(target=lambda: pytest.raises(TimeoutError, link.query, "PACKET_RATE",
+                                                           timeout=1.5, retries=0))
+        t.start()
+        time.sleep(0.2)
+        t0 = time.monotonic()
+        with pytest.raises(TimeoutError):
+            link.recv(0)
+        assert time.monotonic() - t0 < 0.5
+        t.join(5)
+
+
+def test_connect_checks_its_timeout_and_retries(silent_pty):
+    url, master = silent_pty
+    for kw in ({"timeout": "x"}, {"timeout": 0}, {"retries": -1}, {"retries": True}):
+        with pytest.raises(tase.FieldError, match="timeout must be"):
+            tase.connect(url, **kw)
+
+
+def test_a_serial_device_path_may_hold_colons():
+    # /dev/serial/by-path names: "not a link URL"
+    p = "/dev/serial/by-path/pci-0000:00:14.0-usb-0:2:1.0-port0"
+    assert tase.link.parse_url("serial:" + p) == ("serial", p, 57600)
+    assert tase.link.parse_url("serial:%s:9600" % p) == ("serial", p, 9600)
 
 
 def test_send_to_a_gimbal_that_stopped_reading_ends(silent_pty):

@@ -237,3 +237,28 @@ def test_a_bool_is_not_a_length():
     # length=True was taken as 1
     with pytest.raises(tase.FieldError, match="not an accepted data length"):
         tase.Packet("CAMERA_CMD", raw={"camera": 0}, length=True)
+
+
+def test_repr_of_a_packet_holding_a_do_not_change_code_evaluates_back():
+    # an engineering value that lands on such a code is refused, so repr
+    # gives those fields in raw= (eval(repr(p)) failed on pan_nogo_center=-0.01)
+    p = tase.Packet("AXIS_SETTING", pan_max_rate=40)
+    assert p.raw["pan_nogo_center"] == -1
+    r = repr(p)
+    assert "raw={" in r and "pan_nogo_center=-0.01" not in r
+    assert eval(r, {"Packet": tase.Packet}) == p
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: tase.Packet("GIMBAL_ANGLE", pan=10**400, tilt=0, roll=0),
+        lambda: tase.Packet("GIMBAL_ANGLE", raw={"pan": 10**400, "tilt": 0, "roll": 0}),
+        lambda: tase.Packet("CAMERA_CMD", camera=1, length=-1),
+        lambda: tase.Packet("CAMERA_CMD", camera=1, length=10**30),
+    ],
+)
+def test_huge_values_and_lengths_are_field_errors(make):
+    # a review: OverflowError from deep inside
+    with pytest.raises(tase.FieldError):
+        make()
