@@ -415,6 +415,9 @@ class Packet(tuple):
                 % (len(data), lib.TASE_DATA_MAX),
                 lib.TASE_ELENGTH,
             )
+        if isinstance(offset, bool) or not isinstance(offset, int) or offset < 0:
+            # "a" was taken, -5 failed only later in .json()
+            raise FieldError("from_data: offset %r is not a stream offset (an int >= 0)" % (offset,))
         return _from_data(group << 8 | type, data, offset)
 
     offset = property(operator.itemgetter(_OFF), doc="stream offset of the first sync byte")
@@ -544,6 +547,10 @@ class Packet(tuple):
         raw = self.raw
         extra = fields.pop("raw", None) or {}
         data = fields.pop("data", self.data)
+        twice = sorted(set(fields) & set(extra))
+        if twice:
+            # the raw value was kept silently; Packet() says "given twice"
+            raise FieldError("%s: %s given twice (a value and in raw=)" % (t.name, ", ".join(twice)))
         for k, v in fields.items():
             f = t.by_name.get(k)
             if f is None:
@@ -885,6 +892,13 @@ class Decoder:
     rate (baud / 10) for the time bound."""
 
     def __init__(self, bytes_per_s=5760, dir=None):
+        if dir not in (None, "in", "out"):
+            # "x" printed as "dir":"out"
+            raise FieldError('Decoder: dir %r is not "in", "out" or None' % (dir,))
+        if isinstance(bytes_per_s, bool) or not isinstance(bytes_per_s, int) or not (
+            0 <= bytes_per_s <= 0xFFFFFFFF
+        ):
+            raise FieldError("Decoder: bytes_per_s %r is not a byte rate" % (bytes_per_s,))
         self.rx = ffi.new("tase_rx_t *")
         _check(lib.tase_rx_init(self.rx), "decoder")
         _check(lib.tase_rx_set_timing(self.rx, bytes_per_s, 0), "decoder")

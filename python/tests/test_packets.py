@@ -262,3 +262,20 @@ def test_huge_values_and_lengths_are_field_errors(make):
     # a review: OverflowError from deep inside
     with pytest.raises(tase.FieldError):
         make()
+
+
+@pytest.mark.parametrize(
+    "make, text",
+    [
+        # a review: each was taken, and misreported or failed later
+        (lambda: tase.Packet("GIMBAL_ANGLE", pan=1, tilt=0, roll=0).replace(pan=2, raw={"pan": 5}),
+         "pan given twice"),
+        (lambda: tase.Packet.from_data(0x08, 0x10, bytes(6), offset="a"), "offset 'a'"),
+        (lambda: tase.Packet.from_data(0x08, 0x10, bytes(6), offset=-5), "offset -5"),
+        (lambda: tase.Decoder(dir="x"), "dir 'x'"),
+        (lambda: tase.Decoder(-1), "bytes_per_s -1"),
+    ],
+)
+def test_wrong_arguments_are_field_errors_at_once(make, text):
+    with pytest.raises(tase.FieldError, match=text):
+        make()
