@@ -69,15 +69,23 @@ int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms)
 /* The quiet limit of what the window holds (frame.h, TIME BOUND): the
  * time its remaining bytes need at the link's rate, or the margin. The
  * remaining bytes run to the held candidate's last byte, or, for a partial
- * sync or a scan not caught up, to the last byte of a maximal frame
- * beginning at the scan position. */
+ * sync, to the last byte of a maximal frame beginning at the scan
+ * position. A scan not caught up has not found the candidate it will
+ * hold: one may begin at any byte it has not reached, the last one too,
+ * so a whole maximal frame's time (a review: counted from the lagging
+ * scan position, the limit shrank to the margin, and a real frame whose
+ * first bytes came behind a burst was settled away mid-pause). */
 static uint32_t quiet_limit(const tase_rx_t *rx)
 {
     uint32_t rate = (rx->rate != 0u) ? rx->rate : TASE_RX_SLOWEST_RATE;
     uint32_t last = (rx->end != 0u && rx->end != RX_BLOCKED) ? (uint32_t)rx->end + 1u
                                                              : (uint32_t)rx->scan + TASE_FRAME_MAX;
     uint32_t left = (last > rx->len) ? last - rx->len : 0u;
-    uint32_t ms = (left * 1000u + rate - 1u) / rate; /* at most 261,000 / 1 */
+    uint32_t ms;
+    if (rx->lag != 0u) {
+        left = TASE_FRAME_MAX;
+    }
+    ms = (left * 1000u + rate - 1u) / rate; /* at most 261,000 / 1 */
     return (ms > rx->margin_ms) ? ms : rx->margin_ms;
 }
 
@@ -108,17 +116,18 @@ int tase_rx_tick(tase_rx_t *rx, uint32_t now_ms, tase_rx_handler_t on_frame, voi
     if (!settle && rx->lag == 0u) {
         return 0;
     }
-    /* a lagging scan goes on; past the quiet limit, as at end of input */
-    r = tase_rx_continue(rx, settle, on_frame, user);
-    if (settle && r >= 0 && rx->lag != 0u && rx->ticked != 0u) {
-        /* stopped by a callback before it was done (not re-initialised:
-         * that clears `ticked`): the next tick settles the rest, whatever
-         * the scan's position does to the quiet limit meanwhile */
+    /* a lagging scan goes on; past the quiet limit, as at end of input.
+     * A settle marks `ticked` first: a callback that re-initialises rx
+     * clears it (and may tick the new receiver: never to RX_SETTLING
+     * unless its own settle was stopped), so that the end below leaves a
+     * re-initialised receiver alone (a review: it set RX_SETTLING on the
+     * new one, whose next tick then settled a frame still arriving). */
+    if (settle) {
         rx->ticked = RX_SETTLING;
-    } else if (rx->ticked == RX_SETTLING) {
-        rx->ticked = 1u;
-    } else {
-        /* nothing stopped */
+    }
+    r = tase_rx_continue(rx, settle, on_frame, user);
+    if (settle && rx->ticked == RX_SETTLING && (r < 0 || rx->lag == 0u)) {
+        rx->ticked = 1u; /* done; stopped before it was, the next tick settles the rest */
     }
     return r;
 }

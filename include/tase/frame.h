@@ -108,7 +108,9 @@
  * of what is held is
  *     max(time its remaining bytes need at the link's byte rate, margin)
  * where the remaining bytes are those up to the held candidate's last
- * byte (for a partial sync, up to a maximal frame's), the byte rate is
+ * byte (for a partial sync, up to a maximal frame's; while the scan lags,
+ * and so has not found what it will hold, a maximal frame's whole
+ * TASE_FRAME_MAX), the byte rate is
  * set with tase_rx_set_timing() (0, the default after tase_rx_init(), is
  * taken as TASE_RX_SLOWEST_RATE, 960 bytes/s: a 9600-baud line, the
  * slowest of the spec) and the margin is TASE_RX_QUIET_MS (20 ms unless
@@ -334,7 +336,13 @@ int tase_rx_feed(tase_rx_t *rx, const uint8_t *data, size_t n, tase_rx_handler_t
  * in if a callback stopped the call before room was made for it:
  * stats.bytes_in says), or TASE_EARG (rx NULL
  * or visibly corrupted) / TASE_EBUSY (inside a callback of this
- * receiver), receiver unchanged. Longest block: the scan work the byte's
+ * receiver), receiver unchanged. One difference from tase_rx_feed(): a
+ * byte inside a held candidate (the fast path) is checked only as far as
+ * keeps it inside the window; a receiver corrupted otherwise (its held
+ * candidate's Size and end disagree) takes such bytes and is refused
+ * (TASE_EARG) at the candidate's last byte, at most 253 bytes later,
+ * where tase_rx_feed() refuses it at once (the full check costs every
+ * byte a frame carries). Longest block: the scan work the byte's
  * credit pays for (COST: the byte's own and what earlier bytes left, up
  * to a cap) plus one compaction of the window and the callbacks of the
  * frames that work releases: bounded whatever the stream (docs/TIMING.md:
