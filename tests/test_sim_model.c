@@ -596,6 +596,30 @@ static void retracted_gimbal_holds_still_until_deployed(void **state)
     near(m.pan, 15.0, 1e-9);
 }
 
+/* A review: a deploy sent to a deployed gimbal made it "moving" for one
+ * step, so the GIMBAL_CMD or SPOI_CMD sent right after it was dropped
+ * (PROTOCOL-NOTES R6 drops commands only while retracted or moving). It is
+ * echoed at the next step and nothing is dropped. */
+static void a_deploy_while_deployed_is_echoed_and_drops_nothing(void **state)
+{
+    sim_model_t m;
+    (void)state;
+    sim_model_init(&m);
+    assert_int_equal(m.tax, SIM_3AX_DEPLOYED);
+    sim_model_retract_deploy(&m, true);
+    assert_int_equal(m.tax, SIM_3AX_DEPLOYED);
+    assert_int_equal(sim_model_command(&m, 45.0, -10.0, 0x20, 0.0), SIM_CMD_OK);
+    assert_true(sim_model_step(&m, 0.005)); /* the echo, at once */
+    assert_false(sim_model_step(&m, 0.005));
+    run(&m, 5.0);
+    near(m.pan, 45.0, 1e-6);
+    near(m.tilt, -10.0, 1e-6);
+    /* a real move still takes its time and holds the axes */
+    sim_model_retract_deploy(&m, false);
+    assert_int_equal(m.tax, SIM_3AX_MOVING);
+    assert_int_equal(sim_model_command(&m, 0.0, 0.0, 0x20, 0.0), SIM_CMD_NOT_DEPLOYED);
+}
+
 /* ---- item 11: an independent WGS-84 reference ----
  * Written differently from sim_model.c on purpose: points on the ellipsoid
  * from the reduced (parametric) latitude plus the height along the unit
@@ -764,6 +788,7 @@ int main(void)
         cmocka_unit_test(nav_health_reports_filter_mode_normal_4),
         cmocka_unit_test(a_removed_camera_is_gone_from_every_report),
         cmocka_unit_test(retracted_gimbal_holds_still_until_deployed),
+        cmocka_unit_test(a_deploy_while_deployed_is_echoed_and_drops_nothing),
         cmocka_unit_test(spoi_geometry_matches_an_independent_wgs84_reference),
         cmocka_unit_test(a_stalled_periodic_output_resumes_without_a_burst),
     };

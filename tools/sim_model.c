@@ -267,8 +267,14 @@ void sim_model_retract_deploy(sim_model_t *m, bool deploy)
         m->impulse_left = 0.0;
     }
     m->tax_target_deployed = deploy;
+    if (there) {
+        /* already there: echoed at once, never "moving" (a deploy sent to
+         * a deployed gimbal dropped the command sent right after it) */
+        m->tax_echo_due = true;
+        return;
+    }
     m->tax = SIM_3AX_MOVING;
-    m->tax_left = there ? 0.0 : m->tax_duration;
+    m->tax_left = m->tax_duration;
 }
 
 /* The solution in use from the sources (NAVIGATION in sim_model.h). */
@@ -414,6 +420,10 @@ bool sim_model_step(sim_model_t *m, double dt)
             m->tax = m->tax_target_deployed ? SIM_3AX_DEPLOYED : SIM_3AX_RETRACTED;
             done = true;
         }
+    }
+    if (m->tax_echo_due) {
+        m->tax_echo_due = false;
+        done = true;
     }
     return done;
 }

@@ -141,6 +141,7 @@ typedef struct {
     /* retract/deploy mechanism */
     sim_3ax_t tax;
     bool tax_target_deployed;
+    bool tax_echo_due;   /* a command for where it already is: echoed at the next step */
     double tax_left;     /* s until the move completes */
     double tax_duration; /* s a full move takes */
 } sim_model_t;

@@ -115,9 +115,23 @@ static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
         const uint8_t a[] = {r->angle_1, r->angle_2, r->angle_3};
         const uint8_t t[] = {r->rate_1, r->rate_2, r->rate_3};
         const uint8_t g[] = {r->geo_ref_1, r->geo_ref_2, r->geo_ref_3};
+        tase_packet_rate_t old; /* in force until this one is stored */
+        bool have_old;
+        uint8_t og[TASE_GIMBAL_PORTS];
         unsigned i;
+        memset(&old, 0, sizeof old);
+        have_old = tase_gimbal_setup_get_msg(&s->g, TASE_ID_PACKET_RATE, &old) >= 0;
+        og[0] = old.geo_ref_1;
+        og[1] = old.geo_ref_2;
+        og[2] = old.geo_ref_3;
         for (i = 0; i < TASE_GIMBAL_PORTS; i++) {
-            sim_rate_reset(&s->georef_rate[i], now);
+            /* only a port whose GEOREFERENCE rate changed starts measuring
+             * afresh (the gimbal role keeps the others' timing; resetting
+             * all made sample_rate read 20, 10, 7, 255 under a host that
+             * re-sends the same setting) */
+            if (!have_old || og[i] != g[i]) {
+                sim_rate_reset(&s->georef_rate[i], now);
+            }
         }
         sim_log(s, now, "PACKET_RATE: port %u (this link) angle %u/s, rate %u/s, georef %u/s (%s)",
                 s->link + 1u, a[s->link], t[s->link], g[s->link], storage(r->temporary));
@@ -522,8 +536,17 @@ int main(int argc, char **argv)
     if (have_klv) {
         tk_pty_unlink(klv_link, klv_path);
     }
-    sim_log(&s, tase_posix_now_ms(), "stopped: %lu frames in, %lu out",
-            (unsigned long)s.g.stats.frames_rx, (unsigned long)s.g.stats.frames_tx);
+    {
+        /* what was dropped too: it was never logged (a bad checksum, a
+         * setup packet of a wrong length, a frame a pause cut short) */
+        const tase_rx_stats_t *rs = &s.rx[s.link].stats;
+        sim_log(&s, tase_posix_now_ms(),
+                "stopped: %lu frames in, %lu out; dropped: %lu checksum errors, %lu setup "
+                "packets of a wrong length, %lu of %lu bytes discarded",
+                (unsigned long)s.g.stats.frames_rx, (unsigned long)s.g.stats.frames_tx,
+                (unsigned long)rs->checksum_errors, (unsigned long)s.g.stats.bad_length,
+                (unsigned long)rs->bytes_discarded, (unsigned long)rs->bytes_in);
+    }
     tk_link_close(&dl);
     return 0;
 }

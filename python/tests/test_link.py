@@ -414,6 +414,26 @@ def test_a_serial_device_path_may_hold_colons():
     assert tase.link.parse_url("serial:%s:9600" % p) == ("serial", p, 9600)
 
 
+def test_a_packet_rate_sent_again_keeps_the_simulators_measured_rate(sim):
+    # a review: every PACKET_RATE restarted tase-sim's rate meter, also one
+    # that changed nothing, so GEOREFERENCE_DATA's sample_rate (the rate
+    # achieved, PROTOCOL-NOTES P11) read 20, 10, 7, 255 under a host
+    # re-sending its setting
+    with tase.connect(sim.url) as link:
+        cur = link.query("PACKET_RATE").raw
+        cur["temporary"] = 1
+        same = tase.Packet("PACKET_RATE", raw=cur)
+        rates = []
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 3.5:
+            link.query(same)
+            for p in link.packets(timeout=0.2):
+                if p.name == "GEOREFERENCE_DATA" and time.monotonic() - t0 > 1.0:
+                    rates.append(p.raw["sample_rate"])
+        assert len(rates) >= 6, rates
+        assert all(3 <= r <= 5 for r in rates), rates  # 4 per second on this port
+
+
 def test_send_to_a_gimbal_that_stopped_reading_ends(silent_pty):
     # nobody reads the pty: its queue fills and each write waits for room;
     # it waited for ever, now the port's bound (1 s) ends the send

@@ -73,3 +73,23 @@ def test_a_sim_never_stopped_is_stopped(tase_sim, how):
         if _running(pid):
             os.kill(pid, 9)
         shutil.rmtree(where, ignore_errors=True)
+
+
+def test_the_simulator_says_what_it_dropped(tase_sim):
+    # a review: a frame with a bad checksum, a setup packet of a wrong
+    # length were dropped without a word (other packets were logged)
+    import tty
+
+    bad = bytearray(tase.encode(tase.Packet.query("PACKET_RATE")))
+    bad[-1] ^= 0xFF
+    short = tase.encode(tase.Packet.from_data(0x48, 0x00, bytes(15)))  # PACKET_RATE is 16
+    with tase.sim.start() as sim:
+        fd = os.open(sim.url.split(":")[1], os.O_RDWR | os.O_NOCTTY)
+        try:
+            tty.setraw(fd)
+            os.write(fd, bytes(bad) + short)
+            time.sleep(0.5)
+        finally:
+            os.close(fd)
+    line = [l for l in sim.log().splitlines() if "stopped:" in l][-1]
+    assert "dropped: 1 checksum errors, 1 setup packets of a wrong length" in line, line
