@@ -37,7 +37,10 @@ json_int() { sed -n "s/.*\"$2\":\(-\{0,1\}[0-9][0-9]*\).*/\1/p" <<<"$1"; }
 near() { local d=$(($1 - $2)); [ "${d#-}" -le "$3" ]; }
 
 start_sim() {
-    "$SIM" --link "$dir/gimbal" --klv-link "$dir/klv" --seconds 120 >"$dir/sim.log" 2>&1 &
+    # long enough for the whole script, also under memcheck (slow): a
+    # simulator that ended on its own made "a second tase-sim on a live
+    # link" start (a loaded machine, valgrind)
+    "$SIM" --link "$dir/gimbal" --klv-link "$dir/klv" --seconds $((120 * slow)) >"$dir/sim.log" 2>&1 &
     sim_pid=$!
     for _ in $(seq 100); do
         [ -L "$dir/gimbal" ] && [ -L "$dir/klv" ] && return 0
