@@ -239,6 +239,9 @@ int tk_cap_finish(tk_cap_writer_t *w)
 void tk_cap_close(tk_cap_writer_t *w)
 {
     int e = tk_cap_finish(w);
+    if (e == EPIPE) {
+        tk_exit_broken_pipe(); /* `tase record -o - | head -c 100` */
+    }
     if (e != 0) {
         tk_die("cannot write capture %s: %s", w->path, strerror(e));
     }

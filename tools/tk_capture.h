@@ -90,7 +90,8 @@ void tk_cap_put_can(tk_cap_writer_t *w, const struct timespec *t, const uint8_t 
  * it. */
 bool tk_cap_flush(tk_cap_writer_t *w);
 /* Flush and close; dies on a write error, or one tk_cap_flush() met,
- * after tk_cap_finish() has kept what it could. */
+ * after tk_cap_finish() has kept what it could; a pipe whose reader went
+ * away (EPIPE) ends the program quietly with 128 + SIGPIPE instead. */
 void tk_cap_close(tk_cap_writer_t *w);
 /* The same without dying (for exit handlers): returns 0 or an errno (the
  * first write error). After an error the file written ends at its last
@@ -171,8 +172,10 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *path, const char *iface, 
  * bytes) or, with `can` non-NULL, to a CAN interface (frames as recorded;
  * serial bytes cut into frames of their direction's ID), at the capture's
  * timing divided by `speed` (0: no waiting). Prints a summary on stdout;
- * a caught signal stops it (the caller then exits 128 + N). Returns the
- * number of malformed records skipped (each reported on stderr). */
+ * a caught signal stops it (the caller then exits 128 + N). Sends at most
+ * the first `records` records (those tk_cap_check() read: not what was
+ * appended since). Returns the number of malformed records skipped (each
+ * reported on stderr). */
 typedef struct {
     const char *serial; /* device, or NULL */
     long baud;

@@ -415,7 +415,11 @@ unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
         tk_link_serial(&rp.link, o->serial, o->baud);
     }
     rp.port = tk_link_port(&rp.link);
-    while (tk_signal == 0 && (rc = tk_cap_next(r, &rec, why, sizeof(why))) != TK_CAP_END) {
+    /* Only the records tk_cap_check() read: records another program
+     * appends to the capture after the check are not sent (a record cut
+     * short there would fail after the others had gone out). */
+    while (tk_signal == 0 && r->index < o->records &&
+           (rc = tk_cap_next(r, &rec, why, sizeof(why))) != TK_CAP_END) {
         if (rc == TK_CAP_BAD) {
             tk_warn("%s: record %lu skipped: %s", r->path, rec.index, why);
             rp.bad++;

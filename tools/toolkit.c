@@ -257,13 +257,18 @@ void tk_stdout_flush(void)
                     e ? strerror(e) : "write error");
         }
         if (e == EPIPE) {
-            /* the reader went away (`tase monitor | head`): end quietly as
-             * SIGPIPE would, but through the path that closes the links */
-            close_all_links();
-            exit(128 + SIGPIPE);
+            tk_exit_broken_pipe(); /* `tase monitor | head` */
         }
         tk_die("cannot write to standard output: %s", e ? strerror(e) : "write error");
     }
+}
+
+void tk_exit_broken_pipe(void)
+{
+    /* quietly, as SIGPIPE would, but through the path that closes the
+     * links (their settings restored) */
+    close_all_links();
+    exit(128 + SIGPIPE);
 }
 
 static void on_signal(int sig)

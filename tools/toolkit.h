@@ -109,6 +109,10 @@ void tk_stdout_buffered(void);
  * killed by SIGPIPE do (links closed first). After tk_mark_sent() both
  * exit TK_EXIT_SENT naming the packet sent. */
 void tk_stdout_flush(void);
+/* The reader of our output went away (EPIPE on standard output or on a
+ * capture written to a pipe): close every link and exit 128 + SIGPIPE
+ * without a message, as a program killed by SIGPIPE does. */
+void tk_exit_broken_pipe(void);
 /* Flush standard output now, as far as it goes: a failure is kept (on
  * stdout and its errno) for the next tk_stdout_flush() to report, so a
  * command that waits after printing (for an echo) finishes its wait and

@@ -319,6 +319,12 @@ check "record -o - | decode -: packets decoded, status on stderr, no file named 
 "$TASE" decode "$dir/pipe.pcap" >"$dir/pipe.json" 2>/dev/null
 check "record -o /dev/stdout into a pipe: a capture that decodes" \
     grep -q '"dir":"out".*GIMBAL_ANGLE' "$dir/pipe.json"
+# A reader that goes away (`| head -c 100`) ended record with exit 1 and
+# "cannot write capture /dev/stdout: Broken pipe": as SIGPIPE would now.
+"$TASE" record --serial "$dir/gimbal" -o - --seconds 5 2>"$dir/head.err" | head -c 100 >/dev/null
+rc=${PIPESTATUS[0]}
+check "record -o - | head -c 100: exit $rc (128 + SIGPIPE), no error message ('$(grep -v "^recording" "$dir/head.err")')" \
+    eval '[ $rc = 141 ] && ! grep -qv "^recording" "$dir/head.err"'
 : >"$dir/target.pcap"
 ln -s "$dir/target.pcap" "$dir/link.pcap"
 "$TASE" record --serial "$dir/gimbal" -o "$dir/link.pcap" --seconds 0.6 >/dev/null 2>&1
@@ -451,6 +457,40 @@ for d in out in; do
 done
 check "record --tap-in: both lines decoded, each direction exactly the generator's packets" \
     eval 'same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.out" && same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.in"'
+
+# Records appended to the capture after replay's check pass (another
+# program still writing it) were sent too ("replayed 151 of 90 records"),
+# and a record cut short there failed after the others had gone out. The
+# capture is larger than a read buffer; records are appended once the
+# first has arrived on B, while replay waits 3 s for its third.
+"${TASE_PYTHON:-python3}" - "$dir/grow.pcap" <<'PY'
+import struct, sys
+rec = lambda sec, data: struct.pack("<IIII", sec, 0, len(data), len(data)) + data
+ga = bytes([0, 0x00, 0xFF, 0x5A, 0x08, 0x08, 0x10, 0, 0, 0, 0, 0, 0, 0x01, 0x79])
+with open(sys.argv[1], "wb") as f:  # 300 records, 9 KB
+    f.write(struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 147))
+    f.write(rec(1700000001, ga) + rec(1700000000, ga) + rec(1700000003, ga) * 298)
+PY
+cat "$dir/B" >"$dir/grow.got" &
+catp=$!
+"$TASE" replay "$dir/grow.pcap" --serial "$dir/A" --dir out >"$dir/grow.out" 2>&1 &
+rp=$!
+for _ in $(seq 200); do [ -s "$dir/grow.got" ] && break; sleep 0.05; done
+"${TASE_PYTHON:-python3}" - "$dir/grow.pcap" <<'PY'
+import struct, sys
+rec = lambda sec, data: struct.pack("<IIII", sec, 0, len(data), len(data)) + data
+ga = bytes([0, 0x00, 0xFF, 0x5A, 0x08, 0x08, 0x10, 0, 0, 0, 0, 0, 0, 0x01, 0x79])
+with open(sys.argv[1], "ab") as f:
+    f.write(rec(1700000003, ga) * 3 + rec(1700000003, ga)[:20])
+PY
+wait $rp
+rc=$?
+sleep 0.2
+kill $catp 2>/dev/null
+wait $catp 2>/dev/null
+check "replay of a capture appended to after its check: only the records checked sent (exit $rc: $(tail -1 "$dir/grow.out"))" \
+    eval '[ $rc = 0 ] && grep -q "^replayed 300 of 300 records (4200 bytes)" "$dir/grow.out" &&
+          [ "$(wc -c <"$dir/grow.got")" = 4200 ]'
 
 # (last: no recorder follows to find its bytes in the joined ptys)
 expect_error "replay > /dev/full: exit 5, the message says data was sent" 5 \
