@@ -6,8 +6,10 @@
 #include "tk_capture.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -23,36 +25,85 @@
 
 /* ---- writing ---- */
 
-/* The length of the whole records of an existing classic pcap file:
- * the 24-byte file header and every record whose 16-byte header and data
- * are complete. Returns -1 when it is not a classic pcap (pcapng, or not a
- * capture: libpcap's append refuses those with its own message). */
-static long whole_records_len(FILE *f, long size)
+/* ---- appending (--record) ----
+ * A capture is appended to by writes of whole records to a descriptor
+ * opened O_APPEND, one write(2) a flush: two programs recording the same
+ * session into one file (`tase monitor --record` beside `tase point
+ * --record`, or a Python Link's recording) put their records between each
+ * other's, never over them. (libpcap's append seeks to the end it saw at
+ * the start and writes through stdio, which flushes where its buffer
+ * fills, so a second writer overwrote the first.) */
+
+#define APPEND_BUF 65536u
+
+typedef struct {
+    bool big;  /* byte order of the file's fields */
+    bool nano; /* fractions in nanoseconds, else microseconds */
+    uint32_t snaplen;
+    uint32_t linktype;
+} cap_head_t;
+
+static uint32_t get32(const uint8_t *p, bool big)
 {
-    uint8_t h[24];
-    bool big;
-    long at = 24;
-    if (fread(h, 1, sizeof(h), f) != sizeof(h)) {
-        return -1;
+    return big ? ((uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3])
+               : ((uint32_t)p[3] << 24 | (uint32_t)p[2] << 16 | (uint32_t)p[1] << 8 | p[0]);
+}
+
+static void put32(uint8_t *p, uint32_t v, bool big)
+{
+    unsigned i;
+    for (i = 0; i < 4u; i++) {
+        p[big ? i : 3u - i] = (uint8_t)(v >> (24u - 8u * i));
     }
-    /* magic a1b2c3d4 (microseconds) or a1b23c4d (nanoseconds), either order */
+}
+
+/* The fields of a classic pcap file header; false when it is not one
+ * (pcapng, or not a capture). */
+static bool cap_head_parse(const uint8_t h[24], cap_head_t *c)
+{
     if (((h[0] == 0xD4u && h[1] == 0xC3u) || (h[0] == 0x4Du && h[1] == 0x3Cu)) && h[2] == 0xB2u &&
         h[3] == 0xA1u) {
-        big = false;
+        c->big = false;
+        c->nano = h[0] == 0x4Du;
     } else if (h[0] == 0xA1u && h[1] == 0xB2u &&
                ((h[2] == 0xC3u && h[3] == 0xD4u) || (h[2] == 0x3Cu && h[3] == 0x4Du))) {
-        big = true;
+        c->big = true;
+        c->nano = h[3] == 0x4Du;
     } else {
-        return -1;
+        return false;
     }
+    c->snaplen = get32(h + 16, c->big);
+    c->linktype = get32(h + 20, c->big) & 0x0FFFFFFu; /* the low 24 bits name it */
+    return true;
+}
+
+/* Where the whole records of an existing classic pcap file end: after the
+ * 24-byte file header and every record whose 16-byte header and data are
+ * complete. A record that runs past the end of the file with a sound
+ * header is what a crash or a full disk leaves (the caller cuts it off);
+ * a header that no writer writes (more data than the snapshot length or
+ * than the packet's length, a fraction of a second or more) is damage in
+ * the middle of a file, not a cut: returns -1 and its number in
+ * *damaged, and nothing may be cut (41 KB of a file behind a damaged
+ * header were removed as if a crash had cut it). */
+static long whole_records_len(int fd, long size, const cap_head_t *c, unsigned long *damaged)
+{
+    long at = 24;
+    unsigned long index = 0;
     while (at + 16 <= size) {
         uint8_t r[16];
-        uint32_t caplen;
-        if (fseek(f, at, SEEK_SET) != 0 || fread(r, 1, sizeof(r), f) != sizeof(r)) {
+        uint32_t caplen, len, frac;
+        if (pread(fd, r, sizeof(r), (off_t)at) != (ssize_t)sizeof(r)) {
             break;
         }
-        caplen = big ? ((uint32_t)r[8] << 24 | (uint32_t)r[9] << 16 | (uint32_t)r[10] << 8 | r[11])
-                     : ((uint32_t)r[11] << 24 | (uint32_t)r[10] << 16 | (uint32_t)r[9] << 8 | r[8]);
+        index++;
+        frac = get32(r + 4, c->big);
+        caplen = get32(r + 8, c->big);
+        len = get32(r + 12, c->big);
+        if (caplen > c->snaplen || caplen > len || frac >= (c->nano ? 1000000000u : 1000000u)) {
+            *damaged = index;
+            return -1;
+        }
         if ((long)caplen > size - at - 16) {
             break; /* its data runs past the end */
         }
@@ -61,73 +112,183 @@ static long whole_records_len(FILE *f, long size)
     return at;
 }
 
-/* Appending to a capture that a full disk or a crash cut inside a record
- * would put every new record behind the partial one, unreadable: cut the
- * file back to its last whole record first, and say so. */
-static void trim_partial_record(const char *path)
+/* Open `path` for appending records of `linktype` (a new file gets a
+ * nanosecond header): checked and, when a crash or a full disk cut it
+ * inside its last record, cut back to its last whole record (every new
+ * record would be unreadable behind the partial one), said on stderr. The
+ * check and the repair hold the flock every writer of ours holds for a
+ * write, so that two of our programs neither both write a header nor cut
+ * a record the other is writing. */
+static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
 {
-    FILE *f = fopen(path, "rb");
     struct stat st;
-    long keep;
-    if (f == NULL) {
-        return; /* a new file, or libpcap reports why it cannot open it */
+    uint8_t h[24];
+    cap_head_t c = {false, true, SERIAL_SNAPLEN, (uint32_t)linktype};
+    bool existed = lstat(path, &st) == 0;
+    int fd = open(path, O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0666);
+    int e = 0;
+    unsigned long damaged = 0;
+    if (fd < 0) {
+        tk_die("cannot write capture %s: %s", path, strerror(errno));
     }
-    keep = (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode))
-               ? whole_records_len(f, (long)st.st_size)
-               : -1;
-    (void)fclose(f);
-    if (keep >= 24 && keep < (long)st.st_size) {
-        if (truncate(path, (off_t)keep) != 0) {
-            tk_die("cannot repair capture %s: %s", path, strerror(errno));
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        (void)close(fd);
+        tk_die("cannot write capture %s: not a regular file (--record appends to a file; "
+               "'tase record -o' writes to a pipe or a device)",
+               path);
+    }
+    if (flock(fd, LOCK_EX) != 0 || fstat(fd, &st) != 0) {
+        e = errno;
+    } else if (st.st_size == 0) {
+        memset(h, 0, sizeof(h));
+        put32(h, 0xA1B23C4Du, false);
+        h[4] = 2; /* version 2.4, little-endian */
+        h[6] = 4;
+        put32(h + 16, SERIAL_SNAPLEN, false);
+        put32(h + 20, (uint32_t)linktype, false);
+        errno = 0;
+        if (write(fd, h, sizeof(h)) != (ssize_t)sizeof(h)) {
+            e = errno != 0 ? errno : ENOSPC;
+            (void)ftruncate(fd, 0);
         }
-        tk_warn("%s ended inside a record (a full disk or a crash?): %ld bytes of it removed "
-                "before appending",
-                path, (long)st.st_size - keep);
+    } else {
+        long keep;
+        if (pread(fd, h, sizeof(h), 0) != (ssize_t)sizeof(h) || !cap_head_parse(h, &c)) {
+            (void)close(fd);
+            tk_die("cannot write capture %s: not a classic pcap file (--record appends only to "
+                   "one; give a new file name)",
+                   path);
+        }
+        if (c.linktype != (uint32_t)linktype) {
+            (void)close(fd);
+            tk_die("cannot write capture %s: its link type is %lu, not TASE serial (%d): give a "
+                   "new file name",
+                   path, (unsigned long)c.linktype, linktype);
+        }
+        keep = whole_records_len(fd, (long)st.st_size, &c, &damaged);
+        if (keep < 0) {
+            (void)close(fd);
+            tk_die("cannot write capture %s: its record %lu is damaged (not the end of a file a "
+                   "crash cut short): not appending, the file is left as it is",
+                   path, damaged);
+        }
+        if (keep < (long)st.st_size) {
+            if (ftruncate(fd, (off_t)keep) != 0) {
+                tk_die("cannot repair capture %s: %s", path, strerror(errno));
+            }
+            tk_warn("%s ended inside a record (a full disk or a crash?): %ld bytes of it removed "
+                    "before appending",
+                    path, (long)st.st_size - keep);
+        }
     }
+    (void)flock(fd, LOCK_UN);
+    if (e != 0) {
+        (void)close(fd);
+        if (!existed) {
+            (void)unlink(path); /* a file this call made goes again */
+        }
+        tk_die("cannot write capture %s: %s", path, strerror(e));
+    }
+    w->abuf = malloc(APPEND_BUF);
+    if (w->abuf == NULL) {
+        tk_die("cannot write capture %s: out of memory", path);
+    }
+    w->afd = fd;
+    w->alen = 0;
+    w->big = c.big;
+    w->nano = c.nano;
 }
+
+/* One write of the whole records buffered; a write a full disk cut short
+ * is cut off the file again (when nothing was appended behind it). */
+static bool append_flush(tk_cap_writer_t *w)
+{
+    ssize_t k;
+    if (w->alen == 0u) {
+        return true;
+    }
+    /* under the lock every writer of ours takes for a write (the Python
+     * package's too), so that append_open() never takes another's record
+     * in progress for one a crash cut short */
+    (void)flock(w->afd, LOCK_EX);
+    errno = 0;
+    k = write(w->afd, w->abuf, w->alen);
+    if (k != (ssize_t)w->alen) {
+        struct stat st;
+        off_t end = lseek(w->afd, 0, SEEK_CUR);
+        w->err = errno != 0 ? errno : ENOSPC;
+        if (k > 0 && end >= k && fstat(w->afd, &st) == 0 && st.st_size == end) {
+            (void)ftruncate(w->afd, end - k);
+        }
+    }
+    (void)flock(w->afd, LOCK_UN);
+    w->alen = 0;
+    return w->err == 0;
+}
+
+static void append_record(tk_cap_writer_t *w, const struct timespec *t, const uint8_t *rec,
+                          size_t n)
+{
+    uint8_t *h;
+    if (w->alen + 16u + n > APPEND_BUF && !append_flush(w)) {
+        return;
+    }
+    h = w->abuf + w->alen;
+    put32(h, (uint32_t)t->tv_sec, w->big);
+    put32(h + 4, (uint32_t)(w->nano ? t->tv_nsec : t->tv_nsec / 1000), w->big);
+    put32(h + 8, (uint32_t)n, w->big);
+    put32(h + 12, (uint32_t)n, w->big);
+    memcpy(h + 16, rec, n);
+    w->alen += 16u + n;
+    w->records++;
+}
+
+/* ---- writing a new capture ---- */
 
 void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool append)
 {
     int snaplen = linktype == TK_CAP_LINKTYPE_CAN ? (int)TK_CAP_CAN_MAX : SERIAL_SNAPLEN;
-    pcap_t *p = pcap_open_dead_with_tstamp_precision(linktype, snaplen, PCAP_TSTAMP_PRECISION_NANO);
+    pcap_t *p;
     pcap_dumper_t *d;
     struct stat st;
     /* the path itself, not what a symlink names: a rename onto a symlink
      * replaces the link (`-o /dev/stdout` into a file, as root, turned
      * /dev/stdout into a regular file) */
     bool existed = lstat(path, &st) == 0;
-    if (p == NULL) {
-        tk_die("cannot start a capture: out of memory");
-    }
     w->tmp[0] = '\0';
     w->err = 0;
     w->good = -1;
+    w->afd = -1;
+    w->path = path;
+    w->linktype = linktype;
+    w->records = 0;
     if (append) {
-        trim_partial_record(path);
+        append_open(w, path, linktype);
+        w->open = true;
+        return;
+    }
+    p = pcap_open_dead_with_tstamp_precision(linktype, snaplen, PCAP_TSTAMP_PRECISION_NANO);
+    if (p == NULL) {
+        tk_die("cannot start a capture: out of memory");
     }
     /* a temporary file and a rename only for a regular file (or a new
      * one): a device, a FIFO, a symlink (/dev/stdout) is written in place
      * (through the link), never replaced by a rename */
-    if (!append && (existed ? S_ISREG(st.st_mode) : errno == ENOENT)) {
+    if (existed ? S_ISREG(st.st_mode) : errno == ENOENT) {
         int k = snprintf(w->tmp, sizeof(w->tmp), "%s.partial-%ld", path, (long)getpid());
         if (k < 0 || (size_t)k >= sizeof(w->tmp)) {
             tk_die("cannot write capture %s: the path is too long", path);
         }
     }
     errno = 0;
-    d = append ? pcap_dump_open_append(p, path)
-               : pcap_dump_open(p, w->tmp[0] != '\0' ? w->tmp : path);
+    d = pcap_dump_open(p, w->tmp[0] != '\0' ? w->tmp : path);
     if (d == NULL) {
         int e = errno;
         /* nothing recorded: a file this call created goes again (a full
          * disk leaves it empty or cut inside the file header) */
         if (w->tmp[0] != '\0') {
             (void)unlink(w->tmp);
-        } else if (append && !existed) {
-            (void)unlink(path);
         }
-        /* the reason: errno where libpcap's own message is of a step
-         * ("Can't seek to the end of ..." for a full disk) */
         if (e != 0) {
             tk_die("cannot write capture %s: %s", path, strerror(e));
         }
@@ -136,14 +297,16 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
     w->pcap = p;
     w->dumper = d;
     w->good = ftell(pcap_dump_file(d)); /* the end of the last whole record */
-    w->path = path;
-    w->linktype = linktype;
-    w->records = 0;
+    w->open = true;
 }
 
 static void put_record(tk_cap_writer_t *w, const struct timespec *t, const uint8_t *rec, size_t n)
 {
     struct pcap_pkthdr h;
+    if (w->afd >= 0) {
+        append_record(w, t, rec, n);
+        return;
+    }
     memset(&h, 0, sizeof(h));
     h.ts.tv_sec = t->tv_sec;
     h.ts.tv_usec = (suseconds_t)t->tv_nsec; /* nanoseconds: the dumper's precision */
@@ -188,6 +351,9 @@ bool tk_cap_flush(tk_cap_writer_t *w)
     if (w->err != 0) {
         return false;
     }
+    if (w->afd >= 0) {
+        return append_flush(w);
+    }
     errno = 0;
     if (pcap_dump_flush(w->dumper) != 0) {
         w->err = errno != 0 ? errno : EIO;
@@ -199,8 +365,27 @@ bool tk_cap_flush(tk_cap_writer_t *w)
 
 int tk_cap_finish(tk_cap_writer_t *w)
 {
-    FILE *f = pcap_dump_file(w->dumper);
-    int e = w->err; /* the first failure, not the close's */
+    FILE *f;
+    int e;
+    w->open = false;
+    if (w->afd >= 0) {
+        if (w->err == 0) {
+            (void)append_flush(w);
+        }
+        e = w->err;
+        if (fsync(w->afd) != 0 && e == 0) {
+            e = errno; /* a full or failing disk may only tell here */
+        }
+        if (close(w->afd) != 0 && e == 0) {
+            e = errno;
+        }
+        w->afd = -1;
+        free(w->abuf);
+        w->abuf = NULL;
+        return e;
+    }
+    f = pcap_dump_file(w->dumper);
+    e = w->err; /* the first failure, not the close's */
     if (e == 0 && (fflush(f) != 0 || ferror(f))) {
         e = errno != 0 ? errno : EIO;
     }
@@ -310,7 +495,7 @@ static tk_cap_tap_t session_tap;
 static void close_session_capture(void)
 {
     int e;
-    if (session_capture.dumper == NULL) {
+    if (!session_capture.open) {
         return;
     }
     e = tk_cap_finish(&session_capture);
@@ -331,7 +516,7 @@ static void close_session_capture(void)
 
 tase_port_t tk_cap_record_session(const char *path, tase_port_t inner)
 {
-    if (session_capture.dumper != NULL) {
+    if (session_capture.open) {
         tk_die("only one link per run can be recorded");
     }
     tk_cap_create(&session_capture, path, TK_CAP_LINKTYPE_SERIAL, true);

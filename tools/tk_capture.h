@@ -57,8 +57,17 @@ typedef enum {
 /* ---- writing ---- */
 
 typedef struct {
-    void *pcap;   /* pcap_t of pcap_open_dead() */
-    void *dumper; /* pcap_dumper_t */
+    void *pcap;   /* pcap_t of pcap_open_dead() (a new capture) */
+    void *dumper; /* pcap_dumper_t (a new capture) */
+    /* appending (tk_cap_create()'s `append`): whole records written to an
+     * O_APPEND descriptor, one write a flush, in the file's byte order
+     * and time precision */
+    int afd; /* -1 when not appending */
+    uint8_t *abuf;
+    size_t alen;
+    bool big;
+    bool nano;
+    bool open;
     const char *path;
     int linktype;
     unsigned long records;
@@ -74,9 +83,14 @@ typedef struct {
  * w->tmp and renamed to path by tk_cap_close()/tk_cap_finish() when
  * complete (until then an existing file at path is untouched; a failed
  * finish keeps the partial file and says where), anything else (a device,
- * a FIFO) is written in place; or with `append` add to path itself (creating it if it
- * does not exist; an existing file must be a nanosecond pcap of the same
- * link type). Dies with the reason on failure. */
+ * a FIFO) is written in place; or with `append` add to path itself, a
+ * regular file (created when it does not exist; an existing one must be a
+ * classic pcap of the same link type, whose records are then written in
+ * its byte order and time precision, each flush one O_APPEND write of
+ * whole records, so that other programs appending to it do not overwrite
+ * them). A record a crash or a full disk cut short at its end is cut off
+ * first (said on stderr); a damaged record header anywhere is refused,
+ * the file left as it is. Dies with the reason on failure. */
 void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool append);
 /* One serial record: direction byte + n (>= 1) bytes, at wall-clock time t. */
 void tk_cap_put_serial(tk_cap_writer_t *w, const struct timespec *t, unsigned dir,

@@ -8,6 +8,7 @@ packet's time that of the record carrying its last byte.
 
 import collections
 import errno
+import fcntl
 import os
 import struct
 import time
@@ -326,6 +327,10 @@ class CaptureWriter:
                         "%s: not a nanosecond serial capture of tase record: not appending" % path
                     )
                 self.f = open(path, "r+b", buffering=0)
+                # under the lock every writer of ours takes for a write
+                # (tase --record too): another's record in progress is not
+                # taken for one a crash cut short
+                fcntl.flock(self.f.fileno(), fcntl.LOCK_EX)
                 self.good = self._whole_records_end()
                 self.f.truncate(self.good)
                 self.f.close()
@@ -353,19 +358,32 @@ class CaptureWriter:
             raise _write_error(path, e) from e
 
     def _whole_records_end(self):
-        """Where the last whole record of the open file ends."""
+        """Where the last whole record of the open file ends. A record
+        header no writer writes (more data than the snapshot length or the
+        packet's length, a fraction of 10^9 ns or more) is damage, not the
+        end of a file a crash cut short: a CaptureError, nothing cut."""
         size = os.fstat(self.f.fileno()).st_size
         pos = 24
+        index = 0
         while pos + 16 <= size:
-            self.f.seek(pos + 8)
-            n = struct.unpack("<I", self.f.read(4))[0]
+            self.f.seek(pos)
+            _, frac, n, length = struct.unpack("<IIII", self.f.read(16))
+            index += 1
+            if n > 65535 or n > length or frac >= 1000000000:
+                raise CaptureError(
+                    "%s: its record %d is damaged (not the end of a file a crash cut short): "
+                    "not appending, the file is left as it is" % (self.path, index)
+                )
             if pos + 16 + n > size:
                 break
             pos += 16 + n
         return pos
 
     def _write(self, buf):
+        fd = self.f.fileno()
+        fcntl.flock(fd, fcntl.LOCK_EX)  # as tase --record: see __init__
         try:
+            self.good = os.fstat(fd).st_size  # others may have appended
             view = memoryview(buf)
             while view:
                 view = view[self.f.write(view) :]
@@ -375,8 +393,8 @@ class CaptureWriter:
             except (OSError, ValueError):
                 pass
             raise _write_error(self.path, e) from e
-        # the end of the file after this record (others may append too)
-        self.good = os.fstat(self.f.fileno()).st_size
+        finally:
+            fcntl.flock(fd, fcntl.LOCK_UN)
 
     def put(self, dir, data, t_ns=None):
         """One record: dir 0 (bytes from the gimbal) or 1 (to it)."""

@@ -6,6 +6,7 @@ import os
 import struct
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -226,6 +227,53 @@ def test_two_writers_appending_to_one_capture_keep_every_record(tmp_path):
     w2.close()
     got = sorted(p.raw["pan"] for _, p in tase.read_capture(path))
     assert got == list(range(12))
+
+
+def test_a_damaged_record_header_is_refused_not_cut_as_a_crash(tmp_path):
+    # a review: a damaged header in the middle was taken for a crash's cut
+    # end, and everything behind it removed before appending
+    path = tmp_path / "damaged.pcap"
+    w = tase.capture.CaptureWriter(str(path))
+    frame = tase.encode(tase.Packet("GIMBAL_ANGLE", raw={"pan": 1, "tilt": 0, "roll": 0}))
+    for _ in range(5):
+        w.put(0, frame)
+    w.close()
+    data = bytearray(path.read_bytes())
+    data[24 + 16 + 1 + len(frame) + 8 : 24 + 16 + 1 + len(frame) + 12] = struct.pack("<I", 0x7FFFFF00)
+    path.write_bytes(bytes(data))
+    with pytest.raises(tase.capture.CaptureError, match="its record 2 is damaged"):
+        tase.capture.CaptureWriter(str(path))
+    assert path.read_bytes() == bytes(data)
+
+
+def test_a_writer_in_the_middle_of_a_record_is_waited_for(tmp_path):
+    # tase --record holds the file's lock while it writes a record; a new
+    # writer cut that record off as a crash's and appended behind it
+    import fcntl
+    import threading
+    path = tmp_path / "mid.pcap"
+    frame = tase.encode(tase.Packet("GIMBAL_ANGLE", raw={"pan": 7, "tilt": 0, "roll": 0}))
+    w = tase.capture.CaptureWriter(str(path))
+    w.close()
+    rec = struct.pack("<IIII", 1700000000, 0, len(frame) + 1, len(frame) + 1) + b"\x00" + frame
+    other = open(path, "ab", buffering=0)
+    fcntl.flock(other.fileno(), fcntl.LOCK_EX)
+    other.write(rec[:20])
+
+    def finish():
+        time.sleep(0.5)
+        other.write(rec[20:])
+        fcntl.flock(other.fileno(), fcntl.LOCK_UN)
+        other.close()
+
+    t = threading.Thread(target=finish)
+    t.start()
+    w2 = tase.capture.CaptureWriter(str(path))
+    w2.put(0, frame)
+    w2.close()
+    t.join()
+    got = [p.raw["pan"] for _, p in tase.read_capture(str(path))]
+    assert got == [7, 7]
 
 
 def test_read_capture_takes_a_path_not_a_descriptor(tmp_path):
