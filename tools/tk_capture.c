@@ -437,13 +437,37 @@ void tk_cap_close(tk_cap_writer_t *w)
  * still goes out and is reported, and the failure is reported at exit
  * (close_session_capture()) with the status that says whether a packet
  * was sent. */
+/* The record time of port time `ms` (tk_cap_tap_t). */
+static struct timespec tap_time(tk_cap_tap_t *tap, uint32_t ms)
+{
+    struct timespec t;
+    int64_t ns;
+    if (!tap->based) {
+        clock_gettime(CLOCK_REALTIME, &t);
+        tap->base_ns = ((int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000) * 1000000;
+        tap->base_ms = ms;
+        tap->based = true;
+    }
+    /* a port time before the base (a call that read its clock first)
+     * counts back from it */
+    ns = tap->base_ns + (int64_t)(int32_t)(ms - tap->base_ms) * 1000000;
+    t.tv_sec = (time_t)(ns / 1000000000);
+    t.tv_nsec = (long)(ns % 1000000000);
+    return t;
+}
+
 static void tap_record(tk_cap_tap_t *tap, unsigned dir, const uint8_t *data, size_t n)
 {
     struct timespec t;
+    uint32_t ms = tap->inner.ops->now_ms(tap->inner.ctx);
+    if (dir == TK_CAP_FROM_GIMBAL) {
+        tap->last_read_ms = ms;
+        tap->read_recorded = true;
+    }
     if (tap->w->err != 0) {
         return;
     }
-    clock_gettime(CLOCK_REALTIME, &t);
+    t = tap_time(tap, ms);
     tk_cap_put_serial(tap->w, &t, dir, data, n);
     (void)tk_cap_flush(tap->w); /* a failure stays in w->err */
 }
@@ -479,6 +503,7 @@ static const tase_port_ops_t tap_ops = {tap_write, tap_read, tap_now_ms};
 tase_port_t tk_cap_tap_port(tk_cap_tap_t *tap, tase_port_t inner, tk_cap_writer_t *w)
 {
     tase_port_t p;
+    memset(tap, 0, sizeof(*tap));
     tap->inner = inner;
     tap->w = w;
     p.ops = &tap_ops;
@@ -524,6 +549,16 @@ tase_port_t tk_cap_record_session(const char *path, tase_port_t inner)
         tk_die("cannot record %s: atexit failed", path);
     }
     return tk_cap_tap_port(&session_tap, inner, &session_capture);
+}
+
+bool tk_cap_session_last_read(uint32_t *ms, struct timespec *t)
+{
+    if (!session_capture.open || !session_tap.read_recorded) {
+        return false;
+    }
+    *ms = session_tap.last_read_ms;
+    *t = tap_time(&session_tap, session_tap.last_read_ms);
+    return true;
 }
 
 /* ---- reading ---- */

@@ -115,16 +115,32 @@ int tk_cap_finish(tk_cap_writer_t *w);
 
 /* A port that records what passes through `inner` into `w` (reads as
  * TK_CAP_FROM_GIMBAL, accepted writes as TK_CAP_TO_GIMBAL) and is
- * otherwise `inner` itself. `tap` must outlive the port. */
+ * otherwise `inner` itself. `tap` must outlive the port.
+ * Its records are stamped on the port's own millisecond clock (now_ms),
+ * carried to wall-clock time by the offset seen at the first record: a
+ * receiver ticked at `last_read_ms` (the port time of the last read
+ * recorded) decides every quiet gap exactly as `tase decode` of the
+ * capture does from the record times (both differences of the same whole
+ * milliseconds). Times in such a capture have millisecond resolution and
+ * follow the port's clock, not later steps of the wall clock. */
 typedef struct {
     tase_port_t inner;
     tk_cap_writer_t *w;
+    bool based;      /* base_ns and base_ms set */
+    int64_t base_ns; /* wall-clock ns (a whole ms) at port time base_ms */
+    uint32_t base_ms;
+    uint32_t last_read_ms;
+    bool read_recorded; /* last_read_ms is set */
 } tk_cap_tap_t;
 tase_port_t tk_cap_tap_port(tk_cap_tap_t *tap, tase_port_t inner, tk_cap_writer_t *w);
 /* --record FILE: append this process's serial session to FILE (a tap port
  * over `inner`, the capture closed by an exit handler, which reports a
  * write error on stderr and exits 1). Once per run. */
 tase_port_t tk_cap_record_session(const char *path, tase_port_t inner);
+/* Whether this run records its session (--record) and has recorded a
+ * read: then *ms is the port time of the last read recorded and *t its
+ * record time (what `tase decode` of the capture will see). */
+bool tk_cap_session_last_read(uint32_t *ms, struct timespec *t);
 
 /* ---- reading ---- */
 

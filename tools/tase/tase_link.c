@@ -261,15 +261,28 @@ int cli_cmd_monitor(cli_args_t *a)
         if (n > 0) {
             tk_time_t now;
             uint64_t ns = link.is_can ? tase_socketcan_rx_time_ns(&link.can) : 0u;
+            uint32_t at = port.ops->now_ms(port.ctx);
+            struct timespec rec;
             if (ns != 0u) { /* the kernel's receive time of the frame */
                 now.sec = (int64_t)(ns / 1000000000u);
                 now.usec = (uint32_t)(ns % 1000000000u / 1000u);
+            } else if (tk_cap_session_last_read(&at, &rec)) {
+                /* --record: the time and port time of the record, so that
+                 * `tase decode` of the capture ticks as this loop does */
+                now.sec = (int64_t)rec.tv_sec;
+                now.usec = (uint32_t)(rec.tv_nsec / 1000);
             } else {
                 tk_time_now(&now);
             }
+            /* quiet until the bytes came (a candidate whose limit passed
+             * before them is settled first, as decode does), then their
+             * arrival */
+            tk_dec_tick(&d, st, at);
             tk_dec_bytes(&d, st, buf, (size_t)n, fmt.time ? &now : NULL);
+            tk_dec_tick(&d, st, at);
+        } else {
+            tk_dec_tick(&d, st, port.ops->now_ms(port.ctx)); /* quiet until now */
         }
-        tk_dec_tick(&d, st, port.ops->now_ms(port.ctx)); /* arrival, or quiet until now */
         tk_stdout_flush();
     }
     if (link.is_can) {
