@@ -250,7 +250,8 @@ int cli_cmd_monitor(cli_args_t *a)
     while ((limit == 0 || d.n.frames < (uint64_t)limit) && (seconds == 0.0 || tk_now_s() < t_end) &&
            tk_signal == 0) {
         /* wake by the receiver's quiet limit (tase/frame.h, TIME BOUND) */
-        uint32_t wait = tase_rx_quiet_ms(&st->rx, port.ops->now_ms(port.ctx));
+        uint32_t asked = port.ops->now_ms(port.ctx);
+        uint32_t wait = tase_rx_quiet_ms(&st->rx, asked);
         int n = port.ops->read(port.ctx, buf, sizeof(buf), wait < 50u ? wait : 50u);
         if (n < 0) {
             if (tk_signal == 0) {
@@ -274,10 +275,15 @@ int cli_cmd_monitor(cli_args_t *a)
             } else {
                 tk_time_now(&now);
             }
-            /* quiet until the bytes came (a candidate whose limit passed
-             * before them is settled first, as decode does), then their
-             * arrival */
-            tk_dec_tick(&d, st, at);
+            /* A read that waited for its bytes says the line was quiet
+             * until they came: tick there first (a candidate whose limit
+             * passed before them is settled, as decode does at the
+             * record's time). Bytes that were waiting when read was
+             * called (this loop was late: a slow standard output) came at
+             * some time before: no such tick, no pause read into it. */
+            if (at != asked) {
+                tk_dec_tick(&d, st, at);
+            }
             tk_dec_bytes(&d, st, buf, (size_t)n, fmt.time ? &now : NULL);
             tk_dec_tick(&d, st, at);
         } else {
