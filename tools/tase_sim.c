@@ -46,7 +46,9 @@ static const char usage[] =
     "second (the gimbal role's capacity rule), whatever PACKET_RATE asks. Runs until SIGINT, "
     "SIGTERM or SIGHUP, or for S\n"
     "seconds, then removes its links. A link another running tase-sim holds is\n"
-    "refused. Exit status: 0 success, 1 failure, 2 bad command line.\n";
+    "refused; it holds a lock on PATH.lock beside each link while it runs, so that\n"
+    "the tools refuse the link of a simulator that was killed.\n"
+    "Exit status: 0 success, 1 failure, 2 bad command line.\n";
 
 void sim_log(const sim_t *s, uint32_t now, const char *fmt, ...)
 {
@@ -529,13 +531,8 @@ int main(int argc, char **argv)
             next_klv = sim_next_due(next_klv, now, KLV_PERIOD_MS); /* no burst after a stall */
         }
     }
-    /* only links that still point at our ptys */
-    if (link != NULL) {
-        tk_pty_unlink(link, path);
-    }
-    if (have_klv) {
-        tk_pty_unlink(klv_link, klv_path);
-    }
+    /* the links (only those that still point at our ptys) and their lock
+     * files are removed at exit (tk_pty_open()) */
     {
         /* what was dropped too: it was never logged (a bad checksum, a
          * setup packet of a wrong length, a frame a pause cut short) */

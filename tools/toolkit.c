@@ -1,6 +1,6 @@
 /* Shared helpers of the host tools: errors, numbers, standard output,
  * signals, clocks, descriptor-backed ports and pseudo-terminals. */
-#define _GNU_SOURCE /* posix_openpt, grantpt, unlockpt, ptsname; struct ucred */
+#define _GNU_SOURCE /* posix_openpt, grantpt, unlockpt, ptsname */
 
 #include "toolkit.h"
 
@@ -11,12 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <limits.h>
-#include <stddef.h>
 #include <sys/file.h>
 #include <sys/ioctl.h>
-#include <sys/socket.h>
 #include <sys/stat.h>
-#include <sys/un.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -367,10 +364,18 @@ uint32_t tk_now_ms(void)
 
 int tk_link_serial_try(tk_link_t *l, const char *path, long baud)
 {
+    char why[PATH_MAX * 3 + 512];
     int rc;
     memset(l, 0, sizeof(*l));
     if (baud <= 0 || !tase_posix_uart_baud_supported((uint32_t)baud)) {
         tk_usage_error("unsupported baud rate %ld", baud);
+    }
+    /* a stale link of a killed simulator leads to a pty that may be
+     * another program's now: refused before the open (which already sets
+     * up the line), and again after it (the simulator may have died in
+     * between) */
+    if (tk_simlink_check(path, why, sizeof(why)) != 0) {
+        tk_die("%s", why);
     }
     {
         /* a fatal signal between the open (the line is raw from here) and
@@ -384,6 +389,9 @@ int tk_link_serial_try(tk_link_t *l, const char *path, long baud)
             track_link(l, true);
         }
         (void)sigprocmask(SIG_SETMASK, &old, NULL);
+    }
+    if (rc == TASE_OK && tk_simlink_check(path, why, sizeof(why)) != 0) {
+        tk_die("%s", why); /* closes the link: its settings given back */
     }
     return rc;
 }
@@ -537,58 +545,90 @@ int tk_canonical_path(const char *path, char *out, size_t cap)
     return 0;
 }
 
-/* Claim `link` for this process: an abstract Unix socket named after the
- * link's canonical path, released by the kernel when the process ends
- * (a crash included), so no lock file is ever left behind. */
-static void claim_link(const char *link)
+/* The links this process made (tk_pty_open()), removed at its exit: the
+ * link first (if still ours), then its lock file. */
+#define MAX_CLAIMS 2
+static struct {
+    const char *link;
+    int lock_fd;
+    char slave[64]; /* "" until the link exists */
+} claims[MAX_CLAIMS];
+static size_t nclaims;
+
+static void release_claims(void)
 {
-    char canon[PATH_MAX];
-    struct sockaddr_un sa;
-    uint64_t h = 1469598103934665603u; /* FNV-1a 64 */
-    const char *c;
-    socklen_t len;
+    size_t i;
+    for (i = 0; i < nclaims; i++) {
+        if (claims[i].slave[0] != '\0') {
+            tk_pty_unlink(claims[i].link, claims[i].slave);
+        }
+        tk_simlink_release(claims[i].link, claims[i].lock_fd);
+    }
+    nclaims = 0;
+}
+
+/* Claim `link` for this process (tk_simlink_claim()); dies when it cannot. */
+static size_t claim_link(const char *link)
+{
+    char why[PATH_MAX + 256];
     int fd;
-    if (tk_canonical_path(link, canon, sizeof(canon)) != 0) {
-        tk_die("cannot create symlink %s: %s", link, strerror(errno));
+    if (nclaims == MAX_CLAIMS) {
+        tk_die("internal error: more than %d links", MAX_CLAIMS);
     }
-    for (c = canon; *c != '\0'; c++) {
-        h = (h ^ (uint8_t)*c) * 1099511628211u;
-    }
-    memset(&sa, 0, sizeof(sa));
-    sa.sun_family = AF_UNIX;
-    len = (socklen_t)(offsetof(struct sockaddr_un, sun_path) + 1u +
-                      (size_t)snprintf(sa.sun_path + 1, sizeof(sa.sun_path) - 1u,
-                                       "tase-sim-link:%016llx", (unsigned long long)h));
-    fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    fd = tk_simlink_claim(link, why, sizeof(why));
     if (fd < 0) {
-        tk_die("cannot claim %s: %s", link, strerror(errno));
+        tk_die("%s", why);
     }
-    if (bind(fd, (struct sockaddr *)&sa, len) != 0) {
-        int e = errno;
-        struct ucred cred;
-        socklen_t cl = sizeof(cred);
-        int q = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-        long pid = 0;
-        if (e == EADDRINUSE && q >= 0 && connect(q, (struct sockaddr *)&sa, len) == 0 &&
-            getsockopt(q, SOL_SOCKET, SO_PEERCRED, &cred, &cl) == 0) {
-            pid = (long)cred.pid;
-        }
-        if (e == EADDRINUSE) {
-            tk_die("%s is the link of a running tase-sim (pid %ld); not taking it over", link, pid);
-        }
-        tk_die("cannot claim %s: %s", link, strerror(e));
+    if (nclaims == 0 && atexit(release_claims) != 0) {
+        tk_simlink_release(link, fd);
+        tk_die("cannot claim %s: atexit failed", link);
     }
-    (void)listen(fd, 4); /* so a refused simulator can name the owner */
-    /* kept open (and bound) until this process ends */
+    claims[nclaims].link = link;
+    claims[nclaims].lock_fd = fd;
+    claims[nclaims].slave[0] = '\0';
+    return nclaims++;
+}
+
+/* An existing `link` we hold the claim of: removed when it is a stale
+ * link of a simulator (into /dev/pts/; its maker is gone, since the claim
+ * is ours), before the new pty exists, so that no tool opens it
+ * meanwhile; anything else is never touched. */
+static void remove_stale_link(const char *link)
+{
+    struct stat st;
+    char target[PATH_MAX];
+    ssize_t n;
+    if (lstat(link, &st) != 0) {
+        return;
+    }
+    if (!S_ISLNK(st.st_mode)) {
+        tk_die("%s exists and is not a symlink; not replacing it", link);
+    }
+    /* Only a link of our own kind, into /dev/pts/, is replaced. Anyone
+     * else's symlink (ln -s /dev/ttyS0 PATH) is left alone. */
+    n = readlink(link, target, sizeof(target) - 1u);
+    if (n <= 0 || (size_t)n >= sizeof(target) - 1u) {
+        tk_die("cannot read symlink %s: %s", link, n < 0 ? strerror(errno) : "too long");
+    }
+    target[n] = '\0';
+    if (strncmp(target, "/dev/pts/", 9) != 0 || strchr(target + 9, '/') != NULL) {
+        tk_die("%s is a symlink to %s, not a link left by tase-sim (those lead into "
+               "/dev/pts/); not replacing it (remove it, or choose another path)",
+               link, target);
+    }
+    if (unlink(link) != 0) {
+        tk_die("cannot replace the stale link %s: %s", link, strerror(errno));
+    }
 }
 
 int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
 {
     int fd, sfd;
     const char *name;
-    struct stat st;
+    size_t c = 0;
     if (link != NULL) {
-        claim_link(link); /* before anything is created */
+        c = claim_link(link); /* before anything is created */
+        remove_stale_link(link);
     }
     fd = posix_openpt(O_RDWR | O_NOCTTY);
     if (fd < 0) {
@@ -597,7 +637,7 @@ int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
     if (grantpt(fd) != 0 || unlockpt(fd) != 0 || (name = ptsname(fd)) == NULL) {
         tk_die("cannot set up the pseudo-terminal: %s", strerror(errno));
     }
-    if (strlen(name) + 1 > cap) {
+    if (strlen(name) + 1 > cap || (link != NULL && strlen(name) + 1 > sizeof(claims[c].slave))) {
         tk_die("pseudo-terminal path too long");
     }
     strcpy(slave, name);
@@ -609,32 +649,14 @@ int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
     }
     *slave_fd = sfd;
     if (link != NULL) {
-        if (lstat(link, &st) == 0) {
-            char target[PATH_MAX];
-            ssize_t n;
-            if (!S_ISLNK(st.st_mode)) {
-                tk_die("%s exists and is not a symlink; not replacing it", link);
-            }
-            /* Only a link of our own kind, into /dev/pts/, is replaced: the
-             * claim above is ours, so the simulator that made it is gone.
-             * Anyone else's symlink (ln -s /dev/ttyS0 PATH) is left alone. */
-            n = readlink(link, target, sizeof(target) - 1u);
-            if (n <= 0 || (size_t)n >= sizeof(target) - 1u) {
-                tk_die("cannot read symlink %s: %s", link, n < 0 ? strerror(errno) : "too long");
-            }
-            target[n] = '\0';
-            if (strncmp(target, "/dev/pts/", 9) != 0 || strchr(target + 9, '/') != NULL) {
-                tk_die("%s is a symlink to %s, not a link left by tase-sim (those lead into "
-                       "/dev/pts/); not replacing it (remove it, or choose another path)",
-                       link, target);
-            }
-            if (unlink(link) != 0) {
-                tk_die("cannot replace the stale link %s: %s", link, strerror(errno));
-            }
+        /* the record first: a tool that finds the link finds it too */
+        if (tk_simlink_record(claims[c].lock_fd, slave) != 0) {
+            tk_die("cannot write the lock file of %s: %s", link, strerror(errno));
         }
         if (symlink(slave, link) != 0) {
             tk_die("cannot create symlink %s: %s", link, strerror(errno));
         }
+        strcpy(claims[c].slave, slave);
     }
     return fd;
 }

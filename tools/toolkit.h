@@ -172,10 +172,13 @@ int tk_port_write_all(const tase_port_t *p, const uint8_t *data, size_t n);
  * slave's path (cap bytes) and a descriptor of the slave that this process
  * keeps open (so the master never sees a hang-up between clients). With
  * `link` non-NULL, also makes `link` a symlink to the slave. The link is
- * claimed for the life of the process first: if a running process holds
- * the claim it dies naming its pid; a symlink into /dev/pts/ that nobody
- * claims (left by a simulator that was killed) is replaced; any other
- * symlink, and a file that is not a symlink, never is. Dies on error. */
+ * claimed for the life of the process first (tk_simlink_claim(): the lock
+ * file LINK.lock): if a running process holds the claim it dies naming its
+ * pid; a symlink into /dev/pts/ that nobody claims (left by a simulator
+ * that was killed) is removed at once and replaced; any other symlink, and
+ * a file that is not a symlink, never is. At exit (exit() or a return
+ * from main, a fatal error included) the link is removed if it still
+ * points at the slave, then the lock file. Dies on error. */
 int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd);
 /* Remove `link` only if it is still a symlink to `slave` (ours). */
 void tk_pty_unlink(const char *link, const char *slave);
@@ -194,6 +197,36 @@ int tk_pty_unread(int slave_fd);
  * device. If the flag is set and nobody holds the device's lock, clear
  * it. Returns true when it did. */
 bool tk_pty_clear_stale_excl(int slave_fd);
+
+/* ---- tase-sim's links (tk_simlink.c, also in the Python package) ----
+ * tase-sim's --link PATH is a symlink to its pty /dev/pts/N; beside it,
+ * PATH.lock records "tase-sim PID /dev/pts/N" and tase-sim holds a POSIX
+ * record lock on it while it runs (the kernel drops it when the process
+ * ends, SIGKILL included). A killed simulator leaves both; its pty may
+ * then belong to another program, which the tools must never write to. */
+
+#define TK_SIMLINK_LOCK_SUFFIX ".lock"
+
+/* The lock file of `link` (LINK.lock). Returns 0, or -1 (ENAMETOOLONG). */
+int tk_simlink_lock_path(const char *link, char *out, size_t cap);
+/* Take `link`'s lock file (created if missing) for this process: returns
+ * its descriptor, or -1 with the reason in why[0..cap) (a running
+ * tase-sim holds it, naming its pid; a file of that name that is not a
+ * lock file of tase-sim; an error). */
+int tk_simlink_claim(const char *link, char *why, size_t cap);
+/* Write the record (this pid, `slave`) into the claimed file. 0 or -1. */
+int tk_simlink_record(int fd, const char *slave);
+/* Remove `link`'s lock file if it is still the one `fd` holds; close fd. */
+void tk_simlink_release(const char *link, int fd);
+/* Before opening `path` as a serial device: -1 with the reason in
+ * why[0..cap) when it is (or leads through) the link of a tase-sim that
+ * no longer runs, whose pty may belong to another program now (its lock
+ * file names the pty the link points to, and no process holds it, or one
+ * other than the pid recorded: a new simulator taking it over); else 0 (no
+ * symlink, no lock file: socat's or a user's symlink; a live tase-sim's
+ * link; a link repointed since). Opens and writes nothing but the lock
+ * file's reading. */
+int tk_simlink_check(const char *path, char *why, size_t cap);
 
 /* ---- packets (the library's schema table, tase/schema.h) ---- */
 

@@ -8,7 +8,8 @@ py_encode(): the one place to change when that API moves.
 
 The JSON of packets comes from the bench tools' own formatter
 (tools/tk_json.c, tk_format_frame()), so the package prints exactly what
-`tase --json` prints.
+`tase --json` prints; a serial link is checked as the tools check it
+(tools/tk_simlink.c: never the stale link of a killed tase-sim).
 
 Sources are found from the repository root: TASE_SOURCE_DIR in the
 environment, else two directories above this package (python/tase/..).
@@ -195,7 +196,12 @@ size_t py_json(char *buf, size_t cap, int units, uint64_t offset, int timed, int
                const uint8_t *data, size_t len);
 """
 
-CDEF = LIB_CDEF + HELPER_DECL + r"""
+# The bench tools' own C the package shares (tools/toolkit.h).
+TOOLS_CDEF = r"""
+int tk_simlink_check(const char *path, char *why, size_t cap);
+"""
+
+CDEF = LIB_CDEF + HELPER_DECL + TOOLS_CDEF + r"""
 extern "Python+C" int py_port_write(void *ctx, const uint8_t *data, size_t n);
 extern "Python+C" int py_port_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms);
 extern "Python+C" uint32_t py_port_now(void *ctx);
@@ -478,7 +484,7 @@ ffibuilder.set_source(
     "tase._tase",
     PY_HELPER,
     sources=sorted(glob.glob(os.path.join(ROOT, "src", "*.c")))
-    + [os.path.join(ROOT, "tools", "tk_json.c")],
+    + [os.path.join(ROOT, "tools", "tk_json.c"), os.path.join(ROOT, "tools", "tk_simlink.c")],
     include_dirs=[
         os.path.join(ROOT, "include"),
         os.path.join(ROOT, "src"),

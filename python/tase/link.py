@@ -162,18 +162,33 @@ class _Recorder:
 # ---- transports: bytes in and out -------------------------------------------
 
 
+def _check_simlink(dev):
+    """LinkError when `dev` is (or leads through) the link of a tase-sim
+    that no longer runs: its pty may be another program's now (the tools'
+    own check, tools/tk_simlink.c, as `tase` refuses it)."""
+    why = ffi.new("char[]", 4096)
+    if lib.tk_simlink_check(os.fsencode(dev), why, len(why)) != 0:
+        raise LinkError(ffi.string(why).decode(errors="replace"), lib.TASE_ENODEV)
+
+
 class _SerialTransport:
     def __init__(self, dev, baud):
         try:
             import serial
         except ImportError as e:  # pragma: no cover - packaging
             raise Error("serial links need pyserial (Debian: python3-serial)") from e
+        _check_simlink(dev)
         if not os.path.exists(dev):
             raise LinkError("%s: No such file or directory" % dev, lib.TASE_ENODEV)
         try:
             self.ser = serial.Serial(dev, baud, timeout=0, exclusive=True)
         except (serial.SerialException, OSError, ValueError) as e:
             raise LinkError("cannot open %s: %s" % (dev, e), lib.TASE_EIO) from e
+        try:
+            _check_simlink(dev)  # again: the simulator may have died meanwhile
+        except BaseException:
+            self.ser.close()
+            raise
         self.fd = self.ser.fileno()
         self.name = dev
         self.bytes_per_s = baud // 10

@@ -93,3 +93,26 @@ def test_the_simulator_says_what_it_dropped(tase_sim):
             os.close(fd)
     line = [l for l in sim.log().splitlines() if "stopped:" in l][-1]
     assert "dropped: 1 checksum errors, 1 setup packets of a wrong length" in line, line
+
+
+def test_the_stale_link_of_a_killed_sim_is_refused(tase_sim):
+    # a review: tase-sim killed with SIGKILL leaves its link to /dev/pts/N;
+    # the next program that asks for a pty may get N (here another
+    # simulator) and connect() opened it, the commands going to that
+    # program. Refused whether the pty was reused or not, nothing sent.
+    with tase.sim.start() as sim:
+        dev = sim.link
+        pts = os.readlink(dev)
+        sim.proc.kill()
+        sim.proc.wait()
+        with tase.sim.start() as other:  # likely on the same pty
+            with pytest.raises(tase.LinkError, match="is the link of a tase-sim that is no "
+                               "longer running .*may belong to another program now") as e:
+                with tase.connect(sim.url) as link:
+                    link.point(10, 5)
+            assert pts in str(e.value)
+            time.sleep(0.3)
+            assert "GIMBAL_CMD" not in other.log()
+        with tase.sim.start() as live:  # a live simulator's link still opens
+            with tase.connect(live.url) as link:
+                assert link.query("SYSTEM_VERSION").name == "SYSTEM_VERSION"

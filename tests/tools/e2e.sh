@@ -449,6 +449,27 @@ for _ in $(seq 100); do [ -L "$dir/stale" ] && break; sleep 0.05; done
 kill -KILL $kpid
 wait $kpid 2>/dev/null
 old=$(readlink "$dir/stale")
+# The killed simulator's pty goes to the next program that asks for one
+# (the lowest free number: here a simulator without a link, as it could be
+# a terminal). The stale link must not lead the tools to it: a command
+# written there would reach that program. Refused whether or not the pty
+# was reused, nothing sent.
+"$SIM" --seconds 30 >"$dir/other.log" 2>&1 &
+otherpid=$!
+for _ in $(seq 100); do grep -q "simulated gimbal" "$dir/other.log" && break; sleep 0.05; done
+ln -s stale "$dir/via-stale"
+expect_error "tase point over a killed simulator's stale link ($old; $(head -c 60 "$dir/other.log")): refused" 1 \
+    "stale is the link of a tase-sim that is no longer running (pid $kpid, killed?): $old may belong to another program now; not opened, nothing sent" \
+    "$TASE" point 10 5 --serial "$dir/stale"
+expect_error "... and a symlink to the stale link: refused" 1 \
+    "via-stale (through .*stale) is the link of a tase-sim that is no longer running" \
+    "$TASE" monitor --serial "$dir/via-stale" --count 1
+sleep 0.3
+check "... nothing reached the program that has the pty now" \
+    eval '[ "$(grep -c GIMBAL_CMD "$dir/other.log")" = 0 ]'
+kill $otherpid
+wait $otherpid
+rm "$dir/via-stale"
 "$SIM" --link "$dir/stale" --seconds 30 >"$dir/stale.log" 2>&1 &
 kpid=$!
 for _ in $(seq 100); do grep -q -e "simulated gimbal" -e "tase-sim:" "$dir/stale.log" && break; sleep 0.05; done
