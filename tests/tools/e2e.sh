@@ -383,6 +383,19 @@ expect_error "query timeout" 1 "timeout: no answer to PACKET_RATE after 2 attemp
 expect_error "send timeout on its query: says the setting was not sent" 1 \
     "timeout: no answer to PACKET_RATE after 2 attempts of 100 ms (only the query went out, to read the gimbal's settings; the new setting was not sent)$" \
     "$TASE" send PACKET_RATE angle_1=5 "${L[@]}" --timeout 100 --retries 1
+# a setting that goes out and is never echoed: what was sent is printed (it
+# was printed only with the echo, so never), then the timeout
+out=$("$TASE" send SENSOR_FILTER cutoff=0 decimation=0 "${L[@]}" --timeout 100 --retries 1 2>"$dir/noecho.err")
+rc=$?
+check "send of a setting the gimbal does not answer: exit $rc, prints what it sent ($out), then the timeout ($(cat "$dir/noecho.err"))" \
+    eval '[ $rc = 1 ] && [ "$out" = "sent SENSOR_FILTER cutoff=0 decimation=0" ] &&
+          [ "$(grep -vc "^==" "$dir/noecho.err")" = 1 ] &&
+          grep -q "^tase: timeout: no answer to SENSOR_FILTER after 2 attempts of 100 ms (SENSOR_FILTER was sent)$" "$dir/noecho.err"'
+out=$("$TASE" send SENSOR_FILTER cutoff=0 decimation=0 "${L[@]}" --timeout 100 --retries 0 --json 2>/dev/null)
+rc=$?
+check "... and with --json: exit $rc, the packet sent as its JSON line ($out)" \
+    eval '[ $rc = 1 ] && [ "$(wc -l <<<"$out")" = 1 ] &&
+          grep -q "^{\"offset\":0,\"dir\":\"in\",.*\"name\":\"SENSOR_FILTER\",.*\"fields\":{\"cutoff\":0,\"decimation\":0}" <<<"$out"'
 "$TASE" query PACKET_RATE "${L[@]}" --timeout 20000 >/dev/null 2>"$dir/sig.err" &
 qpid=$!
 sleep "$settle"

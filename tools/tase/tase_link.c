@@ -79,15 +79,21 @@ void cli_session_service(cli_session_t *s, uint32_t wait_ms)
 
 /* Wait for the answer to a request, servicing the port so a signal is
  * seen within 20 ms; dies with the reason on failure, `note` (or NULL)
- * added to a timeout's message. */
-int cli_transact_note(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data,
-                      size_t len, uint8_t *reply, const cli_req_opts_t *r, const char *note)
+ * added to a timeout's message. With `show_sent`, the packet is printed
+ * ("sent ...") as soon as it has gone out, before the wait: a gimbal that
+ * never answers leaves that line, as every other command that sends. */
+static int transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
+                    uint8_t *reply, const cli_req_opts_t *r, const char *note, bool show_sent)
 {
     int rc = tase_host_request_start(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len,
                                      reply, TASE_DATA_MAX, r->timeout_ms, r->retries,
                                      s->port.ops->now_ms(s->port.ctx));
     if (rc >= 0 && len > 0) {
         tk_mark_sent(tase_schema_packet_name(p)); /* a query changes nothing */
+    }
+    if (rc >= 0 && show_sent) {
+        cli_print_packet(p, data, len, r->json, "in", "sent");
+        tk_stdout_flush_soft(); /* seen while it waits; a failure reported at the end */
     }
     while (rc >= 0) {
         tk_exit_if_signalled();
@@ -110,10 +116,16 @@ int cli_transact_note(cli_session_t *s, const tase_packet_desc_t *p, const uint8
     return rc;
 }
 
+int cli_transact_note(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data,
+                      size_t len, uint8_t *reply, const cli_req_opts_t *r, const char *note)
+{
+    return transact(s, p, data, len, reply, r, note, false);
+}
+
 int cli_transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
                  uint8_t *reply, const cli_req_opts_t *r)
 {
-    return cli_transact_note(s, p, data, len, reply, r, NULL);
+    return transact(s, p, data, len, reply, r, NULL, false);
 }
 
 void cli_send_frame(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len)
@@ -195,8 +207,7 @@ void cli_send_fields(cli_session_t *s, const cli_fields_t *fs, size_t len, const
         cli_print_packet(p, fs->data, len, o->r.json, "in", "sent");
         return;
     }
-    n = cli_transact(s, p, fs->data, len, reply, &o->r);
-    cli_print_packet(p, fs->data, len, o->r.json, "in", "sent");
+    n = transact(s, p, fs->data, len, reply, &o->r, NULL, true);
     cli_print_packet(p, reply, (size_t)n, o->r.json, "out", "echo");
     if (len > 0) {
         /* `temporary` tells the gimbal what to do with this packet (store
