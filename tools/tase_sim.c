@@ -5,6 +5,7 @@
  * in sim_commands.c. Behaviour and conventions: docs/TOOLS.md. */
 #define _XOPEN_SOURCE 700
 
+#include <errno.h>
 #include <limits.h>
 #include <math.h>
 #include <signal.h>
@@ -47,8 +48,39 @@ static const char usage[] =
     "SIGTERM or SIGHUP, or for S\n"
     "seconds, then removes its links. A link another running tase-sim holds is\n"
     "refused; it holds a lock on PATH.lock beside each link while it runs, so that\n"
-    "the tools refuse the link of a simulator that was killed.\n"
-    "Exit status: 0 success, 1 failure, 2 bad command line.\n";
+    "the tools refuse the link of a simulator that was killed. A log that cannot be\n"
+    "written (a full disk) is said on standard error; the simulation goes on.\n"
+    "Exit status: 0 success, 1 failure (a log left incomplete included), 2 bad\n"
+    "command line.\n";
+
+/* The log (standard output) that cannot be written: a full disk,
+ * /dev/full, a reader that went away. The simulator is the gimbal a host
+ * under test talks to, so it goes on serving (ending it would turn a
+ * logging problem into a link failure of the test); the failure is said at
+ * once on standard error, nothing more is written to the log, and the exit
+ * status is 1 with a count of the lines lost, so that neither the engineer
+ * nor a script takes an incomplete log for a complete run. */
+static struct {
+    int err;            /* errno of the first failed write, 0 none */
+    unsigned long lost; /* log lines not written from then on */
+} log_failed;
+
+/* Flush `lines` log lines just printed; on a failure say so (once). */
+static void log_flush(unsigned long lines)
+{
+    if (log_failed.err != 0) {
+        log_failed.lost += lines;
+        return;
+    }
+    errno = 0;
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        log_failed.err = errno != 0 ? errno : EIO;
+        log_failed.lost = lines;
+        tk_warn("cannot write the log to standard output: %s; the simulated gimbal goes on "
+                "without its log (exit status 1 at the end)",
+                strerror(log_failed.err));
+    }
+}
 
 void sim_log(const sim_t *s, uint32_t now, const char *fmt, ...)
 {
@@ -56,12 +88,16 @@ void sim_log(const sim_t *s, uint32_t now, const char *fmt, ...)
     if (s->quiet) {
         return;
     }
+    if (log_failed.err != 0) {
+        log_failed.lost++;
+        return;
+    }
     printf("[%8.3f] ", (double)(uint32_t)(now - s->t0) / 1000.0);
     va_start(ap, fmt);
     vprintf(fmt, ap);
     va_end(ap);
     fputc('\n', stdout);
-    fflush(stdout);
+    log_flush(1u);
 }
 
 void sim_send_packet(sim_t *s, unsigned port, uint16_t id, const void *msg)
@@ -482,7 +518,7 @@ int main(int argc, char **argv)
     if (have_klv) {
         printf("tase-sim: KLV output on %s (link %s)\n", klv_path, klv_link);
     }
-    fflush(stdout);
+    log_flush(have_klv ? 2u : 1u);
 
     last = now;
     next_klv = now + KLV_PERIOD_MS;
@@ -545,5 +581,9 @@ int main(int argc, char **argv)
                 (unsigned long)rs->bytes_discarded, (unsigned long)rs->bytes_in);
     }
     tk_link_close(&dl);
+    if (log_failed.err != 0) {
+        tk_die("the log on standard output is incomplete: %lu line%s not written (%s)",
+               log_failed.lost, log_failed.lost == 1u ? "" : "s", strerror(log_failed.err));
+    }
     return 0;
 }

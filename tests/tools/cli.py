@@ -362,6 +362,21 @@ for args in (["decode", noisy], ["list"], ["--help"], ["klv", os.path.join(os.pa
     ok("tase %s > /dev/full fails with a message" % args[0],
        rc == 1 and "cannot write to standard output" in err, "exit %d %s" % (rc, err))
 
+# a review: tase-sim's log into /dev/full was lost without a word (exit 0).
+# It says so at once on stderr and exits 1 at the end (that it goes on
+# serving its link meanwhile: e2e.sh).
+for extra in ([], ["--quiet"]):
+    with open("/dev/full", "wb") as full:
+        rc, _, err = run([SIM, "--seconds", "0.3"] + extra, stdout=full)
+    ok("tase-sim %s> /dev/full: exit 1, the failure said on stderr, then what was lost"
+       % "".join(e + " " for e in extra),
+       rc == 1 and len(err.splitlines()) == 2 and err.splitlines()[0] ==
+       "tase-sim: cannot write the log to standard output: No space left on device; the "
+       "simulated gimbal goes on without its log (exit status 1 at the end)" and
+       re.match(r"tase-sim: the log on standard output is incomplete: [0-9]+ lines? not "
+                r"written \(No space left on device\)$", err.splitlines()[1]) is not None,
+       "exit %d %r" % (rc, err))
+
 # a review: `deploy --wait` exited 5 ("sent and confirmed") the moment its
 # "sent" line failed to write, without waiting: it waits, and a gimbal that
 # never echoes is a timeout (exit 1, the packet named as sent)

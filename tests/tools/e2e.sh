@@ -440,6 +440,21 @@ wait $hpid
 rc=$?
 check "tase-sim cleans up on SIGHUP: exit $rc, both links removed" \
     eval '[ $rc = 0 ] && [ ! -e "$dir/hup" ] && [ ! -L "$dir/hup" ] && [ ! -L "$dir/hupk" ]'
+# a review: a log into /dev/full was lost without a word (exit 0): the
+# simulator goes on serving, says so on stderr and exits 1 (the messages:
+# cli.py)
+"$SIM" --link "$dir/full" --seconds 30 >/dev/full 2>"$dir/full.err" &
+fpid=$!
+for _ in $(seq 100); do [ -L "$dir/full" ] && break; sleep 0.05; done
+"$TASE" query SYSTEM_VERSION --serial "$dir/full" >/dev/null 2>&1
+qrc=$?
+kill -TERM $fpid
+wait $fpid
+rc=$?
+check "tase-sim > /dev/full goes on serving (query exit $qrc) and exits $rc on SIGTERM ($(grep -v "^==" "$dir/full.err" | tr '\n' '|'))" \
+    eval '[ $qrc = 0 ] && [ $rc = 1 ] &&
+          grep -q "^tase-sim: cannot write the log to standard output: No space left on device" "$dir/full.err" &&
+          grep -q "^tase-sim: the log on standard output is incomplete" "$dir/full.err"'
 "$SIM" --link "$dir/own" --seconds 30 >"$dir/own.log" 2>&1 &
 opid=$!
 for _ in $(seq 100); do [ -L "$dir/own" ] && break; sleep 0.05; done
