@@ -93,6 +93,7 @@ uint8_t tase_schema_reserved_flags(const tase_packet_desc_t *p);
 
 int tase_frame_build(uint8_t group, uint8_t type, const uint8_t *data, size_t len,
                      uint8_t *out, size_t cap);
+int tase_command_check_data(uint16_t id, const uint8_t *data, size_t len);
 
 typedef struct {
     uint32_t bytes_in;

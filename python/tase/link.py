@@ -397,6 +397,8 @@ def py_port_now(ctx):
         return 0
 
 
+# The modes of the spec's table 5, for the message that lists them; whether
+# a flags value is one is the C library's answer (_gimbal_mode_ok()).
 _GIMBAL_CMD_FLAGS = {
     lib.TASE_GIMBAL_FLAGS_RATE: "rate",
     lib.TASE_GIMBAL_FLAGS_RATE_STAB: "rate, stabilised",
@@ -409,6 +411,17 @@ _GIMBAL_CMD_FLAGS = {
 }
 for _f in range(lib.TASE_GIMBAL_FLAGS_LEGACY_RATE, lib.TASE_GIMBAL_FLAGS_LEGACY_POSITION_STAB + 1):
     _GIMBAL_CMD_FLAGS[_f] = "legacy"
+
+
+def _gimbal_mode_ok(packet):
+    """Whether a GIMBAL_CMD's flags are a mode of the spec's table 5: the C
+    library's tase_command_check_data() (what the host role checks), asked
+    of the packet with pan and tilt 0 (in range for every mode), so that
+    only its flags can fail (a position out of range is the host role's
+    own refusal, with its own message)."""
+    probe = packet.replace(raw={"pan": 0, "tilt": 0}).payload
+    return lib.tase_command_check_data(packet.id, probe, len(probe)) == lib.TASE_OK
+
 
 # How to send anyway what _checked() refuses for reserved flag bits.
 _SEND_RESERVED = "send(..., reserved=True) sends it anyway, as tase send --raw"
@@ -609,7 +622,7 @@ class Link:
                 )
         if t.name == "GIMBAL_CMD" and packet.size > 0:
             flags = packet.raw["flags"]
-            if flags not in _GIMBAL_CMD_FLAGS:
+            if not _gimbal_mode_ok(packet):
                 raise FieldError(
                     "GIMBAL_CMD flags 0x%02X is not a mode of the spec's table 5 (%s): not sent"
                     % (flags, ", ".join("0x%02X" % f for f in sorted(_GIMBAL_CMD_FLAGS)))

@@ -181,6 +181,36 @@ def test_refused_input_sends_nothing(silent_pty, call, exc, text):
     assert _drain(master, 0.05) == b""
 
 
+def test_gimbal_cmd_modes_are_the_c_librarys_answer(silent_pty, monkeypatch):
+    # a review: table 5 was checked three times (the C library, `tase send`,
+    # and Link's own table). Link's table only names the modes in the
+    # message: with it emptied, the modes still go out and the others are
+    # still refused (the answer is tase_command_check_data()'s); with it
+    # in place, its list is exactly what the C library accepts.
+    from tase.link import _GIMBAL_CMD_FLAGS
+
+    def cmd(flags):
+        return tase.Packet("GIMBAL_CMD", pan=0, tilt=0, roll=0, flags=flags, impulse_time=0)
+
+    url, master = silent_pty
+    accepted = []
+    with tase.connect(url) as link:
+        for flags in range(256):
+            try:
+                link.send(cmd(flags))
+                accepted.append(flags)
+            except tase.FieldError as e:
+                assert "not a mode of the spec's table 5" in str(e), e
+    assert accepted == sorted(_GIMBAL_CMD_FLAGS)
+    assert tase.decode(_drain(master)) == [cmd(f) for f in accepted]
+    monkeypatch.setattr(tase.link, "_GIMBAL_CMD_FLAGS", {})
+    with tase.connect(url) as link:
+        link.send(cmd(0x20))
+        with pytest.raises(tase.FieldError, match="0x55 is not a mode of the spec's table 5"):
+            link.send(cmd(0x55))
+    assert tase.decode(_drain(master)) == [cmd(0x20)]
+
+
 def test_reserved_bits_go_out_when_asked(silent_pty):
     url, master = silent_pty
     p = tase.Packet("CAMERA_CMD", raw={"flags": 0xF8})

@@ -230,6 +230,20 @@ static void check_reserved_flags(const cli_fields_t *fs, unsigned nf)
                    tase_schema_packet_name(p), v, first, last, mask);
 }
 
+/* Whether a GIMBAL_CMD's flags are a mode of the spec's table 5: the
+ * library's answer (tase_command_check_data(), what the host role checks),
+ * asked of the packet with pan and tilt 0 (in range for every mode), so
+ * that only the flags can fail; a position out of range has its own
+ * message below. The names of the modes (cli_gimbal_mode(),
+ * cli_refuse_gimbal_cmd()) are only for the messages. */
+static bool gimbal_mode_ok(const cli_fields_t *fs, size_t len)
+{
+    cli_fields_t probe = *fs;
+    cli_fields_set(&probe, "pan", 0);
+    cli_fields_set(&probe, "tilt", 0);
+    return tase_command_check_data(TASE_ID_GIMBAL_CMD, probe.data, len) == TASE_OK;
+}
+
 int cli_cmd_send(cli_args_t *a)
 {
     cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, false, NULL};
@@ -308,7 +322,7 @@ int cli_cmd_send(cli_args_t *a)
         if (!fs.given[fi]) {
             cli_refuse_gimbal_cmd("needs flags");
         }
-        if (cli_gimbal_mode(cli_fields_value(&fs, (unsigned)fi)) == NULL) {
+        if (!gimbal_mode_ok(&fs, len)) {
             cli_refuse_gimbal_cmd("flags is not a mode of the spec's table 5");
         }
     }
