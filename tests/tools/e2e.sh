@@ -396,6 +396,12 @@ rc=$?
 check "... and with --json: exit $rc, the packet sent as its JSON line ($out)" \
     eval '[ $rc = 1 ] && [ "$(wc -l <<<"$out")" = 1 ] &&
           grep -q "^{\"offset\":0,\"dir\":\"in\",.*\"name\":\"SENSOR_FILTER\",.*\"fields\":{\"cutoff\":0,\"decimation\":0}" <<<"$out"'
+# the same for a SPOI awaiting its echo (spoi printed it only with the echo)
+out=$("$TASE" spoi 45 -120 100 "${L[@]}" --timeout 100 --retries 1 2>"$dir/spoiecho.err")
+rc=$?
+check "spoi the gimbal does not echo: exit $rc, prints what it sent ($out), then the timeout ($(cat "$dir/spoiecho.err"))" \
+    eval '[ $rc = 1 ] && grep -q "^sent SPOI_CMD lat=162000000 lon=-432000000 height=10000 " <<<"$out" &&
+          ! grep -q "echo" <<<"$out" && grep -q "^tase: timeout: no answer to SPOI_CMD after 2 attempts of 100 ms (SPOI_CMD was sent)$" "$dir/spoiecho.err"'
 "$TASE" query PACKET_RATE "${L[@]}" --timeout 20000 >/dev/null 2>"$dir/sig.err" &
 qpid=$!
 sleep "$settle"

@@ -115,6 +115,8 @@ void cli_session_service(cli_session_t *s, uint32_t wait_ms);
  * message. */
 int cli_transact_note(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data,
                       size_t len, uint8_t *reply, const cli_req_opts_t *r, const char *note);
+/* The same without a note; a request with data (a command, not a query)
+ * is printed ("sent ...") as soon as it has gone out, before the wait. */
 int cli_transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
                  uint8_t *reply, const cli_req_opts_t *r);
 /* Send a packet, awaiting nothing. */

@@ -125,7 +125,7 @@ int cli_transact_note(cli_session_t *s, const tase_packet_desc_t *p, const uint8
 int cli_transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
                  uint8_t *reply, const cli_req_opts_t *r)
 {
-    return transact(s, p, data, len, reply, r, NULL, false);
+    return transact(s, p, data, len, reply, r, NULL, len > 0u);
 }
 
 void cli_send_frame(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len)

@@ -397,8 +397,7 @@ int cli_cmd_spoi(cli_args_t *a)
         cli_send_fields(&s, &fs, p->len, &o);
     } else {
         uint8_t reply[TASE_DATA_MAX];
-        int n = cli_transact(&s, p, fs.data, p->len, reply, &v.r);
-        cli_print_packet(p, fs.data, p->len, v.r.json, "in", "sent");
+        int n = cli_transact(&s, p, fs.data, p->len, reply, &v.r); /* prints it sent */
         cli_print_packet(p, reply, (size_t)n, v.r.json, "out", "echo");
         /* the echo's flags carry the gimbal's state, not our request */
         cli_confirm_echo(&fs, p->len, reply, n, "flags");
