@@ -598,6 +598,17 @@ static void host_service(void)
     worst_report("tase_host_service", &w, ", each fed after the bytes before it" READS);
 }
 
+/* tase_host_poll() with the request `start` makes pending (its attempt
+ * then times out), as one candidate for the worst case. */
+static void host_poll_pending(worst_t *w, measure_fn start, const char *input)
+{
+    host_snapshot();
+    h = h_snap;
+    start(NULL);
+    h_snap = h;
+    worst_try(w, measure_exact(restore_h, c_hpoll, NULL), "%s", input);
+}
+
 static void host(void)
 {
     report("tase_host_init", measure_plain(c_hinit), "a port with byte rate 5760 B/s");
@@ -617,18 +628,12 @@ static void host(void)
      * re-sent (re-sent), and the longest (a 253-byte CAMERA_PASS, failed) */
     {
         worst_t w = {0, ""};
-        host_snapshot();
-        h = h_snap;
-        (void)c_hrequest_setup(NULL);
-        h_snap = h;
-        worst_try(&w, measure_exact(restore_h, c_hpoll, NULL),
-                  "the attempt of a pending AXIS_SETTING request (23 bytes) timed out: re-sent");
-        host_snapshot();
-        h = h_snap;
-        (void)c_hrequest(NULL);
-        h_snap = h;
-        worst_try(&w, measure_exact(restore_h, c_hpoll, NULL),
-                  "the one attempt of a pending 253-byte CAMERA_PASS request timed out: failed");
+        host_poll_pending(&w, c_hrequest_setup,
+                          "the attempt of a pending AXIS_SETTING request (23 bytes) timed out: "
+                          "re-sent");
+        host_poll_pending(&w, c_hrequest,
+                          "the one attempt of a pending 253-byte CAMERA_PASS request timed out: "
+                          "failed");
         worst_report("tase_host_poll", &w, PORT);
     }
     report("tase_host_busy", measure_exact(restore_h, c_hbusy, NULL),
