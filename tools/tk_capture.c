@@ -451,6 +451,13 @@ static struct timespec tap_time(tk_cap_tap_t *tap, uint32_t ms)
     /* a port time before the base (a call that read its clock first)
      * counts back from it */
     ns = tap->base_ns + (int64_t)(int32_t)(ms - tap->base_ms) * 1000000;
+    if ((uint32_t)(ms - tap->base_ms) >= 0x40000000u &&
+        (uint32_t)(ms - tap->base_ms) < 0x80000000u) {
+        /* 12 days on: the base follows, so that the 32-bit port clock's
+         * difference never reaches 2^31 ms in a session of months */
+        tap->base_ns = ns;
+        tap->base_ms = ms;
+    }
     t.tv_sec = (time_t)(ns / 1000000000);
     t.tv_nsec = (long)(ns % 1000000000);
     return t;

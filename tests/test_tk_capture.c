@@ -1,0 +1,185 @@
+/* The bench tools' capture writer (tools/tk_capture.c): the clock of a
+ * --record tap and appending in an existing file's own format. The shell
+ * tests (tests/tools/capture.sh) run the programs; these run the module
+ * with a fake port whose clock the test sets. */
+#include <fcntl.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "tk_capture.h"
+
+static uint32_t fake_ms;
+
+static int fake_write(void *ctx, const uint8_t *data, size_t n)
+{
+    (void)ctx;
+    (void)data;
+    return (int)n;
+}
+
+/* one byte a read: its value is the read's number */
+static int fake_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    static uint8_t next;
+    (void)ctx;
+    (void)timeout_ms;
+    if (cap == 0u) {
+        return 0;
+    }
+    buf[0] = next++;
+    return 1;
+}
+
+static uint32_t fake_now(void *ctx)
+{
+    (void)ctx;
+    return fake_ms;
+}
+
+static const tase_port_ops_t fake_ops = {fake_write, fake_read, fake_now};
+
+static void temp_path(char *out, size_t cap)
+{
+    int fd;
+    snprintf(out, cap, "/tmp/tase_test_tk_capture_XXXXXX");
+    fd = mkstemp(out);
+    assert_true(fd >= 0);
+    close(fd);
+    assert_int_equal(unlink(out), 0); /* tk_cap_create() makes it */
+}
+
+static int64_t rec_us(const tk_cap_rec_t *rec)
+{
+    return rec->t.sec * 1000000 + (int64_t)rec->t.usec;
+}
+
+/* A --record session of months: the tap stamps its records on the port's
+ * 32-bit millisecond clock; a difference of 2^31 ms or more from the first
+ * record turned negative (times went back 24.8 days into the session). */
+static void tap_times_follow_the_port_clock_across_months_and_its_wrap(void **state)
+{
+    char path[64];
+    tk_cap_writer_t w;
+    tk_cap_tap_t tap;
+    tase_port_t inner = {&fake_ops, NULL, 5760u};
+    tase_port_t port;
+    tk_cap_reader_t r;
+    tk_cap_rec_t rec;
+    char why[160];
+    uint8_t b;
+    int fd, i;
+    int64_t first = 0, prev = 0;
+    (void)state;
+    temp_path(path, sizeof(path));
+    tk_cap_create(&w, path, TK_CAP_LINKTYPE_SERIAL, true);
+    port = tk_cap_tap_port(&tap, inner, &w);
+    fake_ms = 0xF0000000u; /* the 32-bit clock wraps on the way */
+    for (i = 0; i < 12; i++) {
+        assert_int_equal(port.ops->read(port.ctx, &b, 1u, 0u), 1);
+        fake_ms += 0x20000000u; /* 6.2 days */
+    }
+    assert_int_equal(tk_cap_finish(&w), 0);
+    fd = open(path, O_RDONLY);
+    assert_true(fd >= 0);
+    tk_cap_reader_open(&r, fd, NULL, 0u, path);
+    for (i = 0; i < 12; i++) {
+        int64_t t;
+        assert_int_equal(tk_cap_next(&r, &rec, why, sizeof(why)), TK_CAP_RECORD);
+        assert_int_equal(rec.dir, TK_CAP_FROM_GIMBAL);
+        t = rec_us(&rec);
+        if (i == 0) {
+            first = t;
+        } else {
+            assert_true(t - prev == (int64_t)0x20000000 * 1000);
+        }
+        prev = t;
+    }
+    assert_true(prev - first == (int64_t)11 * 0x20000000 * 1000);
+    assert_int_equal(tk_cap_next(&r, &rec, why, sizeof(why)), TK_CAP_END);
+    tk_cap_reader_close(&r);
+    close(fd);
+    unlink(path);
+}
+
+static void put_be32(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)(v >> 24);
+    p[1] = (uint8_t)(v >> 16);
+    p[2] = (uint8_t)(v >> 8);
+    p[3] = (uint8_t)v;
+}
+
+static uint32_t get_be32(const uint8_t *p)
+{
+    return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3];
+}
+
+/* An existing big-endian microsecond capture (another tool's) is appended
+ * to in its own byte order and precision, its first record kept. */
+static void append_writes_in_the_files_own_format(void **state)
+{
+    char path[64];
+    uint8_t file[24 + 16 + 3];
+    uint8_t got[sizeof(file) + 16 + 2];
+    tk_cap_writer_t w;
+    tk_cap_tap_t tap;
+    tase_port_t inner = {&fake_ops, NULL, 5760u};
+    tase_port_t port;
+    struct timespec t;
+    uint8_t b;
+    int fd;
+    (void)state;
+    temp_path(path, sizeof(path));
+    memset(file, 0, sizeof(file));
+    put_be32(file, 0xA1B2C3D4u); /* microseconds, big-endian */
+    file[5] = 2;
+    file[7] = 4;
+    put_be32(file + 16, 65535u);
+    put_be32(file + 20, TK_CAP_LINKTYPE_SERIAL);
+    put_be32(file + 24, 1700000000u);
+    put_be32(file + 28, 999999u);
+    put_be32(file + 32, 3u);
+    put_be32(file + 36, 3u);
+    file[40] = 0;
+    file[41] = 0xAA;
+    file[42] = 0xBB;
+    fd = open(path, O_WRONLY | O_CREAT | O_EXCL, 0600);
+    assert_true(fd >= 0);
+    assert_int_equal(write(fd, file, sizeof(file)), (ssize_t)sizeof(file));
+    close(fd);
+    tk_cap_create(&w, path, TK_CAP_LINKTYPE_SERIAL, true);
+    port = tk_cap_tap_port(&tap, inner, &w);
+    fake_ms = 1234u;
+    assert_int_equal(port.ops->read(port.ctx, &b, 1u, 0u), 1);
+    assert_true(tk_cap_session_last_read(&fake_ms, &t) == false); /* not the session's tap */
+    assert_int_equal(tk_cap_finish(&w), 0);
+    fd = open(path, O_RDONLY);
+    assert_true(fd >= 0);
+    assert_int_equal(read(fd, got, sizeof(got)), (ssize_t)sizeof(got));
+    assert_int_equal(read(fd, got, 1u), 0);
+    close(fd);
+    assert_memory_equal(got, file, sizeof(file)); /* header and record 1 kept */
+    assert_true(get_be32(got + sizeof(file) + 4) < 1000000u); /* microseconds */
+    assert_int_equal(get_be32(got + sizeof(file) + 8), 2u);   /* direction + 1 byte */
+    assert_int_equal(get_be32(got + sizeof(file) + 12), 2u);
+    assert_int_equal(got[sizeof(file) + 16], TK_CAP_FROM_GIMBAL);
+    assert_int_equal(got[sizeof(file) + 17], b);
+    unlink(path);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(tap_times_follow_the_port_clock_across_months_and_its_wrap),
+        cmocka_unit_test(append_writes_in_the_files_own_format),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
