@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -61,10 +62,9 @@ static int64_t rec_us(const tk_cap_rec_t *rec)
     return rec->t.sec * 1000000 + (int64_t)rec->t.usec;
 }
 
-/* A --record session of months: the tap stamps its records on the port's
- * 32-bit millisecond clock; a difference of 2^31 ms or more from the first
- * record turned negative (times went back 24.8 days into the session). */
-static void tap_times_follow_the_port_clock_across_months_and_its_wrap(void **state)
+/* Record the reads of a tap whose port clock takes the steps given into
+ * a new capture; returns their times (microseconds) in t[0..n). */
+static void tap_session(const uint32_t *ms, int n, int64_t *t)
 {
     char path[64];
     tk_cap_writer_t w;
@@ -76,37 +76,70 @@ static void tap_times_follow_the_port_clock_across_months_and_its_wrap(void **st
     char why[160];
     uint8_t b;
     int fd, i;
-    int64_t first = 0, prev = 0;
-    (void)state;
     temp_path(path, sizeof(path));
     tk_cap_create(&w, path, TK_CAP_LINKTYPE_SERIAL, true);
     port = tk_cap_tap_port(&tap, inner, &w);
-    fake_ms = 0xF0000000u; /* the 32-bit clock wraps on the way */
-    for (i = 0; i < 12; i++) {
+    for (i = 0; i < n; i++) {
+        fake_ms = ms[i];
         assert_int_equal(port.ops->read(port.ctx, &b, 1u, 0u), 1);
-        fake_ms += 0x20000000u; /* 6.2 days */
     }
     assert_int_equal(tk_cap_finish(&w), 0);
     fd = open(path, O_RDONLY);
     assert_true(fd >= 0);
     tk_cap_reader_open(&r, fd, NULL, 0u, path);
-    for (i = 0; i < 12; i++) {
-        int64_t t;
+    for (i = 0; i < n; i++) {
         assert_int_equal(tk_cap_next(&r, &rec, why, sizeof(why)), TK_CAP_RECORD);
         assert_int_equal(rec.dir, TK_CAP_FROM_GIMBAL);
-        t = rec_us(&rec);
-        if (i == 0) {
-            first = t;
-        } else {
-            assert_true(t - prev == (int64_t)0x20000000 * 1000);
-        }
-        prev = t;
+        t[i] = rec_us(&rec);
     }
-    assert_true(prev - first == (int64_t)11 * 0x20000000 * 1000);
     assert_int_equal(tk_cap_next(&r, &rec, why, sizeof(why)), TK_CAP_END);
     tk_cap_reader_close(&r);
     close(fd);
     unlink(path);
+}
+
+static int64_t wall_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+/* The tap stamps its records on the port's 32-bit millisecond clock, so
+ * that `tase decode` measures the gaps the live receiver did: exactly its
+ * steps, also where that clock wraps. */
+static void tap_times_are_the_port_clocks_steps_across_its_wrap(void **state)
+{
+    static const uint32_t ms[6] = {0xFFFFFF00u, 0xFFFFFF64u, 0xFFFFFFC8u,
+                                   0x0000002Cu, 0x00000090u, 0x000000F4u};
+    int64_t t[6];
+    int i;
+    (void)state;
+    tap_session(ms, 6, t);
+    for (i = 1; i < 6; i++) {
+        assert_true(t[i] - t[i - 1] == 100000); /* 100 ms, to the microsecond */
+    }
+}
+
+/* A port clock that leaves the wall clock (it stood still while the
+ * computer slept, or no record came for 2^31 ms: a difference from the
+ * first record of 2^31 ms or more turned negative, times went back 49.7
+ * days): the times stay at the wall clock, in order. */
+static void tap_times_follow_the_wall_clock_when_the_port_clock_jumps(void **state)
+{
+    static const uint32_t ms[6] = {0xF0000000u, 0xF0000000u, 0x80000000u,
+                                   0x80000000u, 0x10000000u, 0x10000000u};
+    int64_t t[6], before = wall_us(), after;
+    int i;
+    (void)state;
+    tap_session(ms, 6, t);
+    after = wall_us();
+    for (i = 0; i < 6; i++) {
+        assert_true(t[i] >= before - 1000 && t[i] <= after + 1000); /* whole ms */
+        if (i > 0) {
+            assert_true(t[i] >= t[i - 1]);
+        }
+    }
 }
 
 static void put_be32(uint8_t *p, uint32_t v)
@@ -166,7 +199,7 @@ static void append_writes_in_the_files_own_format(void **state)
     assert_int_equal(read(fd, got, sizeof(got)), (ssize_t)sizeof(got));
     assert_int_equal(read(fd, got, 1u), 0);
     close(fd);
-    assert_memory_equal(got, file, sizeof(file)); /* header and record 1 kept */
+    assert_memory_equal(got, file, sizeof(file));             /* header and record 1 kept */
     assert_true(get_be32(got + sizeof(file) + 4) < 1000000u); /* microseconds */
     assert_int_equal(get_be32(got + sizeof(file) + 8), 2u);   /* direction + 1 byte */
     assert_int_equal(get_be32(got + sizeof(file) + 12), 2u);
@@ -178,7 +211,8 @@ static void append_writes_in_the_files_own_format(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(tap_times_follow_the_port_clock_across_months_and_its_wrap),
+        cmocka_unit_test(tap_times_are_the_port_clocks_steps_across_its_wrap),
+        cmocka_unit_test(tap_times_follow_the_wall_clock_when_the_port_clock_jumps),
         cmocka_unit_test(append_writes_in_the_files_own_format),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -73,61 +73,90 @@ static bool cap_head_parse(const uint8_t h[24], cap_head_t *c)
         return false;
     }
     c->snaplen = get32(h + 16, c->big);
-    c->linktype = get32(h + 20, c->big) & 0x0FFFFFFu; /* the low 24 bits name it */
+    c->linktype = get32(h + 20, c->big) & 0x03FFFFFFu; /* as libpcap: the low 26 bits name it */
     return true;
 }
 
-/* Where the whole records of an existing classic pcap file end: after the
- * 24-byte file header and every record whose 16-byte header and data are
- * complete. A record that runs past the end of the file with a sound
- * header is what a crash or a full disk leaves (the caller cuts it off);
- * a header that no writer writes (more data than the snapshot length or
- * than the packet's length, a fraction of a second or more) is damage in
- * the middle of a file, not a cut: returns -1 and its number in
- * *damaged, and nothing may be cut (41 KB of a file behind a damaged
- * header were removed as if a crash had cut it). */
-static long whole_records_len(int fd, long size, const cap_head_t *c, unsigned long *damaged)
+/* The largest record a capture's header allows: its snapshot length, 0
+ * or above libpcap's maximum (262144) read as that maximum, as libpcap
+ * reads them. */
+#define PCAP_MAX_SNAPLEN 262144u
+static uint32_t cap_limit(const cap_head_t *c)
 {
-    long at = 24;
-    unsigned long index = 0;
+    return (c->snaplen == 0u || c->snaplen > PCAP_MAX_SNAPLEN) ? PCAP_MAX_SNAPLEN : c->snaplen;
+}
+
+/* Scan the records of an existing classic pcap file from `at` (a record
+ * boundary; *index records before it) to `size`: returns where its whole
+ * records end, the 16-byte header and data of each complete. A record that
+ * runs past the end of the file with a sound header is what a crash or a
+ * full disk leaves (the caller cuts it off); a header no writer writes
+ * (more data than the snapshot length allows or than the packet's length)
+ * is damage in the middle of a file, not a cut: returns -1 with its number
+ * in *index, and nothing may be cut (41 KB of a file behind a damaged
+ * header were removed as if a crash had cut it). */
+static long whole_records_len(int fd, long at, long size, const cap_head_t *c, unsigned long *index)
+{
     while (at + 16 <= size) {
         uint8_t r[16];
-        uint32_t caplen, len, frac;
+        uint32_t caplen, len;
         if (pread(fd, r, sizeof(r), (off_t)at) != (ssize_t)sizeof(r)) {
             break;
         }
-        index++;
-        frac = get32(r + 4, c->big);
         caplen = get32(r + 8, c->big);
         len = get32(r + 12, c->big);
-        if (caplen > c->snaplen || caplen > len || frac >= (c->nano ? 1000000000u : 1000000u)) {
-            *damaged = index;
+        if (caplen > cap_limit(c) || caplen > len) {
+            ++*index;
             return -1;
         }
         if ((long)caplen > size - at - 16) {
             break; /* its data runs past the end */
         }
         at += 16 + (long)caplen;
+        ++*index;
     }
     return at;
+}
+
+/* flock() that a caught signal ends (tk_exit_if_signalled(): exit 128+N)
+ * and that says once when it waits for another program. */
+static void lock_capture(int fd, const char *path)
+{
+    bool said = false;
+    while (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        if (errno != EWOULDBLOCK && errno != EINTR) {
+            tk_die("cannot lock capture %s: %s", path, strerror(errno));
+        }
+        tk_exit_if_signalled();
+        if (!said) {
+            tk_warn("%s is being written by another program: waiting for it", path);
+            said = true;
+        }
+        {
+            struct timespec ts = {0, 10000000};
+            nanosleep(&ts, NULL);
+        }
+    }
 }
 
 /* Open `path` for appending records of `linktype` (a new file gets a
  * nanosecond header): checked and, when a crash or a full disk cut it
  * inside its last record, cut back to its last whole record (every new
  * record would be unreadable behind the partial one), said on stderr. The
- * check and the repair hold the flock every writer of ours holds for a
- * write, so that two of our programs neither both write a header nor cut
- * a record the other is writing. */
+ * file is scanned first without the lock (a long capture takes a while,
+ * and every other recorder waits for the lock); under the lock every
+ * writer of ours holds for a write, only what was added since and the
+ * tail are scanned again, so that two of our programs neither both write
+ * a header nor cut a record the other is writing. */
 static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
 {
     struct stat st;
     uint8_t h[24];
     cap_head_t c = {false, true, SERIAL_SNAPLEN, (uint32_t)linktype};
-    bool existed = lstat(path, &st) == 0;
     int fd = open(path, O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0666);
     int e = 0;
-    unsigned long damaged = 0;
+    long at = 24, keep;
+    unsigned long index = 0;
     if (fd < 0) {
         tk_die("cannot write capture %s: %s", path, strerror(errno));
     }
@@ -137,22 +166,7 @@ static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
                "'tase record -o' writes to a pipe or a device)",
                path);
     }
-    if (flock(fd, LOCK_EX) != 0 || fstat(fd, &st) != 0) {
-        e = errno;
-    } else if (st.st_size == 0) {
-        memset(h, 0, sizeof(h));
-        put32(h, 0xA1B23C4Du, false);
-        h[4] = 2; /* version 2.4, little-endian */
-        h[6] = 4;
-        put32(h + 16, SERIAL_SNAPLEN, false);
-        put32(h + 20, (uint32_t)linktype, false);
-        errno = 0;
-        if (write(fd, h, sizeof(h)) != (ssize_t)sizeof(h)) {
-            e = errno != 0 ? errno : ENOSPC;
-            (void)ftruncate(fd, 0);
-        }
-    } else {
-        long keep;
+    if (st.st_size > 0) {
         if (pread(fd, h, sizeof(h), 0) != (ssize_t)sizeof(h) || !cap_head_parse(h, &c)) {
             (void)close(fd);
             tk_die("cannot write capture %s: not a classic pcap file (--record appends only to "
@@ -165,12 +179,55 @@ static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
                    "new file name",
                    path, (unsigned long)c.linktype, linktype);
         }
-        keep = whole_records_len(fd, (long)st.st_size, &c, &damaged);
+        if (cap_limit(&c) < 1u + READ_CHUNK) {
+            (void)close(fd);
+            tk_die("cannot write capture %s: its snapshot length (%lu bytes) is below the %u "
+                   "bytes a record of ours may take: give a new file name",
+                   path, (unsigned long)c.snaplen, 1u + READ_CHUNK);
+        }
+        at = whole_records_len(fd, 24, (long)st.st_size, &c, &index);
+        if (at < 0) { /* looked at again under the lock: a write under way? */
+            at = 24;
+            index = 0;
+        }
+    }
+    lock_capture(fd, path);
+    if (fstat(fd, &st) != 0) {
+        e = errno;
+    } else if (st.st_size == 0) {
+        /* new or empty: ours to start (another program may have written
+         * the header since our open: then it is checked below) */
+        memset(h, 0, sizeof(h));
+        put32(h, 0xA1B23C4Du, false);
+        h[4] = 2; /* version 2.4, little-endian */
+        h[6] = 4;
+        put32(h + 16, SERIAL_SNAPLEN, false);
+        put32(h + 20, (uint32_t)linktype, false);
+        errno = 0;
+        if (write(fd, h, sizeof(h)) != (ssize_t)sizeof(h)) {
+            e = errno != 0 ? errno : ENOSPC;
+            (void)ftruncate(fd, 0);
+            if (fstat(fd, &st) == 0 && st.st_size == 0) {
+                (void)unlink(path); /* empty: nobody's capture */
+            }
+        }
+        at = -2; /* nothing to scan */
+    }
+    if (e == 0 && at != -2) {
+        if (at == 24 && index == 0 &&
+            (pread(fd, h, sizeof(h), 0) != (ssize_t)sizeof(h) || !cap_head_parse(h, &c) ||
+             c.linktype != (uint32_t)linktype || cap_limit(&c) < 1u + READ_CHUNK)) {
+            (void)close(fd); /* made by another program meanwhile, not ours to add to */
+            tk_die("cannot write capture %s: not a classic pcap file of TASE serial records "
+                   "(--record appends only to one; give a new file name)",
+                   path);
+        }
+        keep = whole_records_len(fd, at, (long)st.st_size, &c, &index);
         if (keep < 0) {
             (void)close(fd);
             tk_die("cannot write capture %s: its record %lu is damaged (not the end of a file a "
                    "crash cut short): not appending, the file is left as it is",
-                   path, damaged);
+                   path, index);
         }
         if (keep < (long)st.st_size) {
             if (ftruncate(fd, (off_t)keep) != 0) {
@@ -184,9 +241,6 @@ static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
     (void)flock(fd, LOCK_UN);
     if (e != 0) {
         (void)close(fd);
-        if (!existed) {
-            (void)unlink(path); /* a file this call made goes again */
-        }
         tk_die("cannot write capture %s: %s", path, strerror(e));
     }
     w->abuf = malloc(APPEND_BUF);
@@ -199,26 +253,36 @@ static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
     w->nano = c.nano;
 }
 
-/* One write of the whole records buffered; a write a full disk cut short
- * is cut off the file again (when nothing was appended behind it). */
+/* One append of the whole records buffered, under the lock; a write a
+ * full disk cut short is cut off the file again (when nothing was
+ * appended behind it), and the reason is the errno of the write that
+ * failed (a short count has none). */
 static bool append_flush(tk_cap_writer_t *w)
 {
-    ssize_t k;
+    size_t done = 0;
     if (w->alen == 0u) {
         return true;
     }
     /* under the lock every writer of ours takes for a write (the Python
      * package's too), so that append_open() never takes another's record
-     * in progress for one a crash cut short */
-    (void)flock(w->afd, LOCK_EX);
-    errno = 0;
-    k = write(w->afd, w->abuf, w->alen);
-    if (k != (ssize_t)w->alen) {
-        struct stat st;
-        off_t end = lseek(w->afd, 0, SEEK_CUR);
-        w->err = errno != 0 ? errno : ENOSPC;
-        if (k > 0 && end >= k && fstat(w->afd, &st) == 0 && st.st_size == end) {
-            (void)ftruncate(w->afd, end - k);
+     * in progress for one a crash cut short; a signal does not end the
+     * wait (the records are written, the signal seen after) */
+    while (flock(w->afd, LOCK_EX) != 0 && errno == EINTR) {
+    }
+    while (done < w->alen) {
+        ssize_t k = write(w->afd, w->abuf + done, w->alen - done);
+        if (k > 0) {
+            done += (size_t)k;
+        } else if (k < 0 && errno == EINTR) {
+            continue;
+        } else {
+            struct stat st;
+            off_t end = lseek(w->afd, 0, SEEK_CUR);
+            w->err = (k < 0) ? errno : ENOSPC;
+            if (done > 0u && end >= (off_t)done && fstat(w->afd, &st) == 0 && st.st_size == end) {
+                (void)ftruncate(w->afd, end - (off_t)done);
+            }
+            break;
         }
     }
     (void)flock(w->afd, LOCK_UN);
@@ -438,21 +502,32 @@ void tk_cap_close(tk_cap_writer_t *w)
  * (close_session_capture()) with the status that says whether a packet
  * was sent. */
 /* The record time of port time `ms` (tk_cap_tap_t). */
-static struct timespec tap_time(tk_cap_tap_t *tap, uint32_t ms)
+/* The record time of port time `ms` (tk_cap_tap_t). With `stamping` (a
+ * new record), a mapping more than TAP_DRIFT_MS away from the wall clock
+ * starts again from it: the port's clock stood still while the computer
+ * slept (CLOCK_MONOTONIC), the wall clock was stepped, or no record came
+ * for 2^31 ms. Across such a restart `tase decode` measures the wall
+ * clock's gap, the live receiver the port's. */
+#define TAP_DRIFT_MS 1000
+static struct timespec tap_time(tk_cap_tap_t *tap, uint32_t ms, bool stamping)
 {
     struct timespec t;
-    int64_t ns;
-    if (!tap->based) {
+    int64_t ns, wall = 0;
+    if (stamping || !tap->based) {
         clock_gettime(CLOCK_REALTIME, &t);
-        tap->base_ns = ((int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000) * 1000000;
-        tap->base_ms = ms;
-        tap->based = true;
+        wall = ((int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000) * 1000000; /* whole ms */
     }
     /* a port time before the base (a call that read its clock first)
      * counts back from it */
     ns = tap->base_ns + (int64_t)(int32_t)(ms - tap->base_ms) * 1000000;
-    if ((uint32_t)(ms - tap->base_ms) >= 0x40000000u &&
-        (uint32_t)(ms - tap->base_ms) < 0x80000000u) {
+    if (!tap->based || (stamping && (ns - wall > (int64_t)TAP_DRIFT_MS * 1000000 ||
+                                     wall - ns > (int64_t)TAP_DRIFT_MS * 1000000))) {
+        tap->base_ns = wall;
+        tap->base_ms = ms;
+        tap->based = true;
+        ns = wall;
+    } else if ((uint32_t)(ms - tap->base_ms) >= 0x40000000u &&
+               (uint32_t)(ms - tap->base_ms) < 0x80000000u) {
         /* 12 days on: the base follows, so that the 32-bit port clock's
          * difference never reaches 2^31 ms in a session of months */
         tap->base_ns = ns;
@@ -474,7 +549,7 @@ static void tap_record(tk_cap_tap_t *tap, unsigned dir, const uint8_t *data, siz
     if (tap->w->err != 0) {
         return;
     }
-    t = tap_time(tap, ms);
+    t = tap_time(tap, ms, true);
     tk_cap_put_serial(tap->w, &t, dir, data, n);
     (void)tk_cap_flush(tap->w); /* a failure stays in w->err */
 }
@@ -564,7 +639,7 @@ bool tk_cap_session_last_read(uint32_t *ms, struct timespec *t)
         return false;
     }
     *ms = session_tap.last_read_ms;
-    *t = tap_time(&session_tap, session_tap.last_read_ms);
+    *t = tap_time(&session_tap, session_tap.last_read_ms, false);
     return true;
 }
 

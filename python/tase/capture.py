@@ -10,6 +10,7 @@ import collections
 import errno
 import fcntl
 import os
+import stat
 import struct
 import time
 
@@ -317,73 +318,99 @@ class CaptureWriter:
         self.path = path
         self.records = 0
         self.f = None
-        created = False
+        existed = os.path.lexists(path)
+        fd = None
         try:
-            if os.path.exists(path) and os.path.getsize(path) > 0:
-                with open(path, "rb") as f:
-                    head = f.read(24)
-                if head != self._HEADER:
-                    raise CaptureError(
-                        "%s: not a nanosecond serial capture of tase record: not appending" % path
-                    )
-                self.f = open(path, "r+b", buffering=0)
-                # under the lock every writer of ours takes for a write
-                # (tase --record too): another's record in progress is not
-                # taken for one a crash cut short
-                fcntl.flock(self.f.fileno(), fcntl.LOCK_EX)
-                self.good = self._whole_records_end()
-                self.f.truncate(self.good)
-                self.f.close()
-                # appended to (O_APPEND), each record in one write: another
-                # writer's records (tase --record, a second link) go between
-                # ours, never over them (a seek to our own end overwrote them)
-                self.f = None
-                self.f = open(path, "ab", buffering=0)
-            else:
-                created = not os.path.exists(path)
-                # appended to as well (O_APPEND: see above); no buffer to write later
-                self.f = open(path, "ab", buffering=0)
-                self.good = 0
-                self._write(self._HEADER)
+            # appended to (O_APPEND), each record in one write: another
+            # writer's records (tase --record, a second link) go between
+            # ours, never over them (a seek to our own end overwrote them).
+            # O_NONBLOCK: a FIFO would hold the open until a reader came.
+            fd = os.open(
+                path, os.O_RDWR | os.O_APPEND | os.O_CREAT | os.O_NONBLOCK | os.O_CLOEXEC, 0o666
+            )
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                raise CaptureError(
+                    "cannot write capture %s: not a regular file (a recording is appended "
+                    "to a file)" % path
+                )
+            os.set_blocking(fd, True)
+            self.f = open(fd, "ab", buffering=0)
+            fd = None
+            fd_ = self.f.fileno()
+            # Scanned first without the lock (a long capture takes a while,
+            # and every other recorder waits for the lock), then, under the
+            # lock every writer of ours takes for a write (tase --record
+            # too), only what was added since and the tail: another's
+            # record in progress is not taken for one a crash cut short,
+            # and two writers of a new file do not both write its header.
+            pos, index = 24, 0
+            size = os.fstat(fd_).st_size
+            if size > 0:
+                self._check_header()
+                pos, index = self._scan(24, 0, size, under_lock=False)
+            fcntl.flock(fd_, fcntl.LOCK_EX)
+            try:
+                size = os.fstat(fd_).st_size
+                if size == 0:
+                    self.good = 0
+                    self._append(self._HEADER)
+                else:
+                    if (pos, index) == (24, 0):
+                        self._check_header()  # another program's header meanwhile
+                    end, _ = self._scan(pos, index, size, under_lock=True)
+                    self.f.truncate(end)
+            finally:
+                fcntl.flock(fd_, fcntl.LOCK_UN)
         except (OSError, CaptureError) as e:
+            if fd is not None:
+                os.close(fd)
             if self.f is not None:
-                self.f.close()
-            if created:
-                try:  # a file this call made goes again (as tase record's)
-                    os.unlink(path)
+                try:
+                    if not existed and os.fstat(self.f.fileno()).st_size == 0:
+                        os.unlink(path)  # a file this call made goes again
                 except OSError:
                     pass
+                self.f.close()
             if isinstance(e, CaptureError):
                 raise
             raise _write_error(path, e) from e
 
-    def _whole_records_end(self):
-        """Where the last whole record of the open file ends. A record
-        header no writer writes (more data than the snapshot length or the
-        packet's length, a fraction of 10^9 ns or more) is damage, not the
-        end of a file a crash cut short: a CaptureError, nothing cut."""
-        size = os.fstat(self.f.fileno()).st_size
-        pos = 24
-        index = 0
+    def _check_header(self):
+        head = os.pread(self.f.fileno(), 24, 0)
+        if head != self._HEADER:
+            raise CaptureError(
+                "%s: not a nanosecond serial capture of tase record: not appending" % self.path
+            )
+
+    def _scan(self, pos, index, size, under_lock):
+        """(end, count) of the whole records from `pos` (a record boundary,
+        `index` records before it) to `size`. A record header no writer
+        writes (more data than the snapshot length or the packet's length)
+        is damage, not the end of a file a crash cut short: a CaptureError
+        under the lock, nothing cut (without it: looked at again under it,
+        from the start, a write of another program may be under way)."""
+        fd = self.f.fileno()
         while pos + 16 <= size:
-            self.f.seek(pos)
-            _, frac, n, length = struct.unpack("<IIII", self.f.read(16))
-            index += 1
-            if n > 65535 or n > length or frac >= 1000000000:
+            _, _, n, length = struct.unpack("<IIII", os.pread(fd, 16, pos))
+            if n > 65535 or n > length:
+                if not under_lock:
+                    return 24, 0
                 raise CaptureError(
                     "%s: its record %d is damaged (not the end of a file a crash cut short): "
-                    "not appending, the file is left as it is" % (self.path, index)
+                    "not appending, the file is left as it is" % (self.path, index + 1)
                 )
             if pos + 16 + n > size:
                 break
             pos += 16 + n
-        return pos
+            index += 1
+        return pos, index
 
-    def _write(self, buf):
+    def _append(self, buf):
+        """Write buf at the end (the caller holds the lock); a write cut
+        short is cut off again."""
         fd = self.f.fileno()
-        fcntl.flock(fd, fcntl.LOCK_EX)  # as tase --record: see __init__
+        self.good = os.fstat(fd).st_size  # others may have appended
         try:
-            self.good = os.fstat(fd).st_size  # others may have appended
             view = memoryview(buf)
             while view:
                 view = view[self.f.write(view) :]
@@ -393,6 +420,12 @@ class CaptureWriter:
             except (OSError, ValueError):
                 pass
             raise _write_error(self.path, e) from e
+
+    def _write(self, buf):
+        fd = self.f.fileno()
+        fcntl.flock(fd, fcntl.LOCK_EX)  # as tase --record: see __init__
+        try:
+            self._append(buf)
         finally:
             fcntl.flock(fd, fcntl.LOCK_UN)
 

@@ -276,6 +276,41 @@ def test_a_writer_in_the_middle_of_a_record_is_waited_for(tmp_path):
     assert got == [7, 7]
 
 
+def _start_writer(path, barrier):
+    barrier.wait()
+    w = tase.capture.CaptureWriter(path)
+    w.put(0, b"\x00")
+    w.close()
+
+
+def test_two_writers_creating_one_capture_write_one_header(tmp_path):
+    # a review: both saw no file, both wrote a header (83 of 100 runs), and
+    # the file was damaged from its second header on
+    import multiprocessing
+    ctx = multiprocessing.get_context("fork")
+    for i in range(20):
+        path = str(tmp_path / ("new%d.pcap" % i))
+        barrier = ctx.Barrier(2)
+        procs = [ctx.Process(target=_start_writer, args=(path, barrier)) for _ in range(2)]
+        for p in procs:
+            p.start()
+        for p in procs:
+            p.join(30)
+            assert p.exitcode == 0
+        data = open(path, "rb").read()
+        assert data.count(tase.capture.CaptureWriter._HEADER) == 1, i
+        assert [r[3] for r in tase.capture.records(path)] == [b"\x00\x00", b"\x00\x00"]
+
+
+def test_a_fifo_is_refused_not_waited_on(tmp_path):
+    path = str(tmp_path / "fifo")
+    os.mkfifo(path)
+    t0 = time.monotonic()
+    with pytest.raises(tase.capture.CaptureError, match="not a regular file"):
+        tase.capture.CaptureWriter(path)
+    assert time.monotonic() - t0 < 5
+
+
 def test_read_capture_takes_a_path_not_a_descriptor(tmp_path):
     with pytest.raises(TypeError, match="is a file path"):
         list(tase.read_capture(0))

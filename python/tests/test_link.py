@@ -350,8 +350,23 @@ def test_a_full_disk_stops_the_recording_not_the_link(silent_pty, tmp_path):
     with tase.connect(url, record=cap) as link:
         link.point(7, 8)
     assert [p.raw["pan"] for _, p in tase.read_capture(cap)] == [100, 700]
-    # a capture that cannot even be created: a CaptureError (was an OSError)
-    with pytest.raises(tase.capture.CaptureError, match="No space left on device"):
+    # a capture that cannot even be created: a CaptureError (was an OSError),
+    # the empty file removed (a file size limit, as a full disk: EFBIG)
+    import resource
+    import signal
+    new = str(tmp_path / "none.pcap")
+    old_handler = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    limits = resource.getrlimit(resource.RLIMIT_FSIZE)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (0, limits[1]))
+    try:
+        with pytest.raises(tase.capture.CaptureError, match="File too large"):
+            tase.connect(url, record=new)
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, limits)
+        signal.signal(signal.SIGXFSZ, old_handler)
+    assert not os.path.exists(new)
+    # a device (/dev/full) is refused as tase --record refuses it
+    with pytest.raises(tase.capture.CaptureError, match="not a regular file"):
         tase.connect(url, record="/dev/full")
 
 

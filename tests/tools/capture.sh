@@ -183,6 +183,18 @@ check "--record on a full disk: the command was carried out, exit $rc (5), '$(ca
           grep -q "^sent GIMBAL_CMD pan=1200 tilt=-300" "$dir/full.out"'
 check "... and the capture still ends at a whole record (tshark reads it cleanly)" \
     eval 'tshark -r "$dir/full.pcap" >/dev/null 2>"$dir/full.tshark" && ! grep -v "Running as user" "$dir/full.tshark" | grep -q .'
+# A write the limit cut short (1 KiB: part of a flush fits) was reported as
+# "No space left on device": the reason is the failing write's, EFBIG here
+(
+    trap '' XFSZ
+    ulimit -f 1
+    exec "$TASE" monitor --serial "$dir/gimbal" --record "$dir/cut1k.pcap" --seconds 1.5
+) >/dev/null 2>"$dir/cut1k.err.all"
+rc=$?
+grep -v '^==[0-9]*== ' "$dir/cut1k.err.all" >"$dir/cut1k.err"
+check "--record cut short by a file size limit: exit $rc, the reason named ('$(tail -1 "$dir/cut1k.err")'), the file ends at a whole record" \
+    eval '[ $rc = 1 ] && grep -q "^tase: cannot write capture $dir/cut1k.pcap: File too large$" "$dir/cut1k.err" &&
+          "$TASE" decode "$dir/cut1k.pcap" >/dev/null 2>&1'
 # issue 25 item 3: appending to a capture a crash cut inside a record
 cp "$dir/session.pcap" "$dir/crashed.pcap"
 truncate -s -5 "$dir/crashed.pcap"
@@ -233,8 +245,37 @@ for _ in $(seq 100); do [ -e "$dir/mid.ready" ] && break; sleep 0.05; done
 wait $mw
 "$TASE" decode "$dir/mid.pcap" >"$dir/mid.json" 2>&1
 rc=$?
-check "--record beside a writer in the middle of a record: waits for it, nothing cut, the file decodes (exit $rc, '$(cat "$dir/mid.err")')" \
-    eval '[ $rc = 0 ] && ! grep -qv "^==" "$dir/mid.err" && [ "$(grep -c SYSTEM_VERSION "$dir/mid.json")" -ge 2 ]'
+check "--record beside a writer in the middle of a record: waits for it, says so, nothing cut, the file decodes (exit $rc, '$(cat "$dir/mid.err")')" \
+    eval '[ $rc = 0 ] && [ "$(grep -v "^==" "$dir/mid.err")" = "tase: $dir/mid.pcap is being written by another program: waiting for it" ] &&
+          [ "$(grep -c SYSTEM_VERSION "$dir/mid.json")" -ge 2 ]'
+# Waiting for that lock, Ctrl-C ended the command with exit 1 ("cannot write
+# capture: Interrupted system call"): 130 now, as any interrupted command.
+cp "$dir/session.pcap" "$dir/locked.pcap"
+flock "$dir/locked.pcap" sleep 5 &
+fl=$!
+sleep 0.2
+"$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/locked.pcap" >/dev/null 2>"$dir/locked.err" &
+qp=$!
+wait_for "$dir/locked.err" "being written by another program"
+kill -INT $qp
+wait $qp
+rc=$?
+kill $fl 2>/dev/null
+wait $fl 2>/dev/null
+check "--record waiting for another writer's lock, Ctrl-C: exit $rc (130), '$(grep -v "^==" "$dir/locked.err" | tail -1)'" \
+    eval '[ $rc = 130 ] && cmp -s "$dir/locked.pcap" "$dir/session.pcap"'
+# A capture whose snapshot length is below a record of ours: the records
+# appended were longer than it allows, and the next --record refused the
+# file as damaged (decode: cut by the snapshot length)
+"${TASE_PYTHON:-python3}" - "$dir/snap32.pcap" <<'PY'
+import struct, sys
+open(sys.argv[1], "wb").write(struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 32, 147))
+PY
+cp "$dir/snap32.pcap" "$dir/snap32.copy"
+expect_error "--record onto a capture of snapshot length 32: refused" 1 \
+    "cannot write capture $dir/snap32.pcap: its snapshot length (32 bytes) is below the 4097 bytes a record of ours may take" \
+    "$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/snap32.pcap"
+check "... the file left as it was" cmp -s "$dir/snap32.pcap" "$dir/snap32.copy"
 # Two programs recording into one capture (two gimbals, one session file):
 # every record of both kept (a guard: libpcap's append did this too).
 "$SIM" --quiet --link "$dir/gimbal2" --seconds 30 >"$dir/sim2.log" 2>&1 &
