@@ -260,14 +260,21 @@ static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
 static bool append_flush(tk_cap_writer_t *w)
 {
     size_t done = 0;
+    bool locked = true;
     if (w->alen == 0u) {
         return true;
     }
     /* under the lock every writer of ours takes for a write (the Python
      * package's too), so that append_open() never takes another's record
-     * in progress for one a crash cut short; a signal does not end the
-     * wait (the records are written, the signal seen after) */
-    while (flock(w->afd, LOCK_EX) != 0 && errno == EINTR) {
+     * in progress for one a crash cut short. A caught signal ends the wait
+     * (a holder stopped with SIGSTOP would hold Ctrl-C up for good): the
+     * records are written without the lock then (a holder is past its
+     * write, which a stop does not cut), and the signal is seen after. */
+    while (flock(w->afd, LOCK_EX) != 0) {
+        if (errno != EINTR || tk_signal != 0) {
+            locked = false;
+            break;
+        }
     }
     while (done < w->alen) {
         ssize_t k = write(w->afd, w->abuf + done, w->alen - done);
@@ -285,7 +292,9 @@ static bool append_flush(tk_cap_writer_t *w)
             break;
         }
     }
-    (void)flock(w->afd, LOCK_UN);
+    if (locked) {
+        (void)flock(w->afd, LOCK_UN);
+    }
     w->alen = 0;
     return w->err == 0;
 }

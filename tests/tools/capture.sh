@@ -264,6 +264,23 @@ kill $fl 2>/dev/null
 wait $fl 2>/dev/null
 check "--record waiting for another writer's lock, Ctrl-C: exit $rc (130), '$(grep -v "^==" "$dir/locked.err" | tail -1)'" \
     eval '[ $rc = 130 ] && cmp -s "$dir/locked.pcap" "$dir/session.pcap"'
+# A lock taken by another program after the recording started (here held
+# for 8 s) held a monitor's Ctrl-C up until it was released
+"$TASE" monitor --serial "$dir/gimbal" --record "$dir/held.pcap" >/dev/null 2>"$dir/held.err" &
+mp=$!
+for _ in $(seq 100); do [ -s "$dir/held.pcap" ] && break; sleep 0.05; done
+flock "$dir/held.pcap" sleep 8 &
+fl=$!
+sleep 0.5
+t0=$(date +%s%N)
+kill -INT $mp
+wait $mp
+rc=$?
+ms=$((($(date +%s%N) - t0) / 1000000))
+kill $fl 2>/dev/null
+wait $fl 2>/dev/null
+check "--record blocked by another program's lock, Ctrl-C: exit $rc (0: monitor's normal end) after $ms ms, the capture decodes" \
+    eval '[ $rc = 0 ] && [ $ms -lt 3000 ] && "$TASE" decode "$dir/held.pcap" >/dev/null 2>&1'
 # A capture whose snapshot length is below a record of ours: the records
 # appended were longer than it allows, and the next --record refused the
 # file as damaged (decode: cut by the snapshot length)
