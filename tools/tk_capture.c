@@ -713,9 +713,22 @@ static int head_close(void *cookie)
     return 0; /* the descriptor is the caller's */
 }
 
+/* The reader open now: closed at exit when tk_die() ends the program
+ * with it open (its cookie and head copy were left to the exit: a leak to
+ * LeakSanitizer). One reader at a time is open in each program. */
+static tk_cap_reader_t *open_reader;
+
+static void close_open_reader(void)
+{
+    if (open_reader != NULL) {
+        tk_cap_reader_close(open_reader);
+    }
+}
+
 void tk_cap_reader_open(tk_cap_reader_t *r, int fd, const uint8_t *head, size_t nhead,
                         const char *path)
 {
+    static bool registered;
     static const cookie_io_functions_t io = {head_read, NULL, NULL, head_close};
     char err[PCAP_ERRBUF_SIZE];
     head_fd_t *h = calloc(1, sizeof(*h));
@@ -724,7 +737,11 @@ void tk_cap_reader_open(tk_cap_reader_t *r, int fd, const uint8_t *head, size_t 
     int lt;
     memset(r, 0, sizeof(*r));
     r->path = path;
+    if (!registered) {
+        registered = atexit(close_open_reader) == 0;
+    }
     if (h == NULL || (nhead > 0 && (h->head = malloc(nhead)) == NULL)) {
+        free(h);
         tk_die("cannot read %s: out of memory", path);
     }
     h->fd = fd;
@@ -734,11 +751,14 @@ void tk_cap_reader_open(tk_cap_reader_t *r, int fd, const uint8_t *head, size_t 
     h->n = nhead;
     in = fopencookie(h, "rb", io);
     if (in == NULL) {
+        free(h->head);
+        free(h);
         tk_die("cannot read %s: %s", path, strerror(errno));
     }
     err[0] = '\0';
     p = pcap_fopen_offline_with_tstamp_precision(in, PCAP_TSTAMP_PRECISION_NANO, err);
     if (p == NULL) {
+        (void)fclose(in); /* frees h (head_close) */
         tk_die("%s: not a capture libpcap can read: %s", path, err);
     }
     lt = pcap_datalink(p);
@@ -752,6 +772,8 @@ void tk_cap_reader_open(tk_cap_reader_t *r, int fd, const uint8_t *head, size_t 
     }
     r->pcap = p;
     r->linktype = lt;
+    r->pcapng = pcap_major_version(p) == 1; /* a pcapng section's version 1.0 */
+    open_reader = r;
 }
 
 void tk_cap_reader_close(tk_cap_reader_t *r)
@@ -759,6 +781,9 @@ void tk_cap_reader_close(tk_cap_reader_t *r)
     if (r->pcap != NULL) {
         pcap_close(r->pcap); /* closes the FILE */
         r->pcap = NULL;
+    }
+    if (open_reader == r) {
+        open_reader = NULL;
     }
 }
 
@@ -831,22 +856,38 @@ int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap)
     rec->index = ++r->index;
     /* A classic pcap record's seconds are an unsigned 32-bit field (good
      * to 2106); libpcap hands them over as a signed 32-bit number, so a
-     * time past 2038-01-19 03:14:07 would come out negative. No capture
-     * holds times before 1970: a negative value is the unsigned field. A
-     * fraction of a second beyond 10^9 ns (a writer that did not
-     * normalise) carries into the seconds. */
+     * time past 2038-01-19 03:14:07 would come out negative. No classic
+     * capture holds times before 1970: a negative value is the unsigned
+     * field. (A pcapng time is 64-bit: one before 1970, from its
+     * if_tsoffset, stays negative.) A fraction of a second beyond 10^9 ns
+     * (a writer that did not normalise; libpcap scales a microsecond
+     * file's to nanoseconds in a 64-bit field) carries into the seconds. */
     {
         int64_t sec = (int64_t)h->ts.tv_sec;
-        uint64_t ns = (uint64_t)(uint32_t)h->ts.tv_usec; /* opened in nanoseconds */
-        if (sec < 0 && sec >= -(int64_t)0x80000000) {
+        uint64_t ns = h->ts.tv_usec > 0 ? (uint64_t)h->ts.tv_usec : 0u; /* opened in ns */
+        if (!r->pcapng && sec < 0 && sec >= -(int64_t)0x80000000) {
             sec += (int64_t)0x100000000;
         }
         sec += (int64_t)(ns / 1000000000u);
         rec->t.sec = sec;
         rec->t.usec = (uint32_t)(ns % 1000000000u / 1000u);
+        if (r->pcapng && h->ts.tv_sec == 0 && h->ts.tv_usec == 0 && r->index > 1u) {
+            /* a pcapng Simple Packet Block has no time (libpcap gives 0):
+             * the time of the record before, not 1970 (whose gap cut a
+             * frame split across the two as a pause) */
+            rec->t = r->last;
+        }
+        r->last = rec->t;
     }
     if (h->caplen < h->len) {
         snprintf(why, cap, "cut to %u of its %u bytes by the capture's snapshot length",
+                 (unsigned)h->caplen, (unsigned)h->len);
+        return TK_CAP_BAD;
+    }
+    if (h->caplen > h->len) {
+        /* no writer keeps more than the packet had: a damaged header (as
+         * --record calls it) */
+        snprintf(why, cap, "%u bytes captured of a packet of %u: a damaged record header",
                  (unsigned)h->caplen, (unsigned)h->len);
         return TK_CAP_BAD;
     }

@@ -149,7 +149,9 @@ bool tk_cap_is_capture(const uint8_t *head, size_t n);
 
 typedef struct {
     void *pcap;
-    int linktype; /* TK_CAP_LINKTYPE_SERIAL or TK_CAP_LINKTYPE_CAN */
+    int linktype;   /* TK_CAP_LINKTYPE_SERIAL or TK_CAP_LINKTYPE_CAN */
+    bool pcapng;    /* else classic pcap */
+    tk_time_t last; /* the time of the record read last */
     const char *path;
     unsigned long index; /* records read so far */
 } tk_cap_reader_t;

@@ -427,7 +427,15 @@ size_t tk_format_time(char *buf, const tk_time_t *t)
     int i;
     b.p = buf;
     b.end = buf + 28;
-    sb_i64(&b, t->sec);
+    if (t->sec < 0 && u > 0u) {
+        /* -0.75 s is sec -1 + 250000 us: the digits of the negative
+         * number, not of its two parts */
+        sb_c(&b, '-');
+        sb_i64(&b, -(t->sec + 1));
+        u = 1000000u - u;
+    } else {
+        sb_i64(&b, t->sec);
+    }
     sb_c(&b, '.');
     for (i = 5; i >= 0; i--) {
         us[i] = (char)('0' + (int)(u % 10u));

@@ -215,7 +215,8 @@ int tk_parse_real(const char *s, double *out)
 int tk_parse_seconds(const char *s, double *out)
 {
     double v;
-    if (tk_parse_real(s, &v) != TK_NUM_OK || s[0] == '-' || s[0] == '+' || v > 1e7) {
+    /* a leading '+' as the other number options take it; never '-' */
+    if (tk_parse_real(s, &v) != TK_NUM_OK || s[0] == '-' || v > 1e7) {
         return -1;
     }
     *out = v;

@@ -247,6 +247,13 @@ expect("tase-sim --can-pty is not for --baud",
        "--can-pty is a pseudo-terminal at CAN's capacity: not with --baud")
 expect("tase-sim --link followed by an option: the value is missing",
        [SIM, "--link", "--quiet", "--seconds", "1"], 2, "option --link needs a value")
+# a fuzzing review: '+5' was a number to --count, --timeout, --baud, ... but
+# not to --seconds, --wait, --speed; --speed 1e-22 was taken (a wait of 10^20 s)
+expect("--seconds takes a leading '+' as the other number options",
+       ["monitor", "--seconds", "+0.5"] + L, 1, "cannot open serial device")
+expect("replay --speed below 0.001 is refused",
+       ["replay", "/dev/null", "--serial", "/dev/null", "--dir", "out", "--speed", "0.0001"], 2,
+       r"bad --speed value '0\.0001' \(a factor: 1 recorded timing, 2 twice as fast, 0\.001 the slowest")
 
 # ---- messages ----
 expect("--serial /dev/null: not a terminal (it exists)",

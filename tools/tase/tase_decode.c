@@ -36,10 +36,11 @@ static const char *input_guess(const cli_input_t *in, const tk_dec_t *d, bool ca
     if (d->n.checksum_errors > 0u) {
         return " (candidate frames were found, each with a bad checksum)";
     }
-    if (candump && d->n.can_frames > d->n.can_other) {
+    /* a candump log, or a capture of a CAN bus (SocketCAN link type) */
+    if ((candump || d->n.can_frames > 0u) && d->n.can_frames > d->n.can_other) {
         return " (its frames of ID 10000000 and 11000000 hold no whole frame)";
     }
-    if (candump) {
+    if (candump || d->n.can_frames > 0u) {
         return " (no frame of ID 10000000 or 11000000)";
     }
     return " (not a capture of a TASE serial line?)";
@@ -84,6 +85,11 @@ static unsigned long decode_capture(cli_input_t *in, tk_dec_t *d, const uint8_t 
             tk_dec_bytes(d, s, rec.data, rec.len, &rec.t);
         } else if (rec.can_data) {
             (void)tk_dec_can(d, "", &rec.frame, &rec.t); /* one interface: no name */
+        } else {
+            /* remote, FD or error frames: counted, as a candump log's
+             * (a capture of only those said nothing and exited 0) */
+            d->n.can_frames++;
+            d->n.can_other++;
         }
         tk_exit_if_signalled();
     }
@@ -130,7 +136,9 @@ static void candump_line(candump_t *c, const char *line, size_t len, bool overlo
     }
     rc = tase_candump_parse(line, len, &rec);
     if (rc == TASE_EUNSUPPORTED) {
-        return; /* remote, FD or error frames carry no datalink bytes */
+        c->d->n.can_frames++; /* remote, FD or error frames carry no datalink bytes */
+        c->d->n.can_other++;
+        return;
     }
     if (rc != TASE_OK) {
         candump_bad(c, memchr(line, '\0', len) != NULL
@@ -148,8 +156,9 @@ static void candump_line(candump_t *c, const char *line, size_t len, bool overlo
     t.sec = (int64_t)rec.sec;
     t.usec = rec.usec;
     if (!tk_dec_can(c->d, rec.ifname, &rec.frame, &t)) {
-        tk_die("%s:%lu: too many CAN interfaces (at most %u)", c->in->name, c->lineno,
-               TK_STREAMS_MAX / 2u);
+        tk_die("%s:%lu: too many CAN streams (at most %u: an interface and a direction each, "
+               "%u interfaces both ways)",
+               c->in->name, c->lineno, TK_STREAMS_MAX, TK_STREAMS_MAX / 2u);
     }
 }
 

@@ -98,9 +98,9 @@ int cli_cmd_replay(cli_args_t *a)
             continue;
         }
         if (cli_opt(a, "--speed", true, &v)) {
-            if (tk_parse_seconds(v, &ro.speed) != 0) {
+            if (tk_parse_seconds(v, &ro.speed) != 0 || (ro.speed > 0.0 && ro.speed < 0.001)) {
                 tk_usage_error("bad --speed value '%s' (a factor: 1 recorded timing, 2 twice as "
-                               "fast, 0 no waiting)",
+                               "fast, 0.001 the slowest, 0 no waiting)",
                                v);
             }
         } else if (cli_opt(a, "--dir", true, &v)) {
