@@ -741,7 +741,6 @@ void tk_cap_reader_open(tk_cap_reader_t *r, int fd, const uint8_t *head, size_t 
         registered = atexit(close_open_reader) == 0;
     }
     if (h == NULL || (nhead > 0 && (h->head = malloc(nhead)) == NULL)) {
-        free(h);
         tk_die("cannot read %s: out of memory", path);
     }
     h->fd = fd;
