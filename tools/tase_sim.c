@@ -365,6 +365,7 @@ int main(int argc, char **argv)
     tase_axis_setting_t axs;
     tase_nav_source_t nav;
 
+    tk_std_fds_open(); /* before anything opens a file */
     tk_prog = "tase-sim";
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];

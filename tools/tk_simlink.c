@@ -33,6 +33,7 @@
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -107,7 +108,15 @@ int tk_simlink_claim(const char *link, char *why, size_t cap)
         struct stat a, b;
         long pid = 0;
         char slave[PATH_MAX];
-        int fd = open(lock, O_RDWR | O_CREAT | O_NOFOLLOW | O_NOCTTY | O_CLOEXEC, 0644);
+        int rec;
+        /* made by us (O_EXCL), or found: a file found empty is either
+         * another simulator's that it has not locked and written yet (it
+         * does both at once), or a user's own: never ours to take */
+        int fd = open(lock, O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_NOCTTY | O_CLOEXEC, 0644);
+        bool created = fd >= 0;
+        if (fd < 0 && errno == EEXIST) {
+            fd = open(lock, O_RDWR | O_NOFOLLOW | O_NOCTTY | O_CLOEXEC);
+        }
         if (fd < 0) {
             snprintf(why, cap, "cannot claim %s: cannot open its lock file %s: %s", link, lock,
                      strerror(errno));
@@ -136,17 +145,36 @@ int tk_simlink_claim(const char *link, char *why, size_t cap)
             snprintf(why, cap, "cannot claim %s: cannot lock %s: %s", link, lock, strerror(e));
             return -1;
         }
-        if (stat(lock, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino) {
-            if (read_record(fd, &pid, slave, sizeof(slave)) < 0) {
-                /* someone's own file of that name: never overwritten */
-                (void)close(fd);
-                snprintf(why, cap, "%s exists and is not a lock file of tase-sim; not using %s",
-                         lock, link);
-                return -1;
-            }
-            return fd;
+        if (stat(lock, &b) != 0 || a.st_dev != b.st_dev || a.st_ino != b.st_ino) {
+            (void)close(fd); /* removed or replaced meanwhile */
+            continue;
         }
-        (void)close(fd);
+        rec = read_record(fd, &pid, slave, sizeof(slave));
+        if (rec < 0 || (rec == 0 && !created)) {
+            (void)close(fd);
+            if (rec == 0 && attempt < 7) {
+                struct timespec ts = {0, 20000000}; /* another simulator's, not written yet? */
+                nanosleep(&ts, NULL);
+                continue;
+            }
+            /* someone's own file of that name: never overwritten */
+            snprintf(why, cap, "%s exists and is not a lock file of tase-sim; not using %s", lock,
+                     link);
+            return -1;
+        }
+        /* ours now: readable by every user's tools (a umask of 077 made
+         * it unreadable to them, and a tool that cannot read it cannot
+         * tell a stale link), and at once a record of a simulator starting
+         * (no pty yet), so that a tool never takes the dead one's record
+         * for ours */
+        (void)fchmod(fd, 0644);
+        if (tk_simlink_record(fd, TK_SIMLINK_STARTING) != 0) {
+            int e = errno;
+            (void)close(fd);
+            snprintf(why, cap, "cannot claim %s: cannot write %s: %s", link, lock, strerror(e));
+            return -1;
+        }
+        return fd;
     }
     snprintf(why, cap, "cannot claim %s: its lock file %s keeps changing", link, lock);
     return -1;
@@ -182,7 +210,11 @@ void tk_simlink_release(const char *link, int fd)
 }
 
 /* One symlink `link` (reached from `given`) leading to `target`: -1 with
- * the reason when it is a tase-sim link whose simulator is gone. */
+ * the reason when it is a tase-sim link whose simulator is gone (or one
+ * whose simulator is starting or taking it over: the link may still lead
+ * to the dead one's pty). Whether the simulator lives is whether anyone
+ * holds the lock: no pid is compared (a simulator in another pid
+ * namespace records a pid the tool's namespace does not know). */
 static int check_one(const char *given, const char *link, const char *target, char *why, size_t cap)
 {
     char lock[PATH_MAX], slave[PATH_MAX], through[PATH_MAX + 16];
@@ -192,8 +224,21 @@ static int check_one(const char *given, const char *link, const char *target, ch
     if (tk_simlink_lock_path(link, lock, sizeof(lock)) != 0) {
         return 0;
     }
+    through[0] = '\0';
+    if (strcmp(given, link) != 0) {
+        snprintf(through, sizeof(through), " (through %s)", link);
+    }
     fd = open(lock, O_RDONLY | O_NOFOLLOW | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) {
+        if (errno == EACCES) {
+            /* a simulator's lock file we may not read: whether its
+             * simulator lives cannot be told, so not opened */
+            snprintf(why, cap,
+                     "%s%s: cannot read %s (%s), so whether the tase-sim of this link still runs "
+                     "cannot be told; not opened, nothing sent",
+                     given, through, lock, strerror(errno));
+            return -1;
+        }
         return 0; /* no lock file: not a link of tase-sim (socat's, a user's) */
     }
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
@@ -203,14 +248,20 @@ static int check_one(const char *given, const char *link, const char *target, ch
     rec = read_record(fd, &pid, slave, sizeof(slave));
     holder = lock_holder(fd);
     (void)close(fd);
-    if (rec <= 0 || strcmp(slave, target) != 0) {
-        /* not tase-sim's, or the link leads elsewhere now (repointed by
-         * someone: not the pty the record is about) */
-        return 0;
+    if (rec < 0 || (rec == 0 && holder == 0)) {
+        return 0; /* not tase-sim's (a user's file of that name) */
     }
-    through[0] = '\0';
-    if (strcmp(given, link) != 0) {
-        snprintf(through, sizeof(through), " (through %s)", link);
+    if (rec == 0 || (strcmp(slave, TK_SIMLINK_STARTING) == 0 && holder != 0)) {
+        snprintf(why, cap,
+                 "%s%s: a tase-sim is starting on this link (pid %ld); not opened, nothing sent "
+                 "(try again)",
+                 given, through, holder);
+        return -1;
+    }
+    if (strcmp(slave, TK_SIMLINK_STARTING) != 0 && strcmp(slave, target) != 0) {
+        /* the link leads elsewhere now (repointed by someone: not the
+         * pty the record is about) */
+        return 0;
     }
     if (holder == 0) {
         snprintf(why, cap,
@@ -218,14 +269,6 @@ static int check_one(const char *given, const char *link, const char *target, ch
                  "%s may belong to another program now; not opened, nothing sent (start "
                  "tase-sim again, or remove %s and %s)",
                  given, through, pid, target, link, lock);
-        return -1;
-    }
-    if (holder != pid && holder > 0) {
-        /* (-1: a holder in another pid namespace; live, not nameable) */
-        snprintf(why, cap,
-                 "%s%s is the link of a tase-sim that is no longer running (pid %ld); another "
-                 "(pid %ld) is taking it over: not opened, nothing sent (try again)",
-                 given, through, pid, holder);
         return -1;
     }
     return 0;

@@ -50,7 +50,7 @@ static void close_all_links(void)
 
 static void vmsg(const char *fmt, va_list ap)
 {
-    char msg[512];
+    char msg[3 * PATH_MAX + 1024]; /* vexit()'s message and its "(X was sent)" */
     vsnprintf(msg, sizeof(msg), fmt, ap);
     /* the contract is one line: fold anything a caller let through */
     for (char *c = msg; *c != '\0'; c++) {
@@ -76,7 +76,7 @@ const char *tk_sent(void)
 
 static void vexit(int status, const char *fmt, va_list ap)
 {
-    char msg[448];
+    char msg[3 * PATH_MAX + 512]; /* a message may name three paths */
     /* what was printed before the error still goes out (errors ignored:
      * the error line is the one to report) */
     (void)fflush(stdout);
@@ -281,9 +281,47 @@ static void on_signal(int sig)
  * the line stayed raw with VMIN 0 for the next program (issue 25 item 4). */
 static sigset_t fatal_set; /* the signals on_fatal_signal() handles */
 
+/* The links this process made (tk_pty_open()), removed at its exit: the
+ * link first (if still ours), then its lock file. */
+#define MAX_CLAIMS 2
+static struct {
+    const char *link;
+    char lock[PATH_MAX]; /* its lock file (tk_simlink_lock_path()) */
+    int lock_fd;
+    char slave[64]; /* "" until the link exists */
+} claims[MAX_CLAIMS];
+static volatile size_t nclaims;
+
+/* The links and lock files of this process, removed by a fatal signal's
+ * handler as the exit handler removes them (only async-signal-safe calls:
+ * readlink, unlink, fstat, stat); a SIGUSR1 or SIGQUIT left both behind. */
+static void release_claims_on_signal(void)
+{
+    size_t i;
+    for (i = 0; i < nclaims && i < MAX_CLAIMS; i++) {
+        char target[64];
+        struct stat a, b;
+        size_t k = 0;
+        if (claims[i].slave[0] != '\0') {
+            ssize_t n = readlink(claims[i].link, target, sizeof(target));
+            while (k < sizeof(claims[i].slave) && claims[i].slave[k] != '\0') {
+                k++;
+            }
+            if (n == (ssize_t)k && memcmp(target, claims[i].slave, k) == 0) {
+                (void)unlink(claims[i].link);
+            }
+        }
+        if (claims[i].lock[0] != '\0' && fstat(claims[i].lock_fd, &a) == 0 &&
+            stat(claims[i].lock, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino) {
+            (void)unlink(claims[i].lock);
+        }
+    }
+}
+
 static void on_fatal_signal(int sig)
 {
     size_t i;
+    release_claims_on_signal();
     for (i = 0; i < MAX_OPEN_LINKS; i++) {
         tk_link_t *l = open_links[i];
         if (l != NULL && !l->is_can && l->uart.fd >= 0 && l->uart.restore) {
@@ -297,6 +335,19 @@ static void on_fatal_signal(int sig)
     }
     (void)signal(sig, SIG_DFL);
     (void)raise(sig);
+}
+
+void tk_std_fds_open(void)
+{
+    int fd;
+    for (fd = 0; fd <= 2; fd++) {
+        if (fcntl(fd, F_GETFD) == -1 && errno == EBADF) {
+            /* the lowest free descriptor: this one */
+            if (open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY) != fd) {
+                _exit(TK_EXIT_FAIL); /* nothing to say it on */
+            }
+        }
+    }
 }
 
 void tk_catch_signals(void)
@@ -546,16 +597,6 @@ int tk_canonical_path(const char *path, char *out, size_t cap)
     return 0;
 }
 
-/* The links this process made (tk_pty_open()), removed at its exit: the
- * link first (if still ours), then its lock file. */
-#define MAX_CLAIMS 2
-static struct {
-    const char *link;
-    int lock_fd;
-    char slave[64]; /* "" until the link exists */
-} claims[MAX_CLAIMS];
-static size_t nclaims;
-
 static void release_claims(void)
 {
     size_t i;
@@ -571,7 +612,7 @@ static void release_claims(void)
 /* Claim `link` for this process (tk_simlink_claim()); dies when it cannot. */
 static size_t claim_link(const char *link)
 {
-    char why[PATH_MAX + 256];
+    char why[3 * PATH_MAX + 256];
     int fd;
     if (nclaims == MAX_CLAIMS) {
         tk_die("internal error: more than %d links", MAX_CLAIMS);
@@ -587,6 +628,9 @@ static size_t claim_link(const char *link)
     claims[nclaims].link = link;
     claims[nclaims].lock_fd = fd;
     claims[nclaims].slave[0] = '\0';
+    if (tk_simlink_lock_path(link, claims[nclaims].lock, sizeof(claims[nclaims].lock)) != 0) {
+        claims[nclaims].lock[0] = '\0';
+    }
     return nclaims++;
 }
 

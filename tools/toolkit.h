@@ -126,6 +126,11 @@ extern volatile sig_atomic_t tk_signal;
 /* Catch those three (without SA_RESTART, so blocking calls return) and
  * ignore SIGPIPE (a closed reader is then a write error). */
 void tk_catch_signals(void);
+/* Open /dev/null on whichever of descriptors 0, 1 and 2 is closed (first
+ * thing in main): a program started with its standard output closed wrote
+ * its log into the first file it opened (tase-sim: the lock file of its
+ * link, which then named no simulator). */
+void tk_std_fds_open(void);
 /* If a signal was caught: run the cleanup the caller did (nothing here)
  * and exit 128 + signal with "interrupted by SIGxxx". */
 void tk_exit_if_signalled(void);
@@ -206,6 +211,8 @@ bool tk_pty_clear_stale_excl(int slave_fd);
  * then belong to another program, which the tools must never write to. */
 
 #define TK_SIMLINK_LOCK_SUFFIX ".lock"
+/* The pty of a record written while the simulator starts (no pty yet). */
+#define TK_SIMLINK_STARTING "-"
 
 /* The lock file of `link` (LINK.lock). Returns 0, or -1 (ENAMETOOLONG). */
 int tk_simlink_lock_path(const char *link, char *out, size_t cap);

@@ -513,6 +513,72 @@ check "a killed simulator's stale link ($old) is replaced by the next one ($(hea
 kill $kpid
 wait $kpid
 
+# A review of the lock files (each failed before):
+# a simulator started with its standard output closed wrote its log into
+# its lock file (the first file it opened), which then named no simulator:
+# its stale link led the tools to whatever program got its pty
+"$SIM" --link "$dir/closed" --seconds 30 >&- 2>/dev/null &
+kpid=$!
+for _ in $(seq 100); do [ -L "$dir/closed" ] && break; sleep 0.05; done
+rec=$(cat "$dir/closed.lock")
+kill -KILL $kpid
+wait $kpid 2>/dev/null
+check "tase-sim with standard output closed: its lock file holds its record ($rec)" \
+    eval '[ "$rec" = "tase-sim $kpid $(readlink "$dir/closed")" ]'
+expect_error "... and its stale link is refused" 1 "closed is the link of a tase-sim that is no longer running" \
+    "$TASE" point 10 5 --serial "$dir/closed"
+rm -f "$dir/closed" "$dir/closed.lock"
+# a umask of 077 made the lock file unreadable to other users' tools,
+# which then took a stale link for a user's own
+(umask 077; exec "$SIM" --quiet --link "$dir/um" --seconds 30 >/dev/null 2>&1) &
+kpid=$!
+for _ in $(seq 100); do [ -L "$dir/um" ] && break; sleep 0.05; done
+mode=$(stat -c %a "$dir/um.lock")
+kill $kpid
+wait $kpid
+check "tase-sim under umask 077: its lock file is readable by every user ($mode)" test "$mode" = 644
+# a user's own (empty) file named LINK.lock was taken, then deleted
+: >"$dir/mine.lock"
+expect_error "tase-sim beside a user's empty LINK.lock: refused" 1 \
+    "mine.lock exists and is not a lock file of tase-sim; not using" \
+    "$SIM" --link "$dir/mine" --seconds 0.3
+check "... the user's file kept" test -f "$dir/mine.lock"
+rm -f "$dir/mine.lock"
+# sim_killed SIGNAL LINK: a simulator on LINK ended by SIGNAL once its link
+# exists (its pid in kpid)
+sim_killed() {
+    "$SIM" --quiet --link "$2" --seconds 30 >/dev/null 2>&1 &
+    kpid=$!
+    for _ in $(seq 100); do [ -L "$2" ] && break; sleep 0.05; done
+    kill -"$1" $kpid
+    wait $kpid 2>/dev/null
+}
+# a fatal signal (SIGUSR1) left the link and its lock file behind
+sim_killed USR1 "$dir/usr1"
+check "tase-sim ended by SIGUSR1: its link and lock file removed" \
+    eval '[ ! -e "$dir/usr1" ] && [ ! -L "$dir/usr1" ] && [ ! -e "$dir/usr1.lock" ]'
+# the refusal names three paths: cut at 448 bytes before (a 100-byte link)
+long="$dir/bench-campaign-2026-11-27/hardware-in-the-loop/gimbal-links/run-0001"
+mkdir -p "$long"
+sim_killed KILL "$long/tase-gimbal-datalink"
+"$TASE" point 1 1 --serial "$long/tase-gimbal-datalink" 2>"$dir/long.err"
+check "the stale-link refusal of a long path is whole ($(wc -c <"$dir/long.err") bytes)" \
+    grep -q "or remove $long/tase-gimbal-datalink and $long/tase-gimbal-datalink.lock)$" "$dir/long.err"
+rm -rf "$dir/bench-campaign-2026-11-27"
+# a simulator in another pid namespace records its pid there (1): its live
+# link was refused as taken over ("pid 1 ... another (pid N)"), also on a retry
+if unshare -p -f --mount-proc true 2>/dev/null; then
+    unshare -p -f --mount-proc "$SIM" --quiet --link "$dir/ns" --seconds 30 >/dev/null 2>&1 &
+    kpid=$!
+    for _ in $(seq 200); do [ -L "$dir/ns" ] && break; sleep 0.05; done
+    "$TASE" query SYSTEM_VERSION --serial "$dir/ns" >/dev/null 2>"$dir/ns.err"
+    rc=$?
+    kill $kpid
+    wait $kpid
+    check "a simulator in another pid namespace: its live link works (exit $rc, $(head -c 120 "$dir/ns.err"))" \
+        test $rc = 0
+fi
+
 # ---- the device goes away (the simulator exits): said so, never a bare I/O error ----
 # hang_up [--frozen] TASE-ARGS...: tase ARGS on a simulator of its own,
 # which exits while tase runs (--frozen: it never answers, stopped from the

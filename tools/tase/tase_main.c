@@ -276,6 +276,7 @@ int main(int argc, char **argv)
 {
     const command_t *c;
     cli_args_t a;
+    tk_std_fds_open(); /* before anything opens a file */
     tk_prog = "tase";
     tk_catch_signals();
     if (argc < 2) {
