@@ -537,6 +537,24 @@ mode=$(stat -c %a "$dir/um.lock")
 kill $kpid
 wait $kpid
 check "tase-sim under umask 077: its lock file is readable by every user ($mode)" test "$mode" = 644
+# another user's lock file this user may not read (0600): whether its
+# simulator runs cannot be told, so the link is not opened (it was taken
+# for a user's own symlink). As nobody, where the tools run as root (not
+# under memcheck: its wrapper lives in the private test directory).
+if [ "$(id -u)" = 0 ] && [ -z "${TASE_UNDER_VALGRIND:-}" ] && command -v setpriv >/dev/null &&
+    setpriv --reuid=65534 --regid=65534 --clear-groups "$TASE" --version >/dev/null 2>&1; then
+    pub=$(mktemp -d)
+    chmod 755 "$pub"
+    printf 'tase-sim 999999 /dev/null\n' >"$pub/priv.lock"
+    chmod 600 "$pub/priv.lock"
+    ln -s /dev/null "$pub/priv"
+    setpriv --reuid=65534 --regid=65534 --clear-groups "$TASE" point 1 1 --serial "$pub/priv" \
+        >/dev/null 2>"$dir/priv.err"
+    rc=$?
+    check "a lock file the user may not read: refused (exit $rc, $(head -c 160 "$dir/priv.err"))" \
+        eval '[ $rc = 1 ] && grep -q "priv: cannot read .*priv.lock (Permission denied), so whether the tase-sim of this link still runs cannot be told; not opened, nothing sent" "$dir/priv.err"'
+    rm -rf "$pub"
+fi
 # a user's own (empty) file named LINK.lock was taken, then deleted
 : >"$dir/mine.lock"
 expect_error "tase-sim beside a user's empty LINK.lock: refused" 1 \
