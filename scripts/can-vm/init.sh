@@ -263,7 +263,11 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
         eval 't=$(json_int "$(head -1 /tmp/mon.json)" time); now=$(date +%s); near "$t" "$now" 5'
 
     # The monitor runs while the position command goes out on the bus.
-    $T monitor $L --json --seconds 3.5 > /tmp/move.json &
+    # (--margin 250 here and in the decodes of this session: the VM runs
+    # under TCG beside the other checks, and a sender starved for 20 ms
+    # between the CAN frames of one packet had the 40-byte CAMERA_PASS
+    # echo cut as a pause, once in CI; the time bound is tested elsewhere)
+    $T monitor $L --json --seconds 3.5 --margin 250 > /tmp/move.json &
     mon=$!
     usleep 400000
     s=$($T point 30 -15 $L | head -1)
@@ -302,7 +306,7 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
         grep -q ' vcan0 11000000#00FF5A02480301A6$' /tmp/tools.log
     check "candump saw the SYSTEM_VERSION answer start 10000000#00FF5A2C4803" \
         grep -q ' vcan0 10000000#00FF5A2C4803' /tmp/tools.log
-    $T decode --candump /tmp/tools.log > /tmp/dec.json 2> /tmp/t.err
+    $T decode --candump --margin 250 /tmp/tools.log > /tmp/dec.json 2> /tmp/t.err
     rc=$?
     echo "   candump: $(wc -l < /tmp/tools.log) frames; decoded: $(wc -l < /tmp/dec.json) packets," \
         "$(grep -c '"dir":"in"' /tmp/dec.json) in, $(grep -c '"dir":"out"' /tmp/dec.json) out"
@@ -332,7 +336,7 @@ if [ -x /bin/tase ] && [ -x /bin/tase-sim ]; then
     # The capture of tase record --can: the same packets as candump's log,
     # the same kernel receive times (to the microsecond candump keeps).
     check "tase record --can: $(tail -1 /tmp/rec.out)" grep -q '^recorded [1-9][0-9]* records' /tmp/rec.out
-    $T decode /tmp/tools.pcap > /tmp/pcap.json
+    $T decode --margin 250 /tmp/tools.pcap > /tmp/pcap.json
     sed 's/"interface":"[^"]*",//' /tmp/dec.json > /tmp/dec.cmp
     check "tase decode of the record --can capture: the candump log's $(wc -l < /tmp/dec.cmp) packets, times to the microsecond" \
         cmp -s /tmp/pcap.json /tmp/dec.cmp

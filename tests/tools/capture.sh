@@ -668,6 +668,27 @@ done
 check "record --tap-in: both lines decoded, each direction exactly the generator's packets" \
     eval 'same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.out" && same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.in"'
 
+# monitor --margin MS (as decode's): a sender that pauses inside a packet
+# (40 ms here) is waited for; without it each such frame is cut
+"$TASE" monitor --serial "$dir/C" --json --seconds 2.5 --margin 100 >"$dir/margin.mon" 2>/dev/null &
+mp=$!
+sleep 0.5
+"${TASE_PYTHON:-python3}" - "$dir/D" <<'PY'
+import os, sys, time
+import tase
+fd = os.open(sys.argv[1], os.O_RDWR | os.O_NOCTTY)
+for i in range(10):
+    f = tase.encode(tase.Packet("GIMBAL_ANGLE", raw={"pan": i, "tilt": 0, "roll": 0}))
+    os.write(fd, f[:6])
+    time.sleep(0.04)
+    os.write(fd, f[6:])
+    time.sleep(0.06)
+os.close(fd)
+PY
+wait $mp
+check "monitor --margin 100: frames paused 40 ms inside are delivered ($(grep -c GIMBAL_ANGLE "$dir/margin.mon") of 10)" \
+    test "$(grep -c GIMBAL_ANGLE "$dir/margin.mon")" = 10
+
 # Records appended to the capture after replay's check pass (another
 # program still writing it) were sent too ("replayed 151 of 90 records"),
 # and a record cut short there failed after the others had gone out. The

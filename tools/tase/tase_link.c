@@ -224,6 +224,7 @@ int cli_cmd_monitor(cli_args_t *a)
     tk_fmt_t fmt = {false, false, false};
     double seconds = 0.0, t_end;
     long long limit = 0;
+    uint16_t margin = 0; /* the receiver's default */
     const char *v;
     tk_link_t link;
     tase_port_t port;
@@ -244,6 +245,8 @@ int cli_cmd_monitor(cli_args_t *a)
             fmt.units = true;
         } else if (cli_opt(a, "--count", true, &v)) {
             limit = cli_int_opt_value("--count", v, 1, 1000000000);
+        } else if (cli_opt(a, "--margin", true, &v)) {
+            margin = (uint16_t)cli_int_opt_value("--margin", v, 1, 65535);
         } else if (cli_opt(a, "--seconds", true, &v)) {
             if (tk_parse_seconds(v, &seconds) != 0 || seconds <= 0.0) {
                 tk_usage_error("bad --seconds value '%s'", v);
@@ -256,6 +259,7 @@ int cli_cmd_monitor(cli_args_t *a)
     tk_dec_init(&d, &fmt, stdout);
     d.limit = (uint64_t)limit;
     d.serial_rate = port.bytes_per_s;
+    d.margin_ms = margin;
     st = tk_dec_stream(&d, "", NULL);
     t_end = tk_now_s() + seconds;
     while ((limit == 0 || d.n.frames < (uint64_t)limit) && (seconds == 0.0 || tk_now_s() < t_end) &&

@@ -76,6 +76,7 @@ static const char usage_spoi[] =
 
 static const char usage_monitor[] =
     "usage: tase monitor LINK [--json] [--time] [--units] [--count N] [--seconds S]\n"
+    "                    [--margin MS]\n"
     "Prints every packet received, one per line: readable text by default, one JSON\n"
     "object per line with --json. --time adds the host time of arrival (text:\n"
     "HH:MM:SS.mmm, JSON: \"time\" in Unix seconds); --units adds engineering units\n"
@@ -86,7 +87,10 @@ static const char usage_monitor[] =
     "A device that goes away or hangs up also stops it: the summary, then\n"
     "'cannot read DEV: the device went away or hung up' (exit 1). Bytes received\n"
     "but no frame found: the summary and a one-line hint (exit 4).\n"
-    "On CAN, --time is the kernel's receive time of the frame.\n";
+    "On CAN, --time is the kernel's receive time of the frame. --margin MS: a\n"
+    "candidate frame the line goes quiet on is judged false after at least MS\n"
+    "(1..65535; default 20) as in 'tase decode', for a sender that pauses inside a\n"
+    "packet (CAN frames sent one at a time, a loaded virtual machine).\n";
 
 static const char usage_send[] =
     "usage: tase send NAME [field=value ...] LINK [--len N] [--zero] [--raw]\n"
