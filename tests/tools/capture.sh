@@ -567,8 +567,12 @@ os.close(fd)
 PY
 wait $mp
 "$TASE" decode "$dir/pause.pcap" 2>/dev/null | sed 's/"time":[0-9.]*,"dir":"out",//' >"$dir/pause.dec"
-check "monitor --record and decode of its capture: the same frames for pauses at the quiet limit ($(grep -c . "$dir/pause.mon") printed, $(grep -c . "$dir/pause.dec") decoded)" \
-    eval '[ "$($U records "$dir/pause.pcap" | grep -c .)" -ge 30 ] && same_lines "$dir/pause.mon" "$dir/pause.dec"'
+# (a timing property: under memcheck the monitor is itself held up, its
+# reads find the bytes waiting, and the check is skipped; the run stays)
+if [ -z "${TASE_UNDER_VALGRIND:-}" ]; then
+    check "monitor --record and decode of its capture: the same frames for pauses at the quiet limit ($(grep -c . "$dir/pause.mon") printed, $(grep -c . "$dir/pause.dec") decoded)" \
+        eval '[ "$($U records "$dir/pause.pcap" | grep -c .)" -ge 30 ] && same_lines "$dir/pause.mon" "$dir/pause.dec"'
+fi
 
 # replay_to NAME REPLAY-ARGS...: record B (and D) while replaying; the
 # recorder is stopped (SIGINT) 0.2 s after the replay ends.
@@ -686,8 +690,10 @@ for i in range(10):
 os.close(fd)
 PY
 wait $mp
-check "monitor --margin 100: frames paused 40 ms inside are delivered ($(grep -c GIMBAL_ANGLE "$dir/margin.mon") of 10)" \
-    test "$(grep -c GIMBAL_ANGLE "$dir/margin.mon")" = 10
+if [ -z "${TASE_UNDER_VALGRIND:-}" ]; then # (timing, as above)
+    check "monitor --margin 100: frames paused 40 ms inside are delivered ($(grep -c GIMBAL_ANGLE "$dir/margin.mon") of 10)" \
+        test "$(grep -c GIMBAL_ANGLE "$dir/margin.mon")" = 10
+fi
 
 # Records appended to the capture after replay's check pass (another
 # program still writing it) were sent too ("replayed 151 of 90 records"),
