@@ -139,6 +139,34 @@ static void lock_capture(int fd, const char *path)
     }
 }
 
+/* The header of a capture `--record` is to append `linktype` records to,
+ * read into *c; a file of another kind, link type or a snapshot length
+ * too small for our records is refused (fd closed, exit 1) with what is
+ * wrong. Used before the lock and again under it for a header another
+ * program may have written meanwhile. */
+static void append_head_check(int fd, const char *path, int linktype, cap_head_t *c)
+{
+    uint8_t h[24];
+    if (pread(fd, h, sizeof(h), 0) != (ssize_t)sizeof(h) || !cap_head_parse(h, c)) {
+        (void)close(fd);
+        tk_die("cannot write capture %s: not a classic pcap file (--record appends only to "
+               "one; give a new file name)",
+               path);
+    }
+    if (c->linktype != (uint32_t)linktype) {
+        (void)close(fd);
+        tk_die("cannot write capture %s: its link type is %lu, not TASE serial (%d): give a "
+               "new file name",
+               path, (unsigned long)c->linktype, linktype);
+    }
+    if (cap_limit(c) < 1u + READ_CHUNK) {
+        (void)close(fd);
+        tk_die("cannot write capture %s: its snapshot length (%lu bytes) is below the %u "
+               "bytes a record of ours may take: give a new file name",
+               path, (unsigned long)c->snaplen, 1u + READ_CHUNK);
+    }
+}
+
 /* Open `path` for appending records of `linktype` (a new file gets a
  * nanosecond header): checked and, when a crash or a full disk cut it
  * inside its last record, cut back to its last whole record (every new
@@ -167,24 +195,7 @@ static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
                path);
     }
     if (st.st_size > 0) {
-        if (pread(fd, h, sizeof(h), 0) != (ssize_t)sizeof(h) || !cap_head_parse(h, &c)) {
-            (void)close(fd);
-            tk_die("cannot write capture %s: not a classic pcap file (--record appends only to "
-                   "one; give a new file name)",
-                   path);
-        }
-        if (c.linktype != (uint32_t)linktype) {
-            (void)close(fd);
-            tk_die("cannot write capture %s: its link type is %lu, not TASE serial (%d): give a "
-                   "new file name",
-                   path, (unsigned long)c.linktype, linktype);
-        }
-        if (cap_limit(&c) < 1u + READ_CHUNK) {
-            (void)close(fd);
-            tk_die("cannot write capture %s: its snapshot length (%lu bytes) is below the %u "
-                   "bytes a record of ours may take: give a new file name",
-                   path, (unsigned long)c.snaplen, 1u + READ_CHUNK);
-        }
+        append_head_check(fd, path, linktype, &c);
         at = whole_records_len(fd, 24, (long)st.st_size, &c, &index);
         if (at < 0) { /* looked at again under the lock: a write under way? */
             at = 24;
@@ -214,13 +225,10 @@ static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
         at = -2; /* nothing to scan */
     }
     if (e == 0 && at != -2) {
-        if (at == 24 && index == 0 &&
-            (pread(fd, h, sizeof(h), 0) != (ssize_t)sizeof(h) || !cap_head_parse(h, &c) ||
-             c.linktype != (uint32_t)linktype || cap_limit(&c) < 1u + READ_CHUNK)) {
-            (void)close(fd); /* made by another program meanwhile, not ours to add to */
-            tk_die("cannot write capture %s: not a classic pcap file of TASE serial records "
-                   "(--record appends only to one; give a new file name)",
-                   path);
+        if (at == 24 && index == 0) {
+            /* empty at open, or no record looked at: the header may be
+             * another program's, written meanwhile */
+            append_head_check(fd, path, linktype, &c);
         }
         keep = whole_records_len(fd, at, (long)st.st_size, &c, &index);
         if (keep < 0) {
@@ -505,32 +513,23 @@ void tk_cap_close(tk_cap_writer_t *w)
     }
 }
 
-/* Record what the tapped link moved. A capture that cannot be written
- * (a full disk) stops recording but not the command: the packet it sends
- * still goes out and is reported, and the failure is reported at exit
- * (close_session_capture()) with the status that says whether a packet
- * was sent. */
-/* The record time of port time `ms` (tk_cap_tap_t). */
-/* The record time of port time `ms` (tk_cap_tap_t). With `stamping` (a
- * new record), a mapping more than TAP_DRIFT_MS away from the wall clock
- * starts again from it: the port's clock stood still while the computer
- * slept (CLOCK_MONOTONIC), the wall clock was stepped, or no record came
- * for 2^31 ms. Across such a restart `tase decode` measures the wall
- * clock's gap, the live receiver the port's. */
+/* The record time of port time `ms` (tk_cap_tap_t): the wall clock's at
+ * the tap's base plus the port clock's time since. A mapping more than
+ * TAP_DRIFT_MS away from the wall clock starts again from it: the port's
+ * clock stood still while the computer slept (CLOCK_MONOTONIC), the wall
+ * clock was stepped, or no record came for 2^31 ms. Across such a
+ * restart `tase decode` measures the wall clock's gap, the live receiver
+ * the port's. */
 #define TAP_DRIFT_MS 1000
-static struct timespec tap_time(tk_cap_tap_t *tap, uint32_t ms, bool stamping)
+static struct timespec tap_time(tk_cap_tap_t *tap, uint32_t ms)
 {
     struct timespec t;
-    int64_t ns, wall = 0;
-    if (stamping || !tap->based) {
-        clock_gettime(CLOCK_REALTIME, &t);
-        wall = ((int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000) * 1000000; /* whole ms */
-    }
-    /* a port time before the base (a call that read its clock first)
-     * counts back from it */
+    int64_t ns, wall;
+    clock_gettime(CLOCK_REALTIME, &t);
+    wall = ((int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000) * 1000000; /* whole ms */
     ns = tap->base_ns + (int64_t)(int32_t)(ms - tap->base_ms) * 1000000;
-    if (!tap->based || (stamping && (ns - wall > (int64_t)TAP_DRIFT_MS * 1000000 ||
-                                     wall - ns > (int64_t)TAP_DRIFT_MS * 1000000))) {
+    if (!tap->based || ns - wall > (int64_t)TAP_DRIFT_MS * 1000000 ||
+        wall - ns > (int64_t)TAP_DRIFT_MS * 1000000) {
         tap->base_ns = wall;
         tap->base_ms = ms;
         tap->based = true;
@@ -547,18 +546,24 @@ static struct timespec tap_time(tk_cap_tap_t *tap, uint32_t ms, bool stamping)
     return t;
 }
 
+/* Record what the tapped link moved. A capture that cannot be written
+ * (a full disk) stops recording but not the command: the packet it sends
+ * still goes out and is reported, and the failure is reported at exit
+ * (close_session_capture()) with the status that says whether a packet
+ * was sent. The time of the last read is kept for
+ * tk_cap_session_last_read() either way. */
 static void tap_record(tk_cap_tap_t *tap, unsigned dir, const uint8_t *data, size_t n)
 {
-    struct timespec t;
     uint32_t ms = tap->inner.ops->now_ms(tap->inner.ctx);
+    struct timespec t = tap_time(tap, ms);
     if (dir == TK_CAP_FROM_GIMBAL) {
         tap->last_read_ms = ms;
+        tap->last_read_t = t;
         tap->read_recorded = true;
     }
     if (tap->w->err != 0) {
         return;
     }
-    t = tap_time(tap, ms, true);
     tk_cap_put_serial(tap->w, &t, dir, data, n);
     (void)tk_cap_flush(tap->w); /* a failure stays in w->err */
 }
@@ -648,7 +653,7 @@ bool tk_cap_session_last_read(uint32_t *ms, struct timespec *t)
         return false;
     }
     *ms = session_tap.last_read_ms;
-    *t = tap_time(&session_tap, session_tap.last_read_ms, false);
+    *t = session_tap.last_read_t;
     return true;
 }
 

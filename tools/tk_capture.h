@@ -129,8 +129,9 @@ typedef struct {
     bool based;      /* base_ns and base_ms set */
     int64_t base_ns; /* wall-clock ns (a whole ms) at port time base_ms */
     uint32_t base_ms;
-    uint32_t last_read_ms;
-    bool read_recorded; /* last_read_ms is set */
+    uint32_t last_read_ms;       /* the port time of the last read recorded */
+    struct timespec last_read_t; /* and its record time */
+    bool read_recorded;          /* last_read_ms and last_read_t are set */
 } tk_cap_tap_t;
 tase_port_t tk_cap_tap_port(tk_cap_tap_t *tap, tase_port_t inner, tk_cap_writer_t *w);
 /* --record FILE: append this process's serial session to FILE (a tap port

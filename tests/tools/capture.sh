@@ -552,19 +552,7 @@ $U serial-pcap "$dir/slow.pcap" 3 40-120 "$DATA/decode_noisy.bin:out" "$DATA/dec
 "$TASE" monitor --serial "$dir/C" --record "$dir/pause.pcap" --json --seconds 4 >"$dir/pause.mon" 2>/dev/null &
 mp=$!
 sleep 0.5
-"${TASE_PYTHON:-python3}" - "$dir/D" <<'PY'
-import os, random, sys, time
-import tase
-fd = os.open(sys.argv[1], os.O_RDWR | os.O_NOCTTY)
-random.seed(7)
-for i in range(30):  # each frame paused 20..21 ms after its sixth byte
-    f = tase.encode(tase.Packet("GIMBAL_ANGLE", raw={"pan": i, "tilt": 0, "roll": 0}))
-    os.write(fd, f[:6])
-    time.sleep(0.020 + random.random() * 0.001)
-    os.write(fd, f[6:])
-    time.sleep(0.08)
-os.close(fd)
-PY
+$U paced-angles "$dir/D" 30 20 1 80 # each frame paused 20..21 ms after its sixth byte
 wait $mp
 "$TASE" decode "$dir/pause.pcap" 2>/dev/null | sed 's/"time":[0-9.]*,"dir":"out",//' >"$dir/pause.dec"
 # (a timing property: under memcheck the monitor is itself held up, its
@@ -677,18 +665,7 @@ check "record --tap-in: both lines decoded, each direction exactly the generator
 "$TASE" monitor --serial "$dir/C" --json --seconds 2.5 --margin 100 >"$dir/margin.mon" 2>/dev/null &
 mp=$!
 sleep 0.5
-"${TASE_PYTHON:-python3}" - "$dir/D" <<'PY'
-import os, sys, time
-import tase
-fd = os.open(sys.argv[1], os.O_RDWR | os.O_NOCTTY)
-for i in range(10):
-    f = tase.encode(tase.Packet("GIMBAL_ANGLE", raw={"pan": i, "tilt": 0, "roll": 0}))
-    os.write(fd, f[:6])
-    time.sleep(0.04)
-    os.write(fd, f[6:])
-    time.sleep(0.06)
-os.close(fd)
-PY
+$U paced-angles "$dir/D" 10 40 0 60
 wait $mp
 if [ -z "${TASE_UNDER_VALGRIND:-}" ]; then # (timing, as above)
     check "monitor --margin 100: frames paused 40 ms inside are delivered ($(grep -c GIMBAL_ANGLE "$dir/margin.mon") of 10)" \

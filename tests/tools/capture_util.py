@@ -54,6 +54,10 @@ checked against a writer other than its own.
         "NAME position speed" line each ("error" for a wrong length).
   records PCAP                     one line per record: time, then (serial)
         the direction byte and the bytes in hex, or (CAN) id#data.
+  paced-angles TTY N PAUSE JITTER GAP  N GIMBAL_ANGLE frames (pan 0..N-1)
+        written to TTY, each paused PAUSE..PAUSE+JITTER ms after its sixth
+        byte (random, seed 7) and GAP ms after its last (a sender that
+        pauses inside a packet, at or past the quiet limit).
   timing PCAP_SENT PCAP_GOT DIR SPEED TOL  the bytes of direction DIR in
         PCAP_SENT arrived in PCAP_GOT (direction out) byte for byte, each
         within TOL seconds of its recorded time divided by SPEED.
@@ -65,6 +69,7 @@ import select
 import struct
 import sys
 import termios
+import time
 import tty
 import xml.etree.ElementTree as ET
 from decimal import ROUND_DOWN, Decimal
@@ -639,6 +644,18 @@ def records(pcap):
             print(t, "%08X#%s" % (can_id, r[8:8 + n].hex().upper()))
 
 
+def paced_angles(tty, n, pause, jitter, gap):
+    fd = os.open(tty, os.O_RDWR | os.O_NOCTTY)
+    rng = random.Random(7)
+    for i in range(int(n)):
+        _, f = gimbal_angle(i, 0)
+        os.write(fd, f[:6])
+        time.sleep((float(pause) + rng.random() * float(jitter)) / 1000)
+        os.write(fd, f[6:])
+        time.sleep(float(gap) / 1000)
+    os.close(fd)
+
+
 def timing(sent, got, d, speed, tol):
     want = DIRS[d]
     sbytes = [(t, b) for t, _, r in read_pcap(sent) if r[0] == want for b in r[1:]]
@@ -659,7 +676,8 @@ def main(argv):
     """Run the command argv[1]: the function of that name (- for _)."""
     commands = {f.__name__.replace("_", "-"): f for f in (
         serial_pcap, expect_serial, can_pcap, replay_checks, times, quiet, bad_pcap, pty_pair,
-        compare_pdml, greedy, expect_decode, expect_pdml, pdml_3ax, records, timing)}
+        compare_pdml, greedy, expect_decode, expect_pdml, pdml_3ax, records, paced_angles,
+        timing)}
     if len(argv) < 2 or argv[1] not in commands:
         raise SystemExit("usage: capture_util.py COMMAND ARGS... (commands: %s)"
                          % ", ".join(commands))
