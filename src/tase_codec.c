@@ -11,6 +11,8 @@
  */
 #include "tase/codec.h"
 
+#include <stddef.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "tase_codec_private.h"
@@ -306,6 +308,41 @@ int tase_packet_decode(const tase_frame_t *f, void *msg)
         return TASE_EARG;
     }
     return decode_find(f->group, f->type, f->data, f->len, msg);
+}
+
+int tase_packet_init_keep(uint16_t id, void *msg)
+{
+    tase_field_iter_t it;
+    const tase_packet_desc_t *p;
+    size_t temp = SIZE_MAX; /* the member of a `temporary` byte */
+    int none = 0;
+    if (msg == NULL) {
+        return TASE_EARG;
+    }
+    p = tase_field_iter_find(&it, TASE_ID_GROUP(id), TASE_ID_TYPE(id), TASE_FIELD_ITER_TABLE_LEN);
+    if (p == NULL) {
+        return TASE_EUNKNOWN;
+    }
+    if (id == TASE_ID_PACKET_RATE) {
+        temp = offsetof(tase_packet_rate_t, temporary);
+    } else if (id == TASE_ID_AXIS_SETTING) {
+        temp = offsetof(tase_axis_setting_t, temporary);
+    } else {
+        /* no other packet has one */
+    }
+    (void)memset(msg, 0, p->size);
+    while (tase_field_iter_next(&it)) {
+        uint8_t *m = (uint8_t *)msg + it.field->member;
+        uint32_t keep;
+        if (it.field->member == temp) {
+            *m = TASE_SETUP_TEMPORARY;
+        } else if (tase_field_iter_keep_bits(&it, &keep)) {
+            member_store(m, it.width, keep);
+        } else {
+            none++;
+        }
+    }
+    return none;
 }
 
 int tase_command_check(uint16_t id, const void *msg)

@@ -709,6 +709,78 @@ static void command_check_takes_what_the_spec_defines_and_nothing_else(void **st
     assert_int_equal(tase_command_check(TASE_ID_PACKET_RATE, &sp), TASE_OK);
 }
 
+/* tase_packet_init_keep(): the spec's "do not change" values (4.4.3:
+ * 0xFF / 0xFFFF for AXIS_SETTING) and temporary 1, checked on the wire
+ * bytes written by hand; the count of fields without such a value; for
+ * every packet, against tase_field_get() and tase_field_is_keep(). */
+static void init_keep_fills_a_packet_that_changes_nothing(void **state)
+{
+    tase_packet_msg_t m;
+    uint8_t data[TASE_DATA_MAX];
+    uint8_t want_axis[23];
+    static const uint8_t want_rate[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1};
+    size_t i;
+    (void)state;
+    memset(want_axis, 0xFF, sizeof want_axis);
+    want_axis[13] = 0x00; /* reserved */
+    want_axis[22] = 0x01; /* temporary: not stored */
+    memset(&m, 0x5A, sizeof m);
+    assert_int_equal(tase_packet_init_keep(TASE_ID_AXIS_SETTING, &m.axis_setting), 0);
+    assert_int_equal(
+        tase_packet_encode_data(TASE_ID_AXIS_SETTING, &m.axis_setting, data, sizeof data), 23);
+    assert_memory_equal(data, want_axis, 23);
+    /* PACKET_RATE: twelve rates with no such value (left 0), temporary 1 */
+    memset(&m, 0x5A, sizeof m);
+    assert_int_equal(tase_packet_init_keep(TASE_ID_PACKET_RATE, &m.packet_rate), 12);
+    assert_int_equal(
+        tase_packet_encode_data(TASE_ID_PACKET_RATE, &m.packet_rate, data, sizeof data), 16);
+    assert_memory_equal(data, want_rate, 16);
+    /* CAMERA_CMD: camera 0xFF, hfov -1, focus 0xFFFF, flags 0x80 ... */
+    memset(&m, 0x5A, sizeof m);
+    assert_true(tase_packet_init_keep(TASE_ID_CAMERA_CMD, &m.camera_cmd) >= 0);
+    assert_int_equal(m.camera_cmd.camera, 0xFF);
+    assert_int_equal(m.camera_cmd.hfov, -1);
+    assert_int_equal(m.camera_cmd.focus, 0xFFFF);
+    assert_int_equal(m.camera_cmd.flags & 0x80, 0x80);
+    /* GIMBAL_CMD has none: all five fields zero */
+    memset(&m, 0x5A, sizeof m);
+    assert_int_equal(tase_packet_init_keep(TASE_ID_GIMBAL_CMD, &m.gimbal_cmd), 5);
+    assert_int_equal(m.gimbal_cmd.pan, 0);
+    assert_int_equal(m.gimbal_cmd.flags, 0);
+    assert_int_equal(m.gimbal_cmd.impulse_time, 0);
+    /* errors write nothing */
+    memset(&m, 0x5A, sizeof m);
+    assert_int_equal(tase_packet_init_keep(TASE_ID(0x7F, 0x7F), &m), TASE_EUNKNOWN);
+    assert_int_equal(((const uint8_t *)&m)[0], 0x5A);
+    assert_int_equal(tase_packet_init_keep(TASE_ID_AXIS_SETTING, NULL), TASE_EARG);
+    /* every packet: each field is its keep value, or 0 and counted */
+    for (i = 0; tase_schema_at(i) != NULL; i++) {
+        const tase_packet_desc_t *p = tase_schema_at(i);
+        int none = 0;
+        int n;
+        size_t k;
+        memset(&m, 0x5A, sizeof m);
+        n = tase_packet_init_keep(p->id, &m);
+        assert_true(n >= 0);
+        assert_int_equal(tase_packet_encode_data_len(p->id, &m, p->len, data, sizeof data),
+                         (int)p->len);
+        for (k = 0; k < p->nfields; k++) {
+            int64_t v;
+            int64_t keep;
+            assert_int_equal(tase_field_get(p, k, data, p->len, &v), TASE_OK);
+            if (tase_field_keep(p, k, &keep) == TASE_OK) {
+                assert_true(tase_field_is_keep(p, k, v));
+            } else if (v == 1 && (p->id == TASE_ID_PACKET_RATE || p->id == TASE_ID_AXIS_SETTING)) {
+                /* temporary */
+            } else {
+                assert_true(v == 0);
+                none++;
+            }
+        }
+        assert_int_equal(n, none);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -728,6 +800,7 @@ int main(void)
         cmocka_unit_test(data_only_codec_matches_the_frame_codec_for_every_packet),
         cmocka_unit_test(data_only_codec_rejects_bad_arguments),
         cmocka_unit_test(command_check_takes_what_the_spec_defines_and_nothing_else),
+        cmocka_unit_test(init_keep_fills_a_packet_that_changes_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -94,6 +94,8 @@ static bool prep_cmd(const tase_packet_desc_t *p)
 MEASURED(c_command_check, tase_command_check(cur_pkt->id, &full_msg))
 MEASURED(c_command_check_data, tase_command_check_data(cur_pkt->id, cmd_data, cmd_len))
 
+MEASURED(c_init_keep, tase_packet_init_keep(cur_pkt->id, &dec))
+
 MEASURED(c_dispatch_init, tase_dispatch_init(&disp, handlers, on_other, NULL, NULL, &stats))
 
 MEASURED(c_frame_encode,
@@ -128,6 +130,7 @@ void timing_codec(void)
     codec_one("tase_command_check", prep_cmd, c_command_check, ", a command that passes");
     codec_one("tase_command_check_data", prep_cmd, c_command_check_data,
               ", a command that passes (decoded first)");
+    codec_one("tase_packet_init_keep", prep_full, c_init_keep, "");
     report("tase_dispatch_init", measure_plain(c_dispatch_init),
            "handler table, default handler and stats given");
     memset(camera_bytes, 0x5A, sizeof(camera_bytes));

@@ -201,7 +201,9 @@ typedef struct {     /* PACKET_RATE 0x48/0x00, 16 bytes */
     uint8_t rate_3;
     uint8_t geo_ref_3;
     uint8_t camera_3;
-    uint8_t temporary; /* 1: do not store in non-volatile memory */
+    uint8_t temporary; /* TASE_SETUP_TEMPORARY (1): not stored; 0 (a zeroed struct,
+                        * and maybe the gimbal's answer) writes the rates to the
+                        * gimbal's non-volatile memory. tase_packet_init_keep() */
 } tase_packet_rate_t;
 
 typedef struct {        /* SENSOR_FILTER 0x48/0x01, 2 bytes */
@@ -225,7 +227,7 @@ typedef struct {             /* AXIS_SETTING 0x48/0x02, 23 bytes */
     uint8_t pan_pos_gain; /* 0.1 (deg/s)/deg */
     uint8_t tilt_pos_gain;
     uint8_t roll_pos_gain;
-    uint8_t temporary;
+    uint8_t temporary; /* as PACKET_RATE's: 0 stores; tase_packet_init_keep() */
 } tase_axis_setting_t;
 
 typedef struct { /* SYSTEM_VERSION 0x48/0x03, 42 bytes */
@@ -397,6 +399,33 @@ int tase_packet_decode_desc(const tase_packet_desc_t *p, const uint8_t *data, si
  * (TASE_ELENGTH when it->accepted is false), and TASE_EARG when it is
  * NULL or bound to no packet. O(length). */
 int tase_packet_decode_iter(tase_field_iter_t *it, const uint8_t *data, void *msg);
+
+/* A packet that changes nothing, to change a setting of: msg, the typed
+ * struct of packet `id` (or a tase_packet_msg_t), zeroed, then every field
+ * that has the spec's "do not change" value set to it (tase_field_keep():
+ * AXIS_SETTING's 0xFF / 0xFFFF, CAMERA_TYPE's 0, CAMERA_CMD's 0xFF, -1,
+ * 0xFFFF and flags 0x80, ...) and a `temporary` byte (PACKET_RATE,
+ * AXIS_SETTING) set to TASE_SETUP_TEMPORARY, so that the gimbal does not
+ * write the settings to its non-volatile memory. Set the fields to change
+ * and send it:
+ *     tase_axis_setting_t ax;
+ *     (void)tase_packet_init_keep(TASE_ID_AXIS_SETTING, &ax);  // returns 0
+ *     ax.pan_max_rate = 12;                                    // 60 deg/s
+ *     r = tase_host_transact_msg(&h, TASE_ID_AXIS_SETTING, &ax, &ax, 500, 2);
+ * A zeroed struct is not such a packet: an AXIS_SETTING of zeros sets
+ * every rate, acceleration and gain to 0 (the axes cannot move), and a
+ * `temporary` of 0 stores whatever is sent.
+ * Returns the number of fields left at 0 because the spec gives them no
+ * "do not change" value: 0 means the packet as filled changes nothing;
+ * otherwise those zeros are sent as values (PACKET_RATE: 12, its rates,
+ * and a rate of 0 stops that stream; SENSOR_FILTER, GPS_LEVER_ARM,
+ * CAMERA_ALIGN, NAV_SOURCE: every field). For such a packet ask for the
+ * gimbal's settings first (a query: tase_host_transact_msg() with msg
+ * NULL), change what you mean to, set `temporary` if it has one (an
+ * answer may carry 0, which would store them) and send that back.
+ * Or TASE_EARG (msg NULL), TASE_EUNKNOWN (id not in the schema; msg is
+ * not written). O(fields), reentrant, no side effects but msg. */
+int tase_packet_init_keep(uint16_t id, void *msg);
 
 /* ---- commands that move the gimbal ------------------------------------ */
 

@@ -100,8 +100,26 @@ expect_fail "$out/pkg-next.log" "compatible" "find_package(tase $((major + 1)).0
 tase_step "2. every header as C (gcc, clang -Weverything) and C++98..C++20 (g++, clang++ -Weverything)"
 gen_all "$TASE_ROOT/include" "$out/hdr"
 for p in "$TASE_ROOT"/port/*/tase/*.h; do echo "#include \"tase/$(basename "$p")\""; done >>"$out/hdr/tase_all.h"
-printf '#include "tase_all.h"\nint main(void) { return 0; }\n' >"$out/hdr/all.c"
-cp "$out/hdr/all.c" "$out/hdr/all.cpp"
+# every header, and the packet id constants used as a user's code uses them (g++
+# -Wuseless-cast failed on user code only: TASE_ID()'s casts of literals)
+{
+    echo '#include "tase_all.h"'
+    echo 'unsigned tase_uses(void);'
+    echo 'unsigned tase_uses(void)'
+    echo '{'
+    echo '    unsigned n = 0u;'
+    sed -n 's/^#define \(TASE_ID_[A-Z0-9_]*[A-Z0-9]\) TASE_ID[_K]*(.*/\1/p' "$TASE_ROOT/include/tase/ids.h" |
+        while read -r id; do
+            echo "    n += $id;"
+            echo "    n += TASE_ID_GROUP($id);"
+            echo "    n += TASE_ID_TYPE($id);"
+        done
+    echo '    return n;'
+    echo '}'
+    echo 'int main(void) { return tase_uses() == 0u; }'
+} >"$out/hdr/all.cpp"
+grep -q "TASE_ID_SPOI_CMD" "$out/hdr/all.cpp" || tase_fail "no packet id constant found in ids.h"
+cp "$out/hdr/all.cpp" "$out/hdr/all.c"
 inc=(-I"$out/hdr" -I"$TASE_ROOT/include")
 for p in "$TASE_ROOT"/port/*/; do inc+=(-I"$p"); done
 gcc -std=c99 -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wshadow -Wbad-function-cast \
