@@ -367,6 +367,8 @@ static void compact(tase_rx_t *rx)
     }
     rx->len = (uint16_t)n;
     rx->scan = 0u;
+    /* the sum cursor moves with its byte (gone if it was decided) */
+    rx->at = (rx->at > s) ? (uint16_t)(rx->at - s) : 0u;
 }
 
 /* The scan has caught up with something to hold at buf[s]: a partial
@@ -452,6 +454,7 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
             len = 0u;
             s = 0u;
             rx->lag = 0u;
+            rx->at = 0u;
             break;
         }
         if (budget < (int32_t)RX_COST_STEP && !holds(p, avail)) {
@@ -485,8 +488,10 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
                 k++;
             }
             if (k == avail && !final) {
-                /* a sync still arriving: to the front */
+                /* a sync still arriving: to the front (hunting from
+                 * here, which keeps no cursor: hunt() may cut len) */
                 rx->scan = (uint16_t)s;
+                rx->at = 0u;
                 hold(rx, s, RX_CAP);
                 s = rx->scan;
                 len = rx->len;
@@ -517,13 +522,46 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
                     /* its last byte just came: the sum is 2 bytes back */
                     at_be = (uint32_t)rx->sum_len - p[fwd] - p[fwd + 1u];
                     cost += 2u;
-                } else if (bwd < fwd) {
-                    at_be = (uint32_t)rx->sum_len - tase_checksum(0u, &p[fwd], bwd);
-                    cost += bwd;
                 } else {
-                    at_be = sum + tase_checksum(0u, p, fwd);
-                    cost += fwd;
+                    /* the shortest of three: b[from..from+n) summed
+                     * forward from scan, back from len, or from the
+                     * cursor either way */
+                    size_t be = s + fwd;
+                    size_t a = rx->at;
+                    size_t from = s;
+                    size_t n = fwd;
+                    uint32_t base = sum;
+                    uint32_t part;
+                    bool back = false;
+                    if (bwd < n) {
+                        from = be;
+                        n = bwd;
+                        base = rx->sum_len;
+                        back = true;
+                    }
+                    if (a > s) {
+                        if (a <= be) {
+                            if (be - a < n) {
+                                from = a;
+                                n = be - a;
+                                base = rx->sum_at;
+                                back = false;
+                            }
+                        } else if (a - be < n) {
+                            from = be;
+                            n = a - be;
+                            base = rx->sum_at;
+                            back = true;
+                        } else {
+                            /* farther than the other two */
+                        }
+                    }
+                    part = tase_checksum(0u, &b[from], n);
+                    at_be = back ? base - part : base + part;
+                    cost += n;
                 }
+                rx->at = (uint16_t)(s + fwd);
+                rx->sum_at = (uint16_t)at_be;
                 want = (uint16_t)(((uint16_t)p[fwd] << 8) | p[fwd + 1u]);
                 budget -= (int32_t)cost;
                 if ((uint16_t)(at_be - sum) == want) {
@@ -866,6 +904,9 @@ RX_NOINLINE static int push_failed(tase_rx_t *rx, uint8_t b, tase_rx_handler_t o
     size_t len = rx->len;
     begin(rx);
     rx->stats.checksum_errors++;
+    /* the cursor at its Check_0 byte, as advance() leaves it */
+    rx->at = (uint16_t)(len - 1u);
+    rx->sum_at = (uint16_t)(rx->sum_len - rx->buf[len - 1u]);
     rx->buf[len] = b;
     rx->len = (uint16_t)(len + 1u);
     rx->sum_len = (uint16_t)(rx->sum_len + b);
@@ -895,6 +936,7 @@ RX_NOINLINE static int push_last(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     rx->stats.bytes_in++;
     rx->len = 0u;
     rx->scan = 0u;
+    rx->at = 0u;
     rx->sum_len = rx->sum_scan;
     rx->busy = 1u;
     rx->end = RX_BLOCKED;

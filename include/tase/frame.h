@@ -222,7 +222,7 @@ typedef struct {
 
 /* Bytes the receiver's window holds: a whole frame (TASE_FRAME_MAX) and
  * the slack the resumable scan needs (frame.h COST, docs/DESIGN.md). */
-#define TASE_RX_WINDOW 300u
+#define TASE_RX_WINDOW 296u
 
 /* Receiver instance. Treat every field except `stats` as private. */
 typedef struct {
@@ -257,6 +257,10 @@ typedef struct {
      * budgeted scan, and the low 16 bits of stats.bytes_in then. */
     uint16_t bank;
     uint16_t bank_at;
+    /* A third known prefix of the window for the scan's sums: sum_at is
+     * the running sum up to buf[at] (at is 0 when there is none). */
+    uint16_t at;
+    uint16_t sum_at;
     uint8_t buf[TASE_RX_WINDOW];
 } tase_rx_t;
 
