@@ -24,10 +24,15 @@
  * the checksum. sum_len (the sum of buf[0..len) plus a constant) grows
  * with every byte stored; sum_scan is the same up to buf[scan]. The
  * candidate's sum is prefix(be) - sum_scan, where be is the index of its
- * Check_0 byte and prefix(be) is summed forward from scan or backward from
- * len, whichever is shorter: for the held candidate whose last byte
- * just came, that is 2 bytes back. (compact() moves the constant, not the
- * sums: the differences stay right.)
+ * Check_0 byte and prefix(be) is summed forward from scan, backward from
+ * len, or either way from the sum cursor (at, sum_at: the last judged
+ * candidate's be and prefix(be)), whichever is shortest: for the held
+ * candidate whose last byte just came, that is 2 bytes back; for syncs a
+ * few bytes apart, the distance between two candidates' ends. (compact()
+ * moves the constant, not the sums: the differences stay right; it moves
+ * `at` with its byte.) The cursor is 0 (none) whenever len may be cut
+ * back: an emptied window, hunting (a partial sync held), a delivery by
+ * push_last().
  *
  * CREDIT. Every byte taken in brings RX_BUDGET units of scan work (a
  * unit is about an instruction on a Cortex-M4; see the costs below); the

@@ -91,9 +91,10 @@
  * adversarial search of bench/search.sh finds 104..106) and 224 on an M0+
  * (-Os). docs/PERFORMANCE.md has the numbers.
  *
- * RAM. sizeof(tase_rx_t) is 360: the TASE_RX_WINDOW (300) window bytes (a
+ * RAM. sizeof(tase_rx_t) is 360: the TASE_RX_WINDOW (296) window bytes (a
  * frame and the room a lagging scan needs), 28 of counters, 15 of the time
- * bound, 13 of scan state and 4 of the scan's credit; checked against
+ * bound, 13 of scan state, 4 of the scan's credit and 4 of its sum cursor;
+ * checked against
  * TASE_RX_SIZE_BUDGET at compile time. Stack: see docs/FOOTPRINT.md.
  *
  * TIME BOUND. A held candidate waits for its last byte, and with it every
