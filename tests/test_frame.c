@@ -1439,6 +1439,41 @@ static void one_byte_never_decides_the_whole_window_at_once(void **state)
     free(want);
 }
 
+/* The sum cursor (`at`, private) is read by the scan's judgements: one
+ * overwritten while the scan lags (here 0xFFFF before every byte) must
+ * not send a sum past the window. A judgement sums from the cursor only
+ * when it is nearer than len, which keeps such a sum inside buf[0..len);
+ * this holds that choice to it (the sanitize check runs it under
+ * AddressSanitizer, and the instance is on the heap at its exact size,
+ * so that a read past it is one past an allocation). The frames may
+ * differ (a corrupted instance gives no promise of which). */
+static void a_corrupted_sum_cursor_reads_nothing_outside_the_window(void **state)
+{
+    static uint8_t buf[4 * 261 + 4 * 256];
+    tase_rx_t *rx = malloc(sizeof(*rx));
+    recorder_t *got;
+    size_t n = 0, i, rep, lagging = 0;
+    (void)state;
+    assert_non_null(rx);
+    got = new_recorder(rx);
+    for (rep = 0; rep < 4; rep++) {
+        n = put_burst(buf, n);
+        n = put_held255(buf, n);
+    }
+    assert_int_equal(tase_rx_init(rx), TASE_OK);
+    for (i = 0; i < n; i++) {
+        if (rx->lag != 0u) {
+            rx->at = 0xFFFFu;
+            lagging++;
+        }
+        assert_true(tase_rx_push(rx, buf[i], record, got) >= 0);
+    }
+    assert_true(lagging > 100u); /* the scan did lag, with the cursor overwritten */
+    assert_true(tase_rx_flush(rx, record, got) >= 0);
+    free(got);
+    free(rx);
+}
+
 /* Issue 21, second pass: a false candidate held over 200 noise bytes
  * (no 00 among them) and a valid frame behind them, then noise, repeated:
  * when the candidate fails, the scan walks the noise in pieces its credit
@@ -2348,6 +2383,7 @@ int main(void)
         cmocka_unit_test(an_empty_read_after_the_limit_settles_stale_candidates),
         cmocka_unit_test(receiver_matches_the_reference_with_quiet_times),
         cmocka_unit_test(one_byte_never_decides_the_whole_window_at_once),
+        cmocka_unit_test(a_corrupted_sum_cursor_reads_nothing_outside_the_window),
         cmocka_unit_test(a_lagging_scan_gives_the_same_frames_for_any_split),
         cmocka_unit_test(the_scans_credit_does_not_depend_on_the_split),
         cmocka_unit_test(a_stats_reset_does_not_move_the_frames),
