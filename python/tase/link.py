@@ -171,6 +171,29 @@ def _check_simlink(dev):
         raise LinkError(ffi.string(why).decode(errors="replace"), lib.TASE_ENODEV)
 
 
+def _open_error(dev, e):
+    """The LinkError of pyserial's failure to open `dev`, with the code the
+    C port (port/posix_uart) gives the same errno: a device held by another
+    program EBUSY, one that is missing or not a terminal ENODEV, one we may
+    not open EACCES, anything else EIO. pyserial keeps the errno of an
+    open or lock (SerialException(errno, text)) but not of its termios
+    calls (/dev/null, a file): that one is the exception it was raised
+    from."""
+    n = getattr(e, "errno", None)
+    if n is None and isinstance(getattr(e, "__context__", None), OSError):
+        n = e.__context__.errno
+    if n is None and e.__context__ is not None and getattr(e.__context__, "args", None):
+        first = e.__context__.args[0]  # termios.error(errno, text)
+        n = first if isinstance(first, int) else None
+    if n in (errno.EBUSY, errno.EAGAIN, errno.EWOULDBLOCK):
+        return LinkError("cannot open %s: in use by another program (%s)" % (dev, e), lib.TASE_EBUSY)
+    if n in (errno.ENOENT, errno.ENXIO, errno.ENODEV, errno.ENOTDIR, errno.EISDIR, errno.ENOTTY):
+        return LinkError("cannot open %s: not a serial device (%s)" % (dev, e), lib.TASE_ENODEV)
+    if n in (errno.EACCES, errno.EPERM, errno.EROFS):
+        return LinkError("cannot open %s: %s" % (dev, e), lib.TASE_EACCES)
+    return LinkError("cannot open %s: %s" % (dev, e), lib.TASE_EIO)
+
+
 class _SerialTransport:
     def __init__(self, dev, baud):
         try:
@@ -183,7 +206,7 @@ class _SerialTransport:
         try:
             self.ser = serial.Serial(dev, baud, timeout=0, exclusive=True)
         except (serial.SerialException, OSError, ValueError) as e:
-            raise LinkError("cannot open %s: %s" % (dev, e), lib.TASE_EIO) from e
+            raise _open_error(dev, e) from e
         try:
             _check_simlink(dev)  # again: the simulator may have died meanwhile
         except BaseException:

@@ -12,6 +12,7 @@ import tty
 import pytest
 
 import tase
+from tase._core import lib
 
 
 def test_live_exchange_with_tase_sim(sim):
@@ -535,6 +536,28 @@ def test_wrong_urls(url, text):
 def test_missing_device():
     with pytest.raises(tase.LinkError, match="No such file"):
         tase.connect("serial:/nonexistent/tty:57600")
+
+
+def test_open_errors_have_the_c_ports_codes(tmp_path):
+    # pyserial's errors all came out as EIO (-11); the C port (and so the
+    # CLI) says ENODEV for what is no serial device and EBUSY for a device
+    # another program holds
+    with pytest.raises(tase.LinkError, match="not a serial device") as e:
+        tase.connect("serial:/dev/null")
+    assert e.value.code == lib.TASE_ENODEV
+    with pytest.raises(tase.LinkError, match="not a serial device") as e:
+        tase.connect("serial:%s" % tmp_path)
+    assert e.value.code == lib.TASE_ENODEV
+    master, slave = pty.openpty()
+    try:
+        name = os.ttyname(slave)
+        with tase.connect("serial:%s" % name):
+            with pytest.raises(tase.LinkError, match="in use by another program") as e:
+                tase.connect("serial:%s" % name)
+            assert e.value.code == lib.TASE_EBUSY
+    finally:
+        os.close(master)
+        os.close(slave)
 
 
 def test_vanished_peer_is_a_clear_error(tase_sim):
