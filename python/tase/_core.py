@@ -127,6 +127,7 @@ class Field:
         "scale",
         "decimals",
         "_div",
+        "depends",
     )
 
     def __repr__(self):
@@ -151,6 +152,8 @@ class Field:
         """Engineering value -> wire integer, rounded half away from zero;
         FieldError when it is not a number or outside the field's range
         (never saturated: nothing is sent on a guess)."""
+        if self.depends is not None:
+            raise FieldError("%s %s: %s" % (pkt, self.name, self.depends))
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise FieldError("%s %s: not a number: %r" % (pkt, self.name, value))
         if isinstance(value, int) and abs(value) > 2**64:
@@ -257,6 +260,22 @@ class PacketType:
         return bool(lib.tase_schema_is_query(self._desc, n))
 
 
+# Fields whose unit another value decides: a number given for them by name
+# (where other fields take engineering values) is refused, never guessed
+# (GIMBAL_CMD pan=30 was sent as 0.30 degrees).
+_DEPENDS = {
+    ("GIMBAL_CMD", f): "its unit is set by flags (1/100 deg for a position, 1/100 deg/s for "
+    "a rate): give the wire integer in raw= (raw={\"%s\": 4500} with flags 0xA0 is 45 deg), "
+    "or use Link.point() / Link.rate()" % f
+    for f in ("pan", "tilt", "roll")
+}
+_DEPENDS[("CAMERA_CMD", "hfov")] = (
+    "its unit is set by its sign (1/100 deg of field of view, or minus 100 times a zoom "
+    "ratio): give the wire integer in raw= (raw={\"hfov\": 1000} is 10 deg), or use "
+    "Link.camera(hfov=..., zoom=...)"
+)
+
+
 def _load_schema():
     types = []
     out = ffi.new("py_field_t *")
@@ -302,6 +321,7 @@ def _load_schema():
             else:
                 f.unit = f.label = f.scale = f.decimals = None
                 f._div = 0
+            f.depends = _DEPENDS.get((t.name, f.name))
             t.fields.append(f)
         t.by_name = {f.name: f for f in t.fields}
         types.append(t)
@@ -354,7 +374,8 @@ class Packet(tuple):
     fields that have a unit and wire integers for the others:
 
         tase.Packet("GIMBAL_ANGLE", pan=12.5, tilt=-45, roll=0)
-        tase.Packet("GIMBAL_CMD", pan=4500, tilt=-2000, roll=0, flags=0xA0, impulse_time=0)
+        tase.Packet("GIMBAL_CMD", raw={"pan": 4500, "tilt": -2000, "roll": 0},
+                    flags=0xA0, impulse_time=0)    # pan/tilt/roll raw only: unit by flags
         tase.Packet("PACKET_RATE", raw={"angle_1": 20, ...})   # wire integers
         tase.Packet.query("SYSTEM_VERSION")                     # zero-length query
 
@@ -596,8 +617,10 @@ class Packet(tuple):
         codes = {}
         raw = self.raw
         for f in t.fields:
-            if f.unit is not None and raw.get(f.name) in (f.keep, f.none):
-                codes[f.name] = raw[f.name]  # a code, not a value: given raw
+            if f.name in raw and (
+                f.depends is not None or (f.unit is not None and raw[f.name] in (f.keep, f.none))
+            ):
+                codes[f.name] = raw[f.name]  # a code, or a field given raw only
         for k, v in self.fields.items():
             if k not in codes:
                 args.append("%s=%r" % (k, v))

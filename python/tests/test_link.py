@@ -105,7 +105,7 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
         (lambda l: l.rate(400, 0), tase.FieldError, "327.67"),
         (lambda l: l.send(tase.Packet("GIMBAL_ANGLE", pan=0, tilt=0, roll=0)), tase.FieldError,
          "sent by the gimbal"),
-        (lambda l: l.send(tase.Packet("GIMBAL_CMD", pan=0, tilt=0, roll=0, flags=0x55,
+        (lambda l: l.send(tase.Packet("GIMBAL_CMD", raw={"pan": 0, "tilt": 0, "roll": 0}, flags=0x55,
                                       impulse_time=0)), tase.FieldError, "table 5"),
         (lambda l: l.send(tase.Packet.from_data(0x28, 1, b"\x01")), tase.FieldError,
          "not a packet of the spec"),
@@ -137,7 +137,7 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
         (lambda l: l.camera("D"), tase.FieldError, "A, B or C"),
         (lambda l: l.camera(hfov=0), tase.FieldError, "0.01..327.67"),
         (lambda l: l.spoi(91, 0, 0), tase.FieldError, "out of range"),
-        (lambda l: l.query(tase.Packet("GIMBAL_CMD", pan=0, tilt=0, roll=0, flags=0xA0,
+        (lambda l: l.query(tase.Packet("GIMBAL_CMD", raw={"pan": 0, "tilt": 0, "roll": 0}, flags=0xA0,
                                        impulse_time=0)), tase.FieldError, "not echoed"),
         (lambda l: l.query(tase.Packet("SPOI_CMD", lat=0, lon=0, height=0, vnorth=0, veast=0,
                                        vdown=0, flags=0)), tase.FieldError, "not echoed"),
@@ -155,7 +155,7 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
                                       vdown=0, flags=0)), tase.FieldError, "out of range"),
         (lambda l: l.send(tase.Packet("SPOI_CMD", lat=0, lon=-180.5, height=0, vnorth=0,
                                       veast=0, vdown=0, flags=0)), tase.FieldError, "out of range"),
-        (lambda l: l.send(tase.Packet("GIMBAL_CMD", pan=20000, tilt=0, roll=0, flags=0x20,
+        (lambda l: l.send(tase.Packet("GIMBAL_CMD", raw={"pan": 20000, "tilt": 0, "roll": 0}, flags=0x20,
                                       impulse_time=0)), tase.FieldError, "out of range"),
         # an engineering value that lands on the wire's "do not change" code
         (lambda l: l.send(tase.Packet("AXIS_SETTING", pan_max_rate=1275)), tase.FieldError,
@@ -191,7 +191,7 @@ def test_gimbal_cmd_modes_are_the_c_librarys_answer(silent_pty, monkeypatch):
     from tase.link import _GIMBAL_CMD_FLAGS
 
     def cmd(flags):
-        return tase.Packet("GIMBAL_CMD", pan=0, tilt=0, roll=0, flags=flags, impulse_time=0)
+        return tase.Packet("GIMBAL_CMD", raw={"pan": 0, "tilt": 0, "roll": 0}, flags=flags, impulse_time=0)
 
     url, master = silent_pty
     accepted = []

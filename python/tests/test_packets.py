@@ -60,15 +60,20 @@ def test_round_trip_every_packet_type(t, data):
     assert got[0].raw == raw and got[0].name == t.name and got[0].offset == 0
     # engineering values convert back to the same wire integers; a "do not
     # change" / "unavailable" code is no value and is refused in engineering
-    # units (AXIS_SETTING pan_max_rate=1275 deg/s was raw 0xFF): given raw
+    # units (AXIS_SETTING pan_max_rate=1275 deg/s was raw 0xFF): given raw,
+    # as are the fields whose unit another value sets (GIMBAL_CMD pan)
     codes = {
-        f.name for f in t.fields if f.unit is not None and raw.get(f.name) in (f.keep, f.none)
+        f.name
+        for f in t.fields
+        if f.depends is not None or (f.unit is not None and raw.get(f.name) in (f.keep, f.none))
     }
     eng = {k: v for k, v in p.fields.items() if k not in codes}
     assert tase.Packet(t.name, data=tail, raw={k: raw[k] for k in codes}, **eng) == p
     for k in codes:
-        with pytest.raises(tase.FieldError, match="code, not a value"):
-            tase.Packet(t.name, data=tail, raw={c: raw[c] for c in codes if c != k}, **p.fields)
+        want = "its unit is set by" if t.by_name[k].depends else "code, not a value"
+        with pytest.raises(tase.FieldError, match=want):
+            tase.Packet(t.name, data=tail, raw={c: raw[c] for c in codes if c != k},
+                        **{f: v for f, v in p.fields.items() if f == k or f not in codes})
 
 
 def test_engineering_values_and_repr():
@@ -209,12 +214,33 @@ def test_from_data_refuses_what_no_frame_carries():
     assert tase.Packet.from_data(0x48, 0, bytes(253)).size == 253
 
 
+def test_a_field_whose_unit_another_value_sets_is_given_raw_only():
+    # GIMBAL_CMD pan=30 was sent as 0.30 degrees (a wire integer, where
+    # GIMBAL_ANGLE pan=30 is 30 degrees); CAMERA_CMD hfov=30 as 0.30 deg
+    for name, field in (("GIMBAL_CMD", "pan"), ("GIMBAL_CMD", "tilt"), ("GIMBAL_CMD", "roll"),
+                        ("CAMERA_CMD", "hfov")):
+        with pytest.raises(tase.FieldError, match="%s %s: its unit is set by" % (name, field)):
+            tase.Packet(name, **{field: 30})
+    p = tase.Packet("GIMBAL_CMD", raw={"pan": 4500, "tilt": -2000, "roll": 0}, flags=0xA0,
+                    impulse_time=0)
+    # Size 10, 0x00/0x80, 4500 = 0x1194, -2000 = 0xF830, 0, 0xA0, 0; the sum
+    # of every byte from 00 FF 5A on: 0x0450
+    assert p.encode().hex() == "00ff5a0a00801194f8300000a0000450"
+    with pytest.raises(tase.FieldError, match="raw="):
+        p.replace(pan=45)
+    assert p.replace(raw={"pan": -4500}).raw["pan"] == -4500
+    # repr gives them raw, so that it builds the same packet again
+    assert eval(repr(p), {"Packet": tase.Packet}) == p
+    c = tase.Packet("CAMERA_CMD", camera=1, raw={"hfov": 1000})
+    assert eval(repr(c), {"Packet": tase.Packet}) == c
+
+
 def test_a_short_form_never_drops_a_given_field():
     with pytest.raises(tase.FieldError, match="1-byte form carries only camera, not hfov"):
-        tase.Packet("CAMERA_CMD", camera=1, hfov=5, length=1)
+        tase.Packet("CAMERA_CMD", camera=1, raw={"hfov": 5}, length=1)
     short = tase.Packet("CAMERA_CMD", camera=1, length=1)
     with pytest.raises(tase.FieldError, match="not hfov"):
-        short.replace(hfov=5)
+        short.replace(raw={"hfov": 5})
     assert short.replace(camera=2).raw == {"camera": 2}
 
 

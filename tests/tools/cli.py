@@ -153,7 +153,7 @@ from tase._core import lib  # noqa: E402
 
 disagree = []
 for flags in (range(256) if not VALGRIND else (0, 3, 4, 0x10, 0x20, 0x55, 0xA0, 0xD0, 0xFF)):
-    pk = tase.Packet("GIMBAL_CMD", pan=0, tilt=0, roll=0, flags=flags, impulse_time=0)
+    pk = tase.Packet("GIMBAL_CMD", raw={"pan": 0, "tilt": 0, "roll": 0}, flags=flags, impulse_time=0)
     mode = lib.tase_command_check_data(pk.id, pk.payload, pk.size) == lib.TASE_OK
     rc, _, err = run(["send", "GIMBAL_CMD", "pan=0", "tilt=0", "flags=%d" % flags, "--zero"] + L)
     refused = rc == 2 and "not a mode of the spec's table 5" in err

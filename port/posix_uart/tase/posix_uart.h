@@ -99,7 +99,15 @@ extern const tase_port_ops_t tase_posix_uart_ops;
  *                     or its TIOCEXCL); nothing was changed;
  *   TASE_EIO          any other OS error.
  * On error u is left closed (fd -1) and the device as it was. Blocks only
- * as long as open() of the device does (O_NONBLOCK: no carrier wait). */
+ * as long as open() of the device does (O_NONBLOCK: no carrier wait).
+ * A SIMULATOR'S LINK (tase-sim --link PATH) is a symlink to a pty; a
+ * simulator killed with SIGKILL leaves it behind, and its /dev/pts/N then
+ * goes to the next program that asks for a pty (a terminal). This port
+ * does not know the simulator and opens whatever PATH leads to: `tase`
+ * and the Python package refuse such a stale link by the lock file the
+ * simulator keeps beside it (PATH.lock, locked with fcntl while it runs:
+ * docs/TOOLS.md). A program of your own on a simulator's link should
+ * start the simulator itself, or check that lock (F_GETLK) first. */
 int tase_posix_uart_open(tase_posix_uart_t *u, const char *path, uint32_t baud);
 
 /* tase_posix_uart_open() with flags: 0 or TASE_POSIX_UART_SHARED (no
