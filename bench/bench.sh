@@ -173,14 +173,16 @@ worstof() {
 }
 
 # 4. docs/TIMING.md: worst case per call of the public functions of src/
-# (bench/cm/timing*.c), M4 -O2 and M0+ -Os, beside the receiver's longest
+# and of the bare-metal port, port/baremetal (bench/cm/timing*.c), M4 -O2
+# and M0+ -Os, beside the receiver's longest
 # push/feed calls of part 3.
 timing_out="$(dirname "$out")/TIMING.md"
 declare -A tm
 timing_cmd() {
     echo "arm-none-eabi-gcc -std=c99 -mcpu=$1 -mthumb -$2 -g ${cmwarn[*]}" \
-         "-ffunction-sections -fdata-sections -Iinclude src/*.c bench/streams.c bench/cm/timing.c" \
-         "bench/cm/timing_codec.c bench/cm/timing_schema.c bench/cm/timing_roles.c bench/cm/timing_misc.c" \
+         "-ffunction-sections -fdata-sections -Iinclude -Iport/baremetal src/*.c port/baremetal/*.c" \
+         "bench/streams.c bench/cm/timing.c bench/cm/timing_codec.c bench/cm/timing_schema.c" \
+         "bench/cm/timing_roles.c bench/cm/timing_misc.c bench/cm/timing_port.c" \
          "bench/cm/measure.c bench/cm/startup.c -T bench/cm/mps2.ld --specs=rdimon.specs" \
          "-nostartfiles -Wl,--gc-sections -o ${bdir#$TASE_ROOT/}/timing_$1_$2.elf"
 }
@@ -199,7 +201,8 @@ for t in "cortex-m4 O2" "cortex-m0plus Os"; do
     done < "$bdir/timing_$key.txt"
 done
 # both_inputs FN: the input each target found worst, once when they agree, else
-# "M4: a; M0+: b" with the ending they share (from a separator on) written once
+# "M4: a; M0+: b", and the ending they share (from a separator on) written
+# once after them as "; both: ending" (it holds for both)
 both_inputs() {
     local a=${tm[cortex-m4-O2,input,$1]} b=${tm[cortex-m0plus-Os,input,$1]:-} n=0 tail=""
     if [ -z "$b" ] || [ "$a" = "$b" ]; then
@@ -215,10 +218,18 @@ both_inputs() {
         *" ("* | *"; "* | *", "*) tail=$(grep -o -E '(; |, | \().*' <<<"$tail" | head -1) ;;
         *) tail="" ;;
     esac
-    echo "M4: ${a:0:${#a}-${#tail}}; M0+: ${b:0:${#b}-${#tail}}$tail"
+    local a0=${a:0:${#a}-${#tail}} b0=${b:0:${#b}-${#tail}}
+    case $tail in
+        "") ;;
+        ", "* | "; "*) tail="; both: ${tail:2}" ;;
+        *) tail="; both:$tail" ;;
+    esac
+    echo "M4: $a0; M0+: $b0$tail"
 }
-# every public function of src/ (the headers' declarations), to list what is not measured
-mapfile -t public_fns < <(grep -ho '^[a-z][a-z0-9_ *]* \**tase_[a-z0-9_]*(' include/tase/*.h |
+# every public function of src/ and of the bare-metal port (the headers'
+# declarations), to list what is not measured
+mapfile -t public_fns < <(grep -ho '^[a-z][a-z0-9_ *]* \**tase_[a-z0-9_]*(' include/tase/*.h \
+                              port/baremetal/tase/*.h |
                           sed 's/($//; s/.*[ *]//' | sort -u)
 
 # 5. Framing flash: init/push/feed/flush linked alone, M4 -Os.
@@ -466,6 +477,18 @@ echo "wrote $out"
     echo "  inputs (zero, signs, fractions, extremes, a subnormal, huge values, NaN, infinity); both"
     echo "  cores here use soft-float, whose library calls are part of the call. Functions defined"
     echo "  \`static inline\` in a header are called through a noinline wrapper, as said in the input."
+    echo "- **Bare-metal port** (port/baremetal, \`bench/cm/timing_port.c\`): a 512-byte ring (the"
+    echo "  example of tase/bm_uart.h) and a 256-byte DMA buffer (tase/bm_dma.h's), trivial hooks (tx"
+    echo "  copies to RAM, millis reads a variable). \`tase_bm_uart_rx_isr\` is the cost of one byte:"
+    echo "  an RXNE interrupt pays it once per byte it takes. The two polls drain into a receiver, so"
+    echo "  their rows include the receiver's calls (\`tase_rx_feed\`, \`tase_rx_tick\`, rows of their"
+    echo "  own): the worst over a window at every 32-byte offset of the first 8 KiB of every stream"
+    echo "  of PERFORMANCE.md (the receiver as the bytes before it left it) and a poll that finds"
+    echo "  nothing after 100 s of quiet; their \`/own\` rows are the same call less those receiver"
+    echo "  calls, made directly on the same state. Both polls are O(ring or buffer size): the row"
+    echo "  holds for the size named, and a poll takes at most one size's worth of bytes. The port's"
+    echo "  \`tase_bm_uart_ops\` functions (write, read, now_ms) are measured through the table;"
+    echo "  the other ports (POSIX UART, SocketCAN) run on an OS and are not measured here."
     echo
     unmeasured=()
     for f in "${public_fns[@]}"; do
@@ -475,11 +498,11 @@ echo "wrote $out"
         esac
     done
     if [ ${#unmeasured[@]} -eq 0 ]; then
-        echo "Every public function of src/ (every function the headers of include/tase/ declare) is"
-        echo "measured above."
+        echo "Every public function of src/ and of port/baremetal (every function the headers of"
+        echo "include/tase/ and port/baremetal/tase/ declare) is measured above."
     else
-        echo "Public functions of src/ not measured here yet (their headers state their bounds in"
-        echo "O() terms):"
+        echo "Public functions of src/ and port/baremetal not measured here yet (their headers state"
+        echo "their bounds in O() terms):"
         echo
         echo "${unmeasured[*]}"
     fi

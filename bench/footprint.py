@@ -63,6 +63,12 @@ def build(cpu, out):
     return bdir, {os.path.basename(o)[:-len(".c.obj")].replace("tase_", "", 1): o for o in objs}
 
 
+def port_objs(bdir):
+    """The bare-metal port's objects (port/baremetal, library tase_baremetal)."""
+    return sorted(glob.glob(os.path.join(bdir, "port", "baremetal", "CMakeFiles",
+                                         "tase_baremetal.dir", "*.c.obj")))
+
+
 def berkeley(path):
     line = run(["arm-none-eabi-size", "-B", path]).splitlines()[1].split()
     return int(line[0]), int(line[1]), int(line[2])  # text(+rodata), data, bss
@@ -141,9 +147,13 @@ def sizeof_types(cpu, out):
 
 
 def stack_graph(bdir):
-    """Nodes (title -> own frame bytes) and edges from the .ci files."""
+    """Nodes (title -> own frame bytes) and edges from the .ci files of the
+    core and of the bare-metal port (whose calls into the core join it)."""
     own, edges, names = {}, {}, {}
-    for ci in glob.glob(os.path.join(bdir, "CMakeFiles", "tase.dir", "src", "*.ci")):
+    cis = glob.glob(os.path.join(bdir, "CMakeFiles", "tase.dir", "src", "*.ci"))
+    cis += glob.glob(os.path.join(bdir, "port", "baremetal", "CMakeFiles", "tase_baremetal.dir",
+                                  "*.ci"))
+    for ci in cis:
         for line in open(ci):
             m = re.match(r'node: \{ title: "([^"]+)" label: "([^"\\]+)[^"]*?(\d+) bytes', line)
             if m:
@@ -385,6 +395,48 @@ def image_tables(p, img, stack_what):
     p("")
 
 
+# The static functions of tase_bm_uart.c that tase_bm_uart_ops holds.
+PORT_OPS = [("tase_bm_uart_ops.write", "bm_write"), ("tase_bm_uart_ops.read", "bm_read"),
+            ("tase_bm_uart_ops.now_ms", "bm_now_ms")]
+
+
+def port_stack_table(p, stacks, objs):
+    """The worst-case stack table of the bare-metal port's public functions
+    (and of the port functions tase_bm_uart_ops holds), made as the core's:
+    the deepest chain, into the core where a poll feeds its receiver."""
+    if not objs:
+        return
+    p("### Bare-metal port (port/baremetal)")
+    p("")
+    p("The public functions of the bare-metal port (tase/ring.h, tase/bm_uart.h, tase/bm_dma.h; "
+      "library `tase_baremetal`, built for each CPU beside the core), walked like the table "
+      "above; the polls' chains go on into the receiver they feed. Not counted: the hooks "
+      "(tx, millis, idle, irq_off, irq_on), the frame handler and libc. "
+      "`tase_bm_uart_rx_isr` runs in the RX interrupt: its depth is added to whatever it "
+      "interrupts (plus the exception frame, 32 B, or 104 B with floating-point context).")
+    p("")
+    p("| function | " + " | ".join(CPUS) + " | deepest chain (Cortex-M4) | not counted |")
+    p("|---|" + "---:|" * len(CPUS) + "---|---|")
+    own4, edges4, names4, memo4 = stacks["cortex-m4"]
+    rows = [(fn, fn) for fn in sorted({s for o in objs for s in globals_of(o)})]
+    for label, static in PORT_OPS:
+        t = [k for k in own4 if k.endswith(":" + static)]
+        if t:
+            rows.append((label, ":" + static))
+    for label, fn in rows:
+        cols = []
+        for c in CPUS:
+            own, edges, names, memo = stacks[c]
+            f = next((k for k in own if k.endswith(fn)), None) if fn.startswith(":") else fn
+            cols.append(str(worst_stack(f, own, edges, names, memo)[0]) if f in own else "-")
+        f4 = next((k for k in own4 if k.endswith(fn)), fn) if fn.startswith(":") else fn
+        d, chain, ext = worst_stack(f4, own4, edges4, names4, memo4)
+        ext = sorted(e.replace("__indirect_call", "callback") for e in ext)
+        p("| `%s` | %s | %s | %s |" % (label, " | ".join(cols), " > ".join(chain),
+                                      ", ".join(ext) or "-"))
+    p("")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "FOOTPRINT.md"))
@@ -423,6 +475,7 @@ def main():
             "graph": stack_graph(bdir),
             "sites": rx_handler_sites(bdir),
             "objs": objs,
+            "port_objs": port_objs(bdir),
             "dispatch": has_dispatch,
         }
 
@@ -670,6 +723,7 @@ def main():
             met(got["cortex-m4"][0], target) if target else "informational",
             " > ".join(got["cortex-m4"][1])))
     p("")
+    port_stack_table(p, stacks, m4["port_objs"])
     with open(args.out, "w") as f:
         f.write("\n".join(w))
     print("wrote %s" % args.out)

@@ -489,6 +489,7 @@ int main(void)
     can();
     klv_();
     timing_misc();
+    timing_port();
     printf("done\n");
     return 0;
 }

@@ -3,7 +3,8 @@
  * share (timing.c has main() and the receiver, codec and KLV stream calls;
  * timing_roles.c the port helpers and the roles; timing_schema.c the
  * schema and field functions; timing_misc.c CAN, candump, KLV helpers,
- * units and the rest). One output line per function:
+ * units and the rest; timing_port.c the bare-metal port, port/baremetal).
+ * One output line per function:
  *   timing FUNCTION INSTRUCTIONS WORST-CASE-INPUT (the rest of the line)
  */
 #ifndef BENCH_CM_TIMING_H
@@ -84,5 +85,6 @@ void timing_codec(void);
 void timing_schema(void);
 void timing_roles(void);
 void timing_misc(void);
+void timing_port(void);
 
 #endif /* BENCH_CM_TIMING_H */
