@@ -73,7 +73,10 @@ typedef struct {
      * 0 when all were taken, a negative TASE_E* code otherwise. Its
      * longest block is the port's write bound W. Required. */
     int (*tx)(void *hw, const uint8_t *data, size_t n);
-    /* Monotonic milliseconds (modulo 2^32). Required. */
+    /* Monotonic milliseconds (modulo 2^32). Required, and it must run:
+     * read() of an empty ring waits on it, so with a clock that stands
+     * still (SysTick not started) it waits until a byte comes, for ever
+     * on a silent line (with idle set, asleep). */
     uint32_t (*millis)(void *hw);
     /* Sleep until an interrupt is pending, e.g. __WFI(). Called by read()
      * only between irq_off() and irq_on(), after it found the ring empty
