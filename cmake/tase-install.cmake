@@ -102,6 +102,10 @@ install(FILES ${PROJECT_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}
         RENAME copyright COMPONENT dev)
 install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/CHANGELOG.md
         DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/libtase-dev COMPONENT dev)
+# The headers refer to docs/*.md (TIMING.md for the worst cases, FOOTPRINT.md
+# for stack, PORTS.md, ...): they go beside the README.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/libtase-dev/docs
+        COMPONENT dev FILES_MATCHING PATTERN "*.md")
 
 # The Debian packages; only when tase is the top-level project (a parent
 # that opts into TASE_INSTALL keeps its own CPack configuration).

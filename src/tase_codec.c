@@ -23,7 +23,7 @@
 #define SPOI_LAT_MAX_MAS 324000000
 #define SPOI_LON_MAX_MAS 648000000
 
-static void member_store(void *dst, unsigned w, uint64_t v)
+static TASE_INLINE_ void member_store(void *dst, unsigned w, uint64_t v)
 {
     uint8_t b = (uint8_t)v;
     uint16_t h = (uint16_t)v;
@@ -222,7 +222,7 @@ int tase_packet_encode_query(uint16_t id, uint8_t *out, size_t cap)
  * form leaves out (CAMERA_CMD's 1-byte form) takes its "do not change"
  * value, so a handler that ignores the length never acts on a zero it was
  * not sent; fields without one stay zero. */
-static void unpack_fields(tase_field_iter_t *it, const uint8_t *data, void *msg)
+TASE_NOINLINE_ static void unpack_fields(tase_field_iter_t *it, const uint8_t *data, void *msg)
 {
     while (tase_field_iter_next(it)) {
         uint8_t *m = (uint8_t *)msg + it->field->member;

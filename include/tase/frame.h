@@ -65,19 +65,21 @@
  *
  * COST. The scan position never moves back: each byte is examined once,
  * each candidate judged once, and a candidate's checksum is read off
- * running sums plus the shorter of the two stretches between them and its
- * checksum bytes (at most half the window, 2 bytes for a candidate whose
- * last byte just came). The scan runs on credit: every byte taken in (and
+ * running sums (to the scan, to the last byte, and to the last judged
+ * candidate's checksum bytes) plus the shortest stretch between one of
+ * them and its checksum bytes (at most half the window, 2 bytes for a
+ * candidate whose last byte just came). The scan runs on credit: every byte taken in (and
  * a call with no byte, or a tick) brings a fixed amount of scan work,
  * what a byte leaves unused is kept up to a cap, and the scan stops when
  * the credit is spent; it goes on in the next call. So every call has a
  * worst case that does not depend on the stream, and a call taking n
  * bytes at most the cap plus n bytes' worth (plus its callbacks):
  * docs/TIMING.md lists it per function, measured on Cortex-M4 and M0+ on
- * the adversarial streams of bench/ (on a Cortex-M4 -O2: about 850
- * instructions for one tase_rx_push(), 4,400 for a 16-byte
- * tase_rx_feed(), 14,500 for a 64-byte one; these are the longest calls
- * found, not proven bounds: docs/DESIGN.md). tase_rx_push() stores a
+ * the adversarial streams of bench/ (on a Cortex-M4 -O2: about 900
+ * instructions for one tase_rx_push(), 4,200 for a 16-byte
+ * tase_rx_feed(), 14,000 for a 64-byte one; these are the longest calls
+ * found, not proven bounds, and a search finds a few per cent more:
+ * docs/DESIGN.md). tase_rx_push() stores a
  * byte inside a frame with one test, a store and an add; the sync bytes,
  * the Size byte and the last byte of a valid frame (its checksum is two
  * bytes off the running sum) are handled beside it without the general
@@ -86,9 +88,9 @@
  * a byte costs 1.2 times a minimal classic parser's on a Cortex-M4
  * (less on an M0+: docs/DESIGN.md); the
  * worst streams measured (false syncs every 4 bytes whose Sizes keep the
- * scan behind and make it sum long stretches) cost about 101 Thumb
+ * scan behind and make it sum long stretches) cost about 97 Thumb
  * instructions per byte through tase_rx_push() on a Cortex-M4 (-O2; the
- * adversarial search of bench/search.sh finds 104..106) and 224 on an M0+
+ * adversarial search of bench/search.sh finds 99.5) and 161 on an M0+
  * (-Os). docs/PERFORMANCE.md has the numbers.
  *
  * RAM. sizeof(tase_rx_t) is 360: the TASE_RX_WINDOW (296) window bytes (a

@@ -10,7 +10,10 @@
  *    tase_host_send();
  *  - run ONE request at a time: send a frame (a zero-length query, or a
  *    setup packet / SPOI command whose echo confirms it; never a packet
- *    the gimbal does not answer, which a retry would repeat) and wait for the
+ *    the gimbal does not answer, which a retry would repeat; a
+ *    SYSTEM_VERSION with data is sent as given and answered with the
+ *    version, as its query is: PROTOCOL-NOTES R1, where the Python
+ *    package refuses it) and wait for the
  *    gimbal's frame of the same group and type, re-sending the request
  *    after `timeout_ms` up to `retries` times. A typed request
  *    (tase_host_request_msg_start(), tase_host_transact_msg()) decodes

@@ -61,7 +61,8 @@ for f in usr/include/tase/frame.h usr/include/tase/config.h usr/include/tase/ver
     "usr/lib/$triplet/cmake/tase/tase-config.cmake" "usr/lib/$triplet/cmake/tase/tase-config-version.cmake" \
     "usr/lib/$triplet/cmake/tase/tase-targets.cmake" "usr/lib/$triplet/pkgconfig/tase.pc" \
     "usr/lib/$triplet/pkgconfig/tase-socketcan.pc" usr/share/doc/libtase-dev/copyright \
-    usr/share/doc/libtase-dev/CHANGELOG.md; do
+    usr/share/doc/libtase-dev/CHANGELOG.md usr/share/doc/libtase-dev/docs/TIMING.md \
+    usr/share/doc/libtase-dev/docs/PORTS.md; do
     grep -qx "$f" "$out/dev.list" || tase_fail "libtase-dev lacks /$f"
 done
 for f in usr/bin/tase usr/bin/tase-sim usr/share/doc/tase-tools/copyright; do
