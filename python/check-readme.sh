@@ -16,8 +16,9 @@ section=$(awk '/^## Python$/{f = 1; next} /^## /{f = 0} f' "$root/README.md")
 cp -r "$root/python" "$work/python"
 rm -rf "$work/python/build" "$work/python/"*.egg-info
 # the install commands: indented lines running python3 -m venv or the venv's programs
-grep -E '^    (python3 -m venv|~/tase-venv/bin/)' <<<"$section" |
-    sed -e "s|~/tase-venv|$work/venv|g" -e "s|^    python3 |$py |" -e "s| \./python| $work/python|" \
+grep -E '^    ((/usr/bin/)?python3 -m venv|~/tase-venv/bin/)' <<<"$section" |
+    sed -e "s|~/tase-venv|$work/venv|g" -e "s|^    \(/usr/bin/\)\{0,1\}python3 |$py |" \
+        -e "s| \./python| $work/python|" \
         >"$work/install.sh"
 [ "$(wc -l <"$work/install.sh")" -ge 3 ] || { cat "$work/install.sh"; echo "install commands not found"; exit 1; }
 echo "== README install commands:"
