@@ -408,15 +408,22 @@ int tase_packet_decode_iter(tase_field_iter_t *it, const uint8_t *data, void *ms
  * AXIS_SETTING) set to TASE_SETUP_TEMPORARY, so that the gimbal does not
  * write the settings to its non-volatile memory. Set the fields to change
  * and send it:
- *     tase_axis_setting_t ax;
+ *     tase_axis_setting_t ax, now;
  *     (void)tase_packet_init_keep(TASE_ID_AXIS_SETTING, &ax);  // returns 0
  *     ax.pan_max_rate = 12;                                    // 60 deg/s
- *     r = tase_host_transact_msg(&h, TASE_ID_AXIS_SETTING, &ax, &ax, 500, 2);
+ *     r = tase_host_transact_msg(&h, TASE_ID_AXIS_SETTING, &ax, &now, 500, 2);
+ *     // now: the settings in force (its `temporary` is the gimbal's: set it
+ *     // to TASE_SETUP_TEMPORARY again before sending `now` back)
  * A zeroed struct is not such a packet: an AXIS_SETTING of zeros sets
  * every rate, acceleration and gain to 0 (the axes cannot move), and a
- * `temporary` of 0 stores whatever is sent.
+ * `temporary` of 0 stores whatever is sent. The other setup packets
+ * (SENSOR_FILTER, NAV_SOURCE, CAMERA_TYPE, GPS_LEVER_ARM, CAMERA_ALIGN)
+ * have no `temporary` byte: the gimbal always stores what they set
+ * (docs/PROTOCOL-NOTES.md S11).
  * Returns the number of fields left at 0 because the spec gives them no
- * "do not change" value: 0 means the packet as filled changes nothing;
+ * "do not change" value: 0 means every field holds such a value, so a
+ * setup packet or CAMERA_CMD as filled changes nothing (a command still
+ * acts when sent: GYRO_ZERO_CMD, which has no fields, zeroes the gyros);
  * otherwise those zeros are sent as values (PACKET_RATE: 12, its rates,
  * and a rate of 0 stops that stream; SENSOR_FILTER, GPS_LEVER_ARM,
  * CAMERA_ALIGN, NAV_SOURCE: every field). For such a packet ask for the

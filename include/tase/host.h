@@ -26,14 +26,17 @@
  *     tase_host_send_msg(&h, TASE_ID_GIMBAL_CMD, &cmd);
  *     r = tase_host_transact_msg(&h, TASE_ID_PACKET_RATE, NULL, &rates, 500, 2);
  *     // r = 16 (the reply's data length): rates holds the gimbal's settings
- *     rates.angle_1 = 20;
- *     rates.temporary = TASE_SETUP_TEMPORARY; // the answer may say 0: stored
- *     r = tase_host_transact_msg(&h, TASE_ID_PACKET_RATE, &rates, &rates, 500, 2);
- * A setup packet (PACKET_RATE, AXIS_SETTING, ...) sent with `temporary` 0
- * is written to the gimbal's non-volatile memory. To change one setting
- * of a packet whose fields have "do not change" values (AXIS_SETTING,
- * CAMERA_TYPE, CAMERA_CMD), start from tase_packet_init_keep() (codec.h),
- * never from a zeroed struct.
+ *     if (r > 0) {                            // else rates holds nothing
+ *         rates.angle_1 = 20;
+ *         rates.temporary = TASE_SETUP_TEMPORARY; // the answer may say 0: stored
+ *         r = tase_host_transact_msg(&h, TASE_ID_PACKET_RATE, &rates, &rates, 500, 2);
+ *     }
+ * PACKET_RATE and AXIS_SETTING sent with `temporary` 0 are written to the
+ * gimbal's non-volatile memory; the other setup packets have no such byte
+ * and are always stored (docs/PROTOCOL-NOTES.md S11). To change one
+ * setting of a packet whose fields have "do not change" values
+ * (AXIS_SETTING, CAMERA_TYPE, CAMERA_CMD), start from
+ * tase_packet_init_keep() (codec.h), never from a zeroed struct.
  *
  * DISPATCH. The frames that are not the pending request's reply go to
  * on_frame, which is a tase_rx_handler_t like tase_dispatch_frame()

@@ -13,11 +13,14 @@ and echoes to requests, with retries; Python only moves the bytes.
 
 import collections
 import errno
+import fcntl
 import math
 import os
 import re
 import sys
 import select
+import struct
+import termios
 import threading
 import time
 import warnings
@@ -171,6 +174,21 @@ def _check_simlink(dev):
         raise LinkError(ffi.string(why).decode(errors="replace"), lib.TASE_ENODEV)
 
 
+# TIOCGEXCL (Linux: _IOR('T', 0x40, int)); Python's termios lacks it
+_TIOCGEXCL = getattr(termios, "TIOCGEXCL", 0x80045440 if sys.platform.startswith("linux") else None)
+
+
+def _excl_held(fd):
+    """Whether the terminal fd is held exclusively (TIOCEXCL) by anyone."""
+    if _TIOCGEXCL is None:
+        return False
+    try:
+        got = fcntl.ioctl(fd, _TIOCGEXCL, b"\0\0\0\0")
+    except OSError:
+        return False  # not a terminal that says
+    return struct.unpack("i", got)[0] != 0
+
+
 def _open_error(dev, e):
     """The LinkError of pyserial's failure to open `dev`, with the code the
     C port (port/posix_uart) gives the same errno: a device held by another
@@ -209,6 +227,15 @@ class _SerialTransport:
             raise _open_error(dev, e) from e
         try:
             _check_simlink(dev)  # again: the simulator may have died meanwhile
+            if _excl_held(self.ser.fileno()):
+                # pyserial's exclusive=True is a flock(); a program that
+                # holds the device with TIOCEXCL alone (root may open it
+                # anyway) is refused as the C port refuses it
+                raise LinkError(
+                    "cannot open %s: in use by another program (it holds the device with "
+                    "TIOCEXCL)" % dev,
+                    lib.TASE_EBUSY,
+                )
         except BaseException:
             self.ser.close()
             raise

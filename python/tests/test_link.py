@@ -2,9 +2,12 @@
 host role, timeouts, refused input (nothing sent), a vanished peer, and the
 virtual CAN bus."""
 
+import errno
+import fcntl
 import os
 import pty
 import select
+import termios
 import threading
 import time
 import tty
@@ -12,6 +15,7 @@ import tty
 import pytest
 
 import tase
+from tase import link as link_module
 from tase._core import lib
 
 
@@ -555,6 +559,45 @@ def test_open_errors_have_the_c_ports_codes(tmp_path):
             with pytest.raises(tase.LinkError, match="in use by another program") as e:
                 tase.connect("serial:%s" % name)
             assert e.value.code == lib.TASE_EBUSY
+    finally:
+        os.close(master)
+        os.close(slave)
+
+
+@pytest.mark.parametrize(
+    "err, code",
+    [
+        (errno.EACCES, "TASE_EACCES"),
+        (errno.EPERM, "TASE_EACCES"),
+        (errno.EROFS, "TASE_EACCES"),
+        (errno.EBUSY, "TASE_EBUSY"),
+        (errno.EAGAIN, "TASE_EBUSY"),
+        (errno.ENOENT, "TASE_ENODEV"),
+        (errno.ENOTTY, "TASE_ENODEV"),
+        (errno.EISDIR, "TASE_ENODEV"),
+        (errno.EIO, "TASE_EIO"),
+    ],
+)
+def test_every_open_errno_is_a_link_error_with_the_c_ports_code(err, code):
+    # EACCES (a user not in the dialout group) raised AttributeError: the
+    # code was not declared to cffi
+    e = link_module._open_error("/dev/ttyX", OSError(err, os.strerror(err)))
+    assert isinstance(e, tase.LinkError)
+    assert e.code == getattr(lib, code)
+
+
+def test_a_device_another_program_holds_with_tiocexcl_is_refused():
+    # pyserial's exclusive=True is a flock: as root (whom the kernel lets
+    # open such a device) Python opened it where the C port says busy
+    master, slave = pty.openpty()
+    try:
+        fcntl.ioctl(slave, termios.TIOCEXCL)
+        name = os.ttyname(slave)
+        if os.geteuid() != 0:
+            pytest.skip("the kernel refuses the open itself unless root")
+        with pytest.raises(tase.LinkError, match="TIOCEXCL") as e:
+            tase.connect("serial:%s" % name)
+        assert e.value.code == lib.TASE_EBUSY
     finally:
         os.close(master)
         os.close(slave)
