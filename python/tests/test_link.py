@@ -542,7 +542,18 @@ def test_missing_device():
         tase.connect("serial:/nonexistent/tty:57600")
 
 
-def test_open_errors_have_the_c_ports_codes(tmp_path):
+@pytest.fixture
+def open_pty():
+    """(the slave's name, its descriptor) of a fresh pty, closed after."""
+    master, slave = pty.openpty()
+    try:
+        yield os.ttyname(slave), slave
+    finally:
+        os.close(master)
+        os.close(slave)
+
+
+def test_open_errors_have_the_c_ports_codes(tmp_path, open_pty):
     # pyserial's errors all came out as EIO (-11); the C port (and so the
     # CLI) says ENODEV for what is no serial device and EBUSY for a device
     # another program holds
@@ -552,16 +563,11 @@ def test_open_errors_have_the_c_ports_codes(tmp_path):
     with pytest.raises(tase.LinkError, match="not a serial device") as e:
         tase.connect("serial:%s" % tmp_path)
     assert e.value.code == lib.TASE_ENODEV
-    master, slave = pty.openpty()
-    try:
-        name = os.ttyname(slave)
-        with tase.connect("serial:%s" % name):
-            with pytest.raises(tase.LinkError, match="in use by another program") as e:
-                tase.connect("serial:%s" % name)
-            assert e.value.code == lib.TASE_EBUSY
-    finally:
-        os.close(master)
-        os.close(slave)
+    name, _ = open_pty
+    with tase.connect("serial:%s" % name):
+        with pytest.raises(tase.LinkError, match="in use by another program") as e:
+            tase.connect("serial:%s" % name)
+        assert e.value.code == lib.TASE_EBUSY
 
 
 @pytest.mark.parametrize(
@@ -586,21 +592,16 @@ def test_every_open_errno_is_a_link_error_with_the_c_ports_code(err, code):
     assert e.code == getattr(lib, code)
 
 
-def test_a_device_another_program_holds_with_tiocexcl_is_refused():
+def test_a_device_another_program_holds_with_tiocexcl_is_refused(open_pty):
     # pyserial's exclusive=True is a flock: as root (whom the kernel lets
     # open such a device) Python opened it where the C port says busy
-    master, slave = pty.openpty()
-    try:
-        fcntl.ioctl(slave, termios.TIOCEXCL)
-        name = os.ttyname(slave)
-        if os.geteuid() != 0:
-            pytest.skip("the kernel refuses the open itself unless root")
-        with pytest.raises(tase.LinkError, match="TIOCEXCL") as e:
-            tase.connect("serial:%s" % name)
-        assert e.value.code == lib.TASE_EBUSY
-    finally:
-        os.close(master)
-        os.close(slave)
+    name, slave = open_pty
+    fcntl.ioctl(slave, termios.TIOCEXCL)
+    if os.geteuid() != 0:
+        pytest.skip("the kernel refuses the open itself unless root")
+    with pytest.raises(tase.LinkError, match="TIOCEXCL") as e:
+        tase.connect("serial:%s" % name)
+    assert e.value.code == lib.TASE_EBUSY
 
 
 def test_vanished_peer_is_a_clear_error(tase_sim):
