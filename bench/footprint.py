@@ -400,6 +400,25 @@ PORT_OPS = [("tase_bm_uart_ops.write", "bm_write"), ("tase_bm_uart_ops.read", "b
             ("tase_bm_uart_ops.now_ms", "bm_now_ms")]
 
 
+def stack_cells(stacks, fn):
+    """The cells of a stack table row: fn's worst depth on every CPU ("-"
+    where it is not linked), and on Cortex-M4 its deepest chain and what the
+    walk did not count. fn is a global name, or ":name" for a static one,
+    matched at the end of its object-qualified key."""
+    def resolve(own):
+        return next((k for k in own if k.endswith(fn)), None) if fn.startswith(":") else fn
+
+    cols = []
+    for c in CPUS:
+        own, edges, names, memo = stacks[c]
+        f = resolve(own)
+        cols.append(str(worst_stack(f, own, edges, names, memo)[0]) if f in own else "-")
+    own4, edges4, names4, memo4 = stacks["cortex-m4"]
+    _, chain, ext = worst_stack(resolve(own4) or fn, own4, edges4, names4, memo4)
+    ext = sorted(e.replace("__indirect_call", "callback") for e in ext)
+    return cols, " > ".join(chain), ", ".join(ext) or "-"
+
+
 def port_stack_table(p, stacks, objs):
     """The worst-case stack table of the bare-metal port's public functions
     (and of the port functions tase_bm_uart_ops holds), made as the core's:
@@ -417,23 +436,15 @@ def port_stack_table(p, stacks, objs):
     p("")
     p("| function | " + " | ".join(CPUS) + " | deepest chain (Cortex-M4) | not counted |")
     p("|---|" + "---:|" * len(CPUS) + "---|---|")
-    own4, edges4, names4, memo4 = stacks["cortex-m4"]
+    own4 = stacks["cortex-m4"][0]
     rows = [(fn, fn) for fn in sorted({s for o in objs for s in globals_of(o)})]
     for label, static in PORT_OPS:
         t = [k for k in own4 if k.endswith(":" + static)]
         if t:
             rows.append((label, ":" + static))
     for label, fn in rows:
-        cols = []
-        for c in CPUS:
-            own, edges, names, memo = stacks[c]
-            f = next((k for k in own if k.endswith(fn)), None) if fn.startswith(":") else fn
-            cols.append(str(worst_stack(f, own, edges, names, memo)[0]) if f in own else "-")
-        f4 = next((k for k in own4 if k.endswith(fn)), fn) if fn.startswith(":") else fn
-        d, chain, ext = worst_stack(f4, own4, edges4, names4, memo4)
-        ext = sorted(e.replace("__indirect_call", "callback") for e in ext)
-        p("| `%s` | %s | %s | %s |" % (label, " | ".join(cols), " > ".join(chain),
-                                      ", ".join(ext) or "-"))
+        cols, chain, ext = stack_cells(stacks, fn)
+        p("| `%s` | %s | %s | %s |" % (label, " | ".join(cols), chain, ext))
     p("")
 
 
@@ -684,18 +695,11 @@ def main():
     p("")
     p("| function | " + " | ".join(CPUS) + " | deepest chain (Cortex-M4) | not counted |")
     p("|---|" + "---:|" * len(CPUS) + "---|---|")
-    own4, edges4, names4, memo4 = stacks["cortex-m4"]
     publics = sorted({s for o in m4["objs"].values() for s in globals_of(o)})
     for fn in publics:
-        cols = []
-        for c in CPUS:
-            own, edges, names, memo = stacks[c]
-            cols.append(str(worst_stack(fn, own, edges, names, memo)[0]) if fn in own else "-")
-        d, chain, ext = worst_stack(fn, own4, edges4, names4, memo4)
-        ext = sorted(e.replace("__indirect_call", "callback") for e in ext)
+        cols, chain, ext = stack_cells(stacks, fn)
         mark = " (encoder)" if "encode" in fn or fn == "tase_frame_build" else ""
-        p("| `%s`%s | %s | %s | %s |" % (fn, mark, " | ".join(cols), " > ".join(chain),
-                                        ", ".join(ext) or "-"))
+        p("| `%s`%s | %s | %s | %s |" % (fn, mark, " | ".join(cols), chain, ext))
     p("")
     d, chain, ext = rx_stack("cortex-m4")
     p("Receive path on Cortex-M4: %d bytes, %s." % (d, " > ".join(chain)))

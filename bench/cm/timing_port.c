@@ -387,12 +387,28 @@ static void describe(char *buf, size_t cap, const char *what, size_t s, size_t o
     }
 }
 
+/* A poll's row (e instructions on input `what`) and its /own row: e less
+ * the receiver calls `rx_calls` that c_rx makes directly on the state
+ * `restore` gives, leaving `own`. */
+static void report_poll(const char *fn, unsigned long e, const char *what, measure_fn restore,
+                        measure_fn c_rx, const char *rx_calls, const char *own)
+{
+    static char name[64], how[256];
+    (void)snprintf(name, sizeof(name), "%s/own", fn);
+    (void)snprintf(how, sizeof(how),
+                   "the row above less its receiver calls (%s), made directly on the same state "
+                   "and bytes: %s",
+                   rx_calls, own);
+    report(fn, e, what);
+    report(name, e - measure_exact(restore, c_rx, NULL), how);
+}
+
 static void uart_calls(void)
 {
     static char what[256];
     size_t s = 0, o = 0;
     bool q = false;
-    unsigned long e, base;
+    unsigned long e;
 
     report("tase_bm_uart_init", measure_plain(c_u_init),
            "512-byte storage, every hook given (all checks pass)");
@@ -413,12 +429,9 @@ static void uart_calls(void)
 
     e = poll_search(load_u, restore_u, c_u_poll, RING_CAP, true, &s, &o, &q);
     describe(what, sizeof(what), "a full 512-byte ring, drained in 16 feeds of 32 bytes", s, o, q);
-    report("tase_bm_uart_poll", e, what);
-    base = measure_exact(restore_u, c_u_poll_rx, NULL);
-    report("tase_bm_uart_poll/own", e - base,
-           "the row above less its receiver calls (the probe, 16 tase_rx_feed of 32 bytes, "
-           "tase_rx_tick), made directly on the same state and bytes: ring copy, chunk loop, "
-           "millis hook");
+    report_poll("tase_bm_uart_poll", e, what, restore_u, c_u_poll_rx,
+                "the probe, 16 tase_rx_feed of 32 bytes, tase_rx_tick",
+                "ring copy, chunk loop, millis hook");
 }
 
 static void dma_calls(void)
@@ -429,7 +442,7 @@ static void dma_calls(void)
                                     0x7FFFFFFFu,   0x80000000u,        0xFFFFFFFFu - DMA_SIZE};
     size_t s = 0, o = 0, k, j;
     bool q = false;
-    unsigned long e, base, best;
+    unsigned long e, best;
     uint32_t pos = DMA_SIZE / 2u, lap = 0u;
 
     report("tase_bm_dma_init", measure_plain(c_d_init), "256-byte buffer");
@@ -451,12 +464,8 @@ static void dma_calls(void)
     } else {
         describe(what, sizeof(what), "", s, o, q);
     }
-    report("tase_bm_dma_poll", e, what);
-    base = measure_exact(restore_d, c_d_poll_rx, NULL);
-    report("tase_bm_dma_poll/own", e - base,
-           "the row above less its receiver calls (the probe, a tase_rx_feed per span, "
-           "tase_rx_tick), made directly on the same state and bytes: span arithmetic and "
-           "counters");
+    report_poll("tase_bm_dma_poll", e, what, restore_d, c_d_poll_rx,
+                "the probe, a tase_rx_feed per span, tase_rx_tick", "span arithmetic and counters");
 
     /* An overrun: nothing fed, the receiver flushed (the window settles),
      * two remainders. The receiver's state from the same windows, then
