@@ -51,9 +51,10 @@
  * tase_rx_push() stores a byte inside a held candidate with one test
  * (len < end) and nothing saved but the return address; the sync and Size
  * bytes of a frame (push_other()), the last byte of a candidate
- * (push_last()) and every other byte (push_body(): stored, then the scan
- * on its credit, as run() does; a lagging scan's bytes go there) are out
- * of line. Every other
+ * (push_last()), a lagging scan's byte (push_lag(), with the scan compiled
+ * in, except at -Os: RX_LAG_FUSED) and every other byte (push_body():
+ * stored, then the scan on its credit, as run() does) are out of line.
+ * Every other
  * path runs with `busy` set and `end` RX_BLOCKED, so that test fails while
  * a callback runs and a re-entrant call lands on the busy check.
  */
@@ -124,6 +125,25 @@ typedef char tase_rx_late_check
 #define RX_NOINLINE
 #define RX_INLINE
 #define RX_LIKELY(x) (x)
+#endif
+
+/* A lagging scan's byte through tase_rx_push() (bench's synclong and the
+ * searched sustained streams: about one byte in four) pays for two calls
+ * and their bookkeeping before any scan work: push_body(), then advance().
+ * Where code size is not the aim (GCC or clang, not -Os), push_lag() takes
+ * such a byte with the scan compiled into it: RX_SCAN makes scan() inline
+ * there and in advance(), the one out-of-line copy every other caller
+ * uses. At -Os (and for other compilers) advance() is scan() under
+ * another name, and push_body() takes every lagging byte, as before
+ * (docs/DESIGN.md). */
+#if defined(__GNUC__) && !defined(__OPTIMIZE_SIZE__)
+#define RX_LAG_FUSED 1
+#define RX_SCAN RX_INLINE
+#define RX_ADVANCE RX_NOINLINE
+#else
+#define RX_LAG_FUSED 0
+#define RX_SCAN
+#define RX_ADVANCE RX_INLINE
 #endif
 
 /* C99 has no _Static_assert: a negative array size fails the build. */
@@ -437,8 +457,9 @@ RX_INLINE static bool take(tase_rx_t *rx, rx_call_t *c, size_t *len, int32_t *bu
  * byte it took in itself (lag 1); what is left goes to the bank unless
  * nothing is left to decide. `final`: end of input, so an incomplete
  * candidate or partial sync fails like a bad one. Returns false when a
- * callback re-initialised the receiver. */
-static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
+ * callback re-initialised the receiver. Reached through advance(), and
+ * where RX_LAG_FUSED, also from push_lag() (compiled into it). */
+RX_SCAN static bool scan(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
 {
     int32_t budget = allowance; /* signed: a step may overrun what is left */
     const uint8_t *b = rx->buf;
@@ -623,6 +644,14 @@ static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
         rx->bank_at = (uint16_t)rx->stats.bytes_in;
     }
     return live;
+}
+
+/* The scan, for every caller but push_lag(): out of line where
+ * RX_LAG_FUSED (scan() is compiled into push_lag() and here), otherwise a
+ * name for scan() itself. */
+RX_ADVANCE static bool advance(tase_rx_t *rx, rx_call_t *c, int32_t allowance, bool final)
+{
+    return scan(rx, c, allowance, final);
 }
 
 /* The scan's credit for this byte (or tick, or 0-byte feed): what the
@@ -897,6 +926,31 @@ RX_NOINLINE static int push_body(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
     return finish(rx, &c, put(rx, &c, b) && scan_on(rx, &c, 0u));
 }
 
+#if RX_LAG_FUSED
+/* tase_rx_push() for a byte while the scan lags (`end` RX_BLOCKED outside
+ * a call) and the window has room: what push_body() does for it, with the
+ * scan compiled in (RX_LAG_FUSED above). Every other state, a full window
+ * included, goes to push_body(). */
+RX_NOINLINE static int push_lag(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
+{
+    rx_call_t c;
+    size_t len = rx->len;
+    if (rx->busy != 0u || rx->lag != 1u || rx->stop != 0u || len >= RX_CAP || rx->scan > len) {
+        return push_body(rx, b, on_frame, user);
+    }
+    c.on_frame = on_frame;
+    c.user = user;
+    c.count = 0u;
+    c.in = NULL;
+    rx->busy = 1u; /* begin(): `end` is RX_BLOCKED already */
+    rx->buf[len] = b;
+    rx->len = (uint16_t)(len + 1u);
+    rx->sum_len = (uint16_t)(rx->sum_len + b);
+    rx->stats.bytes_in++;
+    return finish(rx, &c, scan(rx, &c, credit(rx), false));
+}
+#endif
+
 /* tase_rx_push() for the last byte of a held candidate that failed: the
  * byte is stored, the scan moves past the candidate's first byte (00) and
  * goes on with what is left of the credit after this judgement, exactly
@@ -979,9 +1033,18 @@ RX_NOINLINE static int push_other(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t
     }
     /* One tail call through a pointer: gcc compiles two tail calls here
      * with five registers saved and the arguments moved (a lagging scan's
-     * byte, bench's synclong: 103.1 -> 100.8 M4 instructions a byte). */
+     * byte, bench's synclong: 103.1 -> 100.8 M4 instructions a byte). A
+     * lagging scan's byte goes to push_lag() (100.8 -> 91.9 with the scan
+     * compiled into it, the two searched periods of docs/DESIGN.md 102.3
+     * -> 97.6 and 102.7 -> 97.7); at -Os, to push_body(). */
+#if RX_LAG_FUSED
+    return ((len == end && end != 0u && end < RX_CAP) ? push_last
+            : (end == RX_BLOCKED)                     ? push_lag
+                                                      : push_body)(rx, byte, on_frame, user);
+#else
     return ((len == end && end != 0u && end < RX_CAP) ? push_last : push_body)(rx, byte, on_frame,
                                                                                user);
+#endif
 }
 
 int tase_rx_push(tase_rx_t *rx, uint8_t byte, tase_rx_handler_t on_frame, void *user)
