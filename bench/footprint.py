@@ -624,9 +624,9 @@ def main():
     frame_of = lambda fn: next((v for k, v in own4.items() if k.endswith(":" + fn) or k == fn), 0)
     p("- **Receive path stack, %d B against 128 (%s)**, plus the application's handler: the "
       "deepest of tase_rx_push(), tase_rx_feed(), tase_rx_flush() and tase_rx_tick() down to "
-      "the frame callback (run() %d B, advance() %d B). bench/bench.sh also measures the "
+      "the frame callback (run() %d B, scan() %d B). bench/bench.sh also measures the "
       "push path by painting (docs/PERFORMANCE.md)." % (
-          st4, met(st4, TARGET_RX_STACK), frame_of("run"), frame_of("advance")))
+          st4, met(st4, TARGET_RX_STACK), frame_of("run"), frame_of("scan")))
     p("")
     p("### Biggest contributors per module (Cortex-M4, `arm-none-eabi-nm --size-sort`)")
     p("")

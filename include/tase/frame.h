@@ -88,9 +88,9 @@
  * a byte costs 1.2 times a minimal classic parser's on a Cortex-M4
  * (less on an M0+: docs/DESIGN.md); the
  * worst streams measured (false syncs every 4 bytes whose Sizes keep the
- * scan behind and make it sum long stretches) cost about 97 Thumb
+ * scan behind and make it sum long stretches) cost about 92 Thumb
  * instructions per byte through tase_rx_push() on a Cortex-M4 (-O2; the
- * adversarial search of bench/search.sh finds 102.7) and 161 on an M0+
+ * adversarial search of bench/search.sh finds 97.7) and 161 on an M0+
  * (-Os). docs/PERFORMANCE.md has the numbers.
  *
  * RAM. sizeof(tase_rx_t) is 360: the TASE_RX_WINDOW (296) window bytes (a
