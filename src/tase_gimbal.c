@@ -17,9 +17,9 @@
 #define RATE_BYTES_PER_PORT 5u /* Angle, Rate, Geo-ref, Camera, Reserved */
 #define SETUP_APPLY_MAX 23u    /* longest writable setup packet: AXIS_SETTING */
 #define SERVICE_CHUNK 64u
-#define SERVICE_READS 64u
-#define NO_FRAME 0xFFu     /* frame_port outside a callback */
-#define ECHO_SHORT_AXIS 8u /* an echo: AXIS_SETTING in its 22-byte layout */
+#define SERVICE_READS TASE_GIMBAL_SERVICE_READS /* tase/config.h */
+#define NO_FRAME 0xFFu                          /* frame_port outside a callback */
+#define ECHO_SHORT_AXIS 8u                      /* an echo: AXIS_SETTING in its 22-byte layout */
 /* g->tx_frame is telemetry's frame during tase_gimbal_poll() and the
  * setup path's scratch otherwise: the setting offered to the application
  * at TX_APPLY, the bytes being stored at TX_STORE, an echo's short layout

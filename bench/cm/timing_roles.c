@@ -339,12 +339,14 @@ static void gimbal_poll(uint32_t *worst_now, unsigned *worst_app, unsigned *wors
     worst_report("tase_gimbal_poll", &w, PORT);
 }
 
-/* Each port's read() has 4096 bytes waiting (service reads 64 x 64 bytes
- * per port): back-to-back copies of the costliest setup frame of
- * gimbal_setups(), or the receiver's adversarial streams; then the poll. */
+/* Each port's read() has as many bytes waiting as tase_gimbal_service()
+ * reads from a port in one call (TASE_GIMBAL_SERVICE_READS reads of 64
+ * bytes, tase/config.h: 4096 at the default): back-to-back copies of the
+ * costliest setup frame of gimbal_setups(), or the receiver's adversarial
+ * streams; then the poll. */
 static void gimbal_service(uint32_t now, unsigned app, unsigned cfg)
 {
-    static uint8_t script[4096];
+    static uint8_t script[TASE_GIMBAL_SERVICE_READS * 64u];
     static const char *const streams[] = {"held255", "syncrand", "halfsum"};
     worst_t w = {0, ""};
     size_t i, s;
@@ -365,9 +367,9 @@ static void gimbal_service(uint32_t now, unsigned app, unsigned cfg)
         }
         a_poll_now = now;
         worst_try(&w, measure_exact(restore_g, c_gservice, NULL),
-                  "at %lu ms (tase_gimbal_poll's worst moment), %s, 4096 bytes waiting on each "
+                  "at %lu ms (tase_gimbal_poll's worst moment), %s, %lu bytes waiting on each "
                   "of 3 ports (%s), %s, then the telemetry due",
-                  (unsigned long)now, poll_cfgs[cfg],
+                  (unsigned long)now, poll_cfgs[cfg], (unsigned long)sizeof(script),
                   s == 0u ? "back-to-back copies of tase_gimbal_feed's worst setup frame"
                           : streams[s - 1u],
                   app_names[app]);

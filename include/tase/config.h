@@ -40,6 +40,12 @@
  *       receiver sees it (tase/frame.h, TIME BOUND); the value the library
  *       was built with is what tase_rx_init() sets, and
  *       tase_rx_set_timing() changes it per receiver.
+ *   TASE_GIMBAL_SERVICE_READS (default 64, 1..1024)  the reads
+ *       tase_gimbal_service() makes of each port per call, each of at
+ *       most 64 bytes (tase/gimbal.h): with the default a call takes up to
+ *       4096 bytes a port, about 3.3 million instructions on a Cortex-M4
+ *       for three ports of the worst input (docs/TIMING.md); 1 bounds it
+ *       to 64 bytes a port for a fast loop. Used only inside the library.
  *   TASE_RING_BARRIER()  the bare-metal ring's barrier hook (tase/ring.h),
  *       used only inside port/baremetal/tase_ring.c.
  *   TASE_RX_CANDIDATES (1..16, default 4)  NO EFFECT since 0.2.0: the
@@ -107,6 +113,12 @@
 #endif
 #if TASE_PORT_WRITE_SPINS < 1 || TASE_PORT_WRITE_SPINS > 0x80000000
 #error "TASE_PORT_WRITE_SPINS must be 1..2^31"
+#endif
+#ifndef TASE_GIMBAL_SERVICE_READS
+#define TASE_GIMBAL_SERVICE_READS 64u
+#endif
+#if TASE_GIMBAL_SERVICE_READS < 1 || TASE_GIMBAL_SERVICE_READS > 1024
+#error "TASE_GIMBAL_SERVICE_READS must be 1..1024"
 #endif
 
 /* The link-name tag: "abi" and the ABI level. An option that changes a

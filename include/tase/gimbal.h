@@ -357,7 +357,9 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
  * skipped (the port may
  * recover), counted nowhere else: check the port; so is a read() that
  * claims more bytes than asked (none of them is fed). Uses 64 bytes of stack
- * plus a bounded number of reads (at most 64 per port per call). */
+ * plus a bounded number of reads: at most TASE_GIMBAL_SERVICE_READS
+ * (tase/config.h, default 64) of at most 64 bytes per port per call,
+ * after which it moves on and the rest waits for the next call. */
 int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms);
 
 /* Send one frame on port index `port` (e.g. an answer from on_frame).
