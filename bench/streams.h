@@ -29,8 +29,9 @@
 #include <stdint.h>
 
 /* Fills buf[0..cap) with the named stream (whole frames only) and returns
- * its length, or 0 for an unknown name. The same bytes on every run and
- * every target. */
+ * its length, or 0 for an unknown name. The same bytes for a name and cap
+ * on every call, whatever was generated before, on every run and every
+ * target. */
 size_t bench_stream(const char *name, uint8_t *buf, size_t cap);
 
 #endif /* BENCH_STREAMS_H */

@@ -37,9 +37,8 @@ static const char *const streams[] = {"telemetry", "badsize", "sync4",   "syncra
                                       "noise",     "zeros",   "held255", "burst",
                                       "heldnoise", "halfsum", "synclong"};
 
-/* Each stream generated once (bench_stream() goes on with its generator
- * from call to call: a second call gives other bytes of a random stream),
- * so that every pass of a search and the rows' inputs see the same. */
+/* Each stream generated once, so that every pass of a search and the
+ * rows' inputs read the same memory. */
 static uint8_t streams_mem[COUNT(streams)][SEARCH + RING_CAP];
 static size_t streams_n[COUNT(streams)];
 static const uint8_t *stream;
