@@ -419,6 +419,16 @@ def stack_cells(stacks, fn):
     return cols, " > ".join(chain), ", ".join(ext) or "-"
 
 
+def stack_table(p, stacks, rows):
+    """A stack table: its head, then a row of stack_cells() per (label, fn),
+    the label already in Markdown."""
+    p("| function | " + " | ".join(CPUS) + " | deepest chain (Cortex-M4) | not counted |")
+    p("|---|" + "---:|" * len(CPUS) + "---|---|")
+    for label, fn in rows:
+        cols, chain, ext = stack_cells(stacks, fn)
+        p("| %s | %s | %s | %s |" % (label, " | ".join(cols), chain, ext))
+
+
 def port_stack_table(p, stacks, objs):
     """The worst-case stack table of the bare-metal port's public functions
     (and of the port functions tase_bm_uart_ops holds), made as the core's:
@@ -434,17 +444,13 @@ def port_stack_table(p, stacks, objs):
       "`tase_bm_uart_rx_isr` runs in the RX interrupt: its depth is added to whatever it "
       "interrupts (plus the exception frame, 32 B, or 104 B with floating-point context).")
     p("")
-    p("| function | " + " | ".join(CPUS) + " | deepest chain (Cortex-M4) | not counted |")
-    p("|---|" + "---:|" * len(CPUS) + "---|---|")
     own4 = stacks["cortex-m4"][0]
     rows = [(fn, fn) for fn in sorted({s for o in objs for s in globals_of(o)})]
     for label, static in PORT_OPS:
         t = [k for k in own4 if k.endswith(":" + static)]
         if t:
             rows.append((label, ":" + static))
-    for label, fn in rows:
-        cols, chain, ext = stack_cells(stacks, fn)
-        p("| `%s` | %s | %s | %s |" % (label, " | ".join(cols), chain, ext))
+    stack_table(p, stacks, [("`%s`" % label, fn) for label, fn in rows])
     p("")
 
 
@@ -693,13 +699,10 @@ def main():
       "exact). Calls into libc and through function pointers (your frame handler) are not "
       "included: add your handler's depth to the receive path.")
     p("")
-    p("| function | " + " | ".join(CPUS) + " | deepest chain (Cortex-M4) | not counted |")
-    p("|---|" + "---:|" * len(CPUS) + "---|---|")
     publics = sorted({s for o in m4["objs"].values() for s in globals_of(o)})
-    for fn in publics:
-        cols, chain, ext = stack_cells(stacks, fn)
-        mark = " (encoder)" if "encode" in fn or fn == "tase_frame_build" else ""
-        p("| `%s`%s | %s | %s | %s |" % (fn, mark, " | ".join(cols), chain, ext))
+    stack_table(p, stacks, [("`%s`%s" % (fn, " (encoder)" if "encode" in fn or
+                                          fn == "tase_frame_build" else ""), fn)
+                            for fn in publics])
     p("")
     d, chain, ext = rx_stack("cortex-m4")
     p("Receive path on Cortex-M4: %d bytes, %s." % (d, " > ".join(chain)))

@@ -928,26 +928,18 @@ RX_NOINLINE static int push_body(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_
 
 #if RX_LAG_FUSED
 /* tase_rx_push() for a byte while the scan lags (`end` RX_BLOCKED outside
- * a call) and the window has room: what push_body() does for it, with the
- * scan compiled in (RX_LAG_FUSED above). Every other state, a full window
- * included, goes to push_body(). */
+ * a call) and the window has room (so put() only stores): what push_body()
+ * does for it, with the scan compiled in (RX_LAG_FUSED above). Every other
+ * state, a full window included, goes to push_body(). */
 RX_NOINLINE static int push_lag(tase_rx_t *rx, uint8_t b, tase_rx_handler_t on_frame, void *user)
 {
-    rx_call_t c;
+    rx_call_t c = {on_frame, user, 0u, NULL};
     size_t len = rx->len;
     if (rx->busy != 0u || rx->lag != 1u || rx->stop != 0u || len >= RX_CAP || rx->scan > len) {
         return push_body(rx, b, on_frame, user);
     }
-    c.on_frame = on_frame;
-    c.user = user;
-    c.count = 0u;
-    c.in = NULL;
-    rx->busy = 1u; /* begin(): `end` is RX_BLOCKED already */
-    rx->buf[len] = b;
-    rx->len = (uint16_t)(len + 1u);
-    rx->sum_len = (uint16_t)(rx->sum_len + b);
-    rx->stats.bytes_in++;
-    return finish(rx, &c, scan(rx, &c, credit(rx), false));
+    begin(rx);
+    return finish(rx, &c, put(rx, &c, b) && scan(rx, &c, credit(rx), false));
 }
 #endif
 
