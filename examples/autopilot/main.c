@@ -96,7 +96,8 @@ typedef struct {
     tase_packet_msg_t reply;
     tase_packet_rate_t rate_req;
     tase_nav_source_t nav_req;
-    tase_spoi_cmd_t spoi_req;
+    tase_spoi_cmd_t spoi_req; /* built before the mission starts */
+    bool spoi_built;
     /* kept for the summary (nothing is printed while the mission runs, so
      * the stack high-water mark is the mission's, not printf's) */
     tase_system_version_t version;
@@ -115,6 +116,7 @@ typedef struct {
     /* pointing, from GEOREFERENCE_DATA */
     bool tracking;
     float err_before;       /* last error before the SPOI echo */
+    uint32_t unaimed;       /* GEOREFERENCEs measured before the point was built */
     float err_first;        /* first error after it */
     uint32_t converged_ms;  /* after the echo; 0 = not yet */
     uint32_t after;         /* samples after convergence */
@@ -195,6 +197,7 @@ static void on_georef(void *user, const tase_frame_t *f, const void *msg)
     float err = flight_pointing_error_deg(&plan, g, &m->spoi_req);
     (void)f;
     m->georefs_all++;
+    m->unaimed += m->spoi_built ? 0u : 1u;
     if (!m->tracking) {
         m->err_before = err;
         return;
@@ -403,12 +406,6 @@ static void run_step(mission_t *m)
         return;
     case STEP_WARMUP:
         if (m->now - m->step_at >= WARMUP_MS) {
-            int r = flight_spoi(&plan, SPOI_NORTH_M, SPOI_EAST_M, SPOI_HEIGHT_M,
-                                (uint8_t)TASE_SPOI_ECHO, &m->spoi_req);
-            if (r != TASE_OK) {
-                abort_mission(m, "SPOI_CMD position", r); /* nothing sent */
-                return;
-            }
             /* From here on a GEOREFERENCE may reflect the command (it is
              * sent on the next pass): none counts as "before" any more. */
             m->spoi_at = m->now;
@@ -551,6 +548,8 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
           (long)(GEO_HZ * track_ms / 1000u));
     check(m, m->last_mode == TASE_MODE_SPOI, "gimbal mode at the end (GIMBAL_RATE)",
           (long)m->last_mode, TASE_MODE_SPOI);
+    check(m, m->unaimed == 0u, "GEOREFERENCEs measured against a SPOI not yet built",
+          (long)m->unaimed, 0);
     check(m, m->err_before > 5.0f * TOLERANCE_DEG,
           "pointing error before the SPOI is large (so convergence means something), deg x100",
           (long)(m->err_before * 100.0f), (long)(500.0f * TOLERANCE_DEG));
@@ -593,6 +592,17 @@ int main(void)
         printf("FAIL init: %s\n", tase_strerror(r));
         return 1;
     }
+    /* The point is built first: every GEOREFERENCE, the ones before the
+     * command included, is measured against it (an error against a point
+     * not yet built, 0 deg N 0 deg E, depends on where the circle has
+     * taken the aircraft and could be anything). */
+    r = flight_spoi(&plan, SPOI_NORTH_M, SPOI_EAST_M, SPOI_HEIGHT_M, (uint8_t)TASE_SPOI_ECHO,
+                    &m.spoi_req);
+    if (r != TASE_OK) {
+        printf("FAIL SPOI_CMD position: %s\n", tase_strerror(r)); /* nothing sent */
+        return 1;
+    }
+    m.spoi_built = true;
     board_init(&uart);
     next_step(&m, STEP_VERSION);
 
