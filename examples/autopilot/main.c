@@ -23,7 +23,9 @@
  *     within TOLERANCE_DEG of the SPOI within SETTLE_MS of the command and
  *     stay there; the gimbal must report SPOI mode and echo our host
  *     position and attitude;
- *  6. query SPOI_CMD: the gimbal still holds our point;
+ *  6. stop the host data and query SPOI_CMD: the gimbal still holds our
+ *     point; then wait for the next GEOREFERENCE_DATA (up to HOLD_MS): the
+ *     line of sight is still on the SPOI after the query;
  * then print a summary (with its own flash/RAM/stack numbers) through
  * semihosting and exit 0 on success, 1 on any failure.
  *
@@ -55,6 +57,7 @@
 #define WARMUP_MS 1000u   /* host data streamed before the SPOI command */
 #define TRACK_MS 10000u   /* tracking observed after the SPOI echo */
 #define SETTLE_MS 5000u   /* the line of sight must converge within this */
+#define HOLD_MS 2000u     /* for a GEOREFERENCE after the SPOI query */
 #define MISSION_MS 30000u /* hard limit of the whole run */
 #define TOLERANCE_DEG 1.0f
 /* Echoed yaw against the heading at the echoed position: the aircraft
@@ -85,6 +88,7 @@ typedef enum {
     STEP_SPOI,
     STEP_TRACK,
     STEP_SPOI_GET,
+    STEP_HOLD,
     STEP_DONE
 } step_t;
 
@@ -117,6 +121,8 @@ typedef struct {
     bool tracking;
     float err_before;       /* last error before the SPOI echo */
     uint32_t unaimed;       /* GEOREFERENCEs measured before the point was built */
+    uint32_t held;          /* GEOREFERENCEs after the SPOI query */
+    float err_held;         /* the error of the first of them */
     float err_first;        /* first error after it */
     uint32_t converged_ms;  /* after the echo; 0 = not yet */
     uint32_t after;         /* samples after convergence */
@@ -199,7 +205,17 @@ static void on_georef(void *user, const tase_frame_t *f, const void *msg)
     m->georefs_all++;
     m->unaimed += m->spoi_built ? 0u : 1u;
     if (!m->tracking) {
-        m->err_before = err;
+        /* Before the command, or after tracking ended: a GEOREFERENCE of
+         * the query's round trip or later is not "before" (it would hold
+         * the converged error). */
+        if (m->step <= STEP_WARMUP) {
+            m->err_before = err;
+        } else if (m->step == STEP_HOLD) {
+            m->err_held = (m->held == 0u) ? err : m->err_held;
+            m->held++;
+        } else {
+            /* during the query */
+        }
         return;
     }
     m->georefs++;
@@ -430,6 +446,9 @@ static void run_step(mission_t *m)
         if (m->now - m->step_at >= TRACK_MS) {
             m->tracking = false;
             m->track_ms = m->now - m->spoi_at;
+            /* the query is the last frame sent: its reply shows the gimbal
+             * read everything before it (autopilot.sh counts both ends) */
+            m->streaming = false;
             next_step(m, STEP_SPOI_GET);
         }
         return;
@@ -442,6 +461,11 @@ static void run_step(mission_t *m)
                   (long)(spoi->lat - m->spoi_req.lat), 0);
             check(m, TASE_SPOI_MODE(spoi->flags) == TASE_MODE_SPOI, "SPOI query reports SPOI mode",
                   (long)TASE_SPOI_MODE(spoi->flags), TASE_MODE_SPOI);
+            next_step(m, STEP_HOLD);
+        }
+        return;
+    case STEP_HOLD:
+        if (m->held > 0u || m->now - m->step_at >= HOLD_MS) {
             next_step(m, STEP_DONE);
         }
         return;
@@ -522,6 +546,9 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
            (unsigned long)m->outside, (unsigned long)SETTLE_MS, (unsigned long)m->steady,
            m->steady > 0u ? (double)(m->steady_sum / (float)m->steady) : 0.0, (double)m->steady_max,
            (double)m->pos_max_m, (double)m->yaw_max_deg);
+    printf("after the SPOI query (host data stopped): error %.2f deg at the next "
+           "GEOREFERENCE (%lu within %lu ms)\n",
+           (double)m->err_held, (unsigned long)m->held, (unsigned long)HOLD_MS);
 
     check(m, m->step == STEP_DONE && !m->requesting, "mission completed", (long)m->step, STEP_DONE);
     check(m, hs->timeouts == 0u, "requests timed out", (long)hs->timeouts, 0);
@@ -536,16 +563,25 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
           (long)(rs->bad_length + rs->unknown), 0);
     check(m, bs.rx_overruns == 0u && tase_ring_overflows(&uart->rx) == 0u, "receive overruns",
           (long)(bs.rx_overruns + tase_ring_overflows(&uart->rx)), 0);
-    /* At least half the asked rates (the host's clock is shared with other
-     * work); GEOREFERENCE at GEO_HZ needs the PACKET_RATE change to work,
-     * the default being 4 per second. */
-    check(m, m->angles * 2u >= ANGLE_HZ * track_ms / 1000u, "GIMBAL_ANGLE frames while tracking",
+    /* Every stream alive: a quarter of the asked rate at least (the
+     * simulator shares the host with other work, and a late pass skips
+     * the slots it missed, of every stream alike). That the PACKET_RATE
+     * setting took is in the ratios, which such skips leave as they are:
+     * the defaults 10/10/4 give GEOREFERENCE/GIMBAL_RATE 0.4 and
+     * GIMBAL_ANGLE/GIMBAL_RATE 1.0, the setting 1.0 and 2.0. */
+    check(m, m->angles * 4u >= ANGLE_HZ * track_ms / 1000u, "GIMBAL_ANGLE frames while tracking",
           (long)m->angles, (long)(ANGLE_HZ * track_ms / 1000u));
-    check(m, m->rates * 2u >= RATE_HZ * track_ms / 1000u, "GIMBAL_RATE frames while tracking",
+    check(m, m->rates * 4u >= RATE_HZ * track_ms / 1000u, "GIMBAL_RATE frames while tracking",
           (long)m->rates, (long)(RATE_HZ * track_ms / 1000u));
-    check(m, m->georefs * 10u >= GEO_HZ * track_ms / 1000u * 6u,
-          "GEOREFERENCE_DATA frames while tracking (above the default 4/s)", (long)m->georefs,
+    check(m, m->georefs * 4u >= GEO_HZ * track_ms / 1000u,
+          "GEOREFERENCE_DATA frames while tracking", (long)m->georefs,
           (long)(GEO_HZ * track_ms / 1000u));
+    check(m, m->georefs * 10u >= m->rates * 7u,
+          "GEOREFERENCE_DATA per GIMBAL_RATE, x100 (the default rates give 40)",
+          (long)(m->georefs * 100u / (m->rates > 0u ? m->rates : 1u)), 70);
+    check(m, m->angles * 10u >= m->rates * 15u,
+          "GIMBAL_ANGLE per GIMBAL_RATE, x100 (the default rates give 100)",
+          (long)(m->angles * 100u / (m->rates > 0u ? m->rates : 1u)), 150);
     check(m, m->last_mode == TASE_MODE_SPOI, "gimbal mode at the end (GIMBAL_RATE)",
           (long)m->last_mode, TASE_MODE_SPOI);
     check(m, m->unaimed == 0u, "GEOREFERENCEs measured against a SPOI not yet built",
@@ -555,13 +591,17 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
           (long)(m->err_before * 100.0f), (long)(500.0f * TOLERANCE_DEG));
     check(m, m->converged_ms > 0u && m->converged_ms <= SETTLE_MS,
           "line of sight within tolerance after (ms)", (long)m->converged_ms, SETTLE_MS);
-    check(m, m->steady * 10u >= GEO_HZ * steady_ms / 1000u * 5u,
+    check(m, m->steady * 4u >= GEO_HZ * steady_ms / 1000u,
           "GEOREFERENCE samples after the settling time", (long)m->steady,
           (long)(GEO_HZ * steady_ms / 1000u));
     check(m, m->outside == 0u, "samples beyond the tolerance after convergence", (long)m->outside,
           0);
     check(m, m->position_bad == 0u, "GEOREFERENCE host position/attitude not what we sent",
           (long)m->position_bad, 0);
+    check(m, m->held > 0u, "GEOREFERENCE_DATA after the SPOI query", (long)m->held, 1);
+    check(m, m->held > 0u && m->err_held <= TOLERANCE_DEG,
+          "line of sight on the SPOI after the query, deg x100", (long)(m->err_held * 100.0f),
+          (long)(100.0f * TOLERANCE_DEG));
 
     printf("image: flash %lu B (library %lu B, bare-metal port %lu B), RAM %lu B static + %lu B "
            "stack used\n",

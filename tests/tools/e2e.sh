@@ -54,6 +54,17 @@ start_sim() {
 last_angle() { "$TASE" monitor "${L[@]}" --json --count 40 2>/dev/null | grep '"GIMBAL_ANGLE"' | tail -1; }
 # sim_says PATTERN: how many lines of the simulator's log match
 sim_says() { grep -c -- "$1" "$dir/sim.log"; }
+# sim_reaches N PATTERN: true when the simulator's log comes to N matching
+# lines (waiting up to 5 s: a loaded machine runs the simulator late) and
+# still has N 0.2 s later (a duplicate shows then)
+sim_reaches() {
+    for _ in $(seq $((100 * slow))); do
+        [ "$(sim_says "$2")" -ge "$1" ] && break
+        sleep 0.05
+    done
+    sleep 0.2
+    [ "$(sim_says "$2")" = "$1" ]
+}
 
 L=(--serial "$dir/gimbal")
 start_sim
@@ -75,11 +86,11 @@ out=$("$TASE" send PACKET_RATE angle_1=20 "${L[@]}")
 check "send PACKET_RATE without temporary: sent temporary=1, the output says it is not stored" \
     eval 'grep -q "^sent PACKET_RATE .* temporary=1$" <<<"$out" &&
           grep -q "temporary=1 (the default): not written to the gimbal.s non-volatile storage" <<<"$out" &&
-          sleep 0.1 && [ "$(sim_says "PACKET_RATE: .* (temporary)$")" = 2 ]'
+          sim_reaches 2 "PACKET_RATE: .* (temporary)$"'
 out=$("$TASE" send PACKET_RATE angle_1=20 temporary=0 "${L[@]}")
 check "send PACKET_RATE temporary=0: sent as asked, to be stored" \
     eval 'grep -q "^sent PACKET_RATE .* temporary=0$" <<<"$out" && ! grep -q "the default" <<<"$out" &&
-          sleep 0.1 && [ "$(sim_says "PACKET_RATE: .* (a gimbal would store it in non-volatile memory)$")" = 1 ]' 
+          sim_reaches 1 "PACKET_RATE: .* (a gimbal would store it in non-volatile memory)$"'
 check "read-modify-write kept the other ports' rates" test "$(json_int "$q" angle_3)" = 10
 t0=$(date +%s)
 mon=$("$TASE" monitor "${L[@]}" --json --time --units --seconds 2 2>"$dir/mon.err")
@@ -126,16 +137,23 @@ os.close(fd)' "$dir/gimbal"
 ms() { date +%s%3N; }
 # The same query on a clean line first: what the tool itself takes (start-up,
 # open, the exchange; about 1 s under memcheck) is not the noise's delay.
-t0=$(ms)
-quiet "$TASE" query SYSTEM_VERSION "${L[@]}" --json --retries 0
-base=$(($(ms) - t0))
-noise
-t0=$(ms)
-v=$("$TASE" query SYSTEM_VERSION "${L[@]}" --json --retries 0 2>&1)
-rc=$?
-t1=$(ms)
-check "after noise a query is answered within 100 ms at 57600 baud (exit $rc, $((t1 - t0)) ms, $base ms on a clean line)" \
-    eval '[ $rc = 0 ] && [ $((t1 - t0 - base)) -le $((100 * slow)) ] && grep -q "\"SYSTEM_VERSION\"" <<<"$v"'
+# Up to three tries, each measured against its own clean query: a machine
+# busy with other work delays one of them, a receiver that is slow after
+# noise delays them all.
+noise_ok() { [ $rc = 0 ] && [ $((t1 - t0 - base)) -le $((100 * slow)) ] && grep -q "\"SYSTEM_VERSION\"" <<<"$v"; }
+for try in 1 2 3; do
+    t0=$(ms)
+    quiet "$TASE" query SYSTEM_VERSION "${L[@]}" --json --retries 0
+    base=$(($(ms) - t0))
+    noise
+    t0=$(ms)
+    v=$("$TASE" query SYSTEM_VERSION "${L[@]}" --json --retries 0 2>&1)
+    rc=$?
+    t1=$(ms)
+    noise_ok && break
+done
+check "after noise a query is answered within 100 ms at 57600 baud (try $try: exit $rc, $((t1 - t0)) ms, $base ms on a clean line)" \
+    noise_ok
 bad_q=0
 for _ in 1 2 3; do
     quiet "$TASE" query PACKET_RATE "${L[@]}" --retries 0 || bad_q=$((bad_q + 1))
@@ -144,18 +162,18 @@ check "... and so are the next queries ($bad_q of 3 failed)" test $bad_q = 0
 n=$(sim_says "GIMBAL_CMD: position pan 30.00 tilt -15.00")
 noise
 quiet "$TASE" point 30 -15 "${L[@]}"
-sleep "$(awk "BEGIN { print 0.1 * $slow }")"
-check "after noise tase point is carried out within 100 ms, not when 257 more bytes came" \
-    test "$(sim_says "GIMBAL_CMD: position pan 30.00 tilt -15.00")" = $((n + 1))
+# The line stays quiet after the command: a receiver that waited for 257
+# more bytes would never carry it out (how soon, for a query, is above).
+check "after noise tase point is carried out on a quiet line, not when 257 more bytes came" \
+    sim_reaches $((n + 1)) "GIMBAL_CMD: position pan 30.00 tilt -15.00"
 
 # SPOI error forms outside SPOI mode change nothing: the log says so (that
 # the model's state is unchanged is tests/test_sim_model.c's).
 quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xC0 impulse_time=0 "${L[@]}"
 quiet "$TASE" send GIMBAL_CMD pan=100 tilt=200 roll=0 flags=0xD0 impulse_time=0 "${L[@]}"
-sleep 0.3
-check "tase-sim logs SPOI error GIMBAL_CMDs as ignored, the mode kept ($(grep 'SPOI error' "$dir/sim.log" | head -1 | cut -c12-))" \
-    eval '[ "$(sim_says "GIMBAL_CMD: SPOI error (flags 0xC0, pan 1.00 tilt 2.00) ignored: not in SPOI mode; still in position mode, stabilised")" = 1 ] &&
-          [ "$(sim_says "GIMBAL_CMD: SPOI error rate (flags 0xD0, pan 1.00 tilt 2.00) ignored")" = 1 ] &&
+check "tase-sim logs SPOI error GIMBAL_CMDs as ignored, the mode kept" \
+    eval 'sim_reaches 1 "GIMBAL_CMD: SPOI error (flags 0xC0, pan 1.00 tilt 2.00) ignored: not in SPOI mode; still in position mode, stabilised" &&
+          sim_reaches 1 "GIMBAL_CMD: SPOI error rate (flags 0xD0, pan 1.00 tilt 2.00) ignored" &&
           [ "$(sim_says "GIMBAL_CMD: .* pan 1.00 tilt 2.00, stabilised$")" = 0 ]'
 
 # A command whose output cannot be written was still sent: the status (5)
@@ -168,8 +186,7 @@ expect_error "point into a closed pipe: exit 5 (not a quiet 141), GIMBAL_CMD was
     "GIMBAL_CMD was sent; cannot write to standard output: Broken pipe" \
     python3 -c 'import os,subprocess,sys; r,w=os.pipe(); os.close(r); sys.exit(subprocess.call(sys.argv[1:], stdout=w))' \
     "$TASE" point 30 -15 "${L[@]}"
-sleep 0.2
-check "... and both reached the gimbal" test "$(sim_says GIMBAL_CMD)" = $((n + 2))
+check "... and both reached the gimbal" sim_reaches $((n + 2)) GIMBAL_CMD
 
 # ---- numbers as typed, sent packets printed ----
 s1=$("$TASE" send HOST_SENSOR roll=010 pitch=+5 yaw=-0x10 --zero "${L[@]}" --json)
@@ -220,14 +237,13 @@ out=$("$TASE" retract "${L[@]}" --wait 4)
 check "tase retract --wait: sent, then the echo when the move completed" \
     eval '[ "$(grep -c "RETRACT_DEPLOY_CMD deploy=0" <<<"$out")" = 2 ]'
 check "tase gyro-zero reaches the gimbal" \
-    eval '"$TASE" gyro-zero "${L[@]}" | grep -q "^sent GYRO_ZERO_CMD" && sleep 0.1 && [ "$(sim_says GYRO_ZERO)" = 1 ]'
+    eval '"$TASE" gyro-zero "${L[@]}" | grep -q "^sent GYRO_ZERO_CMD" && sim_reaches 1 GYRO_ZERO'
 # Twenty programs back to back, each writing a command nobody answers and
 # exiting at once: the next one's open must not drop what the last one
 # left queued for the simulator (opening a port discards input only).
-for i in $(seq 20); do quiet "$TASE" gyro-zero "${L[@]}"; done
-sleep 0.3
+for _ in $(seq 20); do quiet "$TASE" gyro-zero "${L[@]}"; done
 check "20 back-to-back gyro-zero commands from 20 programs all reach the gimbal" \
-    test "$(sim_says GYRO_ZERO)" = 21
+    sim_reaches 21 GYRO_ZERO
 
 # ---- camera: select, field of view ----
 quiet "$TASE" camera A --hfov 10 "${L[@]}"
@@ -239,8 +255,8 @@ expect_error "tase camera C on a gimbal without camera C: refused (SYSTEM_VERSIO
     "$TASE" camera C "${L[@]}"
 out=$("$TASE" camera B "${L[@]}")
 check "... and camera B, which it has, is selected ($out)" \
-    eval 'grep -q "= camera B selected (type 97 in SYSTEM_VERSION)" <<<"$out" && sleep 0.1 &&
-          [ "$(sim_says CAMERA_CMD)" = $((n + 1)) ]' 
+    eval 'grep -q "= camera B selected (type 97 in SYSTEM_VERSION)" <<<"$out" &&
+          sim_reaches $((n + 1)) CAMERA_CMD'
 out=$("$TASE" send CAMERA_CMD hfov=1500 "${L[@]}" --json 2>&1)
 check "send CAMERA_CMD hfov=1500: the fields left out go as \"do not change\" ($out)" \
     grep -q '"fields":{"camera":255,"hfov":1500,"focus":65535,"exposure":255,"shutter_speed":255,"bright":255,"flags":128}' <<<"$out"
@@ -259,7 +275,7 @@ check "KLV packet carries the simulated pan (90 deg = raw 16384)" \
 # a review: held up for 4.5 s (SIGSTOP), tase-sim sent the five packets it
 # missed 5 ms apart when it went on; one packet, then one per 900 ms again
 # (the packets' UTC is the simulator's clock when it sent them)
-timeout 6.5 "$TASE" klv "$dir/klv" >"$dir/klv2.txt" 2>/dev/null &
+timeout 7.5 "$TASE" klv "$dir/klv" >"$dir/klv2.txt" 2>/dev/null &
 kpid=$!
 sleep 0.5
 kill -STOP $sim_pid
