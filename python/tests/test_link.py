@@ -481,7 +481,10 @@ def test_a_packet_rate_sent_again_keeps_the_simulators_measured_rate(sim):
                 if p.name == "GEOREFERENCE_DATA" and time.monotonic() - t0 > 1.0:
                     rates.append(p.raw["sample_rate"])
         assert len(rates) >= 6, rates
-        assert all(3 <= r <= 5 for r in rates), rates  # 4 per second on this port
+        # 4 per second on this port; a simulator run late by a busy machine
+        # skips a slot (3) or sends one late (5): 2..6 still tells the
+        # restarted meter's 20, 10, 7 and 255 apart
+        assert all(2 <= r <= 6 for r in rates), rates
 
 
 def test_send_to_a_gimbal_that_stopped_reading_ends(silent_pty):
