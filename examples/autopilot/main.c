@@ -119,7 +119,7 @@ typedef struct {
     tase_gimbal_angle_t last_angle;
     /* pointing, from GEOREFERENCE_DATA */
     bool tracking;
-    float err_before;       /* last error before the SPOI echo */
+    float err_before;       /* last error before the SPOI command */
     uint32_t unaimed;       /* GEOREFERENCEs measured before the point was built */
     uint32_t held;          /* GEOREFERENCEs after the SPOI query */
     float err_held;         /* the error of the first of them */
