@@ -17,9 +17,8 @@
 #define RATE_BYTES_PER_PORT 5u /* Angle, Rate, Geo-ref, Camera, Reserved */
 #define SETUP_APPLY_MAX 23u    /* longest writable setup packet: AXIS_SETTING */
 #define SERVICE_CHUNK 64u
-#define SERVICE_READS TASE_GIMBAL_SERVICE_READS /* tase/config.h */
-#define NO_FRAME 0xFFu                          /* frame_port outside a callback */
-#define ECHO_SHORT_AXIS 8u                      /* an echo: AXIS_SETTING in its 22-byte layout */
+#define NO_FRAME 0xFFu     /* frame_port outside a callback */
+#define ECHO_SHORT_AXIS 8u /* an echo: AXIS_SETTING in its 22-byte layout */
 /* g->tx_frame is telemetry's frame during tase_gimbal_poll() and the
  * setup path's scratch otherwise: the setting offered to the application
  * at TX_APPLY, the bytes being stored at TX_STORE, an echo's short layout
@@ -683,7 +682,7 @@ int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
         if (g->rx == NULL) {
             return TASE_ESTATE; /* nowhere to feed what it would read */
         }
-        for (i = 0; i < SERVICE_READS; i++) {
+        for (i = 0; i < TASE_GIMBAL_SERVICE_READS; i++) {
             int n = g->port[p].ops->read(g->port[p].ctx, buf, sizeof buf, 0);
             /* More than asked: a broken port; skipped like a read error. */
             if (n < 0 || n > (int)sizeof buf) {
