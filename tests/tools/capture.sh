@@ -23,6 +23,7 @@ cleanup() {
 }
 trap cleanup EXIT
 
+# shellcheck source=tests/tools/check-lib.sh
 . "$(dirname "$0")/check-lib.sh"
 under_valgrind TASE SIM
 # Timing tolerances (seconds of replay jitter, ms for a --speed 0 run);
@@ -184,9 +185,9 @@ check "... and the existing capture is untouched, no partial file left" \
     eval 'cmp -s "$dir/precious.pcap" "$dir/precious.copy" && ! ls "$dir"/precious.pcap.partial-* >/dev/null 2>&1'
 
 # ---- a live session with tase-sim, recorded with --record ----
-"$SIM" --quiet --link "$dir/gimbal" --seconds 120 >"$dir/sim.log" 2>&1 &
+"$SIM" --quiet --link "$dir/gimbal" --seconds $((120 * slow)) >"$dir/sim.log" 2>&1 &
 pids+=($!)
-for _ in $(seq 100); do [ -L "$dir/gimbal" ] && break; sleep 0.05; done
+wait_link "$dir/gimbal"
 L=(--serial "$dir/gimbal" --record "$dir/session.pcap")
 t_start=$(date +%s.%N)
 v=$("$TASE" query SYSTEM_VERSION "${L[@]}" --json)
@@ -306,7 +307,7 @@ with open(sys.argv[1], "ab", buffering=0) as f:
     fcntl.flock(f.fileno(), fcntl.LOCK_UN)
 PY
 mw=$!
-for _ in $(seq 100); do [ -e "$dir/mid.ready" ] && break; sleep 0.05; done
+for _ in $(seq $((100 * slow))); do [ -e "$dir/mid.ready" ] && break; sleep 0.05; done
 "$TASE" query SYSTEM_VERSION --serial "$dir/gimbal" --record "$dir/mid.pcap" >/dev/null 2>"$dir/mid.err"
 wait $mw
 "$TASE" decode "$dir/mid.pcap" >"$dir/mid.json" 2>&1
@@ -334,7 +335,7 @@ check "--record waiting for another writer's lock, Ctrl-C: exit $rc (130), '$(gr
 # for 8 s) held a monitor's Ctrl-C up until it was released
 "$TASE" monitor --serial "$dir/gimbal" --record "$dir/held.pcap" >/dev/null 2>"$dir/held.err" &
 mp=$!
-for _ in $(seq 100); do [ -s "$dir/held.pcap" ] && break; sleep 0.05; done
+for _ in $(seq $((100 * slow))); do [ -s "$dir/held.pcap" ] && break; sleep 0.05; done
 flock "$dir/held.pcap" sleep 8 &
 fl=$!
 sleep 0.5
@@ -363,7 +364,7 @@ check "... the file left as it was" cmp -s "$dir/snap32.pcap" "$dir/snap32.copy"
 # every record of both kept (a guard: libpcap's append did this too).
 "$SIM" --quiet --link "$dir/gimbal2" --seconds 30 >"$dir/sim2.log" 2>&1 &
 pids+=($!)
-for _ in $(seq 100); do [ -L "$dir/gimbal2" ] && break; sleep 0.05; done
+wait_link "$dir/gimbal2"
 "$TASE" send PACKET_RATE angle_2=50 --serial "$dir/gimbal" >/dev/null
 "$TASE" send PACKET_RATE angle_2=50 --serial "$dir/gimbal2" >/dev/null
 "$TASE" monitor --serial "$dir/gimbal" --record "$dir/two.pcap" --json --seconds 1.5 >"$dir/two1.json" 2>/dev/null &
@@ -542,7 +543,7 @@ $U pty-pair "$dir/A" "$dir/B" &
 pids+=($!)
 $U pty-pair "$dir/C" "$dir/D" &
 pids+=($!)
-for _ in $(seq 100); do [ -L "$dir/B" ] && [ -L "$dir/D" ] && break; sleep 0.05; done
+wait_link "$dir/B" "$dir/D"
 $U serial-pcap "$dir/slow.pcap" 3 40-120 "$DATA/decode_noisy.bin:out" "$DATA/decode_noisy.bin:in"
 
 # monitor and `tase decode` of monitor's own --record capture disagreed on

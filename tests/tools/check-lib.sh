@@ -3,6 +3,11 @@
 # the script ends with `check_summary WHAT`.
 # shellcheck shell=bash
 fails=0
+# Under scripts/checks/valgrind.sh (TASE_UNDER_VALGRIND=1) the programs run
+# under memcheck and start and run about ten times slower: time limits and
+# the lifetimes of background simulators scale by `slow`.
+slow=1
+if [ "${TASE_UNDER_VALGRIND:-}" = 1 ]; then slow=10; fi
 ok() { echo "ok   $*"; }
 bad() { echo "FAIL $*"; fails=$((fails + 1)); }
 # check NAME CONDITION-COMMAND...: a named assertion
@@ -11,10 +16,10 @@ check() {
     shift
     if "$@"; then ok "$name"; else bad "$name"; fi
 }
-# wait_for FILE PATTERN: up to 5 s for PATTERN to appear in FILE
+# wait_for FILE PATTERN: up to 5 s (times slow) for PATTERN to appear in FILE
 wait_for() {
     local i
-    for i in $(seq 100); do
+    for i in $(seq $((100 * slow))); do
         grep -q -- "$2" "$1" 2>/dev/null && return 0
         sleep 0.05
     done
@@ -50,6 +55,19 @@ under_valgrind() {
             "${!v}" >"$dir/vg-$v"
         chmod +x "$dir/vg-$v"
         eval "$v=\$dir/vg-\$v"
+    done
+}
+# wait_link PATH...: wait up to 5 s (times slow) for each PATH to exist as
+# a symbolic link, as a simulator started in the background makes its pty's;
+# returns 1 when one did not appear
+wait_link() {
+    local p
+    for p in "$@"; do
+        for _ in $(seq $((100 * slow))); do
+            [ -L "$p" ] && break
+            sleep 0.05
+        done
+        [ -L "$p" ] || return 1
     done
 }
 # check_summary WHAT: exit 1 when a check failed

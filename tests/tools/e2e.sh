@@ -18,13 +18,9 @@ trap cleanup EXIT
 . "$(dirname "$0")/check-lib.sh" # ok, bad, check, expect_error, under_valgrind
 
 # Under scripts/checks/valgrind.sh the programs run under memcheck
-# (under_valgrind); they start slowly, so time limits scale.
-slow=1
+# (under_valgrind); they start slowly, so time limits scale (check-lib's slow).
 settle=0.5 # for a program started in the background to set itself up
-if [ "${TASE_UNDER_VALGRIND:-}" = 1 ]; then
-    slow=10
-    settle=4
-fi
+if [ "$slow" != 1 ]; then settle=4; fi
 under_valgrind TASE SIM
 
 # quiet CMD...: run CMD, its output to the log only
@@ -42,11 +38,8 @@ start_sim() {
     # link" start (a loaded machine, valgrind)
     "$SIM" --link "$dir/gimbal" --klv-link "$dir/klv" --seconds $((120 * slow)) >"$dir/sim.log" 2>&1 &
     sim_pid=$!
-    for _ in $(seq 100); do
-        [ -L "$dir/gimbal" ] && [ -L "$dir/klv" ] && return 0
-        sleep 0.05
-    done
-    echo "tase-sim did not start: $(cat "$dir/sim.log")"
+    wait_link "$dir/gimbal" "$dir/klv" && return 0
+    echo "FAIL tase-sim did not start: $(cat "$dir/sim.log")"
     exit 1
 }
 
@@ -456,7 +449,7 @@ expect_error "tase-sim --quiet=1 refused" 2 "option --quiet takes no value" "$SI
 expect_error "tase-sim --link= refused" 2 "option --link needs a value" "$SIM" --link=
 "$SIM" --link "$dir/hup" --klv-link "$dir/hupk" --seconds 30 >"$dir/hup.log" 2>&1 &
 hpid=$!
-for _ in $(seq 100); do [ -L "$dir/hupk" ] && break; sleep 0.05; done
+wait_link "$dir/hupk"
 kill -HUP $hpid
 wait $hpid
 rc=$?
@@ -467,7 +460,7 @@ check "tase-sim cleans up on SIGHUP: exit $rc, both links removed" \
 # cli.py)
 "$SIM" --link "$dir/full" --seconds 30 >/dev/full 2>"$dir/full.err" &
 fpid=$!
-for _ in $(seq 100); do [ -L "$dir/full" ] && break; sleep 0.05; done
+wait_link "$dir/full"
 "$TASE" query SYSTEM_VERSION --serial "$dir/full" >/dev/null 2>&1
 qrc=$?
 kill -TERM $fpid
@@ -479,7 +472,7 @@ check "tase-sim > /dev/full goes on serving (query exit $qrc) and exits $rc on S
           grep -q "^tase-sim: the log on standard output is incomplete" "$dir/full.err"'
 "$SIM" --link "$dir/own" --seconds 30 >"$dir/own.log" 2>&1 &
 opid=$!
-for _ in $(seq 100); do [ -L "$dir/own" ] && break; sleep 0.05; done
+wait_link "$dir/own"
 ln -sfn /dev/null "$dir/own"
 kill -TERM $opid
 wait $opid
@@ -495,7 +488,7 @@ expect_error "tase-sim --link over a user's symlink: refused, naming its target"
 check "... and the user's symlink is untouched" test "$(readlink "$dir/users")" = /dev/null
 "$SIM" --quiet --link "$dir/stale" --seconds 30 >/dev/null 2>&1 &
 kpid=$!
-for _ in $(seq 100); do [ -L "$dir/stale" ] && break; sleep 0.05; done
+wait_link "$dir/stale"
 kill -KILL $kpid
 wait $kpid 2>/dev/null
 old=$(readlink "$dir/stale")
@@ -506,7 +499,7 @@ old=$(readlink "$dir/stale")
 # was reused, nothing sent.
 "$SIM" --seconds 30 >"$dir/other.log" 2>&1 &
 otherpid=$!
-for _ in $(seq 100); do grep -q "simulated gimbal" "$dir/other.log" && break; sleep 0.05; done
+for _ in $(seq $((100 * slow))); do grep -q "simulated gimbal" "$dir/other.log" && break; sleep 0.05; done
 ln -s stale "$dir/via-stale"
 expect_error "tase point over a killed simulator's stale link ($old; $(head -c 60 "$dir/other.log")): refused" 1 \
     "stale is the link of a tase-sim that is no longer running (pid $kpid, killed?): $old may belong to another program now; not opened, nothing sent" \
@@ -522,7 +515,7 @@ wait $otherpid
 rm "$dir/via-stale"
 "$SIM" --link "$dir/stale" --seconds 30 >"$dir/stale.log" 2>&1 &
 kpid=$!
-for _ in $(seq 100); do grep -q -e "simulated gimbal" -e "tase-sim:" "$dir/stale.log" && break; sleep 0.05; done
+for _ in $(seq $((100 * slow))); do grep -q -e "simulated gimbal" -e "tase-sim:" "$dir/stale.log" && break; sleep 0.05; done
 check "a killed simulator's stale link ($old) is replaced by the next one ($(head -1 "$dir/stale.log"))" \
     eval 'grep -q "simulated gimbal on .*(link .*stale)" "$dir/stale.log" &&
           "$TASE" query SYSTEM_VERSION --serial "$dir/stale" >/dev/null'
@@ -535,7 +528,7 @@ wait $kpid
 # its stale link led the tools to whatever program got its pty
 "$SIM" --link "$dir/closed" --seconds 30 >&- 2>/dev/null &
 kpid=$!
-for _ in $(seq 100); do [ -L "$dir/closed" ] && break; sleep 0.05; done
+wait_link "$dir/closed"
 rec=$(cat "$dir/closed.lock")
 kill -KILL $kpid
 wait $kpid 2>/dev/null
@@ -548,7 +541,7 @@ rm -f "$dir/closed" "$dir/closed.lock"
 # which then took a stale link for a user's own
 (umask 077; exec "$SIM" --quiet --link "$dir/um" --seconds 30 >/dev/null 2>&1) &
 kpid=$!
-for _ in $(seq 100); do [ -L "$dir/um" ] && break; sleep 0.05; done
+wait_link "$dir/um"
 mode=$(stat -c %a "$dir/um.lock")
 kill $kpid
 wait $kpid
@@ -583,7 +576,7 @@ rm -f "$dir/mine.lock"
 sim_killed() {
     "$SIM" --quiet --link "$2" --seconds 30 >/dev/null 2>&1 &
     kpid=$!
-    for _ in $(seq 100); do [ -L "$2" ] && break; sleep 0.05; done
+    wait_link "$2"
     kill -"$1" $kpid
     wait $kpid 2>/dev/null
 }
@@ -622,7 +615,7 @@ hang_up() {
     [ "$1" = --frozen ] && frozen=1 && shift
     "$SIM" --quiet --link "$dir/dying" --seconds 60 >/dev/null 2>&1 &
     dpid=$!
-    for _ in $(seq 100); do [ -L "$dir/dying" ] && break; sleep 0.05; done
+    wait_link "$dir/dying"
     [ -n "$frozen" ] && kill -STOP $dpid
     "$TASE" "$@" --serial "$dir/dying" >/dev/null 2>"$dir/hang.err" &
     tpid=$!
