@@ -671,6 +671,13 @@ int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
     int fd, sfd;
     const char *name;
     size_t c = 0;
+    sigset_t old;
+    /* A fatal signal's handler removes the link and the lock file of the
+     * claims it knows: one that came after the lock file or the link was
+     * made, but before the claim recorded it, left it behind (a SIGUSR1 as
+     * soon as the link appeared, found by CI). Such a signal waits until
+     * the claim is whole. */
+    (void)sigprocmask(SIG_BLOCK, &fatal_set, &old);
     if (link != NULL) {
         c = claim_link(link); /* before anything is created */
         remove_stale_link(link);
@@ -703,6 +710,7 @@ int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
         }
         strcpy(claims[c].slave, slave);
     }
+    (void)sigprocmask(SIG_SETMASK, &old, NULL);
     return fd;
 }
 
