@@ -181,10 +181,29 @@ static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
     struct stat st;
     uint8_t h[24];
     cap_head_t c = {false, true, SERIAL_SNAPLEN, (uint32_t)linktype};
-    int fd = open(path, O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0666);
+    int fd = open(path, O_RDWR | O_APPEND | O_CLOEXEC);
     int e = 0;
     long at = 24, keep;
     unsigned long index = 0;
+    sigset_t held;
+    bool made = false;
+    if (fd < 0 && errno == ENOENT) {
+        /* a file this call makes is not left empty, without its header, by
+         * a signal that ends the process (a 0-byte FILE is no capture):
+         * such a signal waits until the header is written (the lock below
+         * is held by other writers for one write at a time) */
+        tk_hold_fatal_signals(&held);
+        fd = open(path, O_RDWR | O_APPEND | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        made = fd >= 0;
+        if (!made) {
+            int err = errno;
+            tk_release_fatal_signals(&held);
+            errno = err;
+            if (errno == EEXIST) { /* another program made it meanwhile */
+                fd = open(path, O_RDWR | O_APPEND | O_CLOEXEC);
+            }
+        }
+    }
     if (fd < 0) {
         tk_die("cannot write capture %s: %s", path, strerror(errno));
     }
@@ -247,6 +266,9 @@ static void append_open(tk_cap_writer_t *w, const char *path, int linktype)
         }
     }
     (void)flock(fd, LOCK_UN);
+    if (made) {
+        tk_release_fatal_signals(&held);
+    }
     if (e != 0) {
         (void)close(fd);
         tk_die("cannot write capture %s: %s", path, strerror(e));

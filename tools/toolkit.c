@@ -62,7 +62,7 @@ static void vmsg(const char *fmt, va_list ap)
 }
 
 /* The packet this run has sent, NULL before (tk_mark_sent()). */
-static const char *sent_what;
+static const char *volatile sent_what; /* read by on_fatal_signal() too */
 
 void tk_mark_sent(const char *what)
 {
@@ -318,9 +318,45 @@ static void release_claims_on_signal(void)
     }
 }
 
+/* The signals on_fatal_signal() handles, by name. */
+static const struct {
+    int sig;
+    const char *name;
+} fatal_signals[] = {{SIGQUIT, "SIGQUIT"}, {SIGUSR1, "SIGUSR1"}, {SIGUSR2, "SIGUSR2"},
+                     {SIGALRM, "SIGALRM"}, {SIGPROF, "SIGPROF"}, {SIGVTALRM, "SIGVTALRM"},
+                     {SIGXCPU, "SIGXCPU"}, {SIGPOLL, "SIGPOLL"}};
+
+/* write(2) of a string, in a signal handler */
+static void say_on_signal(const char *text)
+{
+    size_t n = 0;
+    while (text[n] != '\0') {
+        n++;
+    }
+    if (write(STDERR_FILENO, text, n) < 0) {
+        return; /* nowhere to say it */
+    }
+}
+
 static void on_fatal_signal(int sig)
 {
     size_t i;
+    const char *what = sent_what;
+    if (what != NULL) {
+        /* as after SIGINT/SIGTERM/SIGHUP: a script must not take the exit
+         * status 128+N without this line for "nothing was sent" */
+        size_t k;
+        say_on_signal(tk_prog);
+        say_on_signal(": killed by ");
+        for (k = 0; k < sizeof(fatal_signals) / sizeof(fatal_signals[0]); k++) {
+            if (fatal_signals[k].sig == sig) {
+                say_on_signal(fatal_signals[k].name);
+            }
+        }
+        say_on_signal(" (");
+        say_on_signal(what);
+        say_on_signal(" was sent)\n");
+    }
     release_claims_on_signal();
     for (i = 0; i < MAX_OPEN_LINKS; i++) {
         tk_link_t *l = open_links[i];
@@ -335,6 +371,16 @@ static void on_fatal_signal(int sig)
     }
     (void)signal(sig, SIG_DFL);
     (void)raise(sig);
+}
+
+void tk_hold_fatal_signals(sigset_t *old)
+{
+    (void)sigprocmask(SIG_BLOCK, &fatal_set, old);
+}
+
+void tk_release_fatal_signals(const sigset_t *old)
+{
+    (void)sigprocmask(SIG_SETMASK, old, NULL);
 }
 
 void tk_std_fds_open(void)
@@ -359,21 +405,26 @@ void tk_catch_signals(void)
     sa.sa_flags = 0; /* no SA_RESTART: a blocking wait returns at once */
     (void)sigaction(SIGINT, &sa, NULL);
     (void)sigaction(SIGTERM, &sa, NULL);
-    (void)sigaction(SIGHUP, &sa, NULL);
+    {
+        /* under nohup (SIGHUP ignored) a closed terminal does not end the run */
+        struct sigaction hup;
+        if (sigaction(SIGHUP, NULL, &hup) != 0 || hup.sa_handler != SIG_IGN) {
+            (void)sigaction(SIGHUP, &sa, NULL);
+        }
+    }
     (void)signal(SIGPIPE, SIG_IGN);
     {
-        static const int fatal[] = {SIGQUIT, SIGUSR1,   SIGUSR2, SIGALRM,
-                                    SIGPROF, SIGVTALRM, SIGXCPU, SIGPOLL};
         size_t i;
         sa.sa_handler = on_fatal_signal;
         sa.sa_flags = 0; /* the handler resets the action itself */
         sigemptyset(&fatal_set);
-        for (i = 0; i < sizeof(fatal) / sizeof(fatal[0]); i++) {
+        for (i = 0; i < sizeof(fatal_signals) / sizeof(fatal_signals[0]); i++) {
             struct sigaction old;
+            int sig = fatal_signals[i].sig;
             /* one the caller's shell ignores stays ignored */
-            if (sigaction(fatal[i], NULL, &old) == 0 && old.sa_handler != SIG_IGN) {
-                (void)sigaction(fatal[i], &sa, NULL);
-                (void)sigaddset(&fatal_set, fatal[i]);
+            if (sigaction(sig, NULL, &old) == 0 && old.sa_handler != SIG_IGN) {
+                (void)sigaction(sig, &sa, NULL);
+                (void)sigaddset(&fatal_set, sig);
             }
         }
     }
@@ -524,12 +575,22 @@ void tk_link_close(tk_link_t *l)
     if (!l->open) {
         return;
     }
-    l->open = false;
-    track_link(l, false);
-    if (l->is_can) {
-        tase_socketcan_close(&l->can);
-    } else {
-        (void)tase_posix_uart_close(&l->uart);
+    {
+        /* a fatal signal between the untracking and the close (which gives
+         * the line its settings back and ends its exclusive use; on a UART
+         * the drain before it may take a second) left the line raw and
+         * exclusive, "device busy" to the next program: it waits until
+         * the line is closed */
+        sigset_t old;
+        (void)sigprocmask(SIG_BLOCK, &fatal_set, &old);
+        l->open = false;
+        track_link(l, false);
+        if (l->is_can) {
+            tase_socketcan_close(&l->can);
+        } else {
+            (void)tase_posix_uart_close(&l->uart);
+        }
+        (void)sigprocmask(SIG_SETMASK, &old, NULL);
     }
 }
 

@@ -123,9 +123,17 @@ void tk_stdout_flush_soft(void);
 
 /* SIGINT, SIGTERM or SIGHUP caught since tk_catch_signals(), 0 if none. */
 extern volatile sig_atomic_t tk_signal;
-/* Catch those three (without SA_RESTART, so blocking calls return) and
- * ignore SIGPIPE (a closed reader is then a write error). */
+/* Catch those three (without SA_RESTART, so blocking calls return; a
+ * SIGHUP the process was started with ignored stays ignored) and ignore
+ * SIGPIPE (a closed reader is then a write error). The signals that end a
+ * process (SIGQUIT, SIGUSR1, ...) give the open serial lines their settings
+ * back and remove tase-sim's links first, and say what was sent. */
 void tk_catch_signals(void);
+/* Hold those fatal signals (*old: the mask before) until
+ * tk_release_fatal_signals(old), for a step that must not be cut in two
+ * (a capture file made and its header written). */
+void tk_hold_fatal_signals(sigset_t *old);
+void tk_release_fatal_signals(const sigset_t *old);
 /* Open /dev/null on whichever of descriptors 0, 1 and 2 is closed (first
  * thing in main): a program started with its standard output closed wrote
  * its log into the first file it opened (tase-sim: the lock file of its

@@ -9,11 +9,12 @@ if(TARGET tase_cli AND TARGET tase_sim)
   add_test(NAME tools_cli
            COMMAND ${PROJECT_SOURCE_DIR}/tests/tools/cli.py $<TARGET_FILE:tase_cli>
                    $<TARGET_FILE:tase_sim>)
-  # a signal at the moment tase-sim's link is made (tests/tools/after_symlink.c)
-  add_library(tase_test_after_symlink MODULE ${PROJECT_SOURCE_DIR}/tests/tools/after_symlink.c)
+  # signals at the worst moments for the tools (tests/tools/signal_shim.c)
+  add_library(tase_test_signal_shim MODULE ${PROJECT_SOURCE_DIR}/tests/tools/signal_shim.c)
+  target_link_libraries(tase_test_signal_shim PRIVATE ${CMAKE_DL_LIBS})
   add_test(NAME tools_e2e
            COMMAND ${PROJECT_SOURCE_DIR}/tests/tools/e2e.sh $<TARGET_FILE:tase_cli>
-                   $<TARGET_FILE:tase_sim> $<TARGET_FILE:tase_test_after_symlink>)
+                   $<TARGET_FILE:tase_sim> $<TARGET_FILE:tase_test_signal_shim>)
   set_tests_properties(tools_decode tools_cli tools_e2e PROPERTIES LABELS "check;e2e" TIMEOUT 180)
   tase_python_tests(tools_cli) # frames built and read by the tase package
   # tools_e2e drives real processes on the real clock (timeouts, rates): it

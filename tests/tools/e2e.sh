@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # End-to-end test of the bench tools: a real tase-sim process on a pty and
 # the tase command line against it, plus every error path.
-# Usage: tests/tools/e2e.sh TASE TASE_SIM [AFTER_SYMLINK_SHIM]
-#   (registered by tests/checks/tools.cmake; the shim: tests/tools/after_symlink.c)
+# Usage: tests/tools/e2e.sh TASE TASE_SIM [SIGNAL_SHIM]
+#   (registered by tests/checks/tools.cmake; the shim: tests/tools/signal_shim.c)
 set -uo pipefail
 TASE=$1
 SIM=$2
@@ -590,13 +590,74 @@ check "tase-sim ended by SIGUSR1: its link and lock file removed" \
 # simulator has recorded it (the link was left behind: seen once in CI)
 if [ -n "$SHIM" ]; then
     { # (the shell's note of the signal to /dev/null too)
-        LD_PRELOAD=$SHIM TASE_TEST_SIGNAL_AFTER_SYMLINK=$(kill -l USR1) \
+        LD_PRELOAD=$SHIM TASE_TEST_SIGNAL=$(kill -l USR1) TASE_TEST_SIGNAL_AFTER_SYMLINK=1 \
             "$SIM" --quiet --link "$dir/usr1b" --seconds 30 >/dev/null 2>&1
         rc=$?
     } 2>/dev/null
     check "tase-sim ended by SIGUSR1 as its link is made: exit $rc (138), its link and lock file removed" \
         eval '[ $rc = 138 ] && [ ! -e "$dir/usr1b" ] && [ ! -L "$dir/usr1b" ] && [ ! -e "$dir/usr1b.lock" ]'
 fi
+# A tool killed by a fatal signal as it closes its serial line (the line
+# was no longer tracked, not yet given back): the line's settings and its
+# exclusive use were left, "device busy" to the next program.
+"$SIM" --link "$dir/fatal" --seconds $((60 * slow)) >"$dir/fatal.log" 2>&1 &
+fpid=$!
+wait_link "$dir/fatal"
+if [ -n "$SHIM" ]; then
+    before=$(stty -F "$dir/fatal" -g)
+    {
+        LD_PRELOAD=$SHIM TASE_TEST_SIGNAL=$(kill -l USR1) TASE_TEST_SIGNAL_BEFORE_TCSETATTR=2 \
+            "$TASE" query SYSTEM_VERSION --serial "$dir/fatal" >/dev/null 2>"$dir/fatal.err"
+        rc=$?
+    } 2>/dev/null
+    after=$(stty -F "$dir/fatal" -g)
+    "$TASE" query SYSTEM_VERSION --serial "$dir/fatal" >/dev/null 2>"$dir/fatal2.err"
+    rc2=$?
+    check "a tool killed by SIGUSR1 as it closes its line: exit $rc (138), the line's settings given back ($before -> $after), the next open works (exit $rc2: $(head -c 200 "$dir/fatal2.err"))" \
+        eval '[ $rc = 138 ] && [ "$before" = "$after" ] && [ $rc2 = 0 ]'
+fi
+# A tool killed by a fatal signal after its packet went out says so, as
+# SIGINT/SIGTERM do ("(NAME was sent)"): a script must not send it again
+"$TASE" retract --wait $((30 * slow)) --serial "$dir/fatal" >/dev/null 2>"$dir/sent.err" &
+tpid=$!
+wait_for "$dir/fatal.log" "RETRACT_DEPLOY_CMD"
+sleep 0.2
+kill -USR1 $tpid
+wait $tpid
+rc=$?
+grep -v '^==[0-9]*==' "$dir/sent.err" >"$dir/sent.e"
+check "retract killed by SIGUSR1 after the command went out: exit $rc (138), $(cat "$dir/sent.e")" \
+    eval '[ $rc = 138 ] && [ "$(cat "$dir/sent.e")" = "tase: killed by SIGUSR1 (RETRACT_DEPLOY_CMD was sent)" ]'
+# --record to a new file, killed by a fatal signal the moment the file is
+# made: it was left empty (0 bytes, no pcap header); now it has its header
+if [ -n "$SHIM" ]; then
+    {
+        LD_PRELOAD=$SHIM TASE_TEST_SIGNAL=$(kill -l USR1) TASE_TEST_SIGNAL_AFTER_CREATE=new.pcap \
+            "$TASE" query SYSTEM_VERSION --serial "$dir/fatal" --record "$dir/new.pcap" >/dev/null 2>&1
+        rc=$?
+    } 2>/dev/null
+    "$TASE" decode "$dir/new.pcap" >/dev/null 2>"$dir/new.err"
+    rc2=$?
+    check "--record to a new file, killed by SIGUSR1 as it is made: exit $rc (138), the file a capture ($(stat -c %s "$dir/new.pcap" 2>&1) bytes; decode exit $rc2)" \
+        eval '[ $rc = 138 ] && [ "$(stat -c %s "$dir/new.pcap")" -ge 24 ] && [ $rc2 = 0 ] && [ ! -s "$dir/new.err" ]'
+fi
+kill $fpid
+wait $fpid 2>/dev/null
+# under nohup (SIGHUP ignored), a closed terminal does not end tase-sim
+(
+    trap '' HUP
+    exec "$SIM" --quiet --link "$dir/nohup" --seconds $((30 * slow))
+) >/dev/null 2>&1 &
+npid=$!
+wait_link "$dir/nohup"
+kill -HUP $npid
+sleep 0.5
+"$TASE" query SYSTEM_VERSION --serial "$dir/nohup" >/dev/null 2>&1
+rc=$?
+check "tase-sim with SIGHUP ignored (nohup) goes on after a SIGHUP (a query answered: exit $rc)" \
+    eval '[ $rc = 0 ] && kill -0 $npid'
+kill $npid
+wait $npid 2>/dev/null
 # the refusal names three paths: cut at 448 bytes before (a 100-byte link)
 long="$dir/bench-campaign-2026-11-27/hardware-in-the-loop/gimbal-links/run-0001"
 mkdir -p "$long"
