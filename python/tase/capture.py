@@ -10,6 +10,7 @@ import collections
 import errno
 import fcntl
 import os
+import signal
 import stat
 import struct
 import time
@@ -313,12 +314,32 @@ class CaptureWriter:
 
     _HEADER = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, LINKTYPE_SERIAL)
 
+    # the signals that end a Python program, or interrupt it, by default
+    _ENDING = tuple(
+        getattr(signal, n)
+        for n in ("SIGHUP", "SIGINT", "SIGTERM", "SIGQUIT", "SIGUSR1", "SIGUSR2", "SIGALRM",
+                  "SIGPROF", "SIGVTALRM", "SIGXCPU", "SIGPOLL")
+        if hasattr(signal, n)
+    )
+
     def __init__(self, path):
         path = _path_arg("a capture", path)
+        existed = os.path.lexists(path)
+        # a file made here is not left empty, without its header (no
+        # capture), by a signal that comes between: such signals wait
+        # until the header is written (others hold the lock one write at a
+        # time), as in tase --record
+        held = None if existed else signal.pthread_sigmask(signal.SIG_BLOCK, self._ENDING)
+        try:
+            self._open(path, existed)
+        finally:
+            if held is not None:
+                signal.pthread_sigmask(signal.SIG_SETMASK, held)
+
+    def _open(self, path, existed):
         self.path = path
         self.records = 0
         self.f = None
-        existed = os.path.lexists(path)
         fd = None
         try:
             # appended to (O_APPEND), each record in one write: another

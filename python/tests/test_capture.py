@@ -302,6 +302,35 @@ def test_two_writers_creating_one_capture_write_one_header(tmp_path):
         assert [r[3] for r in tase.capture.records(path)] == [b"\x00\x00", b"\x00\x00"]
 
 
+def _killed_as_made(path):
+    # SIGTERM the moment the file is made (as a user's kill could land)
+    import signal
+    real = os.open
+
+    def open_then_kill(p, *a, **k):
+        fd = real(p, *a, **k)
+        if p == path:
+            os.kill(os.getpid(), signal.SIGTERM)
+        return fd
+    os.open = open_then_kill
+    tase.capture.CaptureWriter(path)
+    os._exit(0)  # not reached when the signal ends the process
+
+
+def test_a_new_capture_killed_as_it_is_made_is_not_left_empty(tmp_path):
+    # a review: killed between making the file and writing its header, a
+    # writer left an empty file, which is no capture
+    import multiprocessing
+    import signal
+    path = str(tmp_path / "killed.pcap")
+    p = multiprocessing.get_context("fork").Process(target=_killed_as_made, args=(path,))
+    p.start()
+    p.join(30)
+    assert p.exitcode == -signal.SIGTERM
+    assert open(path, "rb").read() == tase.capture.CaptureWriter._HEADER
+    assert list(tase.capture.records(path)) == []
+
+
 def test_a_fifo_is_refused_not_waited_on(tmp_path):
     path = str(tmp_path / "fifo")
     os.mkfifo(path)
