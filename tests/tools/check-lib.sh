@@ -70,6 +70,19 @@ wait_link() {
         [ -L "$p" ] || return 1
     done
 }
+# sim_says PATTERN: how many lines of the simulator's log ($dir/sim.log) match
+sim_says() { grep -c -- "$1" "$dir/sim.log"; }
+# sim_reaches N PATTERN: true when the simulator's log comes to N matching
+# lines (waiting up to 5 s, times slow: a loaded machine runs the simulator
+# late) and still has N 0.2 s later (a duplicate shows then)
+sim_reaches() {
+    for _ in $(seq $((100 * slow))); do
+        [ "$(sim_says "$2")" -ge "$1" ] && break
+        sleep 0.05
+    done
+    sleep 0.2
+    [ "$(sim_says "$2")" = "$1" ]
+}
 # check_summary WHAT: exit 1 when a check failed
 check_summary() {
     if [ $fails -ne 0 ]; then

@@ -47,19 +47,6 @@ start_sim() {
 
 # last_angle: the last GIMBAL_ANGLE line of a short monitor run
 last_angle() { "$TASE" monitor "${L[@]}" --json --count 40 2>/dev/null | grep '"GIMBAL_ANGLE"' | tail -1; }
-# sim_says PATTERN: how many lines of the simulator's log match
-sim_says() { grep -c -- "$1" "$dir/sim.log"; }
-# sim_reaches N PATTERN: true when the simulator's log comes to N matching
-# lines (waiting up to 5 s: a loaded machine runs the simulator late) and
-# still has N 0.2 s later (a duplicate shows then)
-sim_reaches() {
-    for _ in $(seq $((100 * slow))); do
-        [ "$(sim_says "$2")" -ge "$1" ] && break
-        sleep 0.05
-    done
-    sleep 0.2
-    [ "$(sim_says "$2")" = "$1" ]
-}
 
 L=(--serial "$dir/gimbal")
 start_sim
@@ -501,7 +488,7 @@ old=$(readlink "$dir/stale")
 # was reused, nothing sent.
 "$SIM" --seconds 30 >"$dir/other.log" 2>&1 &
 otherpid=$!
-for _ in $(seq $((100 * slow))); do grep -q "simulated gimbal" "$dir/other.log" && break; sleep 0.05; done
+wait_for "$dir/other.log" "simulated gimbal"
 ln -s stale "$dir/via-stale"
 expect_error "tase point over a killed simulator's stale link ($old; $(head -c 60 "$dir/other.log")): refused" 1 \
     "stale is the link of a tase-sim that is no longer running (pid $kpid, killed?): $old may belong to another program now; not opened, nothing sent" \
@@ -517,7 +504,7 @@ wait $otherpid
 rm "$dir/via-stale"
 "$SIM" --link "$dir/stale" --seconds 30 >"$dir/stale.log" 2>&1 &
 kpid=$!
-for _ in $(seq $((100 * slow))); do grep -q -e "simulated gimbal" -e "tase-sim:" "$dir/stale.log" && break; sleep 0.05; done
+wait_for "$dir/stale.log" "simulated gimbal\|tase-sim:"
 check "a killed simulator's stale link ($old) is replaced by the next one ($(head -1 "$dir/stale.log"))" \
     eval 'grep -q "simulated gimbal on .*(link .*stale)" "$dir/stale.log" &&
           "$TASE" query SYSTEM_VERSION --serial "$dir/stale" >/dev/null'
