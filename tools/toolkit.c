@@ -485,13 +485,13 @@ int tk_link_serial_try(tk_link_t *l, const char *path, long baud)
          * the tracking (from which its handler restores the line) waits
          * until both are done */
         sigset_t old;
-        (void)sigprocmask(SIG_BLOCK, &fatal_set, &old);
+        tk_hold_fatal_signals(&old);
         rc = tase_posix_uart_open(&l->uart, path, (uint32_t)baud);
         if (rc == TASE_OK) {
             l->open = true;
             track_link(l, true);
         }
-        (void)sigprocmask(SIG_SETMASK, &old, NULL);
+        tk_release_fatal_signals(&old);
     }
     if (rc == TASE_OK && tk_simlink_check(path, why, sizeof(why)) != 0) {
         tk_die("%s", why); /* closes the link: its settings given back */
@@ -582,7 +582,7 @@ void tk_link_close(tk_link_t *l)
          * exclusive, "device busy" to the next program: it waits until
          * the line is closed */
         sigset_t old;
-        (void)sigprocmask(SIG_BLOCK, &fatal_set, &old);
+        tk_hold_fatal_signals(&old);
         l->open = false;
         track_link(l, false);
         if (l->is_can) {
@@ -590,7 +590,7 @@ void tk_link_close(tk_link_t *l)
         } else {
             (void)tase_posix_uart_close(&l->uart);
         }
-        (void)sigprocmask(SIG_SETMASK, &old, NULL);
+        tk_release_fatal_signals(&old);
     }
 }
 
@@ -738,7 +738,7 @@ int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
      * made, but before the claim recorded it, left it behind (a SIGUSR1 as
      * soon as the link appeared, found by CI). Such a signal waits until
      * the claim is whole. */
-    (void)sigprocmask(SIG_BLOCK, &fatal_set, &old);
+    tk_hold_fatal_signals(&old);
     if (link != NULL) {
         c = claim_link(link); /* before anything is created */
         remove_stale_link(link);
@@ -771,7 +771,7 @@ int tk_pty_open(char *slave, size_t cap, const char *link, int *slave_fd)
         }
         strcpy(claims[c].slave, slave);
     }
-    (void)sigprocmask(SIG_SETMASK, &old, NULL);
+    tk_release_fatal_signals(&old);
     return fd;
 }
 
