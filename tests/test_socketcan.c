@@ -14,6 +14,7 @@
 #include <errno.h>
 #include <signal.h>
 #include <sys/socket.h>
+#include <sys/syscall.h>
 #include <sys/time.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -28,6 +29,35 @@ typedef struct {
     int peer; /* the test's end */
     tase_socketcan_t s;
 } pair_t;
+
+/* Fault injection: the next `count` calls of recvmsg() (or write()) fail
+ * with `err`. These definitions come before the C library's for the whole
+ * program, the port's calls included; unarmed they are the system calls. */
+typedef struct {
+    int err;
+    int count;
+} inject_t;
+static inject_t inject_recvmsg, inject_write;
+
+static bool injected(inject_t *in)
+{
+    if (in->count <= 0) {
+        return false;
+    }
+    in->count--;
+    errno = in->err;
+    return true;
+}
+
+ssize_t recvmsg(int fd, struct msghdr *msg, int flags)
+{
+    return injected(&inject_recvmsg) ? -1 : (ssize_t)syscall(SYS_recvmsg, fd, msg, flags);
+}
+
+ssize_t write(int fd, const void *buf, size_t n)
+{
+    return injected(&inject_write) ? -1 : (ssize_t)syscall(SYS_write, fd, buf, n);
+}
 
 static void open_pair(pair_t *p, tase_can_role_t role)
 {
@@ -743,6 +773,73 @@ static void receive_timestamps_are_the_kernels_not_the_read_time(void **state)
     close_pair(&p);
 }
 
+/* The kernel reports an interface going down (ENETDOWN) or removed
+ * (ENODEV) to a reading socket once: a read that holds bytes of a frame
+ * returns them, and the next read the error, never a silent 0. */
+static void a_read_error_after_bytes_in_hand_comes_with_the_next_read(void **state)
+{
+    static const uint8_t d[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    pair_t p;
+    uint8_t buf[8];
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    peer_send(&p, 0x10000000u | CAN_EFF_FLAG, d, 8);
+    assert_int_equal(tase_socketcan_read(&p.s, buf, 5, 200), 5);
+    assert_memory_equal(buf, d, 5);
+    inject_recvmsg.err = ENETDOWN;
+    inject_recvmsg.count = 1;
+    assert_int_equal(tase_socketcan_read(&p.s, buf, 5, 0), 3);
+    assert_memory_equal(buf, d + 5, 3);
+    assert_int_equal(inject_recvmsg.count, 0); /* it met the error */
+    assert_int_equal(tase_socketcan_read(&p.s, buf, 5, 0), TASE_EDOWN);
+    assert_int_equal(p.s.stats.last_errno, ENETDOWN);
+    /* said once: the socket works again (an interface brought back up) */
+    peer_send(&p, 0x10000000u | CAN_EFF_FLAG, d, 2);
+    assert_int_equal(tase_socketcan_read(&p.s, buf, 5, 200), 2);
+    /* with nothing in hand the error comes at once; removed is ENODEV */
+    inject_recvmsg.err = ENODEV;
+    inject_recvmsg.count = 1;
+    assert_int_equal(tase_socketcan_read(&p.s, buf, 5, 0), TASE_ENODEV);
+    assert_int_equal(tase_socketcan_read(&p.s, buf, 5, 0), 0);
+    /* the other errors of a descriptor stay TASE_EIO */
+    inject_recvmsg.err = EBADF;
+    inject_recvmsg.count = 1;
+    assert_int_equal(tase_socketcan_read(&p.s, buf, 5, 0), TASE_EIO);
+    assert_int_equal(p.s.stats.last_errno, EBADF);
+    close_pair(&p);
+}
+
+/* Writing: down is TASE_EDOWN, an unbound socket of a removed interface
+ * (ENXIO) TASE_ENODEV; a full interface queue is counted once a frame in
+ * bus.enobufs however often the frame is retried (tx_retries counts those). */
+static void write_errors_and_the_queue_full_count(void **state)
+{
+    static const uint8_t d[3] = {0x00, 0xFF, 0x5A};
+    pair_t p;
+    tase_socketcan_bus_t b;
+    struct can_frame cf;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    inject_write.err = ENETDOWN;
+    inject_write.count = 1;
+    assert_int_equal(tase_socketcan_write(&p.s, d, 3), TASE_EDOWN);
+    inject_write.err = ENXIO;
+    inject_write.count = 1;
+    assert_int_equal(tase_socketcan_write(&p.s, d, 3), TASE_ENODEV);
+    assert_int_equal(p.s.stats.last_errno, ENXIO);
+    inject_write.err = ENOBUFS;
+    inject_write.count = 5;
+    assert_int_equal(tase_socketcan_write(&p.s, d, 3), 3);
+    assert_int_equal(inject_write.count, 0);
+    assert_int_equal(tase_socketcan_bus(&p.s, &b), TASE_OK);
+    assert_int_equal(b.enobufs, 1);
+    assert_int_equal(p.s.stats.tx_retries, 5);
+    assert_int_equal(recv(p.peer, &cf, sizeof(cf), MSG_DONTWAIT), (ssize_t)sizeof(cf));
+    assert_int_equal(cf.can_dlc, 3);
+    assert_int_equal(recv(p.peer, &cf, sizeof(cf), MSG_DONTWAIT), -1); /* that one only */
+    close_pair(&p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -765,6 +862,8 @@ int main(void)
         cmocka_unit_test(error_frames_report_the_bus_state_and_are_never_data),
         cmocka_unit_test(fd_frames_are_rejected_and_classic_frames_still_read),
         cmocka_unit_test(receive_timestamps_are_the_kernels_not_the_read_time),
+        cmocka_unit_test(a_read_error_after_bytes_in_hand_comes_with_the_next_read),
+        cmocka_unit_test(write_errors_and_the_queue_full_count),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -344,6 +344,84 @@ static void send_klv(sim_t *s, const tase_port_t *klv)
     }
 }
 
+/* ---- a CAN interface that goes down or away ---- */
+
+/* The gimbal role skips a port's read errors (the port may recover), and
+ * an interface that is removed and made again (a USB adapter unplugged
+ * and plugged back) leaves the raw socket unbound for good: tase-sim
+ * watches its CAN port through this wrapper, says what happened in its
+ * log, and opens the interface again when it is back. */
+typedef struct {
+    tase_port_t inner; /* the link's port (its ctx is the tk_link_t's) */
+    int err;           /* the first error since the last look, 0: none */
+    bool worked;       /* a read or write moved bytes since the last look */
+    bool down, gone;   /* what the log said last */
+    uint32_t next_try; /* gone: when to try opening it again */
+} sim_can_watch_t;
+
+static int can_watch_note(sim_can_watch_t *w, int r)
+{
+    if (r < 0 && w->err == 0) {
+        w->err = r;
+    } else if (r > 0) {
+        w->worked = true;
+    }
+    return r;
+}
+
+static int can_watch_write(void *ctx, const uint8_t *data, size_t n)
+{
+    sim_can_watch_t *w = ctx;
+    return can_watch_note(w, w->inner.ops->write(w->inner.ctx, data, n));
+}
+
+static int can_watch_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    sim_can_watch_t *w = ctx;
+    return can_watch_note(w, w->inner.ops->read(w->inner.ctx, buf, cap, timeout_ms));
+}
+
+static uint32_t can_watch_now(void *ctx)
+{
+    sim_can_watch_t *w = ctx;
+    return w->inner.ops->now_ms(w->inner.ctx);
+}
+
+static const tase_port_ops_t can_watch_ops = {can_watch_write, can_watch_read, can_watch_now};
+
+/* After each service: log a change and, while the interface is gone, try
+ * to open it again every half second. */
+static void can_watch_look(sim_t *s, sim_can_watch_t *w, tk_link_t *dl, const char *iface,
+                           uint32_t now)
+{
+    int err = w->err;
+    bool worked = w->worked;
+    w->err = 0;
+    w->worked = false;
+    if (err == TASE_ENODEV && !w->gone) {
+        sim_log(s, now, "CAN interface %s: %s; opening it again when it is back", iface,
+                TK_CAN_REMOVED_TEXT);
+        w->gone = true;
+        w->down = false;
+        w->next_try = now;
+    }
+    if (w->gone) {
+        if ((int32_t)(now - w->next_try) >= 0) {
+            w->next_try = now + 500u;
+            if (tk_link_can_reopen(dl, iface, true) == TASE_OK) {
+                w->gone = false;
+                sim_log(s, now, "CAN interface %s is back: serving on it again", iface);
+            }
+        }
+    } else if (err == TASE_EDOWN && !w->down) {
+        sim_log(s, now, "CAN interface %s: %s; waiting for it to come up", iface, TK_CAN_DOWN_TEXT);
+        w->down = true;
+    } else if (w->down && worked && err == 0) {
+        sim_log(s, now, "CAN interface %s is up again", iface);
+        w->down = false;
+    }
+}
+
 /* ---- main ---- */
 
 int main(int argc, char **argv)
@@ -364,6 +442,7 @@ int main(int argc, char **argv)
     bool have_klv = false;
     tase_axis_setting_t axs;
     tase_nav_source_t nav;
+    sim_can_watch_t watch;
 
     tk_std_fds_open(); /* before anything opens a file */
     tk_prog = "tase-sim";
@@ -466,7 +545,12 @@ int main(int argc, char **argv)
         tk_link_pty(&dl, tk_pty_open(path, sizeof(path), link, &slave_fd));
     }
     port = tk_link_port(&dl);
-    if (can == NULL) {
+    memset(&watch, 0, sizeof(watch));
+    if (can != NULL) {
+        watch.inner = port;
+        port.ops = &can_watch_ops;
+        port.ctx = &watch;
+    } else {
         /* a pty has no speed of its own: the simulated line's is --baud
          * (--can-pty: the CAN port's); the gimbal role sizes telemetry (its
          * capacity) and the receiver's time bound by it */
@@ -555,6 +639,9 @@ int main(int argc, char **argv)
             (void)tk_pty_drop_unread(slave_fd);
         }
         (void)tase_gimbal_service(&s.g, now);
+        if (can != NULL) {
+            can_watch_look(&s, &watch, &dl, can, now);
+        }
         if (s.version_due) {
             /* after the callbacks: they may not store setup packets */
             set_version(&s, now);

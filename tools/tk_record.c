@@ -40,8 +40,8 @@ static FILE *status_out(const char *path)
 static void print_recorded(const tk_cap_writer_t *w, unsigned long bytes, const char *what)
 {
     FILE *out = status_out(w->path);
-    fprintf(out, "recorded %lu record%s (%lu %s) to %s\n", w->records, w->records == 1 ? "" : "s",
-            bytes, what, w->path);
+    fprintf(out, "recorded %lu record%s (%lu %s%s) to %s\n", w->records, w->records == 1 ? "" : "s",
+            bytes, what, bytes == 1 ? "" : "s", w->path);
     if (out == stdout) {
         tk_stdout_flush();
     }
@@ -132,7 +132,7 @@ void tk_cap_record_serial(tk_cap_writer_t *w, const char *path, const char *dev,
         tk_link_close(&links[i]);
     }
     tk_cap_close(w);
-    print_recorded(w, bytes, "bytes");
+    print_recorded(w, bytes, "byte");
     if (failed != 0) {
         tk_die("cannot read %s: %s", failed_dev == 0 ? dev : tap_in,
                tk_link_error(&links[failed_dev], failed));
@@ -174,9 +174,10 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *path, const char *iface, 
     int fd = open_can_recorder(iface);
     double t_end = seconds > 0.0 ? tk_now_s() + seconds : 0.0;
     unsigned long frames = 0;
+    int failed = 0; /* errno of a read that ended the recording */
     print_recording(path, iface, NULL, seconds);
     tk_cap_create(w, path, TK_CAP_LINKTYPE_CAN, false); /* the source is open */
-    while (tk_signal == 0) {
+    while (tk_signal == 0 && failed == 0) {
         struct pollfd pfd = {fd, POLLIN, 0};
         int timeout = ms_left(t_end), pr;
         if (timeout == 0) {
@@ -207,7 +208,8 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *path, const char *iface, 
                 break;
             }
             if (got < 0) {
-                tk_die("cannot read CAN interface %s: %s", iface, strerror(errno));
+                failed = errno; /* as in the serial loop: close, then say why */
+                break;
             }
             if (got != (ssize_t)CAN_MTU && got != (ssize_t)CANFD_MTU) {
                 continue; /* not a frame record */
@@ -227,8 +229,14 @@ void tk_cap_record_can(tk_cap_writer_t *w, const char *path, const char *iface, 
     }
     close(fd);
     tk_cap_close(w);
-    print_recorded(w, frames, "frames");
+    print_recorded(w, frames, "frame");
     tk_stdout_flush();
+    if (failed != 0) {
+        tk_die("cannot read CAN interface %s: %s", iface,
+               failed == ENETDOWN                      ? TK_CAN_DOWN_TEXT
+               : (failed == ENODEV || failed == ENXIO) ? TK_CAN_REMOVED_TEXT
+                                                       : strerror(failed));
+    }
 }
 
 /* ---- replay ---- */

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <limits.h>
+#include <net/if.h>
 #include <sys/file.h>
 #include <sys/ioctl.h>
 #include <sys/stat.h>
@@ -547,10 +548,16 @@ void tk_link_pty(tk_link_t *l, int fd)
 void tk_link_can(tk_link_t *l, const char *iface, bool gimbal)
 {
     int rc;
+    size_t n = strlen(iface);
+    if (n == 0u || n >= (size_t)IFNAMSIZ) {
+        tk_usage_error("bad CAN interface name '%s' (1 to %d characters)", iface, IFNAMSIZ - 1);
+    }
     memset(l, 0, sizeof(*l));
     l->is_can = true;
     rc = tase_socketcan_open(&l->can, iface, gimbal ? TASE_CAN_ROLE_GIMBAL : TASE_CAN_ROLE_HOST);
-    if (rc == TASE_EUNSUPPORTED) {
+    if (rc == TASE_EARG) {
+        tk_die("cannot open CAN interface %s: not a CAN interface", iface);
+    } else if (rc == TASE_EUNSUPPORTED) {
         tk_die("cannot open CAN interface %s: this kernel has no SocketCAN support (load the can "
                "and can-raw modules, or see docs/CAN.md for the VM)",
                iface);
@@ -563,6 +570,18 @@ void tk_link_can(tk_link_t *l, const char *iface, bool gimbal)
     }
     l->open = true;
     track_link(l, true);
+}
+
+int tk_link_can_reopen(tk_link_t *l, const char *iface, bool gimbal)
+{
+    tase_socketcan_t fresh;
+    int rc = tase_socketcan_open(&fresh, iface, gimbal ? TASE_CAN_ROLE_GIMBAL : TASE_CAN_ROLE_HOST);
+    if (rc == TASE_OK) {
+        fresh.tx_timeout_ms = l->can.tx_timeout_ms;
+        tase_socketcan_close(&l->can);
+        l->can = fresh;
+    }
+    return rc;
 }
 
 tase_port_t tk_link_port(tk_link_t *l)
@@ -600,7 +619,10 @@ const char *tk_link_error(const tk_link_t *l, int rc)
         return "the device went away or hung up";
     }
     if (rc == TASE_EDOWN && l->is_can) {
-        return "the interface went down";
+        return TK_CAN_DOWN_TEXT;
+    }
+    if (rc == TASE_ENODEV && l->is_can) {
+        return TK_CAN_REMOVED_TEXT;
     }
     return tase_strerror(rc);
 }

@@ -163,6 +163,15 @@ int tk_link_serial_try(tk_link_t *l, const char *path, long baud);
 void tk_link_serial_die(const char *path, int rc);
 /* Open a CAN interface as the host (gimbal == false) or the gimbal. */
 void tk_link_can(tk_link_t *l, const char *iface, bool gimbal);
+/* Open the CAN interface of link l again (one removed and made anew
+ * leaves the old socket unbound): TASE_OK, the link's port now on the new
+ * socket (its ctx is unchanged), or the code of tase_socketcan_open(), the
+ * link as it was. */
+int tk_link_can_reopen(tk_link_t *l, const char *iface, bool gimbal);
+/* What a CAN interface did when its reads or writes fail (tk_link_error()
+ * and `record --can` say it so). */
+#define TK_CAN_DOWN_TEXT "the interface went down"
+#define TK_CAN_REMOVED_TEXT "the interface was removed"
 /* Take over an open terminal descriptor (a pty master). */
 void tk_link_pty(tk_link_t *l, int fd);
 /* The port interface over an open link. */

@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <net/if.h>
+#include <net/if_arp.h>
 #include <poll.h>
 #include <string.h>
 #include <sys/ioctl.h>
@@ -171,6 +172,17 @@ static int errno_to_tase(int e)
     }
 }
 
+/* A descriptor error of a read or write: counted in last_errno, and the
+ * code ERRORS in the header gives it. */
+static int io_error(tase_socketcan_t *s, int e)
+{
+    s->stats.last_errno = e;
+    if (e == ENETDOWN) {
+        return TASE_EDOWN; /* interface down (or bus-off without auto-restart) */
+    }
+    return (e == ENODEV || e == ENXIO) ? TASE_ENODEV : TASE_EIO;
+}
+
 /* Everything open() checks once the socket exists. */
 static int bind_to(int fd, const char *ifname, tase_can_role_t role)
 {
@@ -182,6 +194,13 @@ static int bind_to(int fd, const char *ifname, tase_can_role_t role)
     }
     memset(&ifr, 0, sizeof(ifr));
     memcpy(ifr.ifr_name, ifname, strlen(ifname) + 1u);
+    /* bind() says ENODEV for lo or eth0 too: tell them apart */
+    if (ioctl(fd, SIOCGIFHWADDR, &ifr) != 0) {
+        return errno_to_tase(errno);
+    }
+    if (ifr.ifr_hwaddr.sa_family != ARPHRD_CAN) {
+        return TASE_EARG;
+    }
     if (ioctl(fd, SIOCGIFFLAGS, &ifr) != 0) {
         return errno_to_tase(errno);
     }
@@ -296,6 +315,7 @@ static bool from_linux(const struct can_frame *cf, tase_can_frame_t *f)
 static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, uint32_t deadline)
 {
     struct can_frame cf;
+    bool refused = false;
     to_linux(f, &cf);
     for (;;) {
         ssize_t n = write(s->fd, &cf, sizeof(cf));
@@ -311,15 +331,11 @@ static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, uint32_t d
         if (e == EINTR) {
             continue;
         }
-        if (e == ENETDOWN) {
-            s->stats.last_errno = e;
-            return TASE_EDOWN; /* interface down (or bus-off without auto-restart) */
-        }
         if (!would_block(e) && e != ENOBUFS) {
-            s->stats.last_errno = e;
-            return TASE_EIO;
+            return io_error(s, e);
         }
-        if (e == ENOBUFS) {
+        if (e == ENOBUFS && !refused) {
+            refused = true; /* the frame, not each retry */
             s->bus.enobufs++;
         }
         if (remaining(deadline) == 0u) {
@@ -508,8 +524,8 @@ static bool skip_ends(uint32_t deadline, unsigned *skipped)
     return *skipped % SKIP_BATCH == 0u && remaining(deadline) == 0u;
 }
 
-/* Next data frame from the socket by `deadline`: 1, 0 or TASE_EIO; *ns is
- * the frame's kernel receive time. */
+/* Next data frame from the socket by `deadline`: 1, 0 or an error (ERRORS
+ * in the header); *ns is the frame's kernel receive time. */
 static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint32_t deadline,
                     unsigned *skipped)
 {
@@ -530,8 +546,7 @@ static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint
             continue;
         }
         if (!would_block(errno)) {
-            s->stats.last_errno = errno;
-            return TASE_EIO;
+            return io_error(s, errno);
         }
         if (remaining(deadline) == 0u) {
             return 0;
@@ -600,14 +615,28 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
     }
     deadline = deadline_in(timeout_ms);
     got = take_pending(s, buf, cap);
+    if (s->rx_err != 0) {
+        /* the error the last call met after its bytes: the kernel said it
+         * once, so it is said now (after what was received before it) */
+        int e = s->rx_err;
+        if (got > 0u) {
+            return (int)got;
+        }
+        s->rx_err = 0;
+        return e;
+    }
     /* Once some bytes are in hand, only drain what is already queued. */
     while (got < cap) {
         /* bytes in hand: what is queued only, now (also for the frames
          * skipped below) */
         uint32_t until = got > 0u ? deadline_in(0u) : deadline;
         int rc = recv_wanted(s, &f, &ns, until, &skipped);
+        if (rc < 0 && got > 0u) {
+            s->rx_err = rc;
+            return (int)got;
+        }
         if (rc < 0) {
-            return got > 0u ? (int)got : rc;
+            return rc;
         }
         if (rc == 0) {
             break;

@@ -26,6 +26,12 @@
  *   agent health IF host COUNT MS    read as host until COUNT error frames
  *                                    came or MS passed; prints READY, then
  *                                    "BUS state=.. errors=.. ..."
+ *   agent downread IF host           prints READY, reads 5 of the 8 bytes of
+ *                                    a frame, takes IF down (ip link), reads
+ *                                    twice more: "DOWNREAD r1=.. r2=.. r3=..
+ *                                    errno=.." (the kernel says ENETDOWN once)
+ *   agent gone IF host               deletes IF (ip link), then reads and
+ *                                    writes: "GONE read=.. write=.. errno=.."
  */
 #define _DEFAULT_SOURCE 1
 #include <signal.h>
@@ -294,6 +300,48 @@ static int do_health(tase_socketcan_t *s, uint32_t count, uint32_t ms)
     return 0;
 }
 
+/* `ip link ARGS` through the VM's shell; false when it failed. */
+static bool ip_link(const char *args)
+{
+    char cmd[128];
+    int n = snprintf(cmd, sizeof cmd, "ip link %s", args);
+    return n > 0 && (size_t)n < sizeof cmd && system(cmd) == 0;
+}
+
+static int do_downread(tase_socketcan_t *s, const char *ifname)
+{
+    uint8_t buf[5];
+    char args[64];
+    int r1, r2, r3;
+    printf("READY\n");
+    fflush(stdout);
+    r1 = tase_socketcan_read(s, buf, sizeof buf, 5000);
+    (void)snprintf(args, sizeof args, "set %s down", ifname);
+    if (!ip_link(args)) {
+        return 1;
+    }
+    r2 = tase_socketcan_read(s, buf, sizeof buf, 500);
+    r3 = tase_socketcan_read(s, buf, sizeof buf, 500);
+    printf("DOWNREAD r1=%d r2=%d r3=%d errno=%d\n", r1, r2, r3, s->stats.last_errno);
+    return 0;
+}
+
+static int do_gone(tase_socketcan_t *s, const char *ifname)
+{
+    static const uint8_t bytes[3] = {0x00, 0xFF, 0x5A};
+    uint8_t buf[8];
+    char args[64];
+    int r, w;
+    (void)snprintf(args, sizeof args, "del %s", ifname);
+    if (!ip_link(args)) {
+        return 1;
+    }
+    r = tase_socketcan_read(s, buf, sizeof buf, 500);
+    w = tase_socketcan_write(s, bytes, sizeof bytes);
+    printf("GONE read=%d write=%d errno=%d\n", r, w, s->stats.last_errno);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     tase_socketcan_t s;
@@ -325,6 +373,10 @@ int main(int argc, char **argv)
         rc = do_query(&s);
     } else if (strcmp(argv[1], "fill") == 0 && argc == 4) {
         rc = do_fill(&s);
+    } else if (strcmp(argv[1], "downread") == 0 && argc == 4) {
+        rc = do_downread(&s, argv[2]);
+    } else if (strcmp(argv[1], "gone") == 0 && argc == 4) {
+        rc = do_gone(&s, argv[2]);
     } else if (strcmp(argv[1], "health") == 0 && argc == 6) {
         rc = do_health(&s, (uint32_t)strtoul(argv[4], NULL, 10),
                        (uint32_t)strtoul(argv[5], NULL, 10));

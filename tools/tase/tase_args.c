@@ -104,8 +104,23 @@ bool cli_link_opt(cli_args_t *a, cli_link_opts_t *l)
         l->baud_given = true;
         return true;
     }
-    return cli_opt(a, "--serial", true, &l->serial) || cli_opt(a, "--can", true, &l->can) ||
-           cli_opt(a, "--record", true, &l->record);
+    {
+        static const char *const names[3] = {"--serial", "--can", "--record"};
+        const char **vals[3];
+        size_t k;
+        vals[0] = &l->serial;
+        vals[1] = &l->can;
+        vals[2] = &l->record;
+        for (k = 0; k < 3u; k++) {
+            if (cli_opt(a, names[k], true, vals[k])) {
+                if (*vals[k][0] == '\0') {
+                    tk_usage_error("option %s needs a value", names[k]); /* --can "" */
+                }
+                return true;
+            }
+        }
+    }
+    return false;
 }
 
 long long cli_int_opt_value(const char *name, const char *v, long long min, long long max)

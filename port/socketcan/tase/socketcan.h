@@ -69,12 +69,18 @@
  * tase_socketcan_rx_time_ns() gives the one of the frame whose data was
  * last returned.
  *
- * ERRORS. open(): interface name missing or too long -> TASE_ENODEV or
- * TASE_EARG; interface not up -> TASE_EDOWN; kernel without CAN
- * (EAFNOSUPPORT/EPROTONOSUPPORT) -> TASE_EUNSUPPORTED; EPERM/EACCES ->
- * TASE_EACCES; anything else -> TASE_EIO. Writing to an interface that
- * went down (ENETDOWN) -> TASE_EDOWN. A descriptor error while reading or
- * writing -> TASE_EIO (errno kept in stats.last_errno).
+ * ERRORS. open(): name empty or too long -> TASE_EARG; no interface of
+ * that name -> TASE_ENODEV; an interface that is not CAN (lo, eth0: its
+ * hardware type is not ARPHRD_CAN) -> TASE_EARG; interface not up ->
+ * TASE_EDOWN; kernel without CAN (EAFNOSUPPORT/EPROTONOSUPPORT) ->
+ * TASE_EUNSUPPORTED; EPERM/EACCES -> TASE_EACCES; anything else ->
+ * TASE_EIO. Reading or writing: an interface that went down (ENETDOWN)
+ * -> TASE_EDOWN; one that was removed (ENODEV, ENXIO; a raw socket stays
+ * unbound when an interface of the same name comes back, so open a new
+ * one) -> TASE_ENODEV; any other descriptor error -> TASE_EIO; errno kept
+ * in stats.last_errno. The kernel reports a read error once: a read()
+ * that meets it with bytes in hand returns the bytes, and the next read()
+ * returns the error (also when it finds nothing else).
  *
  * Threads: one instance is used by one thread at a time. Not ISR code.
  */
@@ -128,7 +134,8 @@ typedef struct {
     uint32_t no_acks;       /* transmissions nobody acknowledged */
     uint32_t bus_errors;    /* protocol, transceiver and bus errors */
     uint32_t overflows;     /* controller RX/TX buffer overflows */
-    uint32_t enobufs;       /* writes the interface queue refused (ENOBUFS) */
+    uint32_t enobufs;       /* frames the interface queue refused (ENOBUFS), each
+                             * counted once however often it was retried */
 } tase_socketcan_bus_t;
 
 /* Instance; every field but `stats` and `tx_timeout_ms` is private. */
@@ -148,6 +155,7 @@ typedef struct {
     uint8_t side_count;
     tase_can_frame_t side[TASE_SOCKETCAN_SIDEQ];
     uint64_t side_ns[TASE_SOCKETCAN_SIDEQ];
+    int rx_err; /* a read error met with bytes in hand: the next read()'s */
 } tase_socketcan_t;
 
 /* Open a raw CAN socket on interface `ifname` for `role`, non-blocking,
