@@ -19,6 +19,7 @@ import os
 import re
 import sys
 import select
+import socket
 import struct
 import termios
 import threading
@@ -298,6 +299,27 @@ class _SerialTransport:
         self.ser.close()
 
 
+def _interface_exists(name):
+    try:
+        socket.if_nametoindex(name)
+        return True
+    except OSError:
+        return False
+
+
+def _can_error(what, name, e):
+    """The LinkError of a failed CAN read or send, with the C port's code
+    and the tools' words for an interface that went down or was removed
+    (python-can may wrap the OSError in a CanError: its cause is looked at)."""
+    os_e = e if isinstance(e, OSError) else e.__cause__ or e.__context__
+    e_no = getattr(os_e, "errno", None) or getattr(e, "error_code", None)
+    if e_no == errno.ENETDOWN:
+        return LinkError("%s %s: the interface went down" % (what, name), lib.TASE_EDOWN)
+    if e_no in (errno.ENODEV, errno.ENXIO):
+        return LinkError("%s %s: the interface was removed" % (what, name), lib.TASE_ENODEV)
+    return LinkError("%s %s: %s" % (what, name, e), lib.TASE_EIO)
+
+
 class _CanTransport:
     """The datalink over CAN as the host (sends 0x11000000, listens to
     0x10000000): the library splits and accepts, python-can moves frames."""
@@ -312,13 +334,18 @@ class _CanTransport:
         try:
             self.bus = can.Bus(interface=scheme, channel=channel)
         except (OSError, can.CanError, ValueError) as e:
+            e_no = getattr(e, "errno", None)
+            code = lib.TASE_ENODEV
             why = {
                 errno.EAFNOSUPPORT: "this kernel has no SocketCAN support (load the can and "
                 "can-raw modules, or see docs/CAN.md for the VM)",
                 errno.ENODEV: "no such device",
                 errno.ENETDOWN: "interface is down (ip link set %s up)" % channel,
-            }.get(getattr(e, "errno", None), str(e))
-            raise LinkError("cannot open %s:%s: %s" % (scheme, channel, why), lib.TASE_ENODEV) from e
+            }.get(e_no, str(e))
+            if e_no == errno.ENODEV and _interface_exists(channel):
+                # bind() says ENODEV for lo or eth0 too, as the C port knows
+                why, code = "not a CAN interface", lib.TASE_EARG
+            raise LinkError("cannot open %s:%s: %s" % (scheme, channel, why), code) from e
         self.bytes_per_s = lib.TASE_SOCKETCAN_BYTES_PER_S
         self.pending = b""
         self.frames = ffi.new("tase_can_frame_t[]", 40)
@@ -336,7 +363,7 @@ class _CanTransport:
             try:
                 self.bus.send(msg, timeout=1.0)
             except (OSError, self.can.CanError) as e:
-                raise LinkError("cannot send on %s: %s" % (self.name, e), lib.TASE_EIO) from e
+                raise _can_error("cannot send on", self.name, e) from e
         return len(data)
 
     def read(self, cap, timeout_s):
@@ -349,7 +376,7 @@ class _CanTransport:
             try:
                 msg = self.bus.recv(left)
             except (OSError, self.can.CanError) as e:
-                raise LinkError("cannot read %s: %s" % (self.name, e), lib.TASE_EIO) from e
+                raise _can_error("cannot read", self.name, e) from e
             if msg is None:
                 return b""
             if msg.is_error_frame or msg.is_remote_frame or getattr(msg, "is_fd", False):

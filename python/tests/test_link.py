@@ -727,6 +727,50 @@ def test_units_json_equals_tase_monitor(sim, tase_cli):
     assert {"GIMBAL_ANGLE", "GIMBAL_RATE", "GEOREFERENCE_DATA"} <= names
 
 
+def test_can_errors_say_what_the_interface_did(monkeypatch):
+    """A CAN interface that goes down or is removed under a link: the C
+    port's code and the tools' words, not an I/O error; one that is not CAN
+    (bind() says ENODEV for lo too) is told from a missing one."""
+    can = pytest.importorskip("can")
+    e = errno
+    with tase.connect("virtual:tase-errors") as link:
+        bus = link._t.bus
+
+        def down(timeout=None):
+            # python-can wraps the socket's OSError in a CanOperationError
+            try:
+                raise OSError(e.ENETDOWN, "Network is down")
+            except OSError as os_e:
+                raise can.CanOperationError("Failed to receive", e.ENETDOWN) from os_e
+
+        monkeypatch.setattr(bus, "recv", down)
+        with pytest.raises(tase.LinkError, match="cannot read tase-errors: the interface went "
+                           "down") as info:
+            link.recv(timeout=0.1)
+        assert info.value.code == lib.TASE_EDOWN
+        assert str(info.value).endswith("the interface went down")
+
+        def gone(msg, timeout=None):
+            raise OSError(e.ENXIO, "No such device or address")
+
+        monkeypatch.setattr(bus, "send", gone)
+        with pytest.raises(tase.LinkError) as info:
+            link.send(tase.Packet.query("PACKET_RATE"))
+        assert info.value.code == lib.TASE_ENODEV
+        assert str(info.value).endswith("the interface was removed")
+
+    def refuse(interface, channel):
+        raise OSError(e.ENODEV, "No such device")
+
+    monkeypatch.setattr(can, "Bus", refuse)
+    with pytest.raises(tase.LinkError, match="socketcan:lo: not a CAN interface") as info:
+        tase.connect("socketcan:lo")
+    assert info.value.code == lib.TASE_EARG
+    with pytest.raises(tase.LinkError, match="socketcan:tasenosuch0: no such device") as info:
+        tase.connect("socketcan:tasenosuch0")
+    assert info.value.code == lib.TASE_ENODEV
+
+
 def test_missing_can_interface():
     pytest.importorskip("can")
     with pytest.raises(tase.LinkError, match="no SocketCAN support|no such device"):
