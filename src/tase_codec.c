@@ -390,6 +390,13 @@ int tase_command_check_data(uint16_t id, const uint8_t *data, size_t len)
     tase_spoi_cmd_t spoi_cmd;
     void *m = (id == TASE_ID_GIMBAL_CMD) ? (void *)&gimbal_cmd : (void *)&spoi_cmd;
     int r;
+    if (id == TASE_ID_RETRACT_DEPLOY_CMD || (len == 0u && id == TASE_ID_GIMBAL_CMD)) {
+        /* no values to check, but a length the packet does not accept (a
+         * zero-length GIMBAL_CMD, which has no query form) is refused */
+        const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
+        return (tase_schema_length_ok(p, len) || tase_schema_is_query(p, len)) ? TASE_OK
+                                                                               : TASE_ELENGTH;
+    }
     if ((id != TASE_ID_GIMBAL_CMD && id != TASE_ID_SPOI_CMD) || len == 0u) {
         return TASE_OK;
     }

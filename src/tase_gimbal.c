@@ -71,7 +71,7 @@ static void sched_start(tase_gimbal_sched_t *s, uint8_t rate, uint32_t now_ms)
 
 /* A port's telemetry demand (bytes/s at the scheduled rates) and its
  * pacing, restarted so that the next due slot of each stream is sent. */
-static void pace_port(tase_gimbal_t *g, unsigned p)
+static void pace_port(tase_gimbal_t *g, unsigned p, bool keep)
 {
     /* Frame length of each telemetry stream's packet (data + 8). */
     static const uint8_t stream_frame_len[TASE_GIMBAL_STREAMS] = {14u, 26u, 71u};
@@ -82,14 +82,20 @@ static void pace_port(tase_gimbal_t *g, unsigned p)
     }
     g->demand[p] = d;
     for (s = 0; s < TASE_GIMBAL_STREAMS; s++) {
-        g->sched[p][s].acc = d;
+        tase_gimbal_sched_t *st = &g->sched[p][s];
+        /* keep: a rate changed. Each stream keeps what it had earned, at
+         * most one slot (a full accumulator for every change gave each
+         * stream a slot for free: a host changing a rate every 200 ms
+         * drove a 9600-baud port at 1,119 B/s of its 720) */
+        st->acc = (!keep || st->acc > d) ? d : st->acc;
     }
 }
 
 /* Restart the streams whose rate changed (all: every stream) and the
  * pacing of their ports only: a PACKET_RATE that changes nothing on a port
  * leaves its pacing alone (re-sent every 200 ms, it restarted every port
- * with a full budget and the ports sent far beyond their capacity). */
+ * with a full budget and the ports sent far beyond their capacity), and
+ * one that changes a rate keeps the budget earned (pace_port()). */
 static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
 {
     unsigned p;
@@ -104,7 +110,7 @@ static void sched_from_rates(tase_gimbal_t *g, uint32_t now_ms, bool all)
             }
         }
         if (changed) {
-            pace_port(g, p);
+            pace_port(g, p, !all);
         }
     }
 }
@@ -149,7 +155,7 @@ int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per
         return TASE_EARG;
     }
     g->capacity[port] = bytes_per_s != 0u ? bytes_per_s : port_capacity(&g->port[port]);
-    pace_port(g, port);
+    pace_port(g, port, false);
     return TASE_OK;
 }
 
@@ -211,6 +217,11 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
     /* CAMERA_TYPE: "no camera" until the application stores its cameras;
      * 0 would be "do not change", which is not a setting. */
     (void)memset(&g->setup[setup_off[SETUP_CAMERA_TYPE]], 0xFF, setup_len[SETUP_CAMERA_TYPE]);
+    /* SYSTEM_VERSION: no cameras (0xFF, 4.4.4's "if none"; 0 is no type of
+     * table 28) until the application stores its version */
+    for (i = 0; i < 3u; i++) {
+        g->setup[setup_off[SETUP_SYSTEM_VERSION] + 24u + 6u * i] = 0xFFu;
+    }
     sched_from_rates(g, now_ms, true);
     return TASE_OK;
 }

@@ -102,12 +102,28 @@ int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg)
                               &h->stats.tx_errors);
 }
 
+/* Send an attempt of the request in h->req and say when it went out in
+ * *sent_at: now_ms plus the time the write took by the port's clock (a
+ * write may block up to the port's bound W, and an attempt's timeout
+ * counts from its sending: timed from before the write, a slow write ate
+ * the wait, and an answer a few ms after it found the request given up). */
+static int send_attempt(tase_host_t *h, uint8_t group, uint8_t type, size_t len, uint32_t now_ms,
+                        uint32_t *sent_at)
+{
+    uint32_t (*clock)(void *) = h->port.ops != NULL ? h->port.ops->now_ms : NULL;
+    uint32_t t0 = clock != NULL ? clock(h->port.ctx) : 0u;
+    int r = host_send(h, group, type, h->req, len);
+    *sent_at = now_ms + (clock != NULL ? tase_port_elapsed_ms(clock(h->port.ctx), t0) : 0u);
+    return r;
+}
+
 /* Send the request whose data is already in h->req and make it pending.
  * Nothing is pending if the first attempt cannot be sent. */
 static int request_send(tase_host_t *h, uint8_t group, uint8_t type, size_t len, uint8_t *reply,
                         size_t reply_cap, uint32_t timeout_ms, uint8_t retries, uint32_t now_ms)
 {
-    int r = host_send(h, group, type, h->req, len);
+    uint32_t sent_at;
+    int r = send_attempt(h, group, type, len, now_ms, &sent_at);
     if (r < 0) {
         return r;
     }
@@ -118,9 +134,9 @@ static int request_send(tase_host_t *h, uint8_t group, uint8_t type, size_t len,
     h->reply_cap = reply_cap;
     h->timeout_ms = timeout_ms;
     h->retries_left = retries;
-    h->sent_at = now_ms;
-    h->first_at = now_ms;
-    h->now = now_ms;
+    h->sent_at = sent_at;
+    h->first_at = sent_at;
+    h->now = sent_at;
     h->attempts = 1u;
     h->result = TASE_EAGAIN;
     h->state = HOST_WAITING;
@@ -151,14 +167,16 @@ static bool timeout_ok(uint32_t timeout_ms)
  * or a packet the schema does not know (nothing says what a repeat does),
  * which are TASE_EARG with retries. Decided before anything is written to
  * h->req, which may hold a typed CAMERA_PASS reply. */
-static int answered(const tase_packet_desc_t *p, bool with_data, unsigned spoi_flags,
-                    uint8_t retries)
+static int answered(const tase_packet_desc_t *p, size_t len, unsigned spoi_flags, uint8_t retries)
 {
     if (p == NULL) {
         return (retries == 0u) ? TASE_OK : TASE_EARG;
     }
-    if (!with_data) {
+    if (len == 0u) {
         return tase_schema_is_query(p, 0u) ? TASE_OK : TASE_ELENGTH;
+    }
+    if (p->id == TASE_ID_SPOI_CMD && !tase_schema_length_ok(p, len)) {
+        return TASE_ELENGTH; /* before its echo flag, which it may not have */
     }
     if ((p->flags & TASE_DIR_BOTH) != TASE_DIR_BOTH ||
         (p->id == TASE_ID_SPOI_CMD && (spoi_flags & TASE_SPOI_ECHO) == 0u)) {
@@ -185,7 +203,7 @@ int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const u
     if (h->state != HOST_IDLE) {
         return TASE_EBUSY;
     }
-    r = answered(tase_schema_find(group, type), len > 0u, len > 18u ? data[18] : 0u, retries);
+    r = answered(tase_schema_find(group, type), len, len > 18u ? data[18] : 0u, retries);
     if (r == TASE_OK) {
         r = tase_command_check_data(TASE_ID(group, type), data, len);
     }
@@ -213,7 +231,7 @@ int tase_host_request_msg_start(tase_host_t *h, uint16_t id, const void *msg, vo
         /* with data unless msg is NULL or the packet has none (GYRO_ZERO) */
         const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
         int r = answered(
-            p, msg != NULL && p != NULL && p->len > 0u,
+            p, (msg != NULL && p != NULL) ? p->len : 0u, /* a typed packet has its length */
             (msg != NULL && id == TASE_ID_SPOI_CMD) ? ((const tase_spoi_cmd_t *)msg)->flags : 0u,
             retries);
         if (r == TASE_OK && msg != NULL) {
@@ -345,8 +363,8 @@ int tase_host_poll(tase_host_t *h, uint32_t now_ms)
     if (h->attempts < 255u) {
         h->attempts++;
     }
-    h->sent_at = now_ms;
-    (void)host_send(h, h->group, h->type, h->req, h->req_len);
+    (void)send_attempt(h, h->group, h->type, h->req_len, now_ms, &h->sent_at);
+    h->now = h->sent_at;
     return TASE_EAGAIN;
 }
 
@@ -364,10 +382,14 @@ int tase_host_cancel(tase_host_t *h)
 
 bool tase_host_busy(const tase_host_t *h)
 {
-    return h != NULL && h->state == HOST_WAITING;
+    /* waiting, or complete with the outcome not yet taken by poll():
+     * tase_host_request_start() refuses both with TASE_EBUSY */
+    return h != NULL && h->state != HOST_IDLE;
 }
 
-/* The port checks of the calls that read (service, transact): TASE_OK when it can be used. */
+/* The checks of the calls that read the port (service, transact): TASE_OK
+ * when it can be used. Inside a callback of the host's receiver (on_frame)
+ * they cannot feed it: the bytes they read would be lost (TASE_EBUSY). */
 static int port_ok(const tase_host_t *h)
 {
     if (h == NULL || h->port.ops == NULL) {
@@ -376,7 +398,7 @@ static int port_ok(const tase_host_t *h)
     if (h->port.ops->read == NULL || h->port.ops->now_ms == NULL) {
         return TASE_EUNSUPPORTED;
     }
-    return TASE_OK;
+    return (h->rx.busy != 0u) ? TASE_EBUSY : TASE_OK;
 }
 
 int tase_host_service(tase_host_t *h, uint32_t wait_ms)
@@ -396,7 +418,10 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms)
         return TASE_EIO; /* a port claiming more than asked is broken */
     }
     if (n >= 0) {
-        (void)tase_host_feed(h, buf, (size_t)n, h->port.ops->now_ms(h->port.ctx));
+        int r = tase_host_feed(h, buf, (size_t)n, h->port.ops->now_ms(h->port.ctx));
+        if (r < 0) {
+            return r;
+        }
     }
     return n;
 }

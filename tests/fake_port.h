@@ -29,6 +29,9 @@ typedef struct {
     unsigned reply_after;
     uint8_t reply[TASE_FRAME_MAX];
     size_t nreply;
+    uint32_t reply_delay_ms; /* the reply comes this long after it is due */
+    uint32_t reply_at;       /* when it comes (reply_due: it has not yet) */
+    int reply_due;
 } fake_port_t;
 
 static inline void fake_push(fake_port_t *f, const uint8_t *p, size_t n)
@@ -85,6 +88,12 @@ static inline int fake_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeou
     size_t n;
     if (f->reply_after != 0 && fake_frames_out(f) >= f->reply_after) {
         f->reply_after = 0;
+        f->reply_at = f->now + f->reply_delay_ms;
+        f->reply_due = 1;
+    }
+    if (f->reply_due && !f->frozen && f->reply_at - f->now <= timeout_ms) {
+        f->now = f->reply_at - f->now < 0x80000000u ? f->reply_at : f->now; /* waited for it */
+        f->reply_due = 0;
         fake_push(f, f->reply, f->nreply);
     }
     n = f->nin - f->rin;

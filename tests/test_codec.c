@@ -702,6 +702,11 @@ static void command_check_takes_what_the_spec_defines_and_nothing_else(void **st
     assert_int_equal(tase_command_check_data(TASE_ID_SPOI_CMD, data, 19), TASE_ERANGE);
     /* a query, other packets, wrong lengths and NULL */
     assert_int_equal(tase_command_check_data(TASE_ID_SPOI_CMD, NULL, 0), TASE_OK);
+    /* no query form: a zero-length GIMBAL_CMD or RETRACT_DEPLOY_CMD is no
+     * command (a review: both passed and went out) */
+    assert_int_equal(tase_command_check_data(TASE_ID_GIMBAL_CMD, NULL, 0), TASE_ELENGTH);
+    assert_int_equal(tase_command_check_data(TASE_ID_RETRACT_DEPLOY_CMD, NULL, 0), TASE_ELENGTH);
+    assert_int_equal(tase_command_check_data(TASE_ID_RETRACT_DEPLOY_CMD, data, 2), TASE_OK);
     assert_int_equal(tase_command_check_data(TASE_ID_SPOI_CMD, data, 18), TASE_ELENGTH);
     assert_int_equal(tase_command_check_data(TASE_ID_GIMBAL_CMD, NULL, 8), TASE_EARG);
     assert_int_equal(tase_command_check_data(TASE_ID_PACKET_RATE, data, 3), TASE_OK);

@@ -420,6 +420,97 @@ static void an_answer_waiting_after_a_slow_write_is_read_not_timed_out(void **st
     assert_int_equal(x->host.stats.retries, 0);
 }
 
+/* A review: an attempt's timeout was counted from before its write, so a
+ * write that blocked 180 ms of a 200 ms timeout left 20 ms for an answer
+ * that came 30 ms after it (a timeout), and one that blocked 250 ms
+ * re-sent the request at once (a setup packet applied twice). host.h:
+ * "each waiting timeout_ms from its sending". */
+static void an_attempts_timeout_counts_from_the_end_of_its_write(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    uint32_t t0;
+    int n;
+
+    x->port.nreply =
+        (size_t)tase_frame_build(0x48, 0x00, rates, 16, x->port.reply, sizeof x->port.reply);
+    x->port.reply_after = 1;
+    x->port.reply_delay_ms = 30;
+    x->port.write_ms = 180;
+    n = tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 200, 0);
+    assert_int_equal(n, 16);
+    assert_int_equal(x->host.stats.timeouts, 0);
+
+    x->port.reply_after = 2;
+    x->port.write_ms = 250;
+    n = tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 200, 2);
+    assert_int_equal(n, 16);
+    assert_int_equal(fake_frames_out(&x->port), 2); /* no attempt re-sent */
+    assert_int_equal(x->host.stats.retries, 0);
+
+    /* the same for the caller-driven calls: start at t0, the write takes
+     * 250 ms of the port's clock; the attempt runs to t0 + 250 + 200 */
+    x->port.reply_after = 0;
+    t0 = x->port.now;
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 200, 1, t0),
+                     TASE_OK);
+    assert_int_equal(x->port.now, t0 + 250u);
+    assert_int_equal(tase_host_poll(&x->host, t0 + 449u), TASE_EAGAIN);
+    assert_int_equal(fake_frames_out(&x->port), 3); /* not re-sent yet */
+    assert_int_equal(tase_host_poll(&x->host, t0 + 450u), TASE_EAGAIN);
+    assert_int_equal(fake_frames_out(&x->port), 4); /* the retry, 250 ms to write */
+    assert_int_equal(tase_host_poll(&x->host, t0 + 450u + 449u), TASE_EAGAIN);
+    assert_int_equal(tase_host_poll(&x->host, t0 + 450u + 450u), TASE_ETIMEOUT);
+}
+
+/* on_frame that tries the calls that read the port, from inside the
+ * host's receiver. */
+typedef struct {
+    tase_host_t *host;
+    int transact, service, start;
+} reentry_t;
+
+static void on_frame_reenters(void *user, const tase_frame_t *f)
+{
+    reentry_t *r = user;
+    uint8_t reply[64];
+    (void)f;
+    r->transact = tase_host_transact(r->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 200, 2);
+    r->service = tase_host_service(r->host, 0);
+    r->start = tase_host_query_start(r->host, 0x48, 0x00, NULL, 0, 200, 0, 0);
+}
+
+/* A review: tase_host_transact() called from on_frame read the gimbal's
+ * answer off the port and fed it to the receiver that was calling
+ * (TASE_EBUSY, ignored): every byte was lost, the request timed out, and
+ * the loop spun 2^20 times on a 0 ms quiet bound. The calls that read the
+ * port refuse inside a callback (nothing read, nothing sent); starting a
+ * request there still works. */
+static void calls_that_read_the_port_refuse_inside_on_frame(void **state)
+{
+    fix_t *x = *state;
+    reentry_t r = {&x->host, 0, 0, 0};
+    uint8_t angle[6] = {0};
+    tase_port_t p = {&fake_ops, &x->port, TASE_UART_BYTES_PER_S(57600)};
+    uint8_t reply[64];
+    assert_int_equal(tase_host_init(&x->host, &p, on_frame_reenters, &r), TASE_OK);
+    fake_push_frame(&x->port, 0x48, 0x00, rates, 16); /* waiting on the port */
+    feed_frame(x, 0x08, 0x10, angle, 6, 0);           /* telemetry: on_frame */
+    assert_int_equal(r.transact, TASE_EBUSY);
+    assert_int_equal(r.service, TASE_EBUSY);
+    assert_int_equal(r.start, TASE_OK);
+    assert_int_equal(x->port.rin, 0);               /* nothing read */
+    assert_int_equal(fake_frames_out(&x->port), 1); /* the started query only */
+    /* outside the callback the answer is there for the started request */
+    assert_true(tase_host_busy(&x->host));
+    assert_int_equal(tase_host_service(&x->host, 0), 24);
+    assert_true(tase_host_busy(&x->host)); /* complete, its outcome not yet taken */
+    assert_int_equal(tase_host_query_start(&x->host, 0x48, 0x00, reply, sizeof reply, 200, 0, 0),
+                     TASE_EBUSY);
+    assert_int_equal(tase_host_poll(&x->host, 1), 16);
+    assert_false(tase_host_busy(&x->host));
+}
+
 /* A broken port: its clock stands still and an empty read returns at once
  * (port.h allows a read to return 0 early). transact looped for ever; it
  * ends as a timeout after TASE_PORT_WRITE_SPINS such reads. */
@@ -832,8 +923,13 @@ static void requests_of_packets_the_gimbal_does_not_answer_send_nothing(void **s
     refused_both_ways(x, TASE_ID_GIMBAL_CMD, &cmd, 8, TASE_EARG);
     /* SPOI_CMD is echoed only when asked to be */
     refused_both_ways(x, TASE_ID_SPOI_CMD, &spoi, 19, TASE_EARG);
+    /* a SPOI_CMD of a length it does not accept is TASE_ELENGTH, as the
+     * header says (a review: it was TASE_EARG, its missing echo flag read
+     * as 0 before any length check) */
     assert_int_equal(tase_host_request_start(&x->host, 0x10, 0x40, data, 18, reply, 8, 10, 2, 0),
-                     TASE_EARG);
+                     TASE_ELENGTH);
+    assert_int_equal(tase_host_request_start(&x->host, 0x10, 0x40, data, 5, reply, 8, 10, 2, 0),
+                     TASE_ELENGTH);
     /* host data and telemetry: the gimbal never sends them back */
     assert_int_equal(tase_host_request_start(&x->host, 0x08, 0x41, data, 20, reply, 8, 10, 2, 0),
                      TASE_EARG);
@@ -927,8 +1023,13 @@ static void motion_commands_the_spec_does_not_define_are_not_sent(void **state)
             tase_packet_encode_data(TASE_ID_GIMBAL_CMD, &bad_cmds[i], data, sizeof data), 8);
         assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, data, 8), TASE_ERANGE);
     }
-    /* a GIMBAL_CMD of a wrong length is not sent either */
+    /* a GIMBAL_CMD of a wrong length is not sent either, nor one of none
+     * (a review: a zero-length GIMBAL_CMD or RETRACT_DEPLOY_CMD went out;
+     * neither has a query form), nor a RETRACT_DEPLOY_CMD of a wrong length */
     assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, data, 7), TASE_ELENGTH);
+    assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, NULL, 0), TASE_ELENGTH);
+    assert_int_equal(tase_host_send(&x->host, 0x00, 0x43, NULL, 0), TASE_ELENGTH);
+    assert_int_equal(tase_host_send(&x->host, 0x00, 0x43, data, 3), TASE_ELENGTH);
     memset(&spoi, 0, sizeof spoi);
     spoi.flags = TASE_SPOI_ECHO;
     spoi.lat = 324000001;
@@ -1166,6 +1267,10 @@ int main(void)
         cmocka_unit_test_setup_teardown(a_port_that_refuses_the_request_leaves_the_host_idle, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(transact_blocks_until_the_scripted_gimbal_answers, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(an_attempts_timeout_counts_from_the_end_of_its_write, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(calls_that_read_the_port_refuse_inside_on_frame, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(an_answer_waiting_after_a_slow_write_is_read_not_timed_out,
                                         setup, teardown),

@@ -455,7 +455,9 @@ int tase_command_check(uint16_t id, const void *msg);
 /* tase_command_check() of the data bytes data[0..len) of packet `id`: a
  * GIMBAL_CMD or SPOI_CMD with data is decoded (tase_packet_decode_data():
  * TASE_ELENGTH for a length the packet does not accept, TASE_EARG for data
- * NULL) and checked; a zero-length frame (a query) and any other packet
+ * NULL) and checked; a RETRACT_DEPLOY_CMD or GIMBAL_CMD of a length the
+ * packet does not accept (a zero-length GIMBAL_CMD: it has no query form)
+ * is TASE_ELENGTH; a zero-length SPOI_CMD (a query) and any other packet
  * give TASE_OK. O(1). */
 int tase_command_check_data(uint16_t id, const uint8_t *data, size_t len);
 

@@ -29,7 +29,8 @@
  *    byte nor a "do not change" value.
  *    SYSTEM_VERSION is query-only: a SYSTEM_VERSION packet of 0 or 42
  *    data bytes is answered with the bytes the application set
- *    (tase_gimbal_setup_set()).
+ *    (tase_gimbal_setup_set()); until it sets them, version 0.0.0 and no
+ *    cameras (A, B and C 0xFF, 4.4.4's "if none"), so set it at start-up.
  *    A setup packet with a wrong data length (SYSTEM_VERSION's included)
  *    is counted (stats.bad_length) and not answered.
  *

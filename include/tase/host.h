@@ -72,7 +72,10 @@
  * Only the last request's group and type is tracked (a request of another
  * type forgets what an earlier one was owed once it owes answers itself).
  * When an owed answer was lost, the next request of that type takes the
- * timeout and a retry to complete: slower, never wrong.
+ * timeout and a retry to complete: slower, never wrong. With retries 0 it
+ * fails (TASE_ETIMEOUT, its echo counted in stats.late) although the
+ * gimbal took it: within one attempt timeout of a failed request, start
+ * the next of its type with retries >= 1.
  *
  * TIME. The core never reads a clock by itself: the poll-driven API takes
  * `now_ms` (any monotonic millisecond count that wraps modulo 2^32, e.g.
@@ -98,7 +101,12 @@
  *  - Tools (blocks, reading the port): tase_host_transact().
  *
  * All functions: not reentrant per instance, not ISR-safe (call from one
- * context); different instances are independent. No allocation, no
+ * context); different instances are independent. From on_frame (inside
+ * the host's receiver) the calls that send, start, poll or cancel a
+ * request may be made; tase_host_service(), tase_host_transact() and
+ * tase_host_transact_msg() return TASE_EBUSY there, nothing read or sent
+ * (they would feed the receiver that is calling: every byte they read
+ * was lost). No allocation, no
  * globals. sizeof(tase_host_t) is 716 bytes on Cortex-M (a tase_rx_t plus a copy
  * of the pending request for re-sending).
  */
@@ -189,7 +197,9 @@ int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg);
 
 /* Start a request: send (group, type, data[0..len)) and wait for the
  * gimbal's frame of the same group and type. len 0 is a query. Up to
- * 1 + retries attempts, each waiting timeout_ms from its sending. The
+ * 1 + retries attempts, each waiting timeout_ms from its sending: from
+ * the end of its write, now_ms plus the time the port's write() took by
+ * the port's clock (a write may block up to the port's bound W). The
  * reply's data will be copied into reply[0..reply_cap) (reply may be NULL
  * when reply_cap is 0: only the length is reported). The data is copied;
  * `reply` must stay valid until the request completes or is cancelled.
@@ -289,7 +299,9 @@ int tase_host_poll(tase_host_t *h, uint32_t now_ms);
  * Returns TASE_OK, or TASE_EARG (h NULL). O(1). */
 int tase_host_cancel(tase_host_t *h);
 
-/* True while a request waits for its reply (false for NULL). O(1). */
+/* True while a request is pending: waiting for its reply, or complete
+ * with its outcome not yet taken by tase_host_poll() (either way
+ * tase_host_request_start() says TASE_EBUSY); false for NULL. O(1). */
 bool tase_host_busy(const tase_host_t *h);
 
 /* Read once from the port, waiting at most wait_ms, and feed what
@@ -298,9 +310,9 @@ bool tase_host_busy(const tase_host_t *h);
  * bound holds (tase/frame.h, TIME BOUND): a call may return 0 early,
  * never late. Returns bytes read (>= 0), a
  * port error, TASE_EIO (the port's read() claimed more bytes than asked;
- * nothing fed), TASE_EUNSUPPORTED (port has no read or now_ms) or
- * TASE_EARG (h NULL, or never initialised: no port ops). Uses 64 bytes of
- * stack. */
+ * nothing fed), TASE_EUNSUPPORTED (port has no read or now_ms), TASE_EBUSY
+ * (called from on_frame: nothing read) or TASE_EARG (h NULL, or never
+ * initialised: no port ops). Uses 64 bytes of stack. */
 int tase_host_service(tase_host_t *h, uint32_t wait_ms);
 
 /* Blocking convenience for tools: start a request, then service the port
@@ -309,7 +321,8 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms);
  * or a negative code (TASE_ETIMEOUT after 1 + retries attempts). Waits at
  * most about (1 + retries) * timeout_ms. Frames that arrive meanwhile go
  * to on_frame. TASE_EARG also for h without port ops (never initialised),
- * TASE_EUNSUPPORTED for a port without read or now_ms (nothing sent).
+ * TASE_EUNSUPPORTED for a port without read or now_ms, TASE_EBUSY called
+ * from on_frame (nothing sent).
  * A broken port whose clock stands still while read() returns nothing at
  * once ends with TASE_ETIMEOUT after TASE_PORT_WRITE_SPINS such reads in a
  * row (tase/config.h), instead of never. */
