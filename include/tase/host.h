@@ -210,7 +210,10 @@ int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg);
  * SPOI_CMD with TASE_SPOI_ECHO set, or a group/type the schema does not
  * know. Send the others with tase_host_send() / tase_host_send_msg().
  * A retry repeats the packet, so retries > 0 only for what sets absolute
- * values (a query, a setup packet, SPOI_CMD); RETRACT_DEPLOY_CMD (its echo
+ * values (a query, a setup packet, SPOI_CMD; a SPOI_CMD with a velocity
+ * is repeated as it was first sent, so the gimbal propagates the point
+ * from the retry's arrival: a timeout's worth behind, which a fresh
+ * SPOI_CMD would not be); RETRACT_DEPLOY_CMD (its echo
  * comes when the move ends, later than a timeout may say), CAMERA_PASS
  * (camera bytes, often relative commands) and unknown packets (nothing
  * says what a repeat does) need retries 0.
