@@ -140,9 +140,23 @@ static uint32_t time_ms(const tk_time_t *t)
     return (uint32_t)((uint64_t)t->sec * 1000u + t->usec / 1000u);
 }
 
+/* Whether the pause from one record to the next is 2^31 ms (24.8 days) or
+ * more, which reads as no time on the receivers' clock (modulo 2^32). */
+static bool long_pause(const tk_time_t *from, const tk_time_t *to)
+{
+    int64_t ms = ((int64_t)to->sec - (int64_t)from->sec) * 1000 +
+                 ((int64_t)to->usec / 1000 - (int64_t)from->usec / 1000);
+    return ms >= (int64_t)0x80000000LL;
+}
+
 void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n, const tk_time_t *time)
 {
     if (d->by_time && time != NULL) {
+        if (s->timed && long_pause(&s->last, time)) {
+            /* told of 2^30 ms of quiet first (a capture appended to over
+             * weeks joined the sessions' cut frames) */
+            tk_dec_tick(d, s, time_ms(&s->last) + 0x40000000u);
+        }
         /* the line was quiet from the last record until this one */
         tk_dec_tick(d, s, time_ms(time));
     }

@@ -25,6 +25,7 @@ _HIST = 264  # chunks remembered for frame times (tools/toolkit.h TK_HIST)
 _CAN_EFF = 0x80000000
 _CAN_RTR = 0x40000000
 _CAN_ERR = 0x20000000
+_CANFD_FDF = 0x04  # flags byte of a SocketCAN record: an FD frame
 # First bytes of the files read_capture() takes (pcap us/ns, both byte
 # orders; pcapng).
 MAGICS = (
@@ -88,7 +89,17 @@ def _pcap(f, head):
             # the record is cut (tase decode skips it; this gave it whole)
             data = data[:snaplen]
         usec = frac // 1000 if nano else frac
-        yield index, linktype, sec * 1000000 + usec, data, len(data) < orig
+        yield index, linktype, sec * 1000000 + usec, data, _damage(len(data), orig)
+
+
+def _damage(incl, orig):
+    """Why a record of `incl` bytes captured of a packet of `orig` is
+    skipped, as tase decode says it, or None."""
+    if incl < orig:
+        return "cut to %d of its %d bytes by the capture's snapshot length" % (incl, orig)
+    if incl > orig:  # no writer keeps more than the packet had
+        return "%d bytes captured of a packet of %d: a damaged record header" % (incl, orig)
+    return None
 
 
 class _Block:
@@ -165,6 +176,7 @@ def _pcapng(f, head):
     its type and what its lengths claim within it; a damaged block is a
     CaptureError saying which, never a partial record."""
     index = 0
+    last_usec = 0  # the time of the record before (a Simple Packet Block's)
     e = None  # the byte order of the sections, from the first one's magic
     ifaces = []
     idb_seen = False
@@ -274,7 +286,12 @@ def _pcapng(f, head):
             index += 1
             ts = hi << 32 | lo
             usec = (ts // res + offset) * 1000000 + ts % res * 1000000 // res
-            yield index, linktype, usec, data, incl < orig
+            if ts == 0 and index > 1:
+                # a Simple Packet Block has no time: the record before's, as
+                # tase decode (1970 cut a frame split across the two as a pause)
+                usec = last_usec
+            last_usec = usec
+            yield index, linktype, usec, data, _damage(incl, orig)
 
 
 def _records(f, path):
@@ -290,8 +307,9 @@ def _records(f, path):
 
 
 def records(path):
-    """(index, linktype, time_us, bytes, cut) of every record of a pcap or
-    pcapng file. A file that is not one, or a damaged record or block, is a
+    """(index, linktype, time_us, bytes, damage) of every record of a pcap
+    or pcapng file (damage: why tase decode skips the record, cut by the
+    snapshot length or a damaged header, or None). A file that is not one, or a damaged record or block, is a
     CaptureError naming the file (the records before it are given)."""
     with open(path, "rb") as f:
         yield from _records(f, path)
@@ -489,7 +507,13 @@ class _Stream:
 
     def bytes(self, data, t):
         ms = (t // 1000) & 0xFFFFFFFF
-        out = self._timed(self.dec.tick(ms), self.last)
+        out = []
+        if self.last is not None and t // 1000 - self.last // 1000 >= 1 << 31:
+            # 2^31 ms or more reads as no time on the receiver's clock
+            # (modulo 2^32): it is told of 2^30 ms of quiet first
+            quiet = (self.last // 1000 + (1 << 30)) & 0xFFFFFFFF
+            out += self._timed(self.dec.tick(quiet), self.last)
+        out += self._timed(self.dec.tick(ms), self.last)
         self.last = t
         self.hist.append((self.dec.bytes + len(data), t))
         out += self._timed(self.dec.feed(data), t)
@@ -562,12 +586,12 @@ class Capture:
         self.streams = {}
         self.records = 0
         frame = ffi.new("tase_can_frame_t *")
-        for index, linktype, t, data, cut in recs:
+        for index, linktype, t, data, damage in recs:
             self.records += 1
+            if damage:
+                self.bad.append((index, damage))
+                continue
             if linktype == LINKTYPE_SERIAL:
-                if cut:
-                    self.bad.append((index, "cut by the snapshot length"))
-                    continue
                 if len(data) < 2:
                     self.bad.append((index, "no bytes"))
                     continue
@@ -580,11 +604,16 @@ class Capture:
                 if len(data) < 8:
                     self.bad.append((index, "CAN record shorter than its header"))
                     continue
-                cid, dlc = struct.unpack(">IB", data[:5])
-                if dlc > len(data) - 8:
-                    self.bad.append((index, "CAN payload longer than the record"))
+                cid, dlc, flags = struct.unpack(">IBB", data[:6])
+                # FD: a 72-byte record or the FD flag (tase decode's test)
+                fd = len(data) == 72 or flags & _CANFD_FDF
+                if dlc > (64 if fd else 8) or dlc > len(data) - 8:
+                    self.bad.append(
+                        (index, "payload length %d does not fit the record (%d bytes)"
+                         % (dlc, len(data)))
+                    )
                     continue
-                if cid & (_CAN_RTR | _CAN_ERR) or len(data) > 16 or not cid & _CAN_EFF or dlc > 8:
+                if fd or cid & (_CAN_RTR | _CAN_ERR) or not cid & _CAN_EFF:
                     continue
                 frame.id = cid & 0x1FFFFFFF
                 frame.extended = True
@@ -620,7 +649,8 @@ def read_capture(path, baud=57600):
     structure), is a CaptureError naming the file and the block, raised
     when the iteration reaches it (`tase decode` fails on those too). A
     record whose contents are bad (a direction byte other than 0 or 1, no
-    bytes, cut by the snapshot length) is skipped, as `tase decode` skips
+    bytes, cut by the snapshot length, a damaged record header, a CAN
+    payload longer than its record) is skipped, as `tase decode` skips
     it (warning, exit 4): iterate over `Capture(path, baud)` instead to
     find them in its `.bad` afterwards."""
     return iter(Capture(path, baud))

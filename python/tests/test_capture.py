@@ -498,3 +498,76 @@ def test_wellformed_pcapng_reads_as_tase_decode(tmp_path, tase_cli):
         assert c.returncode == 0, c.stderr
         assert len(c.stdout.splitlines()) == 2
         assert [p.json() for _, p in tase.read_capture(str(path))] == c.stdout.splitlines()
+
+
+def _pcap_ns(linktype, records):
+    """A nanosecond pcap of (time_ns, bytes, orig or None) records."""
+    out = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, linktype)
+    for t, rec, orig in records:
+        out += struct.pack("<IIII", t // 10**9, t % 10**9, len(rec),
+                           len(rec) if orig is None else orig) + rec
+    return out
+
+
+def _can_rec(cid, flags, data, size=16):
+    rec = struct.pack(">IBBBB", cid, len(data), flags, 0, 0) + data
+    return rec + bytes(max(0, size - len(rec)))
+
+
+def _epb_at(data, usec):
+    body = struct.pack("<IIIII", 0, usec >> 32, usec & 0xFFFFFFFF, len(data), len(data)) + data
+    return _block(6, body + b"\0" * (-len(body) % 4))
+
+
+def test_edge_records_decode_as_tase_decode(tmp_path, tase_cli):
+    """A differential review of the decoders: read_capture and `python -m
+    tase decode` differed from `tase decode` on a Simple Packet Block (time
+    0: 1970 cut the frame split across it), a record with more bytes
+    captured than the packet had (decoded), a 16-byte CAN record with the
+    FD flag (fed), a classic CAN record claiming 9 bytes (skipped without a
+    word); and both read a pause of 25 days as none (modulo 2^32 ms)."""
+    angle = tase.encode(tase.Packet("GIMBAL_ANGLE", raw={"pan": 1234, "tilt": -4500, "roll": 0}))
+    cmd = tase.encode(tase.Packet("GIMBAL_CMD", raw={"pan": 2000, "tilt": -300, "roll": 0,
+                                                     "flags": 0x10, "impulse_time": 0}))
+    t0 = 1700000000 * 10**9
+    eff = 0x80000000 | 0x10000000
+    # a valid 38-byte frame of an unknown type carrying a whole GIMBAL_ANGLE
+    body = bytes([0x28, 0x01]) + angle + bytes(range(1, 17))
+    frame = b"\x00\xff\x5a" + bytes([len(body)]) + body
+    frame += struct.pack(">H", sum(frame) & 0xFFFF)
+    cases = {
+        # (file bytes, what both must show: (name, offset) in order, exit status)
+        "spb.pcapng": (_shb() + _idb() + _epb_at(b"\x00" + angle[:9], 1700000000 * 10**6)
+                       + _block(3, struct.pack("<I", 6) + b"\x00" + angle[9:] + b"\0\0"),
+                       [("GIMBAL_ANGLE", 0)], 0),
+        "damaged.pcap": (_pcap_ns(147, [(t0, b"\x00" + angle, 3), (t0 + 10**6, b"\x00" + cmd, None)]),
+                         [("GIMBAL_CMD", 0)], 4),
+        "fdf16.pcap": (_pcap_ns(227, [(t0, _can_rec(eff, 0, angle[:8]), None),
+                                      (t0 + 10**6, _can_rec(eff, 0x04, angle[8:]), None),
+                                      (t0 + 2 * 10**6, _can_rec(eff, 0, angle[:8]), None),
+                                      (t0 + 3 * 10**6, _can_rec(eff, 0, angle[8:]), None)]),
+                       [("GIMBAL_ANGLE", 8)], 0),
+        "len9.pcap": (_pcap_ns(227, [(t0, _can_rec(eff, 0, angle[:8]), None),
+                                     (t0 + 10**6, struct.pack(">IBBBB", eff, 9, 0, 0, 0) + bytes(9),
+                                      None),
+                                     (t0 + 2 * 10**6, _can_rec(eff, 0, angle[8:]), None)]),
+                      [("GIMBAL_ANGLE", 0)], 4),
+        "gap25d.pcap": (_pcap_ns(147, [(t0, b"\x00" + frame[:20], None),
+                                       (t0 + 25 * 86400 * 10**9, b"\x00" + frame[20:], None)]),
+                        [("GIMBAL_ANGLE", 6)], 0),
+    }
+    for name, (data, want, status) in cases.items():
+        path = tmp_path / name
+        path.write_bytes(data)
+        c = subprocess.run([tase_cli, "decode", str(path)], capture_output=True, text=True,
+                           timeout=30)
+        p = subprocess.run([sys.executable, "-m", "tase", "decode", str(path)],
+                           capture_output=True, text=True, timeout=60)
+        got = [(json.loads(line)["name"], json.loads(line)["offset"])
+               for line in c.stdout.splitlines()]
+        assert (c.returncode, got) == (status, want), (name, c.stdout, c.stderr)
+        assert (p.returncode, p.stdout) == (c.returncode, c.stdout), (name, p.stderr, c.stderr)
+        # the same records skipped, for the same reasons
+        skipped = [line.split(": ", 1)[1] for line in c.stderr.splitlines() if "skipped" in line]
+        assert [line.split(": ", 1)[1] for line in p.stderr.splitlines()
+                if "skipped" in line] == skipped, (name, p.stderr, c.stderr)

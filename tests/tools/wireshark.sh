@@ -215,6 +215,47 @@ compare margin250 "the same with a 250 ms margin (tshark -o tase.margin:250, dec
 check "... delivered: the GIMBAL_CMD" grep -q '"name":"GIMBAL_CMD"' "$dir/margin250.json"
 dissect_opts=()
 
+# A differential review: a valid 38-byte frame of an unknown type carrying
+# a whole GIMBAL_ANGLE, its last 18 bytes 20.9996 ms after its first 20
+# (a nanosecond pcap), at the 20 ms margin: tase decode truncates to 20 ms
+# (no pause: the outer frame), the dissector rounded to 21 (a pause: the
+# inner GIMBAL_ANGLE); and 25 days apart, which tase decode read as no
+# time (modulo 2^32 ms) where the dissector saw the pause.
+${TASE_PYTHON:-python3} -c '
+import struct, sys
+angle = bytes.fromhex("00ff5a08081004d2ee6c000003a9")
+body = bytes([0x28, 0x01]) + angle + bytes(range(1, 17))
+frame = b"\x00\xff\x5a" + bytes([len(body)]) + body
+frame += struct.pack(">H", sum(frame) & 0xFFFF)
+t0 = 1700000000 * 10**9
+for path, gap in ((sys.argv[1], 20999600), (sys.argv[2], 25 * 86400 * 10**9)):
+    out = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 147)
+    for t, rec in ((t0, b"\x00" + frame[:20]), (t0 + gap, b"\x00" + frame[20:])):
+        out += struct.pack("<IIII", t // 10**9, t % 10**9, len(rec), len(rec)) + rec
+    open(path, "wb").write(out)' "$dir/edge-ms.pcap" "$dir/gap25d.pcap"
+compare edgems "a pause of 20.9996 ms at the 20 ms margin (nanosecond pcap): not a pause" \
+    "$dir/edge-ms.pcap" "$dir/edge-ms.pcap"
+check "... the outer frame, not the GIMBAL_ANGLE in it" \
+    eval 'grep -q "\"group\":40" "$dir/edgems.json" && ! grep -q GIMBAL_ANGLE "$dir/edgems.json"'
+compare gap25d "a pause of 25 days inside a frame (2^31 ms and more)" "$dir/gap25d.pcap" \
+    "$dir/gap25d.pcap"
+check "... a pause: the outer frame cut, the GIMBAL_ANGLE in it shown" \
+    grep -q '"offset":6,.*"name":"GIMBAL_ANGLE"' "$dir/gap25d.json"
+# Remote frames (RTR) carry no data: the dissector fed their DLC bytes into
+# the stream (a GIMBAL_ANGLE around one was lost, one after 8 of them moved).
+cat >"$dir/rtr.log" <<'X'
+(1700000000.000000) can0 10000000#R8
+(1700000000.001000) can0 10000000#00FF5A08081003E8
+(1700000000.002000) can0 10000000#R
+(1700000000.003000) can0 10000000#FE0C0000036E
+X
+dissect_opts=(-R frame) # the RTR flag, as the FD one: a tree in the first pass
+compare rtr "remote frames on our IDs ignored, as tase decode does" "$dir/rtr.log" --candump \
+    "$dir/rtr.log"
+check "... the GIMBAL_ANGLE around them at offset 0" \
+    grep -q '"offset":0,.*"name":"GIMBAL_ANGLE"' "$dir/rtr.json"
+dissect_opts=()
+
 # 3AX frames, values by hand from can.h: move 0 deploy / else retract;
 # status position, signed speed in 5 deg/s units; a wrong length.
 cat >"$dir/3ax.log" <<'X'

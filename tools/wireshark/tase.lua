@@ -355,10 +355,15 @@ end
 local FRAME_MAX = 261
 
 -- A packet time (seconds, a double) in whole milliseconds, as `tase
--- decode` truncates a record's time (the half-microsecond guards the
--- double's rounding at 1.7e9 s).
+-- decode` truncates a record's time. The double holds a time near 1.7e9 s
+-- to about 0.12 us, so 0.15 us guards its rounding down, added to the
+-- fraction alone (ts * 1000 is a double of 0.24 us steps, and a guard of
+-- 0.5 us on it rounded 20.9996 ms up to 21 where tase decode says 20: a
+-- pause judged differently). Only a nanosecond capture's time within
+-- about 0.15 us below a millisecond can still read as the next one.
 local function ms_of(ts)
-    return math.floor(ts * 1000 + 0.0005)
+    local s = math.floor(ts)
+    return s * 1000 + math.floor((ts - s) * 1000 + 0.00015)
 end
 
 -- The quiet limit of what stream `st` holds, or nil when it holds nothing.
@@ -557,9 +562,21 @@ local function is_fd(tvb)
     return tvb:len() > 8 or (ok_fd and f_canfd_brs() ~= nil)
 end
 
+-- A remote frame (RTR) carries no data, whatever its DLC says: the
+-- library and `tase decode` ignore it, and Wireshark hands it over with
+-- DLC bytes, which went into the stream. Its flag, like the FD one, is
+-- read from the protocol tree (tshark -2 needs -R frame for its first pass).
+local ok_rtr, f_can_rtr = pcall(Field.new, "can.flags.rtr")
+
+local function is_remote()
+    if not ok_rtr then return false end
+    local v = f_can_rtr()
+    return v ~= nil and v.value == true
+end
+
 function tase.dissector(tvb, pinfo, tree)
     local id = pinfo.match_uint -- the CAN ID it was registered for
-    if is_fd(tvb) then
+    if is_fd(tvb) or is_remote() then
         return 0
     end
     if id == ID_3AX_MOVE or id == ID_3AX_STATUS then
