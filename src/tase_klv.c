@@ -485,20 +485,40 @@ static int64_t nearest_sat(double x, int64_t lo, int64_t hi)
     if (x >= (double)hi) {
         return hi;
     }
-    return x >= 0.0 ? (int64_t)(x + 0.5) : -(int64_t)(-x + 0.5);
+    {
+        /* halves away from zero, exactly: a - trunc(a) is exact in double
+         * arithmetic, where (int64_t)(a + 0.5) rounded 0.5 - 2^-54 up to 1
+         * and an odd a >= 2^52 up by one */
+        double a = (x >= 0.0) ? x : -x;
+        int64_t r = (int64_t)a;
+        if (a - (double)r >= 0.5) {
+            r++;
+        }
+        return (x >= 0.0) ? r : -r;
+    }
 }
 
-/* Low 32 bits of the nearest integer to deg * scale: binary angles wrap.
- * Bounding deg keeps deg * scale (scale <= 2^32 / 360) well inside int64. */
-static uint32_t nearest_wrap(double deg, double scale)
+/* deg * two_pow / 360 to the nearest raw value, as the low 32 bits
+ * (binary angles wrap: modulo two_pow, 2^16 or 2^32, the raw type's).
+ * Bounding deg keeps turns inside int64. Whole turns first (k * 360 and deg - k * 360 are
+ * exact in double arithmetic for |deg| < 1e9, and a turn is two_pow raw),
+ * then scaled by the power of two (exact) and divided once (one rounding):
+ * deg times a precomputed two_pow / 360, inexact, was up to 2 LSB off from
+ * 1e5 deg on. */
+static uint32_t nearest_wrap(double deg, double two_pow)
 {
+    double turns;
+    double rest;
     if (!(deg > -WRAP_LIMIT_DEG && deg < WRAP_LIMIT_DEG)) {
         return 0u;
     }
+    turns = (double)(int64_t)(deg / 360.0);
+    rest = deg - turns * 360.0;
     /* cppcheck's std.cfg spells INT64_MIN as an unsuffixed literal; the
      * libc's own definition is (-INT64_MAX - 1). */
     /* cppcheck-suppress misra-c2012-7.2 */
-    return (uint32_t)((uint64_t)nearest_sat(deg * scale, INT64_MIN, INT64_MAX) & 0xFFFFFFFFu);
+    return (uint32_t)((uint64_t)nearest_sat(rest * two_pow / 360.0, INT64_MIN, INT64_MAX) &
+                      0xFFFFFFFFu);
 }
 
 int32_t tase_klv_lat_raw(double deg)
@@ -508,7 +528,7 @@ int32_t tase_klv_lat_raw(double deg)
 
 int32_t tase_klv_lon_raw(double deg)
 {
-    return as_s32(nearest_wrap(deg, TWO32 / 360.0));
+    return as_s32(nearest_wrap(deg, TWO32));
 }
 
 uint16_t tase_klv_alt_raw(double m)
@@ -518,12 +538,12 @@ uint16_t tase_klv_alt_raw(double m)
 
 uint16_t tase_klv_angle_raw(double deg)
 {
-    return (uint16_t)(nearest_wrap(deg, TWO16 / 360.0) & 0xFFFFu);
+    return (uint16_t)(nearest_wrap(deg, TWO16) & 0xFFFFu);
 }
 
 int16_t tase_klv_tilt_raw(double deg)
 {
-    return as_s16(nearest_wrap(deg, TWO16 / 360.0));
+    return as_s16(nearest_wrap(deg, TWO16));
 }
 
 int16_t tase_klv_pitch_raw(double deg)

@@ -883,6 +883,10 @@ static void units_to_raw_round_to_nearest(void **state)
     assert_int_equal(tase_klv_speed_raw(127.5), 16384);
     assert_int_equal(tase_klv_speed_raw(-1.9921875), -256);
     assert_int_equal(tase_klv_fov_raw(90.0), 32768);
+    /* a review: the value just below a half (0.5 - 2^-54 LSB) went to 1
+     * ((int64_t)(x + 0.5) rounds the sum up); checked with exact fractions */
+    assert_int_equal(tase_klv_lat_raw(2.0954757928848263e-08), 0);
+    assert_int_equal(tase_klv_lat_raw(-2.0954757928848263e-08), 0);
 }
 
 static void units_to_raw_saturate_where_the_range_ends(void **state)
@@ -920,6 +924,10 @@ static void circular_units_to_raw_wrap(void **state)
     assert_int_equal(tase_klv_angle_raw(INFINITY), 0);
     assert_int_equal(tase_klv_lon_raw(NAN), 0);
     assert_int_equal(tase_klv_tilt_raw(-1e12), 0);
+    /* a review: far from 0 the inexact 2^32/360 factor was 1..2 LSB off
+     * (exact nearest by fractions: 400,000,000 deg is 477,218,588 raw) */
+    assert_int_equal(tase_klv_lon_raw(400000000.0), 477218588);
+    assert_int_equal(tase_klv_lon_raw(-481056.2479878449), -1148283222);
 }
 
 static void every_16_bit_raw_value_survives_units_and_back(void **state)

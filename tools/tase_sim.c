@@ -443,6 +443,7 @@ int main(int argc, char **argv)
     tase_axis_setting_t axs;
     tase_nav_source_t nav;
     sim_can_watch_t watch;
+    int klv_unread = 0; /* unread bytes of the KLV link after its last look */
 
     tk_std_fds_open(); /* before anything opens a file */
     tk_prog = "tase-sim";
@@ -648,10 +649,20 @@ int main(int argc, char **argv)
             s.version_due = false;
         }
         if (have_klv && (int32_t)(now - next_klv) >= 0) {
-            /* a packet still unread after 900 ms has no reader: drop it, as a
-             * serial line would, so a reader that opens later gets fresh data */
-            (void)tk_pty_drop_unread(klv_slave);
-            send_klv(&s, &klv_port);
+            int unread = tk_pty_unread(klv_slave);
+            if (unread > 0 && unread < (int)TASE_KLV_PACKET_LEN && unread < klv_unread) {
+                /* a reader is part-way through the last packet and has
+                 * read some since the last look: this one is skipped
+                 * rather than that one cut (dropping every unread byte
+                 * left a reader slower than 97 B/s no whole packet) */
+            } else {
+                /* a packet still unread after 900 ms (or a tail nobody
+                 * reads any more) has no reader: drop it, as a serial line
+                 * would, so a reader that opens later gets fresh data */
+                (void)tk_pty_drop_unread(klv_slave);
+                send_klv(&s, &klv_port);
+            }
+            klv_unread = tk_pty_unread(klv_slave);
             next_klv = sim_next_due(next_klv, now, KLV_PERIOD_MS); /* no burst after a stall */
         }
     }

@@ -39,9 +39,12 @@
  *     follow tag 15 inside the set (its length is fixed by the items).
  *   - The checksum is verified last                     else TASE_ECHECKSUM.
  *   - Checks run in wire order and the first failure is returned. If the
- *     input ends before any check fails, the result is TASE_ETRUNC, so
- *     TASE_ETRUNC means exactly "a valid packet may still follow with more
- *     bytes"; the stream scanner relies on this.
+ *     input ends before any check fails, the result is TASE_ETRUNC, so a
+ *     packet that more bytes could still make valid is never refused
+ *     early; the stream scanner relies on this. (The converse does not
+ *     hold: the checksum is checked only when both its bytes are in, so a
+ *     packet one byte short whose first checksum byte is already wrong is
+ *     TASE_ETRUNC too, and is refused with the next byte.)
  *
  * STREAM SCANNER. tase_klv_rx_t is a caller-owned receiver fed arbitrary
  * chunks of a byte stream (noise, partial and corrupted packets allowed).
@@ -184,7 +187,9 @@ typedef struct {
  * tase_klv_rx_init() (the call that ran the handler then returns as soon
  * as the handler does, with the packets it delivered; the rest of its
  * input is not consumed); tase_klv_rx_feed() and tase_klv_rx_flush()
- * return TASE_EBUSY there and change nothing. */
+ * return TASE_EBUSY there and change nothing, unless the handler has
+ * called tase_klv_rx_init() first: that scanner is a new one, free to be
+ * fed (the call that ran the handler leaves it alone). */
 typedef void (*tase_klv_handler_t)(void *user, uint32_t offset, const tase_klv_t *klv);
 
 /* Called once per candidate whose 16 key bytes matched but which failed,

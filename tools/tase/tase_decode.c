@@ -319,6 +319,47 @@ static void print_klv(void *user, uint32_t offset, const tase_klv_t *k)
            tase_klv_gps_antenna(k->gps_status));
 }
 
+static void klv_feed(tase_klv_rx_t *rx, klv_ctx_t *c, const uint8_t *bytes, size_t n)
+{
+    c->base32 = rx->stats.bytes_in;
+    (void)tase_klv_rx_feed(rx, bytes, n, print_klv, NULL, c);
+    c->base64 += n;
+}
+
+/* The KLV line in a capture of `tase record --serial` (its bytes from the
+ * gimbal, whose first bytes are head[0..n)): the records' bytes fed in
+ * order. Returns the number of bad records (said as tase decode says them). */
+static unsigned long klv_capture(cli_input_t *in, tase_klv_rx_t *rx, klv_ctx_t *c,
+                                 const uint8_t *head, size_t n)
+{
+    tk_cap_reader_t r;
+    tk_cap_rec_t rec;
+    unsigned long bad = 0;
+    char why[160];
+    int rc;
+    tk_cap_reader_open(&r, in->fd, head, n, in->name);
+    if (r.linktype != TK_CAP_LINKTYPE_SERIAL) {
+        tk_exit(TK_EXIT_INPUT, "%s is a CAN capture: the KLV line is a serial line", in->name);
+    }
+    while ((rc = tk_cap_next(&r, &rec, why, sizeof(why))) != TK_CAP_END) {
+        if (rc == TK_CAP_BAD) {
+            if (++bad <= BAD_LINES_SHOWN) {
+                tk_warn("%s: record %lu skipped: %s", in->name, rec.index, why);
+            }
+        } else if (rec.dir == TK_CAP_FROM_GIMBAL) {
+            klv_feed(rx, c, rec.data, rec.len);
+        } else {
+            /* bytes to the gimbal (a tap's other line): not its KLV output */
+        }
+        tk_exit_if_signalled();
+    }
+    tk_cap_reader_close(&r);
+    if (bad > BAD_LINES_SHOWN) {
+        tk_warn("%s: %lu more bad records not shown", in->name, bad - BAD_LINES_SHOWN);
+    }
+    return bad;
+}
+
 int cli_cmd_klv(cli_args_t *a)
 {
     const char *path = NULL;
@@ -329,6 +370,8 @@ int cli_cmd_klv(cli_args_t *a)
     bool baud_given = false;
     cli_input_t in;
     size_t n;
+    bool capture = false;
+    unsigned long bad = 0;
     while (a->i < a->argc) {
         if (cli_common_opt(a)) {
             continue;
@@ -345,19 +388,34 @@ int cli_cmd_klv(cli_args_t *a)
     cli_input_check_baud(&in, baud_given, "");
     tk_stdout_buffered();
     (void)tase_klv_rx_init(&rx);
-    while ((n = cli_input_read(&in, buf, sizeof(buf))) > 0) {
-        c.base32 = rx.stats.bytes_in;
-        (void)tase_klv_rx_feed(&rx, buf, n, print_klv, NULL, &c);
-        c.base64 += n;
-        tk_stdout_flush(); /* a live line's packets go out as they come */
+    /* a serial line carries raw bytes, never a capture file */
+    n = in.device ? cli_input_read(&in, buf, sizeof(buf)) : cli_input_head(&in, buf, sizeof(buf));
+    if (!in.device && tk_cap_is_capture(buf, n)) {
+        /* `tase record` of the KLV line: its records' bytes, in order (a
+         * packet is often split across records); fed raw, the pcap headers
+         * cut packets and the offsets were the file's */
+        capture = true;
+        bad = klv_capture(&in, &rx, &c, buf, n);
+    } else {
+        while (n > 0) {
+            klv_feed(&rx, &c, buf, n);
+            tk_stdout_flush(); /* a live line's packets go out as they come */
+            n = cli_input_read(&in, buf, sizeof(buf));
+        }
     }
     c.base32 = rx.stats.bytes_in;
     (void)tase_klv_rx_flush(&rx, print_klv, NULL, &c);
     cli_input_close(&in);
     tk_stdout_flush();
     cli_input_check_end(&in);
-    if (c.packets == 0 && in.nhead > 0) {
-        tk_exit(TK_EXIT_INPUT, "no KLV packet found in %s%s", in.name, klv_guess(&in));
+    if (bad > 0) {
+        tk_exit(TK_EXIT_INPUT, "%s: %lu bad record%s (the rest was decoded)", in.name, bad,
+                bad == 1 ? "" : "s");
+    }
+    if (c.packets == 0 && (capture ? rx.stats.bytes_in > 0u : in.nhead > 0)) {
+        tk_exit(TK_EXIT_INPUT, "no KLV packet found in %s%s", in.name,
+                capture ? " (a capture of the datalink? 'tase decode' reads those)"
+                        : klv_guess(&in));
     }
     return TK_EXIT_OK;
 }
