@@ -64,10 +64,14 @@ static void decode_raw(cli_input_t *in, tk_dec_t *d, uint8_t *buf, size_t cap, s
     }
 }
 
-/* A pcap/pcapng capture of 'tase record' (tk_capture.h), whose first bytes
- * are head[0..n): serial records go to the stream of their direction, CAN
- * frames as in a candump log. Returns the number of bad records. */
-static unsigned long decode_capture(cli_input_t *in, tk_dec_t *d, const uint8_t *head, size_t n)
+/* Each good record of a pcap/pcapng capture of 'tase record' (tk_capture.h)
+ * whose first bytes are head[0..n), to fn; bad ones are said (the first
+ * BAD_LINES_SHOWN) and skipped. serial_only: a CAN capture is refused
+ * (`what` says for what). Returns the number of bad records. */
+typedef void (*cap_record_fn)(void *ctx, int linktype, const tk_cap_rec_t *rec);
+
+static unsigned long each_record(cli_input_t *in, const uint8_t *head, size_t n, cap_record_fn fn,
+                                 void *ctx, const char *serial_only)
 {
     tk_cap_reader_t r;
     tk_cap_rec_t rec;
@@ -75,21 +79,16 @@ static unsigned long decode_capture(cli_input_t *in, tk_dec_t *d, const uint8_t 
     char why[160];
     int rc;
     tk_cap_reader_open(&r, in->fd, head, n, in->name);
+    if (serial_only != NULL && r.linktype != TK_CAP_LINKTYPE_SERIAL) {
+        tk_exit(TK_EXIT_INPUT, "%s is a CAN capture: %s", in->name, serial_only);
+    }
     while ((rc = tk_cap_next(&r, &rec, why, sizeof(why))) != TK_CAP_END) {
         if (rc == TK_CAP_BAD) {
             if (++bad <= BAD_LINES_SHOWN) {
                 tk_warn("%s: record %lu skipped: %s", in->name, rec.index, why);
             }
-        } else if (r.linktype == TK_CAP_LINKTYPE_SERIAL) {
-            tk_stream_t *s = tk_dec_stream(d, "", rec.dir == TK_CAP_FROM_GIMBAL ? "out" : "in");
-            tk_dec_bytes(d, s, rec.data, rec.len, &rec.t);
-        } else if (rec.can_data) {
-            (void)tk_dec_can(d, "", &rec.frame, &rec.t); /* one interface: no name */
         } else {
-            /* remote, FD or error frames: counted, as a candump log's
-             * (a capture of only those said nothing and exited 0) */
-            d->n.can_frames++;
-            d->n.can_other++;
+            fn(ctx, r.linktype, &rec);
         }
         tk_exit_if_signalled();
     }
@@ -98,6 +97,31 @@ static unsigned long decode_capture(cli_input_t *in, tk_dec_t *d, const uint8_t 
         tk_warn("%s: %lu more bad records not shown", in->name, bad - BAD_LINES_SHOWN);
     }
     return bad;
+}
+
+/* A record of a capture decoded: serial records go to the stream of their
+ * direction, CAN frames as in a candump log. */
+static void decode_record(void *ctx, int linktype, const tk_cap_rec_t *rec)
+{
+    tk_dec_t *d = ctx;
+    if (linktype == TK_CAP_LINKTYPE_SERIAL) {
+        tk_stream_t *s = tk_dec_stream(d, "", rec->dir == TK_CAP_FROM_GIMBAL ? "out" : "in");
+        tk_dec_bytes(d, s, rec->data, rec->len, &rec->t);
+    } else if (rec->can_data) {
+        (void)tk_dec_can(d, "", &rec->frame, &rec->t); /* one interface: no name */
+    } else {
+        /* remote, FD or error frames: counted, as a candump log's
+         * (a capture of only those said nothing and exited 0) */
+        d->n.can_frames++;
+        d->n.can_other++;
+    }
+}
+
+/* A capture whose first bytes are head[0..n), decoded. Returns the number
+ * of bad records. */
+static unsigned long decode_capture(cli_input_t *in, tk_dec_t *d, const uint8_t *head, size_t n)
+{
+    return each_record(in, head, n, decode_record, d, NULL);
 }
 
 typedef struct {
@@ -326,38 +350,21 @@ static void klv_feed(tase_klv_rx_t *rx, klv_ctx_t *c, const uint8_t *bytes, size
     c->base64 += n;
 }
 
-/* The KLV line in a capture of `tase record --serial` (its bytes from the
- * gimbal, whose first bytes are head[0..n)): the records' bytes fed in
- * order. Returns the number of bad records (said as tase decode says them). */
-static unsigned long klv_capture(cli_input_t *in, tase_klv_rx_t *rx, klv_ctx_t *c,
-                                 const uint8_t *head, size_t n)
+typedef struct {
+    tase_klv_rx_t *rx;
+    klv_ctx_t *c;
+} klv_cap_t;
+
+/* A record of a `tase record --serial` capture of the KLV line: its bytes
+ * from the gimbal fed in order (those to it, a tap's other line, are not
+ * its KLV output). */
+static void klv_record(void *ctx, int linktype, const tk_cap_rec_t *rec)
 {
-    tk_cap_reader_t r;
-    tk_cap_rec_t rec;
-    unsigned long bad = 0;
-    char why[160];
-    int rc;
-    tk_cap_reader_open(&r, in->fd, head, n, in->name);
-    if (r.linktype != TK_CAP_LINKTYPE_SERIAL) {
-        tk_exit(TK_EXIT_INPUT, "%s is a CAN capture: the KLV line is a serial line", in->name);
+    klv_cap_t *k = ctx;
+    (void)linktype; /* serial: each_record() refuses the others */
+    if (rec->dir == TK_CAP_FROM_GIMBAL) {
+        klv_feed(k->rx, k->c, rec->data, rec->len);
     }
-    while ((rc = tk_cap_next(&r, &rec, why, sizeof(why))) != TK_CAP_END) {
-        if (rc == TK_CAP_BAD) {
-            if (++bad <= BAD_LINES_SHOWN) {
-                tk_warn("%s: record %lu skipped: %s", in->name, rec.index, why);
-            }
-        } else if (rec.dir == TK_CAP_FROM_GIMBAL) {
-            klv_feed(rx, c, rec.data, rec.len);
-        } else {
-            /* bytes to the gimbal (a tap's other line): not its KLV output */
-        }
-        tk_exit_if_signalled();
-    }
-    tk_cap_reader_close(&r);
-    if (bad > BAD_LINES_SHOWN) {
-        tk_warn("%s: %lu more bad records not shown", in->name, bad - BAD_LINES_SHOWN);
-    }
-    return bad;
 }
 
 int cli_cmd_klv(cli_args_t *a)
@@ -394,8 +401,11 @@ int cli_cmd_klv(cli_args_t *a)
         /* `tase record` of the KLV line: its records' bytes, in order (a
          * packet is often split across records); fed raw, the pcap headers
          * cut packets and the offsets were the file's */
+        klv_cap_t k;
+        k.rx = &rx;
+        k.c = &c;
         capture = true;
-        bad = klv_capture(&in, &rx, &c, buf, n);
+        bad = each_record(&in, buf, n, klv_record, &k, "the KLV line is a serial line");
     } else {
         while (n > 0) {
             klv_feed(&rx, &c, buf, n);
