@@ -507,13 +507,16 @@ static int64_t nearest_sat(double x, int64_t lo, int64_t hi)
  * 1e5 deg on. */
 static uint32_t nearest_wrap(double deg, double two_pow)
 {
-    double turns;
     double rest;
     if (!(deg > -WRAP_LIMIT_DEG && deg < WRAP_LIMIT_DEG)) {
         return 0u;
     }
-    turns = (double)(int64_t)(deg / 360.0);
-    rest = deg - turns * 360.0;
+    if (deg > -360.0 && deg < 360.0) {
+        rest = deg; /* no whole turn: the division saved */
+    } else {
+        double turns = (double)(int64_t)(deg / 360.0);
+        rest = deg - turns * 360.0;
+    }
     /* cppcheck's std.cfg spells INT64_MIN as an unsuffixed literal; the
      * libc's own definition is (-INT64_MAX - 1). */
     /* cppcheck-suppress misra-c2012-7.2 */
