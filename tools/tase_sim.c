@@ -655,14 +655,18 @@ int main(int argc, char **argv)
                  * read some since the last look: this one is skipped
                  * rather than that one cut (dropping every unread byte
                  * left a reader slower than 97 B/s no whole packet) */
+                klv_unread = unread;
             } else {
                 /* a packet still unread after 900 ms (or a tail nobody
                  * reads any more) has no reader: drop it, as a serial line
                  * would, so a reader that opens later gets fresh data */
                 (void)tk_pty_drop_unread(klv_slave);
                 send_klv(&s, &klv_port);
+                /* what was just queued, not a look now: the pty passes
+                 * written bytes to its reader's side a little later, and a
+                 * look right after the write saw some of them or none */
+                klv_unread = (int)TASE_KLV_PACKET_LEN;
             }
-            klv_unread = tk_pty_unread(klv_slave);
             next_klv = sim_next_due(next_klv, now, KLV_PERIOD_MS); /* no burst after a stall */
         }
     }
