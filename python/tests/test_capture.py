@@ -352,6 +352,15 @@ def _pcap(snaplen, records):
     return out
 
 
+def _decode_both(tase_cli, path):
+    """`tase decode PATH` and `python -m tase decode PATH`: (C, Python)."""
+    cli = subprocess.run([tase_cli, "decode", str(path)], capture_output=True, text=True,
+                         timeout=30)
+    py = subprocess.run([sys.executable, "-m", "tase", "decode", str(path)],
+                        capture_output=True, text=True, timeout=60)
+    return cli, py
+
+
 def test_python_decode_exits_as_tase_decode_does(tase_cli, tmp_path):
     # a review: a record longer than the header's snapshot length was
     # decoded whole (libpcap cuts it: tase decode skips it, exit 4); a
@@ -365,10 +374,7 @@ def test_python_decode_exits_as_tase_decode_does(tase_cli, tmp_path):
     for name, data in cases.items():
         path = tmp_path / name
         path.write_bytes(data)
-        cli = subprocess.run([tase_cli, "decode", str(path)], capture_output=True, text=True,
-                             timeout=30)
-        py = subprocess.run([sys.executable, "-m", "tase", "decode", str(path)],
-                            capture_output=True, text=True, timeout=60)
+        cli, py = _decode_both(tase_cli, path)
         assert (py.returncode, py.stdout) == (cli.returncode, cli.stdout), (name, py.stderr,
                                                                            cli.stderr)
         assert py.returncode in (1, 4), name
@@ -559,10 +565,7 @@ def test_edge_records_decode_as_tase_decode(tmp_path, tase_cli):
     for name, (data, want, status) in cases.items():
         path = tmp_path / name
         path.write_bytes(data)
-        c = subprocess.run([tase_cli, "decode", str(path)], capture_output=True, text=True,
-                           timeout=30)
-        p = subprocess.run([sys.executable, "-m", "tase", "decode", str(path)],
-                           capture_output=True, text=True, timeout=60)
+        c, p = _decode_both(tase_cli, path)
         got = [(json.loads(line)["name"], json.loads(line)["offset"])
                for line in c.stdout.splitlines()]
         assert (c.returncode, got) == (status, want), (name, c.stdout, c.stderr)
