@@ -18,6 +18,11 @@ void tk_field(const tase_packet_desc_t *p, unsigned i, size_t len, tk_field_t *o
     out->offset = off >= 0 ? (unsigned)off : f->offset;
     out->width = TASE_FIELD_WIDTH(f);
     out->is_signed = TASE_FIELD_IS_SIGNED(f);
+    {
+        int64_t keep = 0;
+        out->has_keep = tase_field_keep(p, i, &keep) == TASE_OK;
+        out->keep = (long long)keep;
+    }
 }
 
 bool tk_field_get(const tase_packet_desc_t *p, unsigned i, const uint8_t *data, size_t len,
@@ -77,8 +82,12 @@ int tk_field_parse(const tk_field_t *f, const char *s, long long *v)
     if (rc != TK_NUM_OK) {
         return rc;
     }
-    if (hex && f->is_signed && f->width < 8u && x > hi && x <= 2 * hi + 1) {
-        x -= 2 * hi + 2; /* the two's complement bit pattern */
+    if (hex && f->is_signed && f->has_keep && f->keep < 0 && f->width < 8u &&
+        x == f->keep + 2 * hi + 2) {
+        /* the "do not change" code as the spec writes it (0xFFFF); any
+         * other pattern beyond the range is refused, never wrapped into a
+         * value of the other sign */
+        x = f->keep;
     }
     if (x < lo || x > hi) {
         return TK_NUM_RANGE;

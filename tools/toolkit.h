@@ -259,6 +259,8 @@ typedef struct {
     unsigned offset;  /* byte offset in the data (of the layout asked for) */
     unsigned width;   /* 1, 2, 4 or 8 bytes */
     bool is_signed;
+    bool has_keep;  /* the field has a "do not change" code: */
+    long long keep; /* that code (tase_field_keep()) */
 } tk_field_t;
 
 /* Field i of packet p (i < p->nfields) in a packet of `len` data bytes
@@ -273,9 +275,10 @@ int tk_field_set(const tk_field_t *f, uint8_t *data, long long v);
 /* The range of the field's values as text ("-32768..32767"). */
 void tk_field_range(const tk_field_t *f, char *buf, size_t cap);
 /* Parse a value for the field: the integer grammar above, within the
- * field's range; a signed field also takes its bit pattern in hex
- * (0xFFFF is -1 in a 16-bit field, as the spec writes it). Returns a
- * TK_NUM_* code. */
+ * field's range; a signed field whose "do not change" code is negative
+ * also takes that code's bit pattern in hex (CAMERA_CMD hfov=0xFFFF is
+ * -1, as the spec writes it), and no other: pan=0x8000 is out of range,
+ * not -32768. Returns a TK_NUM_* code. */
 int tk_field_parse(const tk_field_t *f, const char *s, long long *v);
 /* The packet named `name`, case-insensitive; dies with a one-line list
  * hint when unknown. */

@@ -185,6 +185,17 @@ class Field:
                 ),
                 lib.TASE_ERANGE,
             )
+        if r == 0 and value != 0 and not self.signed:
+            # an amount (unsigned: a rate limit, gain, filter, range) whose
+            # 0 is none: AXIS_SETTING pan_max_rate 2 deg/s (steps of 5) is
+            # raw 0, which locks the axis, SENSOR_FILTER cutoff 0.04 Hz a
+            # 0 Hz filter; a request for something is not sent as nothing.
+            # A signed value rounds to 0 as to any other (pan 0.004 deg).
+            raise FieldError(
+                "%s %s: %s %s is raw 0 (steps of %s %s): give 0 for 0, or at least half a step"
+                % (pkt, self.name, value, self.label, self.to_eng(1), self.label),
+                lib.TASE_ERANGE,
+            )
         if r == self.keep or r == self.none:
             # e.g. AXIS_SETTING pan_max_rate 1275 deg/s is raw 0xFF: "do not
             # change", which a gimbal reads as no value at all
@@ -200,6 +211,12 @@ class Field:
     def _check(self, value, pkt):
         if not isinstance(value, int) or isinstance(value, bool):
             raise FieldError("%s %s: not an integer: %r" % (pkt, self.name, value))
+        if self.signed and self.keep is not None and self.keep < 0 and value == self.keep + (
+            1 << (8 * self.width)
+        ):
+            # the "do not change" code as the spec writes it (hfov 0xFFFF is
+            # -1), as the CLI takes it; no other pattern is wrapped
+            value = self.keep
         if not self.min <= value <= self.max:
             raise FieldError(
                 "%s %s: %d out of range %d..%d (%s %d-bit)"
@@ -658,7 +675,7 @@ def _bytes(what, data):
 
 def _make(t, raw, length, data):
     """Build packet type t from wire integers (by name) through the codec."""
-    if length is None or (length == t.len and not isinstance(length, bool)):
+    if length is None or (length == t.len and not isinstance(length, bool) and not t.tail):
         n = None
     else:
         if (

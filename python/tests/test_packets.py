@@ -305,3 +305,38 @@ def test_huge_values_and_lengths_are_field_errors(make):
 def test_wrong_arguments_are_field_errors_at_once(make, text):
     with pytest.raises(tase.FieldError, match=text):
         make()
+
+
+def test_a_value_that_rounds_to_raw_0_is_refused():
+    # a review: pan_max_rate=2 deg/s (steps of 5) went out as raw 0, which
+    # locks the axis; cutoff=0.04 Hz as a 0 Hz filter
+    with pytest.raises(tase.FieldError, match=r"pan_max_rate: 2 deg/s is raw 0 \(steps of 5"):
+        tase.Packet("AXIS_SETTING", pan_max_rate=2)
+    with pytest.raises(tase.FieldError, match="is raw 0"):
+        tase.Packet("SENSOR_FILTER", cutoff=0.04, decimation=0.5)
+    # a signed value rounds to 0 as to any other (as before)
+    assert tase.Packet("GIMBAL_ANGLE", pan=0.004, tilt=0, roll=0).raw["pan"] == 0
+    assert tase.Packet("AXIS_SETTING", pan_max_rate=3).raw["pan_max_rate"] == 1  # half a step up
+    assert tase.Packet("AXIS_SETTING", pan_max_rate=0).raw["pan_max_rate"] == 0
+    assert tase.Packet("GIMBAL_ANGLE", pan=-0.005, tilt=0, roll=0).raw["pan"] == -1
+
+
+def test_camera_pass_length_counts_its_data():
+    # a review: length=4 (the table's length) was ignored and the 3 data
+    # bytes sent (7 bytes); the same length with the bytes counted is taken
+    with pytest.raises(tase.Error):
+        tase.Packet("CAMERA_PASS", camera=0, data=b"\x01\x02\x03", length=4)
+    p = tase.Packet("CAMERA_PASS", camera=0, data=b"\x01\x02\x03", length=7)
+    assert p.size == 7 and p.data == b"\x01\x02\x03"
+    assert tase.Packet("CAMERA_PASS", camera=0, length=4).size == 4
+
+
+def test_raw_takes_a_do_not_change_code_as_the_spec_writes_it():
+    # as tase send's hfov=0xFFFF; no other bit pattern is wrapped (pan
+    # 0x8000 is out of range, not -32768, in both)
+    assert tase.Packet("CAMERA_CMD", camera=1, raw={"hfov": 0xFFFF}).raw["hfov"] == -1
+    assert tase.Packet("AXIS_SETTING", raw={"pan_nogo_center": 0xFFFF}).raw["pan_nogo_center"] == -1
+    with pytest.raises(tase.FieldError, match="65534 out of range"):
+        tase.Packet("CAMERA_CMD", camera=1, raw={"hfov": 0xFFFE})
+    with pytest.raises(tase.FieldError, match="32768 out of range"):
+        tase.Packet("GIMBAL_CMD", raw=dict(flags=0x90, pan=0x8000, tilt=0, roll=0, impulse_time=0))

@@ -134,6 +134,28 @@ expect("range error states the range", ["send", "HOST_SENSOR", "roll=40000", "--
        r"out of range -32768\.\.32767")
 expect("data byte range", ["send", "CAMERA_PASS", "camera=0", "baud=0", "data=1,256"] + L, 2,
        r"out of range 0\.\.255")
+expect("CAMERA_PASS --len longer than its data= is refused (was padded with zeros)",
+       ["send", "CAMERA_PASS", "camera=0", "baud=0", "data=1", "--len", "6"] + L, 2,
+       r"CAMERA_PASS with 1 data byte is 5 bytes, not --len 6; nothing sent")
+expect("CAMERA_PASS --len shorter than its data= is refused (bytes were dropped)",
+       ["send", "CAMERA_PASS", "camera=0", "baud=0", "data=1,2,3", "--len", "4"] + L, 2,
+       r"CAMERA_PASS with 3 data bytes is 7 bytes, not --len 4; nothing sent")
+expect("CAMERA_PASS --len without data= is refused (a 0 byte nobody asked for)",
+       ["send", "CAMERA_PASS", "camera=0", "baud=0", "--len", "5"] + L, 2,
+       r"with 0 data bytes is 4 bytes, not --len 5")
+expect("CAMERA_PASS --len equal to its fields and data= reaches the link",
+       ["send", "CAMERA_PASS", "camera=0", "baud=0", "data=1", "--len", "5"] + L, 1,
+       "cannot open serial device")
+expect("hex past a signed motion field's range is refused, not wrapped (0x8000 was -32768)",
+       ["send", "GIMBAL_CMD", "flags=0x90", "pan=0x8000", "tilt=0", "roll=0",
+        "impulse_time=0"] + L, 2, r"bad value '0x8000' for GIMBAL_CMD.pan: out of range")
+expect("0xFFFF in a signed field without a \"do not change\" code is refused (was -1)",
+       ["send", "GIMBAL_CMD", "flags=0x20", "pan=0xFFFF", "tilt=0", "roll=0",
+        "impulse_time=0"] + L, 2, r"bad value '0xFFFF' for GIMBAL_CMD.pan: out of range")
+expect("hfov=0xFFFF is the \"do not change\" code -1, as the spec writes it",
+       ["send", "CAMERA_CMD", "camera=1", "hfov=0xFFFF"] + L, 1, "cannot open serial device")
+expect("hfov=0xFFFE is not that code: refused",
+       ["send", "CAMERA_CMD", "camera=1", "hfov=0xFFFE"] + L, 2, r"hfov: out of range")
 expect("missing fields are named", ["send", "HOST_GPS_DATA", "lat=1", "lon=2"] + L, 2,
        r"HOST_GPS_DATA needs every field.*missing time, height, vnorth")
 expect("GIMBAL_CMD without flags is refused with the modes",

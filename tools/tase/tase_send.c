@@ -298,6 +298,13 @@ int cli_cmd_send(cli_args_t *a)
         fields_assign(&fs, assign[i]);
     }
     len = o.len >= 0 ? (size_t)o.len : p->len + fs.tail;
+    if (tk_packet_has_tail(p) && len != p->len + fs.tail) {
+        /* CAMERA_PASS: its length is its fields and the data= bytes; any
+         * other --len pads the camera's bytes with zeros or drops some */
+        tk_usage_error("%s with %lu data byte%s is %lu bytes, not --len %lu; nothing sent", name,
+                       (unsigned long)fs.tail, fs.tail == 1u ? "" : "s",
+                       (unsigned long)(p->len + fs.tail), (unsigned long)len);
+    }
     if (!tase_schema_length_ok(p, len)) {
         tk_usage_error("%s does not accept a data length of %lu", name, (unsigned long)len);
     }
