@@ -5,8 +5,14 @@
 # installed package and pkg-config files. A value-less define rather than
 # a quoted file name, because a quoted -D does not survive every way a
 # pkg-config or Makefile consumer passes flags through a shell.
-set(TASE_CONFIG_HEADER "" CACHE FILEPATH
-    "Optional configuration header (see tase/config.h), built into the library and passed on to everything that links it")
+# A parent project may set it as a plain variable before add_subdirectory()
+# or FetchContent: under CMP0126's old behaviour (cmake_minimum_required
+# below 3.21) a cache set() would remove that variable on the first
+# configure, and the library would be built without the header.
+if(NOT DEFINED TASE_CONFIG_HEADER)
+  set(TASE_CONFIG_HEADER "" CACHE FILEPATH
+      "Optional configuration header (see tase/config.h), built into the library and passed on to everything that links it")
+endif()
 set(TASE_PC_CFLAGS "")
 if(TASE_CONFIG_HEADER)
   get_filename_component(_tase_cfg "${TASE_CONFIG_HEADER}" ABSOLUTE BASE_DIR ${CMAKE_BINARY_DIR})

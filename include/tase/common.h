@@ -28,6 +28,22 @@
 #include "tase/config.h" /* TASE_CONFIG_HEADER and the defaults */
 #include "tase/version.h"
 
+#if defined(__cplusplus) && __cplusplus >= 201103L && defined(__GNUC__) && !defined(__clang__)
+/* Private: TASE_CAST_() below for g++ from C++11 on. A static_cast the
+ * macros of the headers make of a user's argument (TASE_GIMBAL_FLAGS(2, 1),
+ * TASE_UART_BYTES_PER_S(57600u)) is "useless" to g++ -Wuseless-cast when
+ * the argument has the type already, and a user's code built with that
+ * warning as an error failed; inside a function template the cast is not
+ * reported. constexpr, so that the macros stay constant expressions. (Not
+ * for clang++, which has no such warning and whose -Wc++98-compat reports
+ * the template.) Outside extern "C": a template cannot have C linkage. */
+template <typename T, typename U> constexpr T tase_cast_(U v)
+{
+    return static_cast<T>(v);
+}
+#define TASE_CAST_TEMPLATE_ 1
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -36,7 +52,10 @@ extern "C" {
  * inline functions, macros) that compiles cleanly as C and as C++ (no
  * old-style cast there: clang++ -Wold-style-cast). A type name cannot be
  * put in parentheses, hence the MISRA 20.7 suppressions. */
-#ifdef __cplusplus
+#if defined(TASE_CAST_TEMPLATE_)
+/* cppcheck-suppress misra-c2012-20.7 */
+#define TASE_CAST_(type, value) (tase_cast_<type>(value))
+#elif defined(__cplusplus)
 /* cppcheck-suppress misra-c2012-20.7 */
 #define TASE_CAST_(type, value) (static_cast<type>(value))
 #else

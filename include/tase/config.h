@@ -25,8 +25,8 @@
  * TASE_USER_CONFIG defined, which includes it from here.
  *
  * THE OPTIONS
- *   TASE_PORT_WRITE_TIMEOUT_MS (default 100)  the deadline of one frame
- *       write by tase_port_write_all() (tase/port_io.h).
+ *   TASE_PORT_WRITE_TIMEOUT_MS (default 100, 1..2^31-1)  the deadline of
+ *       one frame write by tase_port_write_all() (tase/port_io.h).
  *   TASE_PORT_WRITE_TRIES (default 64, 1..255)  tase_port_write_all()'s
  *       give-up count for a port without a clock (tase/port_io.h).
  *   TASE_PORT_WRITE_SPINS (default 1048576, 1..2^31)  the same for a port
@@ -46,6 +46,10 @@
  *       4096 bytes a port, about 3.3 million instructions on a Cortex-M4
  *       for three ports of the worst input (docs/TIMING.md); 1 bounds it
  *       to 64 bytes a port for a fast loop. Used only inside the library.
+ *   TASE_GIMBAL_TELEMETRY_SHARE (default 75, 1..100)  the percentage of
+ *       a port's capacity the gimbal role's telemetry may use, the rest
+ *       kept for echoes and answers (tase/gimbal.h, PRIORITY AND
+ *       CAPACITY). Used only inside the library.
  *   TASE_RING_BARRIER()  the bare-metal ring's barrier hook (tase/ring.h),
  *       used only inside port/baremetal/tase_ring.c.
  *   TASE_RX_CANDIDATES (1..16, default 4)  NO EFFECT since 0.2.0: the
@@ -102,6 +106,9 @@
 #ifndef TASE_PORT_WRITE_TIMEOUT_MS
 #define TASE_PORT_WRITE_TIMEOUT_MS 100u
 #endif
+#if TASE_PORT_WRITE_TIMEOUT_MS < 1 || TASE_PORT_WRITE_TIMEOUT_MS > 0x7FFFFFFF
+#error "TASE_PORT_WRITE_TIMEOUT_MS must be 1..2^31-1"
+#endif
 #ifndef TASE_PORT_WRITE_TRIES
 #define TASE_PORT_WRITE_TRIES 64u
 #endif
@@ -119,6 +126,12 @@
 #endif
 #if TASE_GIMBAL_SERVICE_READS < 1 || TASE_GIMBAL_SERVICE_READS > 1024
 #error "TASE_GIMBAL_SERVICE_READS must be 1..1024"
+#endif
+#ifndef TASE_GIMBAL_TELEMETRY_SHARE
+#define TASE_GIMBAL_TELEMETRY_SHARE 75u
+#endif
+#if TASE_GIMBAL_TELEMETRY_SHARE < 1 || TASE_GIMBAL_TELEMETRY_SHARE > 100
+#error "TASE_GIMBAL_TELEMETRY_SHARE must be 1..100"
 #endif
 
 /* The link-name tag: "abi" and the ABI level. An option that changes a

@@ -164,6 +164,16 @@
  * except for an error code), whatever the callback does to the counters.
  * Different receivers are independent; one receiver must not be used from
  * two contexts concurrently (e.g. a main loop and an interrupt).
+ *
+ * INTERRUPTS. The receiver may run in an interrupt handler (a UART's
+ * receive interrupt calling tase_rx_push(), a DMA IDLE-line interrupt
+ * calling tase_rx_feed()): it keeps no global state, takes no lock and
+ * allocates nothing, and every call has a bounded worst case (COST). The
+ * callback then runs in that handler too, so it must be safe there (or
+ * copy the frame out); and every call on that receiver, tase_rx_tick()
+ * included, must come from that one context (the rule above). Receiving
+ * into a ring in the interrupt and feeding from the main loop
+ * (tase/ring.h) keeps the callback out of the interrupt.
  */
 #ifndef TASE_FRAME_H
 #define TASE_FRAME_H

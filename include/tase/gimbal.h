@@ -78,6 +78,11 @@
  *         tase_dispatch_frame(d, f);
  *     }
  *     app.on_frame = to_dispatch; app.user = &dispatcher;
+ * The dispatcher counts unknown and wrong-length frames into the
+ * tase_rx_stats_t given to tase_dispatch_init(): with one port, that
+ * port's receiver's (&rx[0].stats); with several, one dispatcher per port,
+ * each with its receiver's counters (the adapter picks it by `port`), or
+ * one counting into a tase_rx_stats_t of the application's for all.
  * or run your own receiver with tase_dispatch_frame() as its handler and
  * hand the setup packets to the role from their typed handlers with
  * tase_gimbal_handle_frame() (init with rx NULL; examples/firmware does
@@ -189,11 +194,9 @@ extern "C" {
  * room fill_telemetry() gets. */
 #define TASE_GIMBAL_TELEMETRY_MAX 63u
 
-/* Percentage of a port's capacity telemetry may use (see PRIORITY AND
+/* TASE_GIMBAL_TELEMETRY_SHARE (tase/config.h, default 75): the
+ * percentage of a port's capacity telemetry may use (see PRIORITY AND
  * CAPACITY); the rest is kept for echoes and answers. */
-#ifndef TASE_GIMBAL_TELEMETRY_SHARE
-#define TASE_GIMBAL_TELEMETRY_SHARE 75u
-#endif
 
 /* Application callbacks; any may be NULL. `user` is passed back. */
 typedef struct {

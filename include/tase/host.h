@@ -20,7 +20,10 @@
  *    the reply into the caller's typed struct; a raw one copies the
  *    reply's data bytes into a caller buffer.
  *
- * TYPED USE (tase/codec.h structs):
+ * TYPED USE (tase/codec.h structs; scripts/checks/readme-example.sh
+ * compiles this example):
+ *     #include "tase/codec.h"  // the structs, TASE_ID_* (tase/ids.h)
+ *     #include "tase/flags.h"  // TASE_GIMBAL_FLAGS_*, TASE_SETUP_TEMPORARY
  *     tase_gimbal_cmd_t cmd = {1500, -2000, 0, TASE_GIMBAL_FLAGS_POSITION, 0};
  *     tase_packet_rate_t rates;
  *     tase_host_send_msg(&h, TASE_ID_GIMBAL_CMD, &cmd);

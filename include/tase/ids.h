@@ -11,10 +11,12 @@
 #include "tase/common.h"
 
 /* TASE_ID() converts its arguments to unsigned, so that int arguments
- * pass -Wsign-conversion; with arguments that are unsigned int already,
- * g++ -Wuseless-cast calls those conversions useless (as it does
- * TASE_ID_GROUP() / TASE_ID_TYPE() of an unsigned int): pass uint8_t /
- * uint16_t values, or use the constants below. */
+ * pass -Wsign-conversion; in C++98, with arguments that are unsigned int
+ * already, g++ -Wuseless-cast calls those conversions useless (as it does
+ * TASE_ID_GROUP() / TASE_ID_TYPE() of an unsigned int, and the other
+ * macros' conversions, e.g. TASE_GIMBAL_FLAGS(2, 1)): pass uint8_t /
+ * uint16_t values, or use the constants below. From C++11 on g++ sees no
+ * such cast (tase/common.h: TASE_CAST_). */
 #define TASE_ID(group, type)                                                                       \
     TASE_CAST_(uint16_t, (TASE_CAST_(unsigned, group) << 8) | TASE_CAST_(unsigned, type))
 /* Private: TASE_ID() of two unsigned literals, for the constants below

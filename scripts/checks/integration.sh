@@ -114,6 +114,29 @@ for p in "$TASE_ROOT"/port/*/tase/*.h; do echo "#include \"tase/$(basename "$p")
             echo "    n += TASE_ID_GROUP($id);"
             echo "    n += TASE_ID_TYPE($id);"
         done
+    # the function-like macros of flags.h and common.h as a user writes
+    # them (g++ -Wuseless-cast failed on TASE_GIMBAL_FLAGS(2, 1) and
+    # TASE_UART_BYTES_PER_S(57600u): casts of arguments of the type
+    # already; clean from C++11 on, see ids.h)
+    echo '#if !defined(__cplusplus) || __cplusplus >= 201103L'
+    echo '    {'
+    echo '        uint8_t flags = 0x20u;'
+    echo '        uint16_t status = 0x1234u;'
+    echo '        n += TASE_UART_BYTES_PER_S(57600u);'
+    echo '        n += TASE_UART_BYTES_PER_S(57600);'
+    echo '        n += TASE_GIMBAL_FLAGS(2, 1);'
+    echo '        n += TASE_GIMBAL_FLAGS(TASE_GIMBAL_KIND_POSITION, 1);'
+    echo '        n += TASE_GIMBAL_FLAGS(TASE_GIMBAL_KIND(flags), 0u);'
+    echo '        n += TASE_MODE_SET_VALUE(flags, 3u);'
+    echo '        n += TASE_MODE_SET_VALUE(flags, 3);'
+    echo '        n += TASE_MODE_VALUE(flags);'
+    echo '        n += TASE_GPS_FIX(status);'
+    echo '        n += TASE_GPS_ANTENNA(status);'
+    echo '        n += TASE_NAV_FILTER_MODE(0xF000u);'
+    echo '        n += TASE_BITS16_SET(status, 0, 2, 5u);'
+    echo '        n += TASE_ID(TASE_GROUP_COMMAND, 0x10u);'
+    echo '    }'
+    echo '#endif'
     echo '    return n;'
     echo '}'
     echo 'int main(void) { return tase_uses() == 0u; }'
@@ -337,6 +360,29 @@ cmake -S "$cons/consumer" -B "$out/cfg-subdir" -DHOW=subdir -DTASE_SRC="$TASE_RO
 cmake --build "$out/cfg-subdir" -j$jobs >/dev/null
 line=$("$out/cfg-subdir/app")
 echo "   add_subdirectory: $line"
+# A parent that sets TASE_CONFIG_HEADER as a plain variable (not -D): taken
+# on the first configure, both ways in (a cache set() dropped it then, and
+# only a second configure built the library with it)
+for how in subdir fetch; do
+    cmake -S "$cons/consumer" -B "$out/cfg-parent-$how" -DHOW=$how -DTASE_SRC="$TASE_ROOT" \
+        -DPORT=baremetal -DPARENT_CONFIG_HEADER="$cfg" -DEXPECT_WRITE_TIMEOUT_MS=250 >/dev/null
+    cmake --build "$out/cfg-parent-$how" -j$jobs >/dev/null
+    line=$("$out/cfg-parent-$how/app") ||
+        tase_fail "$how: TASE_CONFIG_HEADER set by the parent was not applied on the first configure: $line"
+    echo "   $how, set(TASE_CONFIG_HEADER) in the parent, first configure: $line"
+done
+# Options with a range refuse a value outside it with their own message
+# (TASE_PORT_WRITE_TIMEOUT_MS=0 was a -Wtype-limits error inside the
+# library; TASE_GIMBAL_TELEMETRY_SHARE took 0 and 150 without a word)
+expect_fail "$out/timeout0.log" "TASE_PORT_WRITE_TIMEOUT_MS must be 1" "TASE_PORT_WRITE_TIMEOUT_MS=0" -- \
+    gcc -std=c99 -Wall -Wextra -Werror -DTASE_PORT_WRITE_TIMEOUT_MS=0 -I"$TASE_ROOT/include" \
+    -c "$TASE_ROOT/src/tase_port_io.c" -o "$out/timeout0.o"
+for share in 0 150; do
+    expect_fail "$out/share$share.log" "TASE_GIMBAL_TELEMETRY_SHARE must be 1..100" \
+        "TASE_GIMBAL_TELEMETRY_SHARE=$share" -- \
+        gcc -std=c99 -DTASE_GIMBAL_TELEMETRY_SHARE=$share -I"$TASE_ROOT/include" \
+        -c "$TASE_ROOT/src/tase_gimbal.c" -o "$out/share$share.o"
+done
 # The app's check is not vacuous: built without the installed header (no
 # TASE_USER_CONFIG) it sees 100 ms while the library applies 250.
 expect_fail "$out/cfg-none.log" "^FAIL" "an app without the library's configuration header" -- \

@@ -7,17 +7,37 @@
  * the last call to a receiver as one span, or two where they wrap round
  * the end of the buffer, and reports when the DMA lapped the reader.
  *
- * WIRING IT UP (STM32 HAL names; any DMA that counts works the same):
+ * WIRING IT UP (STM32 HAL names; any DMA that counts works the same;
+ * scripts/checks/readme-example.sh compiles this example with stand-ins
+ * for the HAL's names, a receiver `rx` and its `on_frame`):
  *
  *     static uint8_t dma_buf[256];          // any size >= 1
  *     static volatile uint32_t dma_laps;    // full buffers written so far
  *     static tase_bm_dma_t rxd;
- *     tase_bm_dma_init(&rxd, dma_buf, sizeof dma_buf);
- *     HAL_UART_Receive_DMA(&huart3, dma_buf, sizeof dma_buf);  // circular
- *     void HAL_UART_RxCpltCallback(UART_HandleTypeDef *h) { dma_laps++; }
- *     // main loop (or the IDLE-line interrupt, with on_frame safe there):
- *     uint32_t n = (uint32_t)(sizeof dma_buf - __HAL_DMA_GET_COUNTER(h->hdmarx));
- *     tase_bm_dma_poll(&rxd, dma_laps * sizeof dma_buf + n, now_ms, &rx, on_frame, user);
+ *     void HAL_UART_RxCpltCallback(UART_HandleTypeDef *h)
+ *     {
+ *         if (h == &huart3) {
+ *             dma_laps++;
+ *         }
+ *     }
+ *     void uart_rx_start(void)
+ *     {
+ *         tase_bm_dma_init(&rxd, dma_buf, sizeof dma_buf);
+ *         HAL_UART_Receive_DMA(&huart3, dma_buf, sizeof dma_buf);  // circular
+ *     }
+ *     // from the main loop (or the IDLE-line interrupt, with on_frame
+ *     // safe there):
+ *     void uart_rx_poll(uint32_t now_ms)
+ *     {
+ *         uint32_t laps;
+ *         uint32_t n;
+ *         do { // the laps and the counter of one moment (below)
+ *             laps = dma_laps;
+ *             n = (uint32_t)sizeof dma_buf - __HAL_DMA_GET_COUNTER(huart3.hdmarx);
+ *         } while (laps != dma_laps);
+ *         tase_bm_dma_poll(&rxd, laps * (uint32_t)sizeof dma_buf + n, now_ms, &rx, on_frame,
+ *                          NULL);
+ *     }
  *
  * `written` is the number of bytes the DMA has written since it started,
  * modulo 2^32: laps * size + its position. Read the two consistently (a
