@@ -76,7 +76,7 @@
  * bytes at most the cap plus n bytes' worth (plus its callbacks):
  * docs/TIMING.md lists it per function, measured on Cortex-M4 and M0+ on
  * the adversarial streams of bench/ (on a Cortex-M4 -O2: about 900
- * instructions for one tase_rx_push(), 4,200 for a 16-byte
+ * instructions for one tase_rx_push(), 4,000 for a 16-byte
  * tase_rx_feed(), 14,000 for a 64-byte one; these are the longest calls
  * found, not proven bounds, and a search finds a few per cent more:
  * docs/DESIGN.md). tase_rx_push() stores a

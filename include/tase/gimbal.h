@@ -127,7 +127,7 @@
  * the same fraction of its due slots, spread evenly, and skips the rest
  * (stats.slots_over_capacity); the stored and echoed PACKET_RATE stay
  * what the host asked for. The transmit queue then stays short, and an
- * answer leaves within a few frame times (25 ms at 9600 baud and
+ * answer leaves within a few frame times (24 ms at 9600 baud and
  * 255/255/255, measured in tests/test_gimbal.c, against 4.3 s without a
  * limit).
  *

@@ -128,9 +128,9 @@ static size_t make_packet(uint8_t *out)
     } else if (r < 70) {
         group = 0x08, type = 0x40, len = 18; /* GIMBAL_RATE */
     } else if (r < 85) {
-        group = 0x08, type = 0x41, len = 24; /* HOST_SENSOR */
+        group = 0x08, type = 0x41, len = 24; /* HOST_SENSOR's id (the packet has 20: framing only) */
     } else if (r < 93) {
-        group = 0x10, type = 0x10, len = 30; /* HOST_GPS_DATA */
+        group = 0x10, type = 0x10, len = 30; /* HOST_GPS_DATA's id (32: framing only) */
     } else if (r < 98) {
         group = 0x00, type = 0x42, len = (size_t)(rnd64() % 64u); /* CAMERA_PASS */
     } else {

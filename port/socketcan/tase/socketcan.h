@@ -201,11 +201,13 @@ int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t 
 /* Send one frame (validated with tase_can_frame_check()). Returns TASE_OK,
  * TASE_EARG (s as for write(), f NULL or failing the check; nothing
  * sent), TASE_ENOBUFS (queue still full after tx_timeout_ms),
- * TASE_EDOWN (the interface went down) or TASE_EIO. */
+ * TASE_EDOWN (the interface went down), TASE_ENODEV (it was removed) or
+ * TASE_EIO. */
 int tase_socketcan_send_frame(tase_socketcan_t *s, const tase_can_frame_t *f);
 
 /* Receive one frame, waiting at most timeout_ms. Returns 1 (*f filled),
- * 0 (none in time), TASE_EARG (s as for read(), f NULL) or TASE_EIO.
+ * 0 (none in time), TASE_EARG (s as for read(), f NULL), TASE_EDOWN (the
+ * interface went down), TASE_ENODEV (it was removed) or TASE_EIO.
  * Frames the filters let through but that are not classic data frames
  * are skipped: error frames update the bus health, remote frames and
  * wrong sizes count in stats.bad_frames, FD frames as described above. */
