@@ -128,7 +128,7 @@ static size_t make_packet(uint8_t *out)
     } else if (r < 70) {
         group = 0x08, type = 0x40, len = 18; /* GIMBAL_RATE */
     } else if (r < 85) {
-        group = 0x08, type = 0x41, len = 24; /* HOST_SENSOR's id (the packet has 20: framing only) */
+        group = 0x08, type = 0x41, len = 24; /* HOST_SENSOR's id (its packet: 20 bytes) */
     } else if (r < 93) {
         group = 0x10, type = 0x10, len = 30; /* HOST_GPS_DATA's id (32: framing only) */
     } else if (r < 98) {
