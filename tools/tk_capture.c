@@ -392,6 +392,14 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
         if (w->tmp[0] != '\0') {
             (void)unlink(w->tmp);
         }
+        if (e == EINTR) {
+            tk_exit_if_signalled(); /* Ctrl-C while a FIFO waits for a reader */
+        }
+        if (e != 0 && w->tmp[0] != '\0') {
+            /* the file that could not be made is the one beside FILE */
+            tk_die("cannot write capture %s: cannot create %s beside it: %s", path, w->tmp,
+                   strerror(e));
+        }
         if (e != 0) {
             tk_die("cannot write capture %s: %s", path, strerror(e));
         }

@@ -414,6 +414,10 @@ void tk_catch_signals(void)
         }
     }
     (void)signal(SIGPIPE, SIG_IGN);
+    /* A file-size limit (ulimit -f) is a write error (EFBIG, "File too
+     * large"), handled as a full disk is: the default action killed the
+     * tool without a word, after a packet went out too */
+    (void)signal(SIGXFSZ, SIG_IGN);
     {
         size_t i;
         sa.sa_handler = on_fatal_signal;

@@ -43,7 +43,7 @@ __all__ = [
 ]
 
 from . import capture, plot, sim  # noqa: E402
-from .capture import read_capture  # noqa: E402
+from .capture import CaptureError, read_capture  # noqa: E402
 from .link import Link, connect, parse_url  # noqa: E402
 
-__all__ += ["capture", "plot", "sim", "Link", "connect", "parse_url", "read_capture"]
+__all__ += ["capture", "plot", "sim", "CaptureError", "Link", "connect", "parse_url", "read_capture"]

@@ -6,6 +6,8 @@
 """
 
 import argparse
+import errno
+import signal
 import sys
 
 import tase
@@ -29,8 +31,17 @@ def main(argv=None):
             s = tase.plot.plot_capture(a.capture, a.output, a.baud)
             print("%s: %s" % (a.output, ", ".join("%s (%d)" % (k, len(v[0])) for k, v in s.items())))
         elif a.cmd == "decode":
-            with open(a.file, "rb") as f:
-                head = f.read(4)
+            try:
+                with open(a.file, "rb") as f:
+                    head = f.read(4)
+            except OSError as e:
+                # `tase decode`'s words
+                print(
+                    "tase: cannot %s %s: %s"
+                    % ("open" if e.errno == errno.ENOENT else "read", a.file, e.strerror or e),
+                    file=sys.stderr,
+                )
+                return 1
             n = 0
             if head[:4] in tase.capture.MAGICS:
                 cap = tase.capture.Capture(a.file)
@@ -72,4 +83,9 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
+    # as `tase decode | head`: a reader that went away ends the program as
+    # SIGPIPE does a C one (exit 141, no message), not with "Broken pipe"
+    # (only here: main() called from Python keeps its caller's handling)
+    if hasattr(signal, "SIGPIPE"):
+        signal.signal(signal.SIGPIPE, signal.SIG_DFL)
     sys.exit(main())

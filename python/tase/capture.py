@@ -311,7 +311,11 @@ def records(path):
     or pcapng file (damage: why tase decode skips the record, cut by the
     snapshot length or a damaged header, or None). A file that is not one, or a damaged record or block, is a
     CaptureError naming the file (the records before it are given)."""
-    with open(path, "rb") as f:
+    try:
+        f = open(path, "rb")
+    except IsADirectoryError:
+        raise CaptureError("%s: is a directory, not a capture" % path) from None
+    with f:
         yield from _records(f, path)
 
 

@@ -2,6 +2,8 @@
 pan and tilt (and rates) over the time of a `tase record` capture, drawn
 with matplotlib (Debian python3-matplotlib)."""
 
+import os
+
 from .capture import read_capture
 
 __all__ = ["series", "plot_capture"]
@@ -81,12 +83,16 @@ def series(path, baud=57600):
 
 def plot_capture(path, out, baud=57600, title=None):
     """Draw the capture's curves into image file `out` (PNG, SVG, PDF by
-    its extension). Returns the series drawn."""
+    its extension; PNG for another or none, under the name given: the file
+    written is `out`, never `out` + ".png"). A directory is a ValueError.
+    Returns the series drawn."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    if os.path.isdir(out):
+        raise ValueError("%s is a directory: give the image file's name" % out)
     s = series(path, baud)
     if not s:
         raise ValueError("%s: no GIMBAL_ANGLE, GIMBAL_RATE or GIMBAL_CMD to plot" % path)
@@ -108,6 +114,8 @@ def plot_capture(path, out, baud=57600, title=None):
     ax2.set_xlabel("time since the first packet (s)")
     fig.suptitle(title or path)
     fig.tight_layout()
-    fig.savefig(out)
+    ext = os.path.splitext(out)[1][1:].lower()
+    fmt = ext if ext in fig.canvas.get_supported_filetypes() else "png"
+    fig.savefig(out, format=fmt)
     plt.close(fig)
     return s

@@ -3,6 +3,7 @@ the same packets and times as `tase decode`; capture: links."""
 
 import json
 import os
+import signal
 import struct
 import subprocess
 import sys
@@ -72,6 +73,26 @@ def test_plot_commanded_vs_reported(recorded, tmp_path):
     assert len(s["pan"][0]) > 5 and len(s["pan_rate"][0]) > 5
 
 
+def test_plot_writes_the_file_it_names(recorded, tmp_path):
+    # a review: -o plotout wrote plotout.png and said "plotout: ...", and
+    # -o DIR wrote DIR.png, exit 0
+    pytest.importorskip("matplotlib")
+    cap, _ = recorded
+    out = tmp_path / "plotout"
+    r = subprocess.run([sys.executable, "-m", "tase", "plot", cap, "-o", str(out)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith(str(out) + ": ")
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not (tmp_path / "plotout.png").exists()
+    d = tmp_path / "d"
+    d.mkdir()
+    r = subprocess.run([sys.executable, "-m", "tase", "plot", cap, "-o", str(d)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 1 and "is a directory" in r.stderr, (r.returncode, r.stderr)
+    assert not (tmp_path / "d.png").exists()
+
+
 def test_plot_draws_only_position_and_rate_commands(tmp_path):
     # a review: the kind was read as flags & 0x30, so a SPOI error rate
     # (0xD0) drew a rate command that never was and ended the position
@@ -105,6 +126,38 @@ def test_module_decode_equals_tase_decode(recorded):
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
     assert r.stdout.splitlines() == lines
+
+
+def test_module_decode_into_a_closed_pipe_ends_as_tase_decode(tmp_path):
+    # a review: `python -m tase decode F | head -1` exited 1 with "tase:
+    # [Errno 32] Broken pipe"; `tase decode` ends by SIGPIPE, quietly
+    raw = tmp_path / "many.bin"
+    frame = tase.encode(tase.Packet("GIMBAL_ANGLE", raw={"pan": 1, "tilt": 2, "roll": 3}))
+    raw.write_bytes(frame * 20000)  # about 2 MB of JSON: far more than a pipe holds
+    p = subprocess.Popen([sys.executable, "-m", "tase", "decode", str(raw)],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    assert p.stdout.readline().startswith(b"{")
+    p.stdout.close()
+    err = p.stderr.read()
+    assert p.wait(timeout=60) == -signal.SIGPIPE, err
+    assert err == b""
+
+
+def test_a_directory_is_no_capture(tmp_path, tase_cli):
+    # a review: read_capture() raised IsADirectoryError, and python -m tase
+    # decode said "tase: [Errno 21] Is a directory: '...'"
+    d = tmp_path / "d"
+    d.mkdir()
+    # (PYTHON.md names it tase.CaptureError: it was only tase.capture's)
+    with pytest.raises(tase.CaptureError, match="is a directory"):
+        list(tase.read_capture(str(d)))
+    for path in (d, tmp_path / "missing"):
+        c = subprocess.run([tase_cli, "decode", str(path)], capture_output=True, text=True,
+                           timeout=30)
+        p = subprocess.run([sys.executable, "-m", "tase", "decode", str(path)],
+                           capture_output=True, text=True, timeout=60)
+        assert (p.returncode, p.stderr.replace(str(path), "P")) == (
+            c.returncode, c.stderr.replace(str(path), "P")), (p.stderr, c.stderr)
 
 
 def test_module_decode_of_bad_records_is_tase_decode(recorded, tase_cli, tmp_path):

@@ -260,6 +260,39 @@ grep -v '^==[0-9]*== ' "$dir/cut1k.err.all" >"$dir/cut1k.err"
 check "--record cut short by a file size limit: exit $rc, the reason named ('$(tail -1 "$dir/cut1k.err")'), the file ends at a whole record" \
     eval '[ $rc = 1 ] && grep -q "^tase: cannot write capture $dir/cut1k.pcap: File too large$" "$dir/cut1k.err" &&
           "$TASE" decode "$dir/cut1k.pcap" >/dev/null 2>&1'
+# The same limits with SIGXFSZ as a shell leaves it (its default action
+# kills): the tools ignore it themselves. A review: `ulimit -f` killed point
+# after the GIMBAL_CMD went out, with no word (exit 153), record left its
+# partial file cut inside a record, decode's output ended mid-line.
+cp "$dir/session.pcap" "$dir/xfsz.pcap"
+(
+    ulimit -f "$kb"
+    exec "$TASE" point 12 -3 --serial "$dir/gimbal" --record "$dir/xfsz.pcap"
+) >"$dir/xfsz.out" 2>"$dir/xfsz.err.all"
+rc=$?
+grep -v '^==[0-9]*== ' "$dir/xfsz.err.all" >"$dir/xfsz.err"
+check "--record over ulimit -f, SIGXFSZ not ignored by the shell: exit $rc (5), '$(cat "$dir/xfsz.err")'" \
+    eval '[ $rc -eq 5 ] && grep -q "cannot write capture .*: File too large (GIMBAL_CMD was sent)" "$dir/xfsz.err" &&
+          grep -q "^sent GIMBAL_CMD pan=1200 tilt=-300" "$dir/xfsz.out"'
+(
+    ulimit -f 2
+    exec "$TASE" record --serial "$dir/gimbal" -o "$dir/xfsz2.pcap" --seconds 20
+) >/dev/null 2>"$dir/xfsz2.err.all"
+rc=$?
+grep -v '^==[0-9]*== ' "$dir/xfsz2.err.all" >"$dir/xfsz2.err"
+kept=$(sed -n 's/.*the capture so far is kept in \([^;]*\);.*/\1/p' "$dir/xfsz2.err")
+check "record over ulimit -f, SIGXFSZ not ignored by the shell: exit $rc (1), the partial file named and readable" \
+    eval '[ $rc -eq 1 ] && [ -n "$kept" ] && grep -q "File too large" "$dir/xfsz2.err" &&
+          "$TASE" decode "$kept" 2>&1 >/dev/null | { ! grep -q .; }'
+rm -f "$dir"/xfsz2.pcap.partial-*
+(
+    ulimit -f 1
+    exec "$TASE" decode "$dir/session.pcap"
+) >"$dir/xfsz3.json" 2>"$dir/xfsz3.err.all"
+rc=$?
+grep -v '^==[0-9]*== ' "$dir/xfsz3.err.all" >"$dir/xfsz3.err"
+check "decode > a file over ulimit -f: exit $rc (1), '$(cat "$dir/xfsz3.err")'" \
+    eval '[ $rc -eq 1 ] && grep -q "^tase: cannot write to standard output: File too large$" "$dir/xfsz3.err"'
 # issue 25 item 3: appending to a capture a crash cut inside a record
 cp "$dir/session.pcap" "$dir/crashed.pcap"
 truncate -s -5 "$dir/crashed.pcap"
@@ -464,6 +497,37 @@ check "decode of a capture from a FIFO, SIGINT: exit $rc (130), '$(cat "$dir/fif
     eval '[ $rc -eq 130 ] && grep -q "^tase: interrupted by SIGINT$" "$dir/fifo.err"'
 kill $wp 2>/dev/null
 wait $wp 2>/dev/null
+# A FIFO nobody opened yet: Ctrl-C while open() waits for the other side
+# exited 1 "cannot open ...: Interrupted system call" (a review): 130 now,
+# as any interrupted command; replay refuses a FIFO at once (it hung in
+# open() without a writer, and refused only once one came).
+mkfifo "$dir/lone.fifo"
+for how in decode record; do
+    if [ $how = decode ]; then
+        "$TASE" decode "$dir/lone.fifo" >/dev/null 2>"$dir/lone.err.all" &
+    else
+        "$TASE" record --serial "$dir/gimbal" -o "$dir/lone.fifo" >/dev/null 2>"$dir/lone.err.all" &
+    fi
+    lp=$!
+    sleep $fifo_wait
+    kill -INT $lp
+    wait $lp
+    rc=$?
+    grep -v '^==[0-9]*== ' "$dir/lone.err.all" >"$dir/lone.err"
+    check "$how with a FIFO nobody opened, SIGINT while it waits: exit $rc (130), '$(cat "$dir/lone.err")'" \
+        eval '[ $rc -eq 130 ] && grep -q "^tase: interrupted by SIGINT$" "$dir/lone.err"'
+done
+timeout 20 "$TASE" replay "$dir/lone.fifo" --serial "$dir/gimbal" --dir in >/dev/null 2>"$dir/lone.err.all"
+rc=$?
+grep -v '^==[0-9]*== ' "$dir/lone.err.all" >"$dir/lone.err"
+check "replay of a FIFO: refused at once, exit $rc (1), '$(cat "$dir/lone.err")'" \
+    eval '[ $rc -eq 1 ] && grep -q "lone.fifo: replay reads its capture twice .*give a file, not a pipe$" "$dir/lone.err"'
+# an output FILE whose partial file cannot be made: the message names it
+"$TASE" record --serial "$dir/gimbal" -o /proc/version --seconds 1 >/dev/null 2>"$dir/proc.err.all"
+rc=$?
+grep -v '^==[0-9]*== ' "$dir/proc.err.all" >"$dir/proc.err"
+check "record -o /proc/version: exit $rc (1), the file that could not be made named ('$(cat "$dir/proc.err")')" \
+    eval '[ $rc -eq 1 ] && grep -q "^tase: cannot write capture /proc/version: cannot create /proc/version.partial-[0-9]* beside it: No such file or directory$" "$dir/proc.err"'
 
 # ---- tase record of the gimbal's line; SIGINT ends it cleanly ----
 "$TASE" record --serial "$dir/gimbal" -o "$dir/tele.pcap" >"$dir/rec.out" 2>&1 &

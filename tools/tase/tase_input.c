@@ -39,6 +39,9 @@ void cli_input_open(cli_input_t *in, const char *path, long baud)
     }
     in->fd = open(path, O_RDONLY | O_NOCTTY);
     if (in->fd < 0) {
+        if (errno == EINTR) {
+            tk_exit_if_signalled(); /* Ctrl-C while a FIFO waits for a writer */
+        }
         tk_die("cannot open %s: %s", path, strerror(errno));
     }
 }

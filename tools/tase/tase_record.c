@@ -80,6 +80,11 @@ int cli_cmd_record(cli_args_t *a)
     return TK_EXIT_OK;
 }
 
+/* replay's words for a capture it cannot read twice (a pipe, a FIFO) */
+#define REPLAY_NOT_A_FILE                                                                          \
+    "%s: replay reads its capture twice (checked before anything is sent): give a file, not a "    \
+    "pipe"
+
 int cli_cmd_replay(cli_args_t *a)
 {
     cli_link_opts_t lo = {NULL, NULL, CLI_DEFAULT_BAUD, false, NULL};
@@ -134,6 +139,13 @@ int cli_cmd_replay(cli_args_t *a)
                        "echoes are commands to a gimbal); in = the host's commands (moves a "
                        "gimbal); all = both (moves a gimbal)");
     }
+    {
+        /* a FIFO is refused before its open() waits for a writer */
+        struct stat st;
+        if (strcmp(path, "-") != 0 && stat(path, &st) == 0 && S_ISFIFO(st.st_mode)) {
+            tk_die(REPLAY_NOT_A_FILE, path);
+        }
+    }
     cli_input_open(&in, path, 0);
     n = cli_input_head(&in, head, sizeof(head));
     if (!tk_cap_is_capture(head, n)) {
@@ -147,9 +159,7 @@ int cli_cmd_replay(cli_args_t *a)
     /* The whole capture is checked before anything is sent: read it once
      * (so it must be a file, not a pipe), then again to send. */
     if (lseek(in.fd, 0, SEEK_SET) != 0) {
-        tk_die("%s: replay reads its capture twice (checked before anything is sent): give a "
-               "file, not a pipe",
-               in.name);
+        tk_die(REPLAY_NOT_A_FILE, in.name);
     }
     tk_cap_reader_open(&r, in.fd, NULL, 0, in.name);
     bad = tk_cap_check(&r, &ro, &backward);
