@@ -482,6 +482,75 @@ static void camera_pass_reports_its_baud_and_disables_camera_control(void **stat
     near(m.cam[0].hfov, 10.0, 1e-9);
 }
 
+/* A zoom ratio (CAMERA_CMD hfov negative: ratio x 100) is the focal
+ * length's, so GEOREFERENCE_DATA's focal length is that many times the
+ * widest's (a review: max_hfov / ratio gave 2.141x at 2x, 10.935x at 10x) */
+static void a_zoom_ratio_is_the_focal_lengths(void **state)
+{
+    sim_model_t m;
+    double wide, r;
+    (void)state;
+    sim_model_init(&m);
+    wide = tan(m.cam[0].max_hfov * PI / 360.0);
+    for (r = 2.0; r <= 10.0; r += 8.0) {
+        assert_int_equal(sim_model_camera_cmd(&m, 0, true, -r), SIM_CAM_OK);
+        near(wide / tan(m.cam[0].hfov * PI / 360.0), r, 1e-9);
+    }
+    near(m.cam[0].hfov, 2.0 * atan(wide / 10.0) * 180.0 / PI, 1e-9);
+}
+
+/* A moving SPOI carried over a pole comes down the meridian on the other
+ * side (a review: its latitude went past 90, 90.0053 in the SPOI_CMD
+ * echo); one moving elsewhere is tracked without the position loop's lag
+ * (a review: 5.05 deg of pan behind a target crossing at 100 m/s north,
+ * 200 m/s west, about 4 km off) */
+static void a_moving_spoi_crosses_a_pole(void **state)
+{
+    sim_model_t m;
+    sim_pos_t t;
+    (void)state;
+    sim_model_init(&m);
+    m.host.lat = 89.99;
+    m.host.lon = 0.0;
+    m.host.height = 1500.0;
+    t = m.host;
+    t.lat = 89.99995;
+    t.height = 0.0;
+    t.vn = 300.0;
+    assert_int_equal(sim_model_spoi(&m, &t), SIM_CMD_OK);
+    run(&m, 3.0);
+    assert_true(m.spoi.lat <= 90.0);
+    near(fabs(m.spoi.lon), 180.0, 1e-6);
+    assert_true(m.spoi.vn < 0.0);
+    near(m.spoi.lat, 90.0 - (300.0 * 3.0 - 0.00005 * 111694.0) / 111694.0, 2e-4);
+}
+
+static void a_moving_spoi_is_tracked_without_lag(void **state)
+{
+    sim_model_t m;
+    sim_pos_t t;
+    double pan, tilt;
+    int i;
+    (void)state;
+    sim_model_init(&m);
+    m.host.lat = 45.0;
+    m.host.lon = 7.0;
+    m.host.height = 1500.0;
+    t = m.host;
+    t.lat = 45.0 + north_deg(45.0, 2000.0);
+    t.lon = 7.0 + east_deg(45.0, 3000.0);
+    t.height = 0.0;
+    t.vn = 100.0;
+    t.ve = -200.0;
+    assert_int_equal(sim_model_spoi(&m, &t), SIM_CMD_OK);
+    for (i = 0; i < 1000; i++) { /* 10 s: settled, the target 2.2 km on */
+        sim_model_step(&m, 0.01);
+    }
+    sim_spoi_angles(&m.host, &m.att, &m.spoi, &pan, &tilt);
+    near(sim_wrap180(m.pan - pan), 0.0, 0.02);
+    near(m.tilt - tilt, 0.0, 0.02);
+}
+
 /* Item 7: host navigation data is used only where NAV_SOURCE selects it
  * (and HOST_GPS_DATA only when valid); CAMERA_TYPE changes the cameras. */
 static void navigation_sources_select_host_data(void **state)
@@ -762,6 +831,9 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(rate_command_integrates_both_axes),
+        cmocka_unit_test(a_zoom_ratio_is_the_focal_lengths),
+        cmocka_unit_test(a_moving_spoi_crosses_a_pole),
+        cmocka_unit_test(a_moving_spoi_is_tracked_without_lag),
         cmocka_unit_test(rate_is_clamped_to_axis_max_rate),
         cmocka_unit_test(position_command_uses_gain_then_settles),
         cmocka_unit_test(position_pan_takes_short_way_across_180),

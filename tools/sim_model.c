@@ -66,7 +66,11 @@ static double axis_move(const sim_axis_t *ax, double *pos, double delta)
     return delta;
 }
 
-static double axis_position_step(const sim_axis_t *ax, double *pos, double target, double dt)
+/* A position step towards target: the gain on the error plus ff (deg/s:
+ * the rate at which the target moved during this step, 0 for a fixed
+ * one), within the max rate. */
+static double axis_position_step(const sim_axis_t *ax, double *pos, double target, double ff,
+                                 double dt)
 {
     double err, dir, step;
     if (in_nogo(ax, target)) {
@@ -78,8 +82,12 @@ static double axis_position_step(const sim_axis_t *ax, double *pos, double targe
     if (nogo_distance(ax, *pos, dir) < fabs(err) - EDGE_EPS) {
         err -= dir * 360.0; /* the short way is blocked: go round */
     }
-    step = clamp(ax->gain * err, ax->max_rate) * dt;
-    if (fabs(step) >= fabs(err)) {
+    /* the gain on the error from where the target was at the start of the
+     * step (err - ff * dt), ff for its motion during it: a target moving
+     * steadily is followed with no error left (the gain on err itself
+     * leaves one step of motion behind) */
+    step = clamp(ax->gain * (err - ff * dt) + ff, ax->max_rate) * dt;
+    if (ff == 0.0 && fabs(step) >= fabs(err)) {
         step = err;
     }
     return axis_move(ax, pos, step);
@@ -133,7 +141,12 @@ int sim_model_camera_cmd(sim_model_t *m, unsigned camera, bool set_hfov, double 
     }
     c = &m->cam[m->active_cam];
     if (set_hfov) {
-        double h = hfov > 0.0 ? hfov : (hfov < 0.0 ? c->max_hfov / -hfov : c->max_hfov);
+        /* a zoom ratio r (negative hfov) is the focal length's: tan(h/2)
+         * shrinks by r (GEOREFERENCE_DATA's focal length is then r times
+         * the widest's; max_hfov / r was 2.141x at 2x) */
+        double h = hfov > 0.0   ? hfov
+                   : hfov < 0.0 ? 2.0 * atan(tan(c->max_hfov * DEG / 2.0) / -hfov) / DEG
+                                : c->max_hfov;
         c->hfov = h < c->min_hfov ? c->min_hfov : (h > c->max_hfov ? c->max_hfov : h);
     }
     return SIM_CAM_OK;
@@ -362,6 +375,15 @@ static void propagate(sim_pos_t *p, double dt)
     p->lat += p->vn * dt / (mr + p->height) / DEG;
     p->lon = sim_wrap180(p->lon + p->ve * dt / ((n + p->height) * cos(phi)) / DEG);
     p->height -= p->vd * dt;
+    if (fabs(p->lat) > 90.0) {
+        /* over a pole: down the meridian on the other side, the velocity
+         * the same in space (north and east both turn round there); a
+         * latitude above 90 went out in SPOI_CMD's echo */
+        p->lat = (p->lat > 0.0 ? 180.0 : -180.0) - p->lat;
+        p->lon = sim_wrap180(p->lon + 180.0);
+        p->vn = -p->vn;
+        p->ve = -p->ve;
+    }
 }
 
 /* ---- motion ---- */
@@ -385,6 +407,7 @@ static void spoi_error_step(sim_model_t *m, double dt)
 bool sim_model_step(sim_model_t *m, double dt)
 {
     double dp = 0.0, dtl = 0.0, mdt = dt;
+    double ff_pan = 0.0, ff_tilt = 0.0;
     bool done = false;
     bool rate_mode = m->mode == SIM_MODE_RATE;
     bool deployed = m->tax == SIM_3AX_DEPLOYED;
@@ -397,11 +420,26 @@ bool sim_model_step(sim_model_t *m, double dt)
         rate_mode = true;
     }
     if (m->mode == SIM_MODE_SPOI) {
+        /* the target's angles before and after this step's motion (its
+         * velocity, the SPOI error's rate and impulse), from the same
+         * host position and attitude: how fast the line of sight turns
+         * by the target's own motion is fed forward, so that a moving
+         * target is tracked without the lag of the position loop alone
+         * (rate / gain: 5 deg behind a target crossing at 200 m/s). A
+         * host that jumps (a new HOST_GPS_DATA) is not fed forward. */
+        double p0, t0;
+        sim_spoi_angles(&m->host, &m->att, &m->spoi, &p0, &t0);
+        p0 += m->err_pan;
+        t0 += m->err_tilt;
         propagate(&m->spoi, dt);
         spoi_error_step(m, dt);
         sim_spoi_angles(&m->host, &m->att, &m->spoi, &m->cmd_pan, &m->cmd_tilt);
         m->cmd_pan += m->err_pan;
         m->cmd_tilt += m->err_tilt;
+        if (dt > 0.0) {
+            ff_pan = sim_wrap180(m->cmd_pan - p0) / dt;
+            ff_tilt = sim_wrap180(m->cmd_tilt - t0) / dt;
+        }
     }
     if (!deployed) {
         /* retracted or moving: the axes hold still */
@@ -409,8 +447,8 @@ bool sim_model_step(sim_model_t *m, double dt)
         dp = axis_move(&m->axis_pan, &m->pan, clamp(m->cmd_pan, m->axis_pan.max_rate) * mdt);
         dtl = axis_move(&m->axis_tilt, &m->tilt, clamp(m->cmd_tilt, m->axis_tilt.max_rate) * mdt);
     } else if (m->mode == SIM_MODE_POSITION || m->mode == SIM_MODE_SPOI) {
-        dp = axis_position_step(&m->axis_pan, &m->pan, m->cmd_pan, dt);
-        dtl = axis_position_step(&m->axis_tilt, &m->tilt, m->cmd_tilt, dt);
+        dp = axis_position_step(&m->axis_pan, &m->pan, m->cmd_pan, ff_pan, dt);
+        dtl = axis_position_step(&m->axis_tilt, &m->tilt, m->cmd_tilt, ff_tilt, dt);
     }
     m->pan_rate = dt > 0.0 ? dp / dt : 0.0;
     m->tilt_rate = dt > 0.0 ? dtl / dt : 0.0;
