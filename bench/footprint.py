@@ -647,7 +647,8 @@ def main():
         p("`examples/firmware` linked with `--gc-sections` (`arm-none-eabi-size` of "
           "`tase_gimbal.elf`; the share of each object from the link map). It uses the receiver, "
           "the dispatcher with typed decode, the typed encoder, the gimbal role and the "
-          "bare-metal ring/UART port; everything else is semihosting and newlib's printf, "
+          "bare-metal port (circular-DMA receive, UART transmit); everything else is "
+          "semihosting and newlib's printf, "
           "which a real firmware would not carry.")
         p("")
         image_tables(p, img, "main loop + SysTick interrupt, before printf")

@@ -65,11 +65,18 @@ static void on_gimbal_cmd(void *user, const tase_frame_t *f, const void *msg)
     v[2] = m->roll;
     v[3] = m->flags;
     v[4] = m->impulse_time;
+    trace(app, f, GIMBAL_ROUTE_TYPED, v, 5u);
+    if (tase_command_check(TASE_ID_GIMBAL_CMD, m) != TASE_OK) {
+        /* flags not of the spec's table 5, or a position beyond the
+         * axes' ranges: never applied (a product gimbal built from this
+         * must not move on it); the command in force stays */
+        app->commands_refused++;
+        return;
+    }
     app->cmd_pan = m->pan;
     app->cmd_tilt = m->tilt;
     app->cmd_flags = m->flags;
     app->commands++;
-    trace(app, f, GIMBAL_ROUTE_TYPED, v, 5u);
 }
 
 static void on_gyro_zero(void *user, const tase_frame_t *f, const void *msg)

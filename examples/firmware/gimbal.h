@@ -44,13 +44,14 @@ typedef struct {
     int16_t cmd_tilt;
     uint8_t cmd_flags;
     /* Counters. */
-    uint32_t commands;       /* GIMBAL_CMD */
-    uint32_t gyro_zeros;     /* GYRO_ZERO_CMD */
-    uint32_t host_attitudes; /* HOST_ATTITUDE */
-    uint32_t setups;         /* setup packets handed to the role */
-    uint32_t length_errors;  /* error hook calls */
-    uint32_t unknown;        /* default handler calls */
-    uint32_t encode_errors;  /* telemetry the typed encoder refused */
+    uint32_t commands;         /* GIMBAL_CMD applied */
+    uint32_t commands_refused; /* GIMBAL_CMD failing tase_command_check() */
+    uint32_t gyro_zeros;       /* GYRO_ZERO_CMD */
+    uint32_t host_attitudes;   /* HOST_ATTITUDE */
+    uint32_t setups;           /* setup packets handed to the role */
+    uint32_t length_errors;    /* error hook calls */
+    uint32_t unknown;          /* default handler calls */
+    uint32_t encode_errors;    /* telemetry the typed encoder refused */
     gimbal_trace_t trace;
     void *trace_user;
 } gimbal_app_t;

@@ -43,7 +43,16 @@
 #define CPU_HZ 25000000u /* mps2-an385 */
 #define TICK_HZ 1000u    /* one simulated millisecond per SysTick */
 #define RING_SIZE 64u    /* power of two: the TX port's (unused) receive ring */
-#define DMA_SIZE 64u     /* the receive DMA's circular buffer; > bytes per tick */
+/* The receive DMA's circular buffer. A transmit that takes the line's time
+ * (a plain UART without transmit DMA, unlike this image's instant one)
+ * lets the DMA write as many bytes as go out meanwhile, so the buffer
+ * holds a loop pass's longest transmit, TX_BURST_MAX (the three telemetry
+ * streams due at once, 14 + 26 + 71 bytes, and two setup echoes of up to
+ * 50), and a tick's input besides. 64 overran a review's transmit hook
+ * that took the line's time: 144 bytes lost. */
+#define DMA_SIZE 256u
+#define TX_BURST_MAX (14u + 26u + 71u + 2u * 50u)
+typedef char dma_size_check[DMA_SIZE >= TX_BURST_MAX + STREAM_BYTES_PER_TICK ? 1 : -1];
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
 
 #define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
@@ -368,6 +377,8 @@ int main(void)
           EXPECT_BAD_LENGTH);
     check(app.unknown == EXPECT_UNKNOWN, "default handler calls", (long)app.unknown,
           EXPECT_UNKNOWN);
+    check(app.commands_refused == EXPECT_COMMANDS_REFUSED, "GIMBAL_CMDs refused",
+          (long)app.commands_refused, EXPECT_COMMANDS_REFUSED);
 
     printf("app: %lu typed (%lu GIMBAL_CMD, %lu GYRO_ZERO_CMD, %lu HOST_ATTITUDE, %lu setup), "
            "%lu to the error hook, %lu to the default handler\n",

@@ -101,6 +101,10 @@ LAYOUT = {
 }
 QUERYABLE = {(0x48, t) for t in range(8)}
 ROUTE_TYPED, ROUTE_ERROR, ROUTE_DEFAULT = 0, 1, 2
+# GIMBAL_CMD flags of the spec's table 5 (4.1.1): a command with other
+# flags is refused by the application (the stream's commands are all
+# within the axes' ranges, the other half of tase_command_check()).
+GIMBAL_CMD_FLAGS = {0x00, 0x01, 0x02, 0x03, 0x10, 0x90, 0x20, 0xA0, 0x30, 0xB0, 0xC0, 0xD0}
 
 
 def fields(fmt, data):
@@ -225,6 +229,7 @@ def main():
     clean(0x28, 0x00, [1, 2, 3])                         # group 0x28: unknown, default handler
     stream.extend(frame(0x08, 0x42, list(range(12)))[:9])   # truncated HOST_ATTITUDE
     clean(0x00, 0x80, [0xEE, 0x6C, 0x03, 0xE8, 0, 0, 0xA0, 0])  # GIMBAL_CMD -45.00/10.00
+    clean(0x00, 0x80, [0x75, 0x30, 0x80, 0x00, 0, 0, 0x55, 0])  # flags 0x55: refused, -45/10 kept
     clean(0x48, 0x01, [7, 8, 9])                         # SENSOR_FILTER, 3 bytes: error hook
     for _ in range(6):                                   # garbage with false syncs
         noise(rnd.randrange(3, 40))
@@ -268,7 +273,7 @@ def main():
         rows.append((s, g, t, n, r, len(values), len(v), decided))
         values.extend(v)
         tick = decided  # the tick whose bytes decide it
-        if r == ROUTE_TYPED and (g, t) == (0x00, 0x80):
+        if r == ROUTE_TYPED and (g, t) == (0x00, 0x80) and v[3] in GIMBAL_CMD_FLAGS:
             events.setdefault(tick, []).append(("cmd", v))
         if r == ROUTE_TYPED and (g, t) == (0x48, 0x00) and n > 0:
             events.setdefault(tick, []).append(("rates", data))
@@ -322,6 +327,10 @@ def main():
     w("#define EXPECT_BYTES_DISCARDED %du" % discarded)
     w("#define EXPECT_BAD_LENGTH %du" % sum(1 for r in rows if r[4] == ROUTE_ERROR))
     w("#define EXPECT_UNKNOWN %du" % sum(1 for r in rows if r[4] == ROUTE_DEFAULT))
+    w("/* GIMBAL_CMDs the application refuses (flags not of table 5) */")
+    w("#define EXPECT_COMMANDS_REFUSED %du" % sum(
+        1 for r in rows if r[4] == ROUTE_TYPED and (r[1], r[2]) == (0x00, 0x80)
+        and values[r[5] + 3] not in GIMBAL_CMD_FLAGS))
     w("")
     w("/* The replies the gimbal must send, in order: setup packets echoed with")
     w(" * the current settings. */")

@@ -75,4 +75,21 @@ sent=$(sed -n 's/^host role: \([0-9]*\) frames sent.*/\1/p' "$dir/image.log")
     fail "tase-sim received ${frames:-?} frames, the image sent ${sent:-?}"
 echo "--- tase-sim log:"
 cat "$dir/sim.log"
-echo "autopilot mission against tase-sim: ok"
+
+# A gimbal that never answers (its UART wired to nothing): the mission is
+# aborted at its first request and the summary reports no step after it
+# (a review: it confirmed the PACKET_RATE, NAV_SOURCE and SPOI echoes of
+# steps never reached).
+timeout 60 qemu-system-arm -M mps2-an386 -nographic -monitor none -serial null \
+    -semihosting-config enable=on,target=native \
+    -kernel "$out/tase_autopilot.elf" >"$dir/mute.log" 2>&1
+rc=$?
+cat "$dir/mute.log"
+[ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] || fail "with no gimbal the image exited with status $rc (want a failure)"
+grep -q '^FAIL SYSTEM_VERSION query: timed out' "$dir/mute.log" ||
+    fail "with no gimbal: no 'FAIL SYSTEM_VERSION query: timed out'"
+! grep -q 'echo confirmed' "$dir/mute.log" ||
+    fail "with no gimbal the summary confirms echoes of steps never reached"
+grep -q '^FAIL mission completed (the step reached): got 0, want' "$dir/mute.log" ||
+    fail "with no gimbal: the mission check does not name the step reached"
+echo "autopilot mission against tase-sim: ok; with no gimbal: aborted, nothing confirmed"
