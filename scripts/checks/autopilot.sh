@@ -44,11 +44,17 @@ done
 [ -L "$dir/gimbal" ] || fail "tase-sim did not create its link"
 
 # The image bounds its own mission (30 s); timeout covers a hung guest.
+# The gimbal "boots" 2.5 s after the autopilot (the simulator stopped
+# until then): the image asks again until it answers (a review: one
+# unanswered request ended the mission).
+kill -STOP "$sim_pid"
 timeout 120 qemu-system-arm -M mps2-an386 -nographic -monitor none \
     -chardev serial,id=gimbal,path="$dir/gimbal" -serial chardev:gimbal \
     -semihosting-config enable=on,target=native \
     -kernel "$out/tase_autopilot.elf" >"$dir/image.log" 2>&1 &
 qemu_pid=$!
+sleep 2.5
+kill -CONT "$sim_pid"
 wait "$qemu_pid"
 rc=$?
 qemu_pid=""
@@ -60,6 +66,8 @@ sim_pid=""
 cat "$dir/image.log"
 [ "$rc" -eq 0 ] || fail "the image exited with status $rc"
 grep -q '^PASS: 0 of [0-9]* checks failed' "$dir/image.log" || fail "the image did not report PASS"
+grep -q '^gimbal not answering yet: asking again' "$dir/image.log" ||
+    fail "the image did not wait for the gimbal to boot"
 
 # The simulator saw the setup exchange and the SPOI command the image sent.
 grep -q 'PACKET_RATE: port 2 (this link) angle 20/s, rate 10/s, georef 10/s' "$dir/sim.log" ||
