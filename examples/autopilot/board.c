@@ -34,7 +34,13 @@ static tase_bm_uart_t *rx_uart;
 static volatile board_stats_t stats;
 static volatile uint32_t woken; /* an interrupt since the last board_sleep */
 static uint32_t clock_last;     /* TIMER0 value at the last board_millis */
-static uint64_t clock_cycles;   /* timer cycles since board_init */
+/* timer cycles since board_init, from BOARD_CLOCK_START_MS (a product's
+ * clock is not at 0 when a mission starts, and wraps after 49.7 days:
+ * the checks start it 4 s before the wrap) */
+#ifndef BOARD_CLOCK_START_MS
+#define BOARD_CLOCK_START_MS 0u
+#endif
+static uint64_t clock_cycles = (uint64_t)BOARD_CLOCK_START_MS * (TIMER_HZ / 1000u);
 
 void SysTick_Handler(void)
 {

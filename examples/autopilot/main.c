@@ -105,6 +105,7 @@ typedef struct {
     step_t aborted_in;
     uint32_t boot_timeouts; /* first requests unanswered while the gimbal boots */
     bool requesting;
+    uint32_t start;   /* the clock when the mission began, ms */
     uint32_t step_at; /* when the current step began, ms */
     tase_packet_msg_t reply;
     tase_packet_rate_t rate_req;
@@ -376,16 +377,16 @@ static void stream(mission_t *m)
     if (!m->streaming || (!att && !gps)) {
         return;
     }
-    flight_at(&plan, m->now, &s);
+    flight_at(&plan, m->now - m->start, &s); /* the flight from the mission's start */
     if (att) {
         tase_host_attitude_t a;
-        flight_attitude(&s, m->now, (uint8_t)ATT_HZ, &a);
+        flight_attitude(&s, m->now - m->start, (uint8_t)ATT_HZ, &a);
         send_host(m, TASE_ID_HOST_ATTITUDE, &a, &m->next_att, ATT_HZ);
         m->att_sent++;
     }
     if (gps) {
         tase_host_gps_t g;
-        flight_gps(&plan, &s, m->now, (uint8_t)GPS_HZ, &g);
+        flight_gps(&plan, &s, m->now - m->start, (uint8_t)GPS_HZ, &g);
         send_host(m, TASE_ID_HOST_GPS_DATA, &g, &m->next_gps, GPS_HZ);
         m->gps_sent++;
     }
@@ -551,7 +552,7 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
            (unsigned long)m->rx_mark.bytes_discarded, (unsigned long)rs->bad_length,
            (unsigned long)rs->unknown, (unsigned long)bs.rx_irqs, (unsigned long)bs.rx_overruns,
            (unsigned long)tase_ring_overflows(&uart->rx), (unsigned long)bs.ticks,
-           (unsigned long)m->now);
+           (unsigned long)(m->now - m->start));
     printf("telemetry while tracking (%lu ms): GIMBAL_ANGLE %lu (%.1f/s), GIMBAL_RATE %lu "
            "(%.1f/s, %lu in SPOI mode), GEOREFERENCE_DATA %lu (%.1f/s); %lu other frames\n",
            (unsigned long)track_ms, (unsigned long)m->angles, per_s(m->angles, track_ms),
@@ -670,6 +671,10 @@ int main(void)
     }
     m.spoi_built = true;
     board_init(&uart);
+    m.now = board_millis(NULL);
+    m.start = m.now;
+    m.next_att = m.start; /* host data due from the start (0 is not the start) */
+    m.next_gps = m.start;
     m.aborted_in = STEP_DONE; /* not aborted */
     next_step(&m, STEP_VERSION);
 
@@ -686,14 +691,14 @@ int main(void)
         last = m.now;
         run_step(&m);
         stream(&m);
-        if (m.step != STEP_DONE && m.now >= MISSION_MS) {
+        if (m.step != STEP_DONE && m.now - m.start >= MISSION_MS) { /* across a wrap too */
             abort_mission(&m, "mission time limit", TASE_ETIMEOUT);
         }
     }
     stack = board_stack_used(); /* before printf, which is not ours */
     board_stop();
     printf("TASE autopilot example on Cortex-M4F (mps2-an386): SPOI mission on UART0, %lu ms\n",
-           (unsigned long)m.now);
+           (unsigned long)(m.now - m.start));
     summary(&m, stack, &uart);
     printf("%s: %u of %u checks failed\n", m.failures == 0u ? "PASS" : "FAIL", m.failures,
            m.checks);
