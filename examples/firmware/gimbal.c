@@ -161,6 +161,26 @@ static const tase_packet_handler_t handlers[TASE_PKT_COUNT] = {
     [TASE_PKT_CAMERA_ALIGN] = on_setup,
 };
 
+/* The role calls this with a setting that arrived, before it stores and
+ * echoes it: refuse what no axis can move with (a max rate of 0 locks it;
+ * tase-sim refuses it too), and the role echoes the settings in force.
+ * A product checks its other limits here as well, and writes a setting
+ * to non-volatile memory only when its `temporary` byte is 0 (PACKET_RATE,
+ * AXIS_SETTING). */
+static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
+{
+    gimbal_app_t *app = user;
+    (void)port;
+    if (id == TASE_ID_AXIS_SETTING) {
+        const tase_axis_setting_t *a = msg;
+        if (a->pan_max_rate == 0u || a->tilt_max_rate == 0u) {
+            app->setups_refused++;
+            return -1;
+        }
+    }
+    return 0;
+}
+
 /* The role calls this when a telemetry packet is due: fill its typed
  * struct; the role lays out the bytes. */
 static int fill_telemetry(void *user, unsigned port, uint16_t id, void *msg, uint32_t now_ms)
@@ -212,7 +232,8 @@ int gimbal_app_init(gimbal_app_t *app, const tase_port_t *port, tase_rx_stats_t 
         return r;
     }
     memset(&cb, 0, sizeof cb);
-    cb.fill_telemetry_msg = fill_telemetry; /* apply_setup NULL: accept every setting */
+    cb.fill_telemetry_msg = fill_telemetry;
+    cb.apply_setup_msg = apply_setup;
     cb.user = app;
     r = tase_gimbal_init(&app->role, port, NULL, 1u, &cb, now_ms);
     if (r < 0) {

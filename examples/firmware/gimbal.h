@@ -49,6 +49,7 @@ typedef struct {
     uint32_t gyro_zeros;       /* GYRO_ZERO_CMD */
     uint32_t host_attitudes;   /* HOST_ATTITUDE */
     uint32_t setups;           /* setup packets handed to the role */
+    uint32_t setups_refused;   /* of them, settings apply_setup() refused */
     uint32_t length_errors;    /* error hook calls */
     uint32_t unknown;          /* default handler calls */
     uint32_t encode_errors;    /* telemetry the typed encoder refused */

@@ -379,6 +379,10 @@ int main(void)
           EXPECT_UNKNOWN);
     check(app.commands_refused == EXPECT_COMMANDS_REFUSED, "GIMBAL_CMDs refused",
           (long)app.commands_refused, EXPECT_COMMANDS_REFUSED);
+    check(app.setups_refused == EXPECT_SETUPS_REFUSED &&
+              app.role.stats.setup_refused == EXPECT_SETUPS_REFUSED,
+          "settings refused (AXIS_SETTING max rate 0)", (long)app.role.stats.setup_refused,
+          EXPECT_SETUPS_REFUSED);
 
     printf("app: %lu typed (%lu GIMBAL_CMD, %lu GYRO_ZERO_CMD, %lu HOST_ATTITUDE, %lu setup), "
            "%lu to the error hook, %lu to the default handler\n",

@@ -96,6 +96,7 @@ LAYOUT = {
     (0x08, 0x42): ("IhhhBB", 12),           # HOST_ATTITUDE
     (0x48, 0x00): ("BBBBxBBBBxBBBBxB", 16),  # PACKET_RATE
     (0x48, 0x01): ("BB", 2),                # SENSOR_FILTER
+    (0x48, 0x02): (None, 23),               # AXIS_SETTING (fields not traced)
     (0x48, 0x03): (None, 42),               # SYSTEM_VERSION (queried only)
     (0x48, 0x04): ("BB", 2),                # NAV_SOURCE
 }
@@ -222,6 +223,14 @@ def main():
     clean(0x48, 0x00, rates_new, rates_new)              # PACKET_RATE set: echoed
     noise(20)
     clean(0x48, 0x01, [80, 3], [80, 3])                  # SENSOR_FILTER set: echoed
+    # AXIS_SETTING all zeros (max rates 0 lock the axes, temporary 0
+    # stores it): refused, the settings in force echoed (the role's
+    # defaults: tilt no-go 90/60 deg, max rates 60, accelerations 50,
+    # gains 40 on pan and tilt)
+    axis_default = [0, 0, 0, 0, 0x23, 0x28, 0x17, 0x70, 0, 0, 0, 0, 60, 0, 60, 0, 50, 50, 0,
+                    40, 40, 0, 0]
+    clean(0x48, 0x02, [0] * 23, axis_default)
+    setups_refused = 1
     clean(0x00, 0x80, [0x11, 0x94, 0xFC, 0x18, 0, 0])    # GIMBAL_CMD, 6 bytes: error hook
     corrupt(0x48, 0x04, [], lambda f: f.__setitem__(3, 1))  # Size 1
     corrupt(0x48, 0x04, [], lambda f: f.__setitem__(3, 0))  # Size 0
@@ -327,6 +336,8 @@ def main():
     w("#define EXPECT_BYTES_DISCARDED %du" % discarded)
     w("#define EXPECT_BAD_LENGTH %du" % sum(1 for r in rows if r[4] == ROUTE_ERROR))
     w("#define EXPECT_UNKNOWN %du" % sum(1 for r in rows if r[4] == ROUTE_DEFAULT))
+    w("/* settings the application refuses (AXIS_SETTING max rates 0) */")
+    w("#define EXPECT_SETUPS_REFUSED %du" % setups_refused)
     w("/* GIMBAL_CMDs the application refuses (flags not of table 5) */")
     w("#define EXPECT_COMMANDS_REFUSED %du" % sum(
         1 for r in rows if r[4] == ROUTE_TYPED and (r[1], r[2]) == (0x00, 0x80)
