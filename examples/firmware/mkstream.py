@@ -230,7 +230,6 @@ def main():
     axis_default = [0, 0, 0, 0, 0x23, 0x28, 0x17, 0x70, 0, 0, 0, 0, 60, 0, 60, 0, 50, 50, 0,
                     40, 40, 0, 0]
     clean(0x48, 0x02, [0] * 23, axis_default)
-    setups_refused = 1
     clean(0x00, 0x80, [0x11, 0x94, 0xFC, 0x18, 0, 0])    # GIMBAL_CMD, 6 bytes: error hook
     corrupt(0x48, 0x04, [], lambda f: f.__setitem__(3, 1))  # Size 1
     corrupt(0x48, 0x04, [], lambda f: f.__setitem__(3, 0))  # Size 0
@@ -337,7 +336,9 @@ def main():
     w("#define EXPECT_BAD_LENGTH %du" % sum(1 for r in rows if r[4] == ROUTE_ERROR))
     w("#define EXPECT_UNKNOWN %du" % sum(1 for r in rows if r[4] == ROUTE_DEFAULT))
     w("/* settings the application refuses (AXIS_SETTING max rates 0) */")
-    w("#define EXPECT_SETUPS_REFUSED %du" % setups_refused)
+    w("#define EXPECT_SETUPS_REFUSED %du" % sum(
+        1 for r in rows if (r[1], r[2]) == (0x48, 0x02) and r[3] == 23
+        and 0 in (stream[r[0] + 6 + 12], stream[r[0] + 6 + 14])))
     w("/* GIMBAL_CMDs the application refuses (flags not of table 5) */")
     w("#define EXPECT_COMMANDS_REFUSED %du" % sum(
         1 for r in rows if r[4] == ROUTE_TYPED and (r[1], r[2]) == (0x00, 0x80)

@@ -29,39 +29,66 @@ fail() {
     exit 1
 }
 
-cmake -S "$TASE_ROOT/examples/autopilot" -B "$out" \
-      -DCMAKE_TOOLCHAIN_FILE="$TASE_ROOT/cmake/arm-none-eabi.cmake" -DTASE_CPU=cortex-m4 \
-      >/dev/null || exit 1
-cmake --build "$out" -j2 || exit 1
+# build DIR [CMAKE_ARG...]: the image in DIR
+build() {
+    local b=$1
+    shift
+    cmake -S "$TASE_ROOT/examples/autopilot" -B "$b" \
+          -DCMAKE_TOOLCHAIN_FILE="$TASE_ROOT/cmake/arm-none-eabi.cmake" -DTASE_CPU=cortex-m4 \
+          "$@" >/dev/null || exit 1
+    cmake --build "$b" -j2 || exit 1
+}
+# start_sim: a simulator serving $dir/gimbal (sim_pid), its log sim.log;
+# --seconds bounds it even if this script is killed outright.
+start_sim() {
+    "$sim" --link "$dir/gimbal" --seconds 150 >"$dir/sim.log" 2>&1 &
+    sim_pid=$!
+    for _ in $(seq 100); do
+        [ -L "$dir/gimbal" ] && break
+        sleep 0.05
+    done
+    [ -L "$dir/gimbal" ] || fail "tase-sim did not create its link"
+}
+# stop_sim: so that it writes its closing counters
+stop_sim() {
+    kill "$sim_pid" 2>/dev/null
+    wait "$sim_pid" 2>/dev/null
+    sim_pid=""
+}
+# image SECONDS ELF LOG QEMU_ARG...: QEMU's mps2-an386 running ELF in the
+# background (qemu_pid: its timeout, which cleanup stops), output in LOG;
+# image_wait waits for it and returns its status (the image bounds its own
+# mission; SECONDS a hung guest)
+image() {
+    local secs=$1 elf=$2 log=$3
+    shift 3
+    timeout "$secs" qemu-system-arm -M mps2-an386 -nographic -monitor none "$@" \
+        -semihosting-config enable=on,target=native -kernel "$elf" >"$log" 2>&1 &
+    qemu_pid=$!
+}
+image_wait() {
+    local rc
+    wait "$qemu_pid"
+    rc=$?
+    qemu_pid=""
+    return "$rc"
+}
+to_sim=(-chardev "serial,id=gimbal,path=$dir/gimbal" -serial chardev:gimbal)
 
-# --seconds bounds the simulator even if this script is killed outright.
-"$sim" --link "$dir/gimbal" --seconds 150 >"$dir/sim.log" 2>&1 &
-sim_pid=$!
-for _ in $(seq 100); do
-    [ -L "$dir/gimbal" ] && break
-    sleep 0.05
-done
-[ -L "$dir/gimbal" ] || fail "tase-sim did not create its link"
+build "$out"
+start_sim
 
 # The image bounds its own mission (30 s); timeout covers a hung guest.
 # The gimbal "boots" 2.5 s after the autopilot (the simulator stopped
 # until then): the image asks again until it answers (a review: one
 # unanswered request ended the mission).
 kill -STOP "$sim_pid"
-timeout 120 qemu-system-arm -M mps2-an386 -nographic -monitor none \
-    -chardev serial,id=gimbal,path="$dir/gimbal" -serial chardev:gimbal \
-    -semihosting-config enable=on,target=native \
-    -kernel "$out/tase_autopilot.elf" >"$dir/image.log" 2>&1 &
-qemu_pid=$!
+image 120 "$out/tase_autopilot.elf" "$dir/image.log" "${to_sim[@]}"
 sleep 2.5
 kill -CONT "$sim_pid"
-wait "$qemu_pid"
+image_wait
 rc=$?
-qemu_pid=""
-# Stop the simulator so that it writes its closing counters.
-kill "$sim_pid" 2>/dev/null
-wait "$sim_pid" 2>/dev/null
-sim_pid=""
+stop_sim
 
 cat "$dir/image.log"
 [ "$rc" -eq 0 ] || fail "the image exited with status $rc"
@@ -88,9 +115,8 @@ cat "$dir/sim.log"
 # aborted at its first request and the summary reports no step after it
 # (a review: it confirmed the PACKET_RATE, NAV_SOURCE and SPOI echoes of
 # steps never reached).
-timeout 60 qemu-system-arm -M mps2-an386 -nographic -monitor none -serial null \
-    -semihosting-config enable=on,target=native \
-    -kernel "$out/tase_autopilot.elf" >"$dir/mute.log" 2>&1
+image 60 "$out/tase_autopilot.elf" "$dir/mute.log" -serial null
+image_wait
 rc=$?
 cat "$dir/mute.log"
 [ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] || fail "with no gimbal the image exited with status $rc (want a failure)"
@@ -104,26 +130,13 @@ grep -q '^FAIL mission completed (the step reached): got 0, want' "$dir/mute.log
 # starts 4 s before 2^32 (a review: the mission limit compared the clock
 # itself, so a clock not near 0 at the start aborted it at once, and the
 # flight model jumped at the wrap).
-cmake -S "$TASE_ROOT/examples/autopilot" -B "$out/wrap" \
-      -DCMAKE_TOOLCHAIN_FILE="$TASE_ROOT/cmake/arm-none-eabi.cmake" -DTASE_CPU=cortex-m4 \
-      -DAUTOPILOT_CLOCK_START_MS=4294963296 >/dev/null || exit 1
-cmake --build "$out/wrap" -j2 >/dev/null || exit 1
+build "$out/wrap" -DAUTOPILOT_CLOCK_START_MS=4294963296 >/dev/null
 rm -f "$dir/gimbal"
-"$sim" --link "$dir/gimbal" --seconds 150 >"$dir/sim.log" 2>&1 &
-sim_pid=$!
-for _ in $(seq 100); do
-    [ -L "$dir/gimbal" ] && break
-    sleep 0.05
-done
-[ -L "$dir/gimbal" ] || fail "tase-sim did not create its link (wrap run)"
-timeout 120 qemu-system-arm -M mps2-an386 -nographic -monitor none \
-    -chardev serial,id=gimbal,path="$dir/gimbal" -serial chardev:gimbal \
-    -semihosting-config enable=on,target=native \
-    -kernel "$out/wrap/tase_autopilot.elf" >"$dir/wrap.log" 2>&1
+start_sim
+image 120 "$out/wrap/tase_autopilot.elf" "$dir/wrap.log" "${to_sim[@]}"
+image_wait
 rc=$?
-kill "$sim_pid" 2>/dev/null
-wait "$sim_pid" 2>/dev/null
-sim_pid=""
+stop_sim
 cat "$dir/wrap.log"
 [ "$rc" -eq 0 ] && grep -q '^PASS: 0 of [0-9]* checks failed' "$dir/wrap.log" ||
     fail "the mission across the clock's 2^32 ms wrap did not pass (status $rc)"
