@@ -39,15 +39,20 @@ build() {
     cmake --build "$b" -j2 || exit 1
 }
 # start_sim: a simulator serving $dir/gimbal (sim_pid), its log sim.log;
-# --seconds bounds it even if this script is killed outright.
+# --seconds bounds it even if this script is killed outright. Ready once
+# its first log line is out (written after the pty's line settings): the
+# link appears before those, and a simulator stopped in between had the
+# bytes sent to it meanwhile flushed by them (CI: 8 frames fewer received
+# than sent)
 start_sim() {
     "$sim" --link "$dir/gimbal" --seconds 150 >"$dir/sim.log" 2>&1 &
     sim_pid=$!
     for _ in $(seq 100); do
-        [ -L "$dir/gimbal" ] && break
+        [ -L "$dir/gimbal" ] && grep -q '^tase-sim: simulated gimbal on' "$dir/sim.log" && break
         sleep 0.05
     done
     [ -L "$dir/gimbal" ] || fail "tase-sim did not create its link"
+    grep -q '^tase-sim: simulated gimbal on' "$dir/sim.log" || fail "tase-sim did not start"
 }
 # stop_sim: so that it writes its closing counters
 stop_sim() {
