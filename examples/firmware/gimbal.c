@@ -47,6 +47,12 @@ uint8_t gimbal_mode_byte(uint8_t cmd_flags)
     return (uint8_t)(TASE_MODE_SET_VALUE(0u, mode) | (stab ? TASE_MODE_STAB : 0u));
 }
 
+uint8_t gimbal_mode(const gimbal_app_t *app)
+{
+    return app->spoi_mode ? (uint8_t)(TASE_MODE_SET_VALUE(0u, TASE_MODE_SPOI) | TASE_MODE_STAB)
+                          : gimbal_mode_byte(app->cmd_flags);
+}
+
 static void trace(gimbal_app_t *app, const tase_frame_t *f, unsigned route, const int64_t *v,
                   size_t n)
 {
@@ -60,6 +66,8 @@ static void on_gimbal_cmd(void *user, const tase_frame_t *f, const void *msg)
     gimbal_app_t *app = user;
     const tase_gimbal_cmd_t *m = msg;
     int64_t v[5];
+    unsigned kind;
+    bool spoi_error;
     v[0] = m->pan;
     v[1] = m->tilt;
     v[2] = m->roll;
@@ -73,10 +81,64 @@ static void on_gimbal_cmd(void *user, const tase_frame_t *f, const void *msg)
         app->commands_refused++;
         return;
     }
+    kind = TASE_GIMBAL_KIND(m->flags);
+    spoi_error = kind == TASE_GIMBAL_KIND_SPOI_ERROR || kind == TASE_GIMBAL_KIND_SPOI_ERROR_RATE;
+    if (spoi_error && !app->spoi_mode) {
+        /* a SPOI error with no SPOI to shift: changes nothing */
+        app->commands_ignored++;
+        return;
+    }
+    if (!spoi_error && kind != TASE_GIMBAL_KIND_IMPULSE) {
+        app->spoi_mode = false; /* rate, position, legacy: SPOI ends */
+    }
     app->cmd_pan = m->pan;
     app->cmd_tilt = m->tilt;
     app->cmd_flags = m->flags;
     app->commands++;
+}
+
+/* SPOI_CMD: a point to track, or (zero length, the dispatcher's zeroed
+ * struct) a request for the one in force. The answers go out on the port
+ * the request came in on; this board has one (index 0). */
+static void on_spoi(void *user, const tase_frame_t *f, const void *msg)
+{
+    gimbal_app_t *app = user;
+    const tase_spoi_cmd_t *m = msg;
+    tase_spoi_cmd_t answer;
+    int64_t v[7];
+    v[0] = m->lat;
+    v[1] = m->lon;
+    v[2] = m->height;
+    v[3] = m->vnorth;
+    v[4] = m->veast;
+    v[5] = m->vdown;
+    v[6] = m->flags;
+    trace(app, f, GIMBAL_ROUTE_TYPED, v, 7u);
+    if (f->len != 0u) {
+        if (tase_command_check(TASE_ID_SPOI_CMD, m) != TASE_OK) {
+            /* beyond 90 deg of latitude or 180 of longitude: not a
+             * point, never tracked; the SPOI in force stays */
+            app->spois_refused++;
+            return;
+        }
+        app->spoi = *m;
+        app->spoi.flags = 0u;
+        app->spoi_mode = true; /* a new SPOI clears the SPOI error too */
+        app->cmd_pan = 0;
+        app->cmd_tilt = 0;
+        app->spois++;
+        if ((m->flags & TASE_SPOI_ECHO) == 0u) {
+            return;
+        }
+    } else {
+        app->spoi_queries++;
+    }
+    answer = app->spoi;
+    answer.flags = gimbal_mode(app);
+
+    if (tase_gimbal_send_msg(&app->role, 0u, TASE_ID_SPOI_CMD, &answer) < 0) {
+        app->encode_errors++;
+    }
 }
 
 static void on_gyro_zero(void *user, const tase_frame_t *f, const void *msg)
@@ -153,12 +215,12 @@ static void on_unknown(void *user, const tase_frame_t *f)
 /* In ROM: one entry per packet of the schema, NULL sends a packet to the
  * default handler. */
 static const tase_packet_handler_t handlers[TASE_PKT_COUNT] = {
-    [TASE_PKT_GIMBAL_CMD] = on_gimbal_cmd,       [TASE_PKT_GYRO_ZERO_CMD] = on_gyro_zero,
-    [TASE_PKT_HOST_ATTITUDE] = on_host_attitude, [TASE_PKT_PACKET_RATE] = on_setup,
-    [TASE_PKT_SENSOR_FILTER] = on_setup,         [TASE_PKT_AXIS_SETTING] = on_setup,
-    [TASE_PKT_SYSTEM_VERSION] = on_setup,        [TASE_PKT_NAV_SOURCE] = on_setup,
-    [TASE_PKT_CAMERA_TYPE] = on_setup,           [TASE_PKT_GPS_LEVER_ARM] = on_setup,
-    [TASE_PKT_CAMERA_ALIGN] = on_setup,
+    [TASE_PKT_GIMBAL_CMD] = on_gimbal_cmd,   [TASE_PKT_SPOI_CMD] = on_spoi,
+    [TASE_PKT_GYRO_ZERO_CMD] = on_gyro_zero, [TASE_PKT_HOST_ATTITUDE] = on_host_attitude,
+    [TASE_PKT_PACKET_RATE] = on_setup,       [TASE_PKT_SENSOR_FILTER] = on_setup,
+    [TASE_PKT_AXIS_SETTING] = on_setup,      [TASE_PKT_SYSTEM_VERSION] = on_setup,
+    [TASE_PKT_NAV_SOURCE] = on_setup,        [TASE_PKT_CAMERA_TYPE] = on_setup,
+    [TASE_PKT_GPS_LEVER_ARM] = on_setup,     [TASE_PKT_CAMERA_ALIGN] = on_setup,
 };
 
 /* The role calls this with a setting that arrived, before it stores and
@@ -197,7 +259,7 @@ static int fill_telemetry(void *user, unsigned port, uint16_t id, void *msg, uin
         m.gimbal_rate.time = now_ms;
         m.gimbal_rate.pan_rate = app->cmd_pan;
         m.gimbal_rate.tilt_rate = app->cmd_tilt;
-        m.gimbal_rate.mode = gimbal_mode_byte(app->cmd_flags);
+        m.gimbal_rate.mode = gimbal_mode(app);
     } else if (id == TASE_ID_GEOREFERENCE_DATA) {
         uint8_t rates[16];
         m.georeference.time = now_ms;

@@ -3,9 +3,15 @@
  * does with the packets it receives, built from the library's pieces.
  *
  *  - tase_dispatch_t with a static const handler table (ROM): typed
- *    handlers for GIMBAL_CMD, GYRO_ZERO_CMD, HOST_ATTITUDE and the eight
- *    setup packets; wrong-length frames go to the error hook, packets the
- *    schema does not know to the default handler.
+ *    handlers for GIMBAL_CMD, SPOI_CMD, GYRO_ZERO_CMD, HOST_ATTITUDE and
+ *    the eight setup packets; wrong-length frames go to the error hook,
+ *    packets the schema does not know to the default handler.
+ *  - SPOI_CMD: a point that tase_command_check() accepts becomes the SPOI
+ *    in force (SPOI mode, echoed when its flags ask), a zero-length one
+ *    is answered with it (zeros before the first); a SPOI error command
+ *    (GIMBAL_CMD 0xC0/0xD0) acts only in SPOI mode, and a rate, position
+ *    or legacy command leaves it (docs/PROTOCOL-NOTES.md C14, P4). This
+ *    board does not point anything: a product aims its axes here.
  *  - tase_gimbal_t, the library's gimbal role, on one port: the setup
  *    handler hands each setup frame to it, and it answers queries and
  *    echoes settings; tase_gimbal_poll() sends GIMBAL_ANGLE, GIMBAL_RATE
@@ -43,16 +49,24 @@ typedef struct {
     int16_t cmd_pan;
     int16_t cmd_tilt;
     uint8_t cmd_flags;
+    /* The SPOI in force (zeros before the first) and whether the gimbal
+     * is tracking it (SPOI mode). */
+    tase_spoi_cmd_t spoi;
+    bool spoi_mode;
     /* Counters. */
     uint32_t commands;         /* GIMBAL_CMD applied */
     uint32_t commands_refused; /* GIMBAL_CMD failing tase_command_check() */
+    uint32_t commands_ignored; /* SPOI error commands outside SPOI mode */
+    uint32_t spois;            /* SPOI_CMD points applied */
+    uint32_t spois_refused;    /* SPOI_CMD failing tase_command_check() */
+    uint32_t spoi_queries;     /* zero-length SPOI_CMD answered */
     uint32_t gyro_zeros;       /* GYRO_ZERO_CMD */
     uint32_t host_attitudes;   /* HOST_ATTITUDE */
     uint32_t setups;           /* setup packets handed to the role */
     uint32_t setups_refused;   /* of them, settings apply_setup() refused */
     uint32_t length_errors;    /* error hook calls */
     uint32_t unknown;          /* default handler calls */
-    uint32_t encode_errors;    /* telemetry the typed encoder refused */
+    uint32_t encode_errors;    /* SPOI answers the role could not send */
     gimbal_trace_t trace;
     void *trace_user;
 } gimbal_app_t;
@@ -68,6 +82,11 @@ int gimbal_app_init(gimbal_app_t *app, const tase_port_t *port, tase_rx_stats_t 
  * command, mode position / SPOI / rate (rate and impulse commands), no 3AX
  * (this board has none). */
 uint8_t gimbal_mode_byte(uint8_t cmd_flags);
+
+/* The Mode byte this gimbal reports (GIMBAL_RATE, and the flags of its
+ * SPOI_CMD answers, PROTOCOL-NOTES P4): stabilised SPOI while it tracks a
+ * SPOI, otherwise gimbal_mode_byte() of the last GIMBAL_CMD. */
+uint8_t gimbal_mode(const gimbal_app_t *app);
 
 /* Telemetry contents are functions of the poll time t (ms) so that a
  * receiver can check them: pan = 3t mod 18000, tilt = -(t mod 9000). */

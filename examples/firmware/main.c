@@ -180,6 +180,7 @@ static void on_trace(void *user, const tase_frame_t *f, unsigned route, const in
 /* Host side: what the gimbal sent, through a second receiver. */
 typedef struct {
     size_t replies, telemetry, angles, rates, georefs, other;
+    bool spoi; /* a SPOI_CMD answer in SPOI mode has come */
 } host_t;
 
 static void check_telemetry(host_t *h, const tase_frame_t *f)
@@ -216,10 +217,16 @@ static void check_telemetry(host_t *h, const tase_frame_t *f)
         got[6] = m.gimbal_rate.r;
         got[7] = m.gimbal_rate.mode;
         n = 8;
-        /* Read through flags.h: every GIMBAL_CMD of the stream is a
-         * stabilised position command (0xA0); before the first, rate
-         * feedback without stabilisation. */
-        if (m.gimbal_rate.pan_rate != 0) {
+        /* Read through flags.h: every GIMBAL_CMD of the stream that
+         * moves the axes is a stabilised position command (0xA0); before
+         * the first, rate feedback without stabilisation; once a SPOI
+         * was echoed, stabilised SPOI (its error commands keep it). */
+        if (h->spoi) {
+            check(TASE_MODE_VALUE(m.gimbal_rate.mode) == TASE_MODE_SPOI &&
+                      (m.gimbal_rate.mode & TASE_MODE_STAB) != 0u,
+                  "mode byte: stabilised SPOI", m.gimbal_rate.mode,
+                  TASE_MODE_STAB | TASE_MODE_SET_VALUE(0u, TASE_MODE_SPOI));
+        } else if (m.gimbal_rate.pan_rate != 0) {
             check(TASE_MODE_VALUE(m.gimbal_rate.mode) == TASE_MODE_POSITION &&
                       (m.gimbal_rate.mode & TASE_MODE_STAB) != 0u,
                   "mode byte: stabilised position feedback", m.gimbal_rate.mode,
@@ -254,10 +261,13 @@ static void on_tx_frame(void *user, const tase_frame_t *f)
 {
     host_t *h = user;
     uint16_t id = TASE_ID(f->group, f->type);
-    if (f->group == TASE_GROUP_SETUP) {
+    if (f->group == TASE_GROUP_SETUP || id == TASE_ID_SPOI_CMD) {
         tase_packet_msg_t m;
         size_t k = h->replies++;
         check(tase_packet_decode(f, &m) == (int)f->len, "reply decodes", f->len, f->len);
+        if (id == TASE_ID_SPOI_CMD && TASE_SPOI_MODE(m.spoi_cmd.flags) == TASE_MODE_SPOI) {
+            h->spoi = true;
+        }
         if (k < COUNT(expect_replies)) {
             const expect_reply_t *e = &expect_replies[k];
             check(f->group == e->group && f->type == e->type && f->len == e->len &&
@@ -292,7 +302,7 @@ int main(void)
     host_t host;
     tase_port_t port;
     const tase_rx_stats_t *st = &rx.stats;
-    uint32_t now, last = 0, late = 0;
+    uint32_t now, last = 0, late = 0, poll_errors = 0;
     unsigned long stack;
 
     (void)tase_rx_init(&rx);
@@ -328,8 +338,15 @@ int main(void)
         last = now;
         app.now_ms = now;
         seen.now = now;
-        (void)tase_gimbal_poll(&app.role, now);
-        (void)tase_bm_dma_poll(&dma, uart_pos, now, &rx, tase_dispatch_frame, &app.dispatch);
+        /* Both return a library error code only for a misuse (an
+         * instance not set up, a call from a callback): count it, as a
+         * product logs it; 0 here. */
+        if (tase_gimbal_poll(&app.role, now) < 0) {
+            poll_errors++;
+        }
+        if (tase_bm_dma_poll(&dma, uart_pos, now, &rx, tase_dispatch_frame, &app.dispatch) < 0) {
+            poll_errors++;
+        }
         if (ticks != now) {
             late++; /* the next tick came before this one was handled */
         }
@@ -338,8 +355,10 @@ int main(void)
         }
     }
     SYST_CSR = 0u;
-    (void)tase_bm_dma_poll(&dma, uart_pos, ticks, &rx, tase_dispatch_frame, &app.dispatch);
-    (void)tase_rx_flush(&rx, tase_dispatch_frame, &app.dispatch);
+    if (tase_bm_dma_poll(&dma, uart_pos, ticks, &rx, tase_dispatch_frame, &app.dispatch) < 0 ||
+        tase_rx_flush(&rx, tase_dispatch_frame, &app.dispatch) < 0) {
+        poll_errors++;
+    }
     stack = board_stack_used(); /* before printf, which is not ours */
 
     printf("TASE gimbal example on Cortex-M3 (mps2-an385), %u simulated ms\n",
@@ -360,6 +379,7 @@ int main(void)
     check(dma.stats.bytes_fed == sizeof(stream_bytes), "bytes fed from the DMA buffer",
           (long)dma.stats.bytes_fed, (long)sizeof(stream_bytes));
     check(late == 0u, "ticks the main loop fell behind", (long)late, 0);
+    check(poll_errors == 0u, "poll and flush errors", (long)poll_errors, 0);
     check(st->bytes_in == sizeof(stream_bytes), "bytes_in", (long)st->bytes_in,
           (long)sizeof(stream_bytes));
     check(seen.frames == COUNT(expect_frames), "frames delivered", (long)seen.frames,
@@ -379,14 +399,23 @@ int main(void)
           EXPECT_UNKNOWN);
     check(app.commands_refused == EXPECT_COMMANDS_REFUSED, "GIMBAL_CMDs refused",
           (long)app.commands_refused, EXPECT_COMMANDS_REFUSED);
+    check(app.commands_ignored == EXPECT_COMMANDS_IGNORED,
+          "SPOI error commands outside SPOI mode ignored", (long)app.commands_ignored,
+          EXPECT_COMMANDS_IGNORED);
+    check(app.spois == EXPECT_SPOIS && app.spois_refused == EXPECT_SPOIS_REFUSED &&
+              app.spoi_queries == EXPECT_SPOI_QUERIES,
+          "SPOI_CMD points applied, refused (x100), queries (x10000)",
+          (long)(app.spois + 100u * app.spois_refused + 10000u * app.spoi_queries),
+          (long)(EXPECT_SPOIS + 100u * EXPECT_SPOIS_REFUSED + 10000u * EXPECT_SPOI_QUERIES));
     check(app.setups_refused == EXPECT_SETUPS_REFUSED &&
               app.role.stats.setup_refused == EXPECT_SETUPS_REFUSED,
           "settings refused (AXIS_SETTING max rate 0)", (long)app.role.stats.setup_refused,
           EXPECT_SETUPS_REFUSED);
 
-    printf("app: %lu typed (%lu GIMBAL_CMD, %lu GYRO_ZERO_CMD, %lu HOST_ATTITUDE, %lu setup), "
-           "%lu to the error hook, %lu to the default handler\n",
+    printf("app: %lu typed (%lu GIMBAL_CMD, %lu SPOI_CMD, %lu GYRO_ZERO_CMD, %lu HOST_ATTITUDE, "
+           "%lu setup), %lu to the error hook, %lu to the default handler\n",
            (unsigned long)seen.routes[GIMBAL_ROUTE_TYPED], (unsigned long)app.commands,
+           (unsigned long)(app.spois + app.spois_refused + app.spoi_queries),
            (unsigned long)app.gyro_zeros, (unsigned long)app.host_attitudes,
            (unsigned long)app.setups, (unsigned long)app.length_errors, (unsigned long)app.unknown);
     printf("gimbal role: %lu setup applied, %lu queries answered, %lu telemetry, "

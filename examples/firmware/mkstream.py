@@ -94,13 +94,14 @@ LAYOUT = {
     (0x00, 0x80): ("hhhBB", 8),             # GIMBAL_CMD
     (0x00, 0x40): ("", 0),                  # GYRO_ZERO_CMD
     (0x08, 0x42): ("IhhhBB", 12),           # HOST_ATTITUDE
+    (0x10, 0x40): ("iiihhhB", 19),          # SPOI_CMD
     (0x48, 0x00): ("BBBBxBBBBxBBBBxB", 16),  # PACKET_RATE
     (0x48, 0x01): ("BB", 2),                # SENSOR_FILTER
     (0x48, 0x02): (None, 23),               # AXIS_SETTING (fields not traced)
     (0x48, 0x03): (None, 42),               # SYSTEM_VERSION (queried only)
     (0x48, 0x04): ("BB", 2),                # NAV_SOURCE
 }
-QUERYABLE = {(0x48, t) for t in range(8)}
+QUERYABLE = {(0x48, t) for t in range(8)} | {(0x10, 0x40)}
 ROUTE_TYPED, ROUTE_ERROR, ROUTE_DEFAULT = 0, 1, 2
 # GIMBAL_CMD flags of the spec's table 5 (4.1.1): a command with other
 # flags is refused by the application (the stream's commands are all
@@ -111,8 +112,8 @@ GIMBAL_CMD_FLAGS = {0x00, 0x01, 0x02, 0x03, 0x10, 0x90, 0x20, 0xA0, 0x30, 0xB0, 
 def fields(fmt, data):
     out, i = [], 0
     for c in fmt:
-        w = {"B": 1, "h": 2, "I": 4, "x": 1}[c]
-        v = int.from_bytes(bytes(data[i:i + w]), "big", signed=(c == "h"))
+        w = {"B": 1, "h": 2, "i": 4, "I": 4, "x": 1}[c]
+        v = int.from_bytes(bytes(data[i:i + w]), "big", signed=c in "hi")
         i += w
         if c != "x":
             out.append(v)
@@ -148,6 +149,24 @@ def mode_byte(flags):
     return (0x80 if stab else 0) | mode
 
 
+SPOI_MODE = 0x80 | 2  # stabilised SPOI (PROTOCOL-NOTES P4)
+LAT_MAX_MAS, LON_MAX_MAS = 90 * 3600000, 180 * 3600000
+
+
+def spoi_ok(v):
+    """A SPOI_CMD point the application tracks (tase_command_check():
+    latitude within 90 degrees, longitude within 180)."""
+    return abs(v[0]) <= LAT_MAX_MAS and abs(v[1]) <= LON_MAX_MAS
+
+
+def spoi_data(lat_deg, lon_deg, height_m, flags):
+    d = []
+    for v, w in ((round(lat_deg * 3600000), 4), (round(lon_deg * 3600000), 4),
+                 (round(height_m * 100), 4), (150, 2), (-20, 2), (0, 2)):
+        d += list(v.to_bytes(w, "big", signed=True))
+    return d + [flags]
+
+
 def telemetry(events):
     """Per-millisecond model of the gimbal role's schedule (gimbal.h,
     SCHEDULE): a stream anchored at a with rate r sends slot n >= 1 at
@@ -158,6 +177,7 @@ def telemetry(events):
     rates = [10, 10, 4]
     anchor, nxt = [0, 0, 0], [1, 1, 1]
     cmd = (0, 0, 0)  # pan, tilt, flags of the last GIMBAL_CMD
+    spoi = False     # tracking a SPOI (SPOI mode)
     out = []
     ids = [(0x08, 0x10), (0x08, 0x40), (0x10, 0x41)]
     for t in range(1, RUN_MS + 1):
@@ -167,13 +187,19 @@ def telemetry(events):
                 if s == 0:
                     v = [sim_pan(t), sim_tilt(t), 0]
                 elif s == 1:
-                    v = [t, cmd[0], cmd[1], 0, 0, 0, 0, mode_byte(cmd[2])]
+                    v = [t, cmd[0], cmd[1], 0, 0, 0, 0, SPOI_MODE if spoi else mode_byte(cmd[2])]
                 else:
                     v = [t, 1000 * t, -2000 * t, 12345, sim_pan(t), sim_tilt(t), rates[2], 4000]
                 out.append((ids[s], t, v))
         for kind, data in events.get(t, []):
             if kind == "cmd":
+                k = (data[3] >> 4) & 7
+                if k in (4, 5) and not spoi:
+                    continue  # a SPOI error with no SPOI: nothing changes
+                spoi = spoi and k in (3, 4, 5)  # rate, position, legacy end it
                 cmd = (data[0], data[1], data[3])
+            elif kind == "spoi":
+                spoi, cmd = True, (0, 0, cmd[2])  # the SPOI error cleared
             else:
                 new = [data[0], data[1], data[2]]
                 for s in range(3):
@@ -255,6 +281,18 @@ def main():
     corrupt(0x08, 0x41, list(range(18)), lambda f: f.__setitem__(len(f) - 1, f[-1] ^ 1))
     clean(0x48, 0x01, [], [80, 3])                       # SENSOR_FILTER query: kept
     clean(0x48, 0x00, [], rates_new)                     # PACKET_RATE query: the new rates
+    # SPOI_CMD: a query before any (zeros, the mode of the last GIMBAL_CMD:
+    # stabilised position), a SPOI error command with no SPOI (ignored), a
+    # point beyond 90 deg of latitude (refused, no echo), a point with the
+    # echo flag (SPOI mode), a SPOI error command in SPOI mode (applied,
+    # still SPOI), a query (the point, SPOI mode)
+    clean(0x10, 0x40, [], [0] * 18 + [mode_byte(0xA0)])
+    clean(0x00, 0x80, [0x00, 0x64, 0xFF, 0x38, 0, 0, 0xC0, 0])  # SPOI error 1.00/-2.00
+    clean(0x10, 0x40, spoi_data(90.5, 7.25, 500, 0x80))
+    spoi = spoi_data(45.0123, -7.25, 612.5, 0x80)
+    clean(0x10, 0x40, spoi, spoi[:18] + [SPOI_MODE])
+    clean(0x00, 0x80, [0x00, 0x64, 0xFF, 0x38, 0, 0, 0xC0, 0])
+    clean(0x10, 0x40, [], spoi[:18] + [SPOI_MODE])
     for _ in range(3):
         clean(0x08, 0x42, [rnd.randrange(256) for _ in range(12)])  # HOST_ATTITUDE
         noise(rnd.randrange(0, 8))
@@ -283,6 +321,8 @@ def main():
         tick = decided  # the tick whose bytes decide it
         if r == ROUTE_TYPED and (g, t) == (0x00, 0x80) and v[3] in GIMBAL_CMD_FLAGS:
             events.setdefault(tick, []).append(("cmd", v))
+        if r == ROUTE_TYPED and (g, t) == (0x10, 0x40) and n > 0 and spoi_ok(v):
+            events.setdefault(tick, []).append(("spoi", v))
         if r == ROUTE_TYPED and (g, t) == (0x48, 0x00) and n > 0:
             events.setdefault(tick, []).append(("rates", data))
     telem = telemetry(events)
@@ -343,9 +383,28 @@ def main():
     w("#define EXPECT_COMMANDS_REFUSED %du" % sum(
         1 for r in rows if r[4] == ROUTE_TYPED and (r[1], r[2]) == (0x00, 0x80)
         and values[r[5] + 3] not in GIMBAL_CMD_FLAGS))
+    spoi_rows = [r for r in rows if r[4] == ROUTE_TYPED and (r[1], r[2]) == (0x10, 0x40)]
+    w("/* SPOI_CMD points tracked, refused (beyond the Earth's ranges), and")
+    w(" * queries; SPOI error commands with no SPOI in force (ignored) */")
+    w("#define EXPECT_SPOIS %du" % sum(
+        1 for r in spoi_rows if r[3] > 0 and spoi_ok(values[r[5]:r[5] + 2])))
+    w("#define EXPECT_SPOIS_REFUSED %du" % sum(
+        1 for r in spoi_rows if r[3] > 0 and not spoi_ok(values[r[5]:r[5] + 2])))
+    w("#define EXPECT_SPOI_QUERIES %du" % sum(1 for r in spoi_rows if r[3] == 0))
+    ignored, in_spoi = 0, False
+    for r in rows:
+        if r[4] != ROUTE_TYPED:
+            continue
+        if (r[1], r[2]) == (0x10, 0x40) and r[3] > 0 and spoi_ok(values[r[5]:r[5] + 2]):
+            in_spoi = True
+        elif (r[1], r[2]) == (0x00, 0x80) and values[r[5] + 3] in GIMBAL_CMD_FLAGS:
+            k = (values[r[5] + 3] >> 4) & 7
+            ignored += k in (4, 5) and not in_spoi
+            in_spoi = in_spoi and k in (3, 4, 5)
+    w("#define EXPECT_COMMANDS_IGNORED %du" % ignored)
     w("")
     w("/* The replies the gimbal must send, in order: setup packets echoed with")
-    w(" * the current settings. */")
+    w(" * the current settings, SPOI_CMD answers. */")
     w("typedef struct {")
     w("    uint8_t group, type, len;")
     w("    const uint8_t *data;")
