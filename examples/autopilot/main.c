@@ -12,7 +12,10 @@
  *  1. query SYSTEM_VERSION and report the gimbal's software and cameras;
  *  2. query PACKET_RATE, set port 2 (the gimbal's 57600-baud Com3 this
  *     image is wired to, PROTOCOL-NOTES A2) to ANGLE_HZ/RATE_HZ/GEO_HZ and confirm
- *     the echo; set NAV_SOURCE to external attitude and GPS and confirm;
+ *     the echo; query NAV_SOURCE and, unless it is already external
+ *     attitude and GPS, set it so and confirm (NAV_SOURCE has no
+ *     "temporary" byte: a gimbal may store every setting in flash, so it
+ *     is not sent when nothing would change);
  *  3. stream HOST_ATTITUDE (ATT_HZ) and HOST_GPS_DATA (GPS_HZ) from the
  *     flight model (flight.c: a circle at constant height);
  *  4. after WARMUP_MS, command a SPOI at a ground point with echo
@@ -26,6 +29,8 @@
  *  6. stop the host data and query SPOI_CMD: the gimbal still holds our
  *     point; then wait for the next GEOREFERENCE_DATA (up to HOLD_MS): the
  *     line of sight is still on the SPOI after the query;
+ * from step 3 on, telemetry that stops for TELEMETRY_LOST_MS aborts the
+ * mission (the gimbal's state is no longer known);
  * then print a summary (with its own flash/RAM/stack numbers) through
  * semihosting and exit 0 on success, 1 on any failure.
  *
@@ -54,10 +59,14 @@
 #define REQUEST_TIMEOUT_MS 300u /* per attempt */
 #define REQUEST_RETRIES 3u      /* re-sends after a timeout */
 
-#define WARMUP_MS 1000u   /* host data streamed before the SPOI command */
-#define TRACK_MS 10000u   /* tracking observed after the SPOI echo */
-#define SETTLE_MS 5000u   /* the line of sight must converge within this */
-#define HOLD_MS 2000u     /* for a GEOREFERENCE after the SPOI query */
+#define WARMUP_MS 1000u /* host data streamed before the SPOI command */
+#define TRACK_MS 10000u /* tracking observed after the SPOI echo */
+#define SETTLE_MS 5000u /* the line of sight must converge within this */
+#define HOLD_MS 2000u   /* for a GEOREFERENCE after the SPOI query */
+/* No GIMBAL_ANGLE, GIMBAL_RATE or GEOREFERENCE_DATA for this long once
+ * the rates are set (20 periods of the slowest stream asked for): the
+ * gimbal stopped reporting (a review: a 3 s silence passed unnoticed) */
+#define TELEMETRY_LOST_MS 2000u
 #define MISSION_MS 30000u /* hard limit of the whole run */
 /* A gimbal often boots more slowly than the autopilot: the first request
  * (SYSTEM_VERSION) is made again until this long has passed before no
@@ -88,6 +97,7 @@ typedef enum {
     STEP_VERSION,
     STEP_RATE_GET,
     STEP_RATE_SET,
+    STEP_NAV_GET,
     STEP_NAV_SET,
     STEP_WARMUP,
     STEP_SPOI,
@@ -110,6 +120,7 @@ typedef struct {
     tase_packet_msg_t reply;
     tase_packet_rate_t rate_req;
     tase_nav_source_t nav_req;
+    bool nav_kept;            /* NAV_SOURCE was already ours: not sent */
     tase_spoi_cmd_t spoi_req; /* built before the mission starts */
     bool spoi_built;
     /* kept for the summary (nothing is printed while the mission runs, so
@@ -125,6 +136,7 @@ typedef struct {
     uint32_t angles, rates, georefs;
     uint32_t angles_all, rates_all, georefs_all, other, bad_length;
     uint8_t last_mode;
+    uint32_t telem_at;        /* the last telemetry frame (or the rates' echo), ms */
     uint32_t spoi_mode_rates; /* GIMBAL_RATE in SPOI mode while tracking */
     tase_gimbal_angle_t last_angle;
     /* pointing, from GEOREFERENCE_DATA */
@@ -167,6 +179,7 @@ static void on_angle(void *user, const tase_frame_t *f, const void *msg)
     mission_t *m = user;
     (void)f;
     m->angles_all++;
+    m->telem_at = m->now;
     m->angles += m->tracking ? 1u : 0u;
     m->last_angle = *(const tase_gimbal_angle_t *)msg;
 }
@@ -177,6 +190,7 @@ static void on_rate(void *user, const tase_frame_t *f, const void *msg)
     const tase_gimbal_rate_t *r = msg;
     (void)f;
     m->rates_all++;
+    m->telem_at = m->now;
     m->last_mode = (uint8_t)TASE_MODE_VALUE(r->mode);
     if (m->tracking) {
         m->rates++;
@@ -213,6 +227,7 @@ static void on_georef(void *user, const tase_frame_t *f, const void *msg)
     float err = flight_pointing_error_deg(&plan, g, &m->spoi_req);
     (void)f;
     m->georefs_all++;
+    m->telem_at = m->now;
     m->unaimed += m->spoi_built ? 0u : 1u;
     if (!m->tracking) {
         /* Before the command, or after tracking ended: a GEOREFERENCE of
@@ -293,6 +308,10 @@ static void abort_mission(mission_t *m, const char *what, int r)
     m->checks++;
     m->failures++;
     m->aborted_in = m->step;
+    if (m->tracking) {
+        m->tracking = false; /* the summary's rates over the time tracked */
+        m->track_ms = m->now - m->spoi_at;
+    }
     next_step(m, STEP_DONE);
 }
 
@@ -392,6 +411,15 @@ static void stream(mission_t *m)
     }
 }
 
+/* NAV_SOURCE is ours: stream the host data from now on. */
+static void start_host_data(mission_t *m)
+{
+    m->streaming = true;
+    m->next_att = m->now;
+    m->next_gps = m->now;
+    next_step(m, STEP_WARMUP);
+}
+
 static void run_step(mission_t *m)
 {
     const tase_spoi_cmd_t *spoi = &m->reply.spoi_cmd;
@@ -422,6 +450,18 @@ static void run_step(mission_t *m)
                 abort_mission(m, "PACKET_RATE echo differs from the request", 16);
                 return;
             }
+            m->telem_at = m->now; /* telemetry expected from here on */
+            next_step(m, STEP_NAV_GET);
+        }
+        return;
+    case STEP_NAV_GET:
+        if (answered(m, TASE_ID_NAV_SOURCE, NULL, 2, "NAV_SOURCE query")) {
+            if (m->reply.nav_source.external_attitude != 0u &&
+                m->reply.nav_source.external_gps != 0u) {
+                m->nav_kept = true; /* nothing to change: nothing stored */
+                start_host_data(m);
+                return;
+            }
             m->nav_req.external_attitude = 1u;
             m->nav_req.external_gps = 1u;
             next_step(m, STEP_NAV_SET);
@@ -434,10 +474,7 @@ static void run_step(mission_t *m)
                 abort_mission(m, "NAV_SOURCE echo differs from the request", 2);
                 return;
             }
-            m->streaming = true;
-            m->next_att = m->now;
-            m->next_gps = m->now;
-            next_step(m, STEP_WARMUP);
+            start_host_data(m);
         }
         return;
     case STEP_WARMUP:
@@ -532,7 +569,8 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
                RATE_HZ, GEO_HZ);
     }
     if (reached > STEP_NAV_SET) {
-        printf("NAV_SOURCE: external attitude and GPS, echo confirmed; host data streamed\n");
+        printf("NAV_SOURCE: external attitude and GPS, %s; host data streamed\n",
+               m->nav_kept ? "already (not sent)" : "echo confirmed");
     }
     if (reached > STEP_SPOI) {
         printf("SPOI_CMD at %.6f, %.6f, %.1f m, echo confirmed after %lu ms\n",
@@ -690,6 +728,11 @@ int main(void)
         }
         last = m.now;
         run_step(&m);
+        if (m.step >= STEP_WARMUP && m.step != STEP_DONE &&
+            m.now - m.telem_at >= TELEMETRY_LOST_MS) {
+            abort_mission(&m, "gimbal telemetry stopped (TELEMETRY_LOST_MS without a frame)",
+                          TASE_ETIMEOUT);
+        }
         stream(&m);
         if (m.step != STEP_DONE && m.now - m.start >= MISSION_MS) { /* across a wrap too */
             abort_mission(&m, "mission time limit", TASE_ETIMEOUT);

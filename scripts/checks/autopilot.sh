@@ -7,11 +7,14 @@
 # log shows the PACKET_RATE setting and the SPOI command the image sent.
 # Everything it starts is stopped and the link removed, also on failure.
 # Packages: scripts/packages.d/firmware.txt.
-# Usage: scripts/checks/autopilot.sh TASE_SIM [outdir]
+# Usage: scripts/checks/autopilot.sh TASE_SIM [outdir [TASE]]
+# (TASE, the CLI, defaults to the tase beside TASE_SIM)
 set -uo pipefail
 . "$(dirname "$0")/../lib.sh"
-sim=${1:?usage: scripts/checks/autopilot.sh TASE_SIM [outdir]}
+sim=${1:?usage: scripts/checks/autopilot.sh TASE_SIM [outdir [TASE]]}
 out=${2:-$TASE_ROOT/build-autopilot}
+cli=${3:-$(dirname "$sim")/tase}
+[ -x "$cli" ] || { echo "FAIL: no tase CLI at $cli"; exit 1; }
 dir=$(mktemp -d)
 sim_pid=""
 qemu_pid=""
@@ -131,13 +134,47 @@ grep -q '^FAIL SYSTEM_VERSION query: timed out' "$dir/mute.log" ||
     fail "with no gimbal the summary confirms echoes of steps never reached"
 grep -q '^FAIL mission completed (the step reached): got 0, want' "$dir/mute.log" ||
     fail "with no gimbal: the mission check does not name the step reached"
+grep -q 'NAV_SOURCE: external attitude and GPS, echo confirmed' "$dir/image.log" ||
+    fail "the mission did not set NAV_SOURCE (the simulator starts with its own)"
+
+# A gimbal that stops reporting while the mission tracks (the simulator
+# stopped for 3 s once the SPOI command reached it): the image aborts
+# after TELEMETRY_LOST_MS without a telemetry frame (a review: a 3 s
+# silence passed unnoticed).
+rm -f "$dir/gimbal"
+start_sim
+image 120 "$out/tase_autopilot.elf" "$dir/stall.log" "${to_sim[@]}"
+for _ in $(seq 400); do
+    grep -q 'SPOI_CMD: pointing at' "$dir/sim.log" && break
+    sleep 0.05
+done
+grep -q 'SPOI_CMD: pointing at' "$dir/sim.log" || fail "the stall run: no SPOI command reached tase-sim"
+sleep 1
+kill -STOP "$sim_pid"
+sleep 3
+kill -CONT "$sim_pid"
+image_wait
+rc=$?
+stop_sim
+cat "$dir/stall.log"
+[ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] ||
+    fail "with the gimbal silent for 3 s the image exited with status $rc (want a failure)"
+grep -q '^FAIL gimbal telemetry stopped' "$dir/stall.log" ||
+    fail "with the gimbal silent for 3 s: no 'FAIL gimbal telemetry stopped'"
+grep -q '^SPOI_CMD at .*echo confirmed' "$dir/stall.log" ||
+    fail "the stall run did not reach tracking before the silence"
 # The mission across the clock's wrap: the board's millisecond clock
 # starts 4 s before 2^32 (a review: the mission limit compared the clock
 # itself, so a clock not near 0 at the start aborted it at once, and the
 # flight model jumped at the wrap).
+# The gimbal has external navigation already (set by tase before the
+# image starts): the image queries NAV_SOURCE and does not send it again
+# (no temporary byte: a gimbal may store it in flash every time).
 build "$out/wrap" -DAUTOPILOT_CLOCK_START_MS=4294963296 >/dev/null
 rm -f "$dir/gimbal"
 start_sim
+"$cli" send NAV_SOURCE external_attitude=1 external_gps=1 --serial "$dir/gimbal" >"$dir/nav.log" 2>&1 ||
+    fail "tase send NAV_SOURCE: $(cat "$dir/nav.log")"
 image 120 "$out/wrap/tase_autopilot.elf" "$dir/wrap.log" "${to_sim[@]}"
 image_wait
 rc=$?
@@ -145,4 +182,9 @@ stop_sim
 cat "$dir/wrap.log"
 [ "$rc" -eq 0 ] && grep -q '^PASS: 0 of [0-9]* checks failed' "$dir/wrap.log" ||
     fail "the mission across the clock's 2^32 ms wrap did not pass (status $rc)"
-echo "autopilot mission against tase-sim: ok; with no gimbal: aborted, nothing confirmed; across the clock's wrap: ok"
+grep -q 'NAV_SOURCE: external attitude and GPS, already (not sent)' "$dir/wrap.log" ||
+    fail "the image did not find NAV_SOURCE already set"
+n=$(grep -c 'NAV_SOURCE: attitude from' "$dir/sim.log")
+[ "$n" -eq 1 ] || fail "tase-sim's log shows NAV_SOURCE set $n times, want once (by tase)"
+echo "autopilot mission against tase-sim: ok; with no gimbal: aborted, nothing confirmed;" \
+     "gimbal silent 3 s while tracking: aborted; across the clock's wrap with NAV_SOURCE set: ok"
