@@ -26,13 +26,14 @@
 #include "tase/bm_uart.h"
 
 #define BOARD_CPU_HZ 25000000u /* mps2-an386 system clock */
-/* UART0 is wired to the gimbal's Com3, port 2 of its PACKET_RATE, at
+/* UART0 is wired to the gimbal's Com3, port 2 of its PACKET_RATE (main.c GIMBAL_PORT), at
  * 57600 baud (spec 3.1): BAUDDIV = 25 MHz / 57600. One constant for the
  * line, its byte rate (main.c) and the comments (a review: the UART was
  * programmed for 115200 while main.c sized the time bound for 57600; QEMU
  * ignores the rate, a real Com3 would have read garbage). */
 #define BOARD_BAUD 57600u
-#define BOARD_TX_TIMEOUT_MS 2u /* 11 byte times at 57600 baud */
+/* 11 byte times at BOARD_BAUD, rounded up (2 ms at 57600) */
+#define BOARD_TX_TIMEOUT_MS ((110000u + BOARD_BAUD - 1u) / BOARD_BAUD)
 
 /* Board counters, written by the interrupts and the TX hook. */
 typedef struct {

@@ -10,8 +10,9 @@
  * calls (tase_host_send_msg(), tase_host_request_msg_start()):
  *
  *  1. query SYSTEM_VERSION and report the gimbal's software and cameras;
- *  2. query PACKET_RATE, set port 2 (the gimbal's 57600-baud Com3 this
- *     image is wired to, PROTOCOL-NOTES A2) to ANGLE_HZ/RATE_HZ/GEO_HZ and confirm
+ *  2. query PACKET_RATE, set GIMBAL_PORT's rates (port 2: the gimbal's
+ *     Com3 this image is wired to, PROTOCOL-NOTES A2; the other ports'
+ *     rates are sent back as they were) to ANGLE_HZ/RATE_HZ/GEO_HZ and confirm
  *     the echo; query NAV_SOURCE and, unless it is already external
  *     attitude and GPS, set it so and confirm (NAV_SOURCE has no
  *     "temporary" byte: a gimbal may store every setting in flash, so it
@@ -48,13 +49,30 @@
 #include "tase/flags.h"
 #include "tase/units.h"
 
-/* Telemetry asked of the gimbal (port 2, Com3), packets per second. */
+/* The gimbal port this UART is wired to, as PACKET_RATE numbers them:
+ * 1, 2 or 3 (bytes 0-2, 5-7, 10-12). Port 2 is the gimbal's Com3
+ * (PROTOCOL-NOTES A2). Only its rates are changed. */
+#ifndef GIMBAL_PORT
+#define GIMBAL_PORT 2u
+#endif
+typedef char gimbal_port_check[(GIMBAL_PORT >= 1u && GIMBAL_PORT <= 3u) ? 1 : -1];
+/* Telemetry asked of the gimbal on that port, packets per second. */
 #define ANGLE_HZ 20u
 #define RATE_HZ 10u
 #define GEO_HZ 10u
 /* Host data streamed to the gimbal. */
 #define ATT_HZ 50u
 #define GPS_HZ 10u
+/* Both directions must fit the line with room to spare (three quarters
+ * of BOARD_BAUD's bytes per second; a frame is its data plus 8 bytes):
+ * GIMBAL_ANGLE 6, GIMBAL_RATE 18, GEOREFERENCE_DATA 63 bytes in,
+ * HOST_ATTITUDE 12 and HOST_GPS_DATA 32 out (1,250 and 1,400 B/s of
+ * 5,760 at 57600 baud; at 9600 neither fits: lower the rates) */
+#define LINE_BUDGET (TASE_UART_BYTES_PER_S(BOARD_BAUD) * 3u / 4u)
+typedef char telemetry_fits_the_line[(ANGLE_HZ * 14u + RATE_HZ * 26u + GEO_HZ * 71u <= LINE_BUDGET)
+                                         ? 1
+                                         : -1];
+typedef char host_data_fits_the_line[(ATT_HZ * 20u + GPS_HZ * 40u <= LINE_BUDGET) ? 1 : -1];
 
 #define REQUEST_TIMEOUT_MS 300u /* per attempt */
 #define REQUEST_RETRIES 3u      /* re-sends after a timeout */
@@ -420,6 +438,16 @@ static void start_host_data(mission_t *m)
     next_step(m, STEP_WARMUP);
 }
 
+/* GIMBAL_PORT's rate of stream i (0 GIMBAL_ANGLE, 1 GIMBAL_RATE, 2
+ * GEOREFERENCE_DATA) in a PACKET_RATE. */
+static uint8_t *port_rate(tase_packet_rate_t *r, unsigned i)
+{
+    uint8_t *const rates[3][3] = {{&r->angle_1, &r->rate_1, &r->geo_ref_1},
+                                  {&r->angle_2, &r->rate_2, &r->geo_ref_2},
+                                  {&r->angle_3, &r->rate_3, &r->geo_ref_3}};
+    return rates[GIMBAL_PORT - 1u][i];
+}
+
 static void run_step(mission_t *m)
 {
     const tase_spoi_cmd_t *spoi = &m->reply.spoi_cmd;
@@ -433,12 +461,12 @@ static void run_step(mission_t *m)
         return;
     case STEP_RATE_GET:
         if (answered(m, TASE_ID_PACKET_RATE, NULL, 16, "PACKET_RATE query")) {
-            /* read-modify-write: only port 2 (this 57600-baud line) changes */
+            /* read-modify-write: only GIMBAL_PORT (this line) changes */
             m->rate_before = m->reply.packet_rate;
             m->rate_req = m->reply.packet_rate;
-            m->rate_req.angle_2 = (uint8_t)ANGLE_HZ;
-            m->rate_req.rate_2 = (uint8_t)RATE_HZ;
-            m->rate_req.geo_ref_2 = (uint8_t)GEO_HZ;
+            *port_rate(&m->rate_req, 0u) = (uint8_t)ANGLE_HZ;
+            *port_rate(&m->rate_req, 1u) = (uint8_t)RATE_HZ;
+            *port_rate(&m->rate_req, 2u) = (uint8_t)GEO_HZ;
             m->rate_req.temporary = 1u; /* a mission setting, not for flash */
             next_step(m, STEP_RATE_SET);
         }
@@ -563,10 +591,10 @@ static void summary(mission_t *m, unsigned long stack, const tase_bm_uart_t *uar
               m->version.camera_a, 0);
     }
     if (reached > STEP_RATE_SET) {
-        printf("PACKET_RATE port 2: %u/%u/%u per s (angle/rate/georef), set to %u/%u/%u, echo "
+        printf("PACKET_RATE port %u: %u/%u/%u per s (angle/rate/georef), set to %u/%u/%u, echo "
                "confirmed\n",
-               m->rate_before.angle_2, m->rate_before.rate_2, m->rate_before.geo_ref_2, ANGLE_HZ,
-               RATE_HZ, GEO_HZ);
+               GIMBAL_PORT, *port_rate(&m->rate_before, 0u), *port_rate(&m->rate_before, 1u),
+               *port_rate(&m->rate_before, 2u), ANGLE_HZ, RATE_HZ, GEO_HZ);
     }
     if (reached > STEP_NAV_SET) {
         printf("NAV_SOURCE: external attitude and GPS, %s; host data streamed\n",
