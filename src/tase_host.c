@@ -10,6 +10,9 @@
 enum { HOST_IDLE = 0, HOST_WAITING = 1, HOST_COMPLETE = 2 };
 
 #define HOST_SERVICE_CHUNK 64u
+/* Reads of what the port has ready before a blocking request (host.h,
+ * MATCHING): 16 KiB. */
+#define HOST_DRAIN_READS 256u
 
 int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on_frame, void *user)
 {
@@ -136,6 +139,7 @@ static int request_send(tase_host_t *h, uint8_t group, uint8_t type, size_t len,
     h->retries_left = retries;
     h->sent_at = sent_at;
     h->first_at = sent_at;
+    h->mark = h->in_count; /* every byte fed so far came before the send */
     h->now = sent_at;
     h->attempts = 1u;
     h->result = TASE_EAGAIN;
@@ -276,19 +280,25 @@ static int decode_reply(tase_host_t *h, size_t len)
     return tase_packet_decode_desc(p, h->req, len, h->reply_msg);
 }
 
-int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
+/* tase_host_handle_frame() for a frame that may (answer) or may not
+ * (it began before the pending request was sent) complete it. */
+static int handle(tase_host_t *h, const tase_frame_t *frame, bool answer)
 {
     bool owed;
-    if (h == NULL || frame == NULL || frame->data == NULL) {
-        return TASE_EARG;
-    }
+    bool match;
     h->stats.frames_rx++;
     /* A zero-length frame is somebody's query (possibly our own, looped
      * back), never the gimbal's answer; an owed one answers an earlier
      * request (counted however it comes). */
+    if (frame->len == 0u) {
+        h->stats.queries_rx++;
+    }
     owed = owed_answer(h, frame);
-    if (!owed && h->state == HOST_WAITING && frame->group == h->group && frame->type == h->type &&
-        frame->len > 0) {
+    match = !owed && h->state == HOST_WAITING && frame->group == h->group &&
+            frame->type == h->type && frame->len > 0;
+    if (match && !answer) {
+        h->stats.stale++;
+    } else if (match) {
         if (h->reply == NULL) {
             h->result = (int)frame->len;
         } else if (frame->len > h->reply_cap) {
@@ -307,6 +317,8 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
         owe(h, h->attempts - 1u,
             h->sent_at + tase_port_elapsed_ms(h->now, h->first_at) + h->timeout_ms);
         return 1;
+    } else {
+        /* not of the pending request */
     }
     if (h->on_frame != NULL) {
         h->on_frame(h->user, frame);
@@ -314,21 +326,46 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
     return 0;
 }
 
+int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame)
+{
+    if (h == NULL || frame == NULL || frame->data == NULL) {
+        return TASE_EARG;
+    }
+    return handle(h, frame, true);
+}
+
+/* A frame from the host's own receiver: it answers the pending request
+ * only if it began at or after the byte count of the request's sending
+ * (its offset on the host's count, in_count, through in_shift). */
 static void host_rx(void *user, const tase_frame_t *frame)
 {
-    (void)tase_host_handle_frame((tase_host_t *)user, frame);
+    tase_host_t *h = user;
+    uint32_t at = frame->offset + h->in_shift;
+    (void)handle(h, frame, (uint32_t)(at - h->mark) < 0x80000000u);
 }
 
 int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_ms)
 {
     int r;
     int t;
+    uint32_t count;
+    uint32_t shift;
     if (h == NULL) {
         return TASE_EARG;
     }
     h->now = now_ms;
+    /* the host's own count of the bytes it was fed, which nothing resets
+     * (rx.stats may be): frames are placed on it for MATCHING */
+    count = h->in_count;
+    shift = h->in_shift;
+    h->in_shift = count - h->rx.stats.bytes_in;
+    h->in_count = count + (uint32_t)n;
     r = tase_rx_feed(&h->rx, bytes, n, host_rx, h);
     if (r < 0) {
+        /* nothing fed (bad arguments, or a call from on_frame: the feed
+         * in progress goes on with its own shift) */
+        h->in_count = count;
+        h->in_shift = shift;
         return r;
     }
     /* the bytes' arrival, or (n == 0) a look that found the line quiet */
@@ -462,10 +499,36 @@ static int transact_wait(tase_host_t *h)
     }
 }
 
+/* Read and feed what the port has ready before a blocking request, so that
+ * an answer that waited unread is not taken as this request's (host.h,
+ * MATCHING): reads that do not wait, until one comes back short of a full
+ * chunk, at most HOST_DRAIN_READS. Nothing is read while a request is
+ * pending (request_start() refuses it anyway). TASE_OK or a read error. */
+static int drain(tase_host_t *h)
+{
+    unsigned i;
+    if (h->state != HOST_IDLE) {
+        return TASE_OK;
+    }
+    for (i = 0; i < HOST_DRAIN_READS; i++) {
+        int n = tase_host_service(h, 0u);
+        if (n < 0) {
+            return n;
+        }
+        if (n < (int)HOST_SERVICE_CHUNK) {
+            break;
+        }
+    }
+    return TASE_OK;
+}
+
 int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len,
                        uint8_t *reply, size_t reply_cap, uint32_t timeout_ms, uint8_t retries)
 {
     int r = port_ok(h);
+    if (r == TASE_OK) {
+        r = drain(h);
+    }
     if (r != TASE_OK) {
         return r;
     }
@@ -478,6 +541,9 @@ int tase_host_transact_msg(tase_host_t *h, uint16_t id, const void *msg, void *r
                            uint32_t timeout_ms, uint8_t retries)
 {
     int r = port_ok(h);
+    if (r == TASE_OK) {
+        r = drain(h);
+    }
     if (r != TASE_OK) {
         return r;
     }

@@ -157,6 +157,131 @@ static void a_late_answer_to_an_ended_request_never_completes_the_next(void **st
     assert_int_equal(tase_host_poll(&x->host, 1310), 16);
 }
 
+/* A review (two gimbals on one line, a gimbal answering twice): the
+ * second answer to a query was partly in when the setting went out, and
+ * completed the setting as its echo (`tase send` exit 3 for a setting the
+ * gimbal applied). A frame that began before the request was sent never
+ * completes it: to on_frame, counted stale; the echo that follows does. */
+static void a_frame_begun_before_the_request_never_completes_it(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64], set[16], fr[TASE_FRAME_MAX];
+    int n = tase_frame_build(0x48, 0x00, rates, sizeof rates, fr, sizeof fr);
+
+    memcpy(set, rates, sizeof set);
+    set[5] = 15; /* angle_2 */
+    assert_true(n > 10);
+    assert_int_equal(tase_host_feed(&x->host, fr, 10, 0), 0); /* the old answer's start */
+    assert_int_equal(tase_host_request_start(&x->host, TASE_GROUP_SETUP, 0x00, set, sizeof set,
+                                             reply, sizeof reply, 500, 2, 5),
+                     TASE_OK);
+    assert_int_equal(tase_host_feed(&x->host, &fr[10], (size_t)n - 10u, 8), 1); /* its rest */
+    assert_int_equal(tase_host_poll(&x->host, 8), TASE_EAGAIN);
+    assert_int_equal(x->others, 1);
+    assert_int_equal(x->host.stats.stale, 1);
+    /* a reset of the receiver's counters changes nothing (the host keeps
+     * its own count) */
+    tase_rx_stats_reset(&x->host.rx);
+    feed_frame(x, 0x48, 0x00, set, sizeof set, 20); /* the setting's echo */
+    assert_int_equal(tase_host_poll(&x->host, 20), 16);
+    assert_memory_equal(reply, set, sizeof set);
+    assert_int_equal(x->host.stats.stale, 1);
+}
+
+/* Started from on_frame in the middle of a feed: the frames after in the
+ * same bytes were read before the request was sent, so none of them is
+ * its answer. */
+typedef struct {
+    fix_t *x;
+    uint8_t reply[64];
+    int started;
+} midfeed_t;
+
+static void start_on_angle(void *user, const tase_frame_t *f)
+{
+    midfeed_t *m = user;
+    if (f->group == 0x08 && f->type == 0x10 && m->started == 0) {
+        m->started = tase_host_query_start(&m->x->host, TASE_GROUP_SETUP, 0x00, m->reply,
+                                           sizeof m->reply, 500, 0, 0) == TASE_OK
+                         ? 1
+                         : -1;
+    }
+}
+
+static void a_request_started_inside_a_feed_skips_the_rest_of_its_bytes(void **state)
+{
+    fix_t *x = *state;
+    midfeed_t m;
+    tase_port_t p = {&fake_ops, &x->port, 0};
+    uint8_t buf[2 * TASE_FRAME_MAX];
+    const uint8_t angle[6] = {0, 1, 0, 2, 0, 3};
+    int a = tase_frame_build(0x08, 0x10, angle, sizeof angle, buf, sizeof buf);
+    int b = tase_frame_build(0x48, 0x00, rates, sizeof rates, &buf[a], sizeof buf - (size_t)a);
+
+    memset(&m, 0, sizeof m);
+    m.x = x;
+    assert_int_equal(tase_host_init(&x->host, &p, start_on_angle, &m), TASE_OK);
+    assert_true(a > 0 && b > 0);
+    assert_int_equal(tase_host_feed(&x->host, buf, (size_t)(a + b), 1), 2);
+    assert_int_equal(m.started, 1);
+    assert_int_equal(x->host.stats.stale, 1);
+    assert_int_equal(tase_host_poll(&x->host, 2), TASE_EAGAIN);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 3);
+    assert_int_equal(tase_host_poll(&x->host, 3), 16);
+}
+
+/* A review: after a stalled gimbal, answers to earlier requests waited
+ * unread and each request took the oldest as its own (Python's query()
+ * stayed three answers behind for good). tase_host_transact() reads what
+ * is ready before it sends: the waiting answer goes to on_frame and the
+ * request gets the gimbal's answer to it. */
+static void transact_reads_what_is_waiting_before_it_sends(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64], set[16], fr[TASE_FRAME_MAX];
+    tase_packet_rate_t echo;
+    int n;
+
+    memcpy(set, rates, sizeof set);
+    set[5] = 15;
+    fake_push_frame(&x->port, 0x48, 0x00, rates, sizeof rates); /* stale, waiting */
+    n = tase_frame_build(0x48, 0x00, set, sizeof set, fr, sizeof fr);
+    assert_true(n > 0);
+    memcpy(x->port.reply, fr, (size_t)n);
+    x->port.nreply = (size_t)n;
+    x->port.reply_after = 1; /* the gimbal echoes the setting */
+    assert_int_equal(tase_host_transact(&x->host, TASE_GROUP_SETUP, 0x00, set, sizeof set, reply,
+                                        sizeof reply, 100, 0),
+                     16);
+    assert_memory_equal(reply, set, sizeof set);
+    assert_int_equal(x->others, 1);
+    /* the typed call too */
+    fake_push_frame(&x->port, 0x48, 0x00, rates, sizeof rates);
+    x->port.reply_after = 2;
+    x->port.reply_due = 0;
+    {
+        tase_packet_rate_t req;
+        assert_int_equal(tase_packet_decode_data(TASE_ID_PACKET_RATE, set, sizeof set, &req), 16);
+        assert_int_equal(tase_host_transact_msg(&x->host, TASE_ID_PACKET_RATE, &req, &echo, 100, 0),
+                         16);
+    }
+    assert_int_equal(echo.angle_2, 15);
+    assert_int_equal(x->others, 2);
+}
+
+/* Our own queries coming back (a loop-back plug, a half-duplex adapter)
+ * are counted: a gimbal sends no zero-length frame. */
+static void zero_length_frames_are_counted_as_queries_received(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    query_rates(x, reply, 500, 0, 0);
+    feed_frame(x, 0x48, 0x00, NULL, 0, 1); /* our query, echoed */
+    assert_int_equal(tase_host_poll(&x->host, 1), TASE_EAGAIN);
+    assert_int_equal(x->host.stats.queries_rx, 1);
+    assert_int_equal(x->host.stats.stale, 0);
+}
+
 /* A failed request owes all its attempts, for one attempt timeout: an
  * answer within it goes to on_frame; after it, answers complete requests
  * again (a gimbal that never answers does not make every later request
@@ -597,15 +722,43 @@ static void transact_returns_a_start_error_without_leaving_a_request(void **stat
     assert_int_equal(x->host.stats.requests, 0);
 }
 
-/* A port whose read fails: transact must give the error back and drop
- * the request instead of spinning. */
+/* A port whose read fails once something was written: transact must give
+ * the error back and drop the request instead of spinning. (The reads
+ * before the send find nothing.) */
 static int failing_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    const fake_port_t *f = ctx;
+    (void)buf, (void)cap, (void)timeout_ms;
+    return f->nout > 0u ? TASE_EIO : 0;
+}
+
+static const tase_port_ops_t failing_read_ops = {fake_write, failing_read, fake_now};
+
+/* A port whose every read fails: transact returns the error of the read
+ * it makes before sending (what the port has ready), nothing sent. */
+static int always_failing_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
 {
     (void)ctx, (void)buf, (void)cap, (void)timeout_ms;
     return TASE_EIO;
 }
 
-static const tase_port_ops_t failing_read_ops = {fake_write, failing_read, fake_now};
+static const tase_port_ops_t always_failing_read_ops = {fake_write, always_failing_read, fake_now};
+
+static void transact_sends_nothing_when_the_read_before_it_fails(void **state)
+{
+    fix_t *x = *state;
+    tase_host_t h;
+    tase_port_t p = {&always_failing_read_ops, &x->port, 0};
+    uint8_t reply[8];
+    assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_OK);
+    assert_int_equal(tase_host_transact(&h, 0x48, 0x01, NULL, 0, reply, sizeof reply, 100, 3),
+                     TASE_EIO);
+    assert_int_equal(tase_host_transact_msg(&h, TASE_ID_SENSOR_FILTER, NULL, NULL, 100, 3),
+                     TASE_EIO);
+    assert_int_equal(fake_frames_out(&x->port), 0);
+    assert_int_equal(h.stats.requests, 0);
+    assert_false(tase_host_busy(&h));
+}
 
 static void transact_gives_back_a_read_error_and_cancels_the_request(void **state)
 {
@@ -1284,6 +1437,16 @@ int main(void)
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(transact_returns_a_start_error_without_leaving_a_request,
                                         setup, teardown),
+        cmocka_unit_test_setup_teardown(a_frame_begun_before_the_request_never_completes_it, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(a_request_started_inside_a_feed_skips_the_rest_of_its_bytes,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(transact_reads_what_is_waiting_before_it_sends, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(zero_length_frames_are_counted_as_queries_received, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(transact_sends_nothing_when_the_read_before_it_fails, setup,
+                                        teardown),
         cmocka_unit_test_setup_teardown(transact_gives_back_a_read_error_and_cancels_the_request,
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(send_counts_port_errors_but_not_argument_errors, setup,

@@ -64,6 +64,19 @@
  * type never completes it. Frames that do not complete the request
  * (telemetry, other answers, unsolicited frames) go to the on_frame
  * callback given at init; the completing reply does not.
+ * A frame that began before the request's first attempt was sent (its
+ * first byte among those fed before; also a frame finished inside the
+ * feed call from whose on_frame the request was started) never completes
+ * it: it goes to on_frame and counts in stats.stale. tase_host_transact()
+ * and tase_host_transact_msg() first read what the port has ready (up to
+ * 256 reads of 64 bytes that come back full), so an answer to somebody
+ * else's earlier request that waited unread is not taken either (a
+ * gimbal that answered twice, a second gimbal on the line, or answers it
+ * sent after a stall). An answer that begins after the send can still be
+ * such a one: a setting's echo that differs from what was sent may be
+ * stale (`tase send` then asks once more before it reports a mismatch).
+ * Zero-length frames received are counted in stats.queries_rx: a gimbal
+ * sends none, so a line where they appear echoes what the host sends.
  * A request that ended after n attempts (completed by one answer: n - 1;
  * failed or cancelled: n) may still be answered for the others: that many
  * answers of its group and type are then OWED, and an owed answer never
@@ -110,7 +123,7 @@
  * tase_host_transact_msg() return TASE_EBUSY there, nothing read or sent
  * (they would feed the receiver that is calling: every byte they read
  * was lost). No allocation, no
- * globals. sizeof(tase_host_t) is 716 bytes on Cortex-M (a tase_rx_t plus a copy
+ * globals. sizeof(tase_host_t) is 736 bytes on Cortex-M (a tase_rx_t plus a copy
  * of the pending request for re-sending).
  */
 #ifndef TASE_HOST_H
@@ -125,15 +138,20 @@ extern "C" {
 
 /* Statistics; only incremented by the library, wrap modulo 2^32. */
 typedef struct {
-    uint32_t frames_tx; /* frames written completely (commands, requests,
+    uint32_t frames_tx;  /* frames written completely (commands, requests,
                            re-sent requests) */
-    uint32_t tx_errors; /* frames the port did not take completely */
-    uint32_t frames_rx; /* valid frames received */
-    uint32_t requests;  /* requests started */
-    uint32_t retries;   /* requests re-sent after a timeout */
-    uint32_t replies;   /* requests completed by a matching frame */
-    uint32_t timeouts;  /* requests that failed after their last attempt */
-    uint32_t late;      /* owed answers of ended requests (MATCHING) */
+    uint32_t tx_errors;  /* frames the port did not take completely */
+    uint32_t frames_rx;  /* valid frames received */
+    uint32_t requests;   /* requests started */
+    uint32_t retries;    /* requests re-sent after a timeout */
+    uint32_t replies;    /* requests completed by a matching frame */
+    uint32_t timeouts;   /* requests that failed after their last attempt */
+    uint32_t late;       /* owed answers of ended requests (MATCHING) */
+    uint32_t stale;      /* frames of the pending request's type that began
+                           before it was sent: never its answer (MATCHING) */
+    uint32_t queries_rx; /* zero-length frames received: a gimbal sends
+                            none, so they are most likely our own queries
+                            coming back (a line that echoes, MATCHING) */
 } tase_host_stats_t;
 
 /* Host instance. Treat every field except `stats` and `rx.stats` as
@@ -153,6 +171,9 @@ typedef struct {
     uint32_t first_at;   /* when the first attempt was sent */
     uint32_t now;        /* the latest now_ms given (feed, poll, start) */
     uint32_t owed_until; /* answers are owed (MATCHING) until then */
+    uint32_t in_count;   /* bytes given to tase_host_feed(), mod 2^32 */
+    uint32_t in_shift;   /* in_count - rx.stats.bytes_in as the feed began */
+    uint32_t mark;       /* in_count when the pending request was sent */
     int result;          /* reply length or error once complete */
     uint8_t state;       /* idle / waiting / complete */
     uint8_t retries_left;
@@ -329,6 +350,9 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms);
  * to on_frame. TASE_EARG also for h without port ops (never initialised),
  * TASE_EUNSUPPORTED for a port without read or now_ms, TASE_EBUSY called
  * from on_frame (nothing sent).
+ * Before sending it reads and feeds what the port has ready (reads of 64
+ * bytes that do not wait, until one comes back short, at most 256: see
+ * MATCHING); a read error there is returned, nothing sent.
  * A broken port whose clock stands still while read() returns nothing at
  * once ends with TASE_ETIMEOUT after TASE_PORT_WRITE_SPINS such reads in a
  * row (tase/config.h), instead of never. */

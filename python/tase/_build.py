@@ -129,6 +129,8 @@ typedef struct {
     uint32_t replies;
     uint32_t timeouts;
     uint32_t late;
+    uint32_t stale;
+    uint32_t queries_rx;
 } tase_host_stats_t;
 typedef struct {
     tase_host_stats_t stats;

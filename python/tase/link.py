@@ -432,6 +432,10 @@ def py_port_write(ctx, data, n):
 # another thread ends a call waiting for an answer that does not come (it
 # waited out the whole timeout).
 _READ_SLICE_S = 0.2
+# tase_host_service() reads at most 64 bytes a call; a poll (timeout 0)
+# reads while they come back full, at most this many times (16 KiB)
+_SERVICE_CHUNK = 64
+_POLL_READS = 256
 
 
 @ffi.def_extern()
@@ -823,7 +827,12 @@ class Link:
                 if not self._call_lock.acquire(blocking=False):
                     continue
                 try:
-                    r = self._call(lib.tase_host_service, self._host, ms)
+                    # everything the port has ready, not one 64-byte read
+                    # (a 10 Hz poll loop fell behind the line), bounded
+                    for _ in range(_POLL_READS):
+                        r = self._call(lib.tase_host_service, self._host, ms)
+                        if r < _SERVICE_CHUNK:
+                            break
                 finally:
                     self._call_lock.release()
             else:
@@ -859,6 +868,11 @@ class Link:
             "replies": h.replies,
             "timeouts": h.timeouts,
             "late": h.late,
+            # frames of a request's type begun before it was sent: not its answer
+            "stale": h.stale,
+            # zero-length frames received: our own queries coming back
+            # (a line that echoes what is sent; a gimbal sends none)
+            "queries_rx": h.queries_rx,
             "bytes_in": rx.bytes_in,
             "checksum_errors": rx.checksum_errors,
             "bad_size": rx.bad_size,

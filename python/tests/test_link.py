@@ -243,6 +243,62 @@ def test_recv_with_no_wait_reads_what_is_there(silent_pty):
         assert list(link.packets(timeout=0)) == []
 
 
+def test_a_poll_reads_everything_that_is_there(silent_pty):
+    # a review: recv(0)/packets(timeout=0) read one 64-byte chunk a call,
+    # so a 10 Hz poll loop fell behind the line for good
+    url, master = silent_pty
+    ps = [tase.Packet("GIMBAL_ANGLE", pan=i, tilt=2, roll=3) for i in range(40)]
+    with tase.connect(url) as link:
+        os.write(master, b"".join(tase.encode(p) for p in ps))  # 560 bytes
+        time.sleep(0.2)
+        assert list(link.packets(timeout=0)) == ps
+
+
+def _answer_twice(master, stop, delay=0.03):
+    """A gimbal that answers every PACKET_RATE (query or setting) twice,
+    the second time `delay` s later: its settings, stored from a setting."""
+    rates = bytearray([10, 10, 4, 0, 0, 10, 10, 4, 0, 0, 10, 10, 4, 0, 0, 1])
+    rx = tase.Decoder()
+    while not stop.is_set():
+        if not select.select([master], [], [], 0.02)[0]:
+            continue
+        for p in rx.feed(os.read(master, 4096)):
+            if (p.group, p.type) != (0x48, 0x00):
+                continue
+            if p.size == 16:
+                rates[:] = p.payload
+            answer = tase.Packet.from_data(0x48, 0x00, bytes(rates)).encode()
+            os.write(master, answer)
+            time.sleep(delay)
+            os.write(master, answer)
+
+
+def test_a_gimbal_answering_twice_leaves_no_query_behind(silent_pty):
+    # a review: the second answer to each request completed the next one,
+    # so every echo query() returned was the setting before (for good)
+    url, master = silent_pty
+    stop = threading.Event()
+    t = threading.Thread(target=_answer_twice, args=(master, stop), daemon=True)
+    t.start()
+    try:
+        with tase.connect(url) as link:
+            for n in range(2, 8):
+                echo = link.query(_rates(angle_2=n))
+                assert echo.raw["angle_2"] == n
+                time.sleep(0.1)  # the duplicate comes meanwhile
+            assert link.stats["replies"] == 6
+    finally:
+        stop.set()
+        t.join()
+
+
+def _rates(**kw):
+    raw = dict(angle_1=10, rate_1=10, geo_ref_1=4, camera_1=0, angle_2=10, rate_2=10, geo_ref_2=4,
+               camera_2=0, angle_3=10, rate_3=10, geo_ref_3=4, camera_3=0, temporary=1)
+    raw.update(kw)
+    return tase.Packet("PACKET_RATE", raw=raw)
+
+
 def test_packets_stops_at_close(silent_pty):
     # the iterator went on reading the closed link's descriptor number,
     # whatever file had it by then

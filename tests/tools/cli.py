@@ -19,6 +19,7 @@ import sys
 import tempfile
 import termios
 import threading
+import tty
 import time
 import tty
 
@@ -805,6 +806,100 @@ got = [tuple(v for k, v in tase.Packet.from_data(g, t, d).raw.items() if k in ke
 ok("decimal arguments round half away from zero on the decimal typed",
    got == [(101, -101), (835, -29), (2,), (-402,), (162000001, 0, 101)], repr(got))
 fg.close()
+
+
+# ---- answers that are not the request's own (a review) ----
+class TwiceGimbal(FakeGimbal):
+    """Answers every PACKET_RATE twice (a gimbal answering twice; two
+    gimbals on one line) with the settings it holds: a query at once and
+    again 5 ms later, a setting (stored as it comes) 20 ms later and again
+    5 ms after that (it takes a moment to apply)."""
+
+    def __init__(self):
+        self.rates = bytearray([10, 10, 4, 0, 0, 10, 10, 4, 0, 0, 10, 10, 4, 0, 0, 1])
+        self.timers = []
+        super().__init__()
+
+    def frame(self, group, ptype, data):
+        self.got.append((group, ptype, bytes(data)))
+        if (group, ptype) != (0x48, 0x00):
+            return
+        if len(data) == 16:
+            self.rates[:15] = data[:15]
+        answer = tase.Packet.from_data(0x48, 0x00, bytes(self.rates)).encode()
+        first = 0.02 if data else 0.0
+        for at in (first, first + 0.005):
+            self.timers.append(threading.Timer(at, os.write, (self.master, answer)))
+            self.timers[-1].start()
+
+    def close(self):
+        # every answer written before the descriptor goes (its number is
+        # reused by the next pty)
+        self.stop = True
+        self.thread.join()
+        for t in self.timers:
+            t.join()
+        super().close()
+
+
+tg = TwiceGimbal()
+rc, out, err = run(["send", "PACKET_RATE", "angle_2=6", "--serial", tg.path])
+# the query's second answer came after the setting went out and was taken
+# as its echo: "angle_2 sent 6, gimbal has 10", exit 3, for a setting the
+# gimbal applied
+ok("send PACKET_RATE to a gimbal answering twice: applied, exit 0",
+   rc == 0 and tg.rates[5] == 6 and "not applied" not in err, "exit %d %r %r" % (rc, out, err))
+time.sleep(0.1)  # the answers still due reach nobody (the next open drops them)
+rc, out, err = run(["send", "PACKET_RATE", "angle_2=7", "--serial", tg.path])
+ok("... and the next one", rc == 0 and tg.rates[5] == 7, "exit %d %r %r" % (rc, out, err))
+tg.close()
+
+
+class EchoLine(FakeGimbal):
+    """A line that echoes what the host sends (a half-duplex adapter), with
+    a gimbal on it that refuses any AXIS_SETTING (answers with what it
+    holds)."""
+
+    def frame(self, group, ptype, data):
+        self.got.append((group, ptype, bytes(data)))
+        os.write(self.master, tase.Packet.from_data(group, ptype, bytes(data)).encode())
+        if (group, ptype) == (0x48, 0x02):
+            os.write(self.master, tase.Packet.from_data(0x48, 0x02, bytes(self.settings) +
+                                                        b"\x00").encode())
+
+
+el = EchoLine()
+rc, out, err = run(["send", "AXIS_SETTING", "pan_max_rate=20", "--serial", el.path])
+# our own setting came back and read as the echo: exit 0 and nothing said
+ok("send on a line that echoes: warned that the echo may be our own frame",
+   "our own queries came back" in err and "does not show the gimbal took it" in err,
+   "exit %d %r %r" % (rc, out, err))
+el.close()
+m, sl = os.openpty()
+tty.setraw(m)
+plugged = threading.Event()
+
+
+def loop_back():
+    # a loop-back plug: every byte sent comes straight back
+    while not plugged.is_set():
+        if select.select([m], [], [], 0.02)[0]:
+            try:
+                os.write(m, os.read(m, 4096))
+            except OSError:  # the tool closed its end: nothing to loop
+                pass
+
+
+loop = threading.Thread(target=loop_back, daemon=True)
+loop.start()
+rc, out, err = run(["query", "PACKET_RATE", "--retries", "0", "--timeout", "200", "--serial",
+                    os.ttyname(sl)])
+ok("query on a loop-back plug: the timeout says our own queries came back",
+   rc == 1 and "our own queries came back on this line" in err, "exit %d %r" % (rc, err))
+plugged.set()
+loop.join()
+os.close(m)
+os.close(sl)
 
 # ---- --units: "do not change" and "unavailable" have no engineering value ----
 # (AXIS_SETTING's 0xFF/0xFFFF showed as 1275 deg/s, -0.01 deg; TAS 0xFFFF as

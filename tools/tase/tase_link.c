@@ -82,12 +82,32 @@ void cli_session_service(cli_session_t *s, uint32_t wait_ms)
  * added to a timeout's message. With `show_sent`, the packet is printed
  * ("sent ...") as soon as it has gone out, before the wait: a gimbal that
  * never answers leaves that line, as every other command that sends. */
+/* Read and feed what the port has ready (reads that do not wait, while
+ * they come back full, at most 256), so that an answer to an earlier
+ * request that waited unread is not taken as the next one's (tase/host.h,
+ * MATCHING: tase_host_transact() does the same). */
+static void session_drain(cli_session_t *s)
+{
+    unsigned i;
+    for (i = 0; i < 256u; i++) {
+        int n = tase_host_service(&s->h, 0u);
+        if (n < 0) {
+            session_read_failed(s, n);
+        }
+        if (n < 64) {
+            break;
+        }
+    }
+}
+
 static int transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
                     uint8_t *reply, const cli_req_opts_t *r, const char *note, bool show_sent)
 {
-    int rc = tase_host_request_start(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len,
-                                     reply, TASE_DATA_MAX, r->timeout_ms, r->retries,
-                                     s->port.ops->now_ms(s->port.ctx));
+    int rc;
+    session_drain(s);
+    rc = tase_host_request_start(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len, reply,
+                                 TASE_DATA_MAX, r->timeout_ms, r->retries,
+                                 s->port.ops->now_ms(s->port.ctx));
     if (rc >= 0 && len > 0) {
         tk_mark_sent(tase_schema_packet_name(p)); /* a query changes nothing */
     }
@@ -105,9 +125,15 @@ static int transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t
         rc = 0;
     }
     if (rc == TASE_ETIMEOUT) {
-        tk_die("timeout: no answer to %s after %u attempt%s of %lu ms%s",
+        /* our own queries coming back: a line that echoes, and nothing
+         * else answering on it */
+        unsigned long back = (unsigned long)s->h.stats.queries_rx;
+        tk_die("timeout: no answer to %s after %u attempt%s of %lu ms%s%s",
                tase_schema_packet_name(p), (unsigned)r->retries + 1u, r->retries ? "s" : "",
-               (unsigned long)r->timeout_ms, note != NULL ? note : "");
+               (unsigned long)r->timeout_ms, note != NULL ? note : "",
+               back != 0u ? " (our own queries came back on this line: it echoes what is sent "
+                            "(a loop-back plug or a half-duplex adapter); is a gimbal on it?)"
+                          : "");
     }
     if (rc < 0) {
         tk_die("%s request failed on %s: %s", tase_schema_packet_name(p), s->name,
@@ -160,20 +186,15 @@ void cli_print_packet(const tase_packet_desc_t *p, const uint8_t *data, size_t l
     tk_print_frame(stdout, &fmt, &m, &f);
 }
 
-/* Compare the gimbal's echo with what was sent; exit 3 naming every field
- * that differs. Fields sent as "do not change" are not compared (the echo
- * has the setting in force); `skip` names another one (or NULL). */
-void cli_confirm_echo(const cli_fields_t *fs, size_t len, const uint8_t *echo, int elen,
-                      const char *skip)
+/* Write into diff[0..cap) every field of echo (elen bytes) that differs
+ * from fs (len bytes sent; fields sent as "do not change" and `skip` not
+ * compared); returns how many differ. */
+static size_t echo_diff(const cli_fields_t *fs, size_t len, const uint8_t *echo, int elen,
+                        const char *skip, char *diff, size_t cap)
 {
     const tase_packet_desc_t *p = fs->p;
-    char diff[1024];
     size_t used = 0, count = 0;
     unsigned i, n = cli_fields_within(p, len);
-    if ((size_t)elen != len) {
-        tk_exit(TK_EXIT_MISMATCH, "%s not confirmed: the echo has %d data bytes, %lu were sent",
-                tase_schema_packet_name(p), elen, (unsigned long)len);
-    }
     diff[0] = '\0';
     for (i = 0; i < n; i++) {
         long long sent = cli_fields_value(fs, i), got = 0;
@@ -181,16 +202,73 @@ void cli_confirm_echo(const cli_fields_t *fs, size_t len, const uint8_t *echo, i
         (void)tk_field_get(p, i, echo, (size_t)elen, &got);
         if (got != sent && !tase_field_is_keep(p, i, sent) &&
             (skip == NULL || strcmp(skip, name) != 0)) {
-            int w = snprintf(diff + used, sizeof(diff) - used, "%s%s sent %lld, gimbal has %lld",
+            int w = snprintf(diff + used, cap - used, "%s%s sent %lld, gimbal has %lld",
                              count ? "; " : "", name, sent, got);
-            if (w > 0 && (size_t)w < sizeof(diff) - used) {
+            if (w > 0 && (size_t)w < cap - used) {
                 used += (size_t)w;
             }
             count++;
         }
     }
-    if (count != 0) {
-        tk_exit(TK_EXIT_MISMATCH, "%s not applied as sent: %s", tase_schema_packet_name(p), diff);
+    return count;
+}
+
+/* Compare the gimbal's echo with what was sent; exit 3 naming every field
+ * that differs. Fields sent as "do not change" are not compared (the echo
+ * has the setting in force); `skip` names another one (or NULL). */
+void cli_confirm_echo(const cli_fields_t *fs, size_t len, const uint8_t *echo, int elen,
+                      const char *skip)
+{
+    char diff[1024];
+    if ((size_t)elen != len) {
+        tk_exit(TK_EXIT_MISMATCH, "%s not confirmed: the echo has %d data bytes, %lu were sent",
+                tase_schema_packet_name(fs->p), elen, (unsigned long)len);
+    }
+    if (echo_diff(fs, len, echo, elen, skip, diff, sizeof diff) != 0) {
+        tk_exit(TK_EXIT_MISMATCH, "%s not applied as sent: %s", tase_schema_packet_name(fs->p),
+                diff);
+    }
+}
+
+/* Confirm a setting by its echo (n bytes in reply). `temporary` tells the
+ * gimbal what to do with the packet (store it or not); it is no setting
+ * in force, so its echo proves nothing. An echo that differs may be a
+ * stale answer that came after the send (to a request made before a
+ * stall, a gimbal answering twice, a second gimbal): the setting in force
+ * decides, asked once more; an error is still one line. */
+static void confirm_setting(cli_session_t *s, const cli_fields_t *fs, size_t len, uint8_t *reply,
+                            int n, const cli_send_opts_t *o)
+{
+    const tase_packet_desc_t *p = fs->p;
+    char first[1024], diff[1024];
+    if ((size_t)n == len && echo_diff(fs, len, reply, n, "temporary", first, sizeof first) != 0) {
+        n = transact(s, p, NULL, 0, reply, &o->r, NULL, false);
+        cli_print_packet(p, reply, (size_t)n, o->r.json, "out", "echo");
+        if (echo_diff(fs, len, reply, n, "temporary", diff, sizeof diff) == 0) {
+            fprintf(stderr,
+                    "tase: note: the first answer differed (%s) but the %s in force is as "
+                    "sent: that answer was an earlier request's (a late answer, a gimbal "
+                    "answering twice, or two gimbals on this line)\n",
+                    first, tase_schema_packet_name(p));
+        } else if (s->h.stats.retries + s->h.stats.late + s->h.stats.stale != 0u) {
+            tk_exit(TK_EXIT_MISMATCH,
+                    "%s not applied as sent: %s (answers came late or twice here: %lu re-sent, "
+                    "%lu late, %lu begun before their request; a longer --timeout may show the "
+                    "setting's own echo)",
+                    tase_schema_packet_name(p), diff, (unsigned long)s->h.stats.retries,
+                    (unsigned long)s->h.stats.late, (unsigned long)s->h.stats.stale);
+        } else {
+            /* the setting in force differs: cli_confirm_echo() says how */
+        }
+        len = (size_t)n; /* the answer's layout (AXIS_SETTING 22 or 23) */
+    }
+    cli_confirm_echo(fs, len, reply, n, "temporary");
+    if (s->h.stats.queries_rx != 0u) {
+        fprintf(stderr,
+                "tase: warning: our own queries came back on %s: the line echoes what is "
+                "sent (a loop-back plug or a half-duplex adapter), so this echo may be our "
+                "own frame and does not show the gimbal took it\n",
+                s->name);
     }
 }
 
@@ -210,9 +288,7 @@ void cli_send_fields(cli_session_t *s, const cli_fields_t *fs, size_t len, const
     n = transact(s, p, fs->data, len, reply, &o->r, NULL, true);
     cli_print_packet(p, reply, (size_t)n, o->r.json, "out", "echo");
     if (len > 0) {
-        /* `temporary` tells the gimbal what to do with this packet (store
-         * it or not); it is no setting in force, so its echo proves nothing */
-        cli_confirm_echo(fs, len, reply, n, "temporary");
+        confirm_setting(s, fs, len, reply, n, o);
     }
 }
 
