@@ -167,6 +167,42 @@ static void position_target_inside_nogo_goes_to_nearest_edge(void **state)
     near(m.pan, 80.0, 1e-6);
 }
 
+/* A review: a no-go range of 360 deg (4.4.3's maximum: nowhere to go)
+ * left the axis free (it is always "inside" the zone, and an axis inside
+ * may move anywhere): a 50 deg/s rate moved it 65 deg. */
+static void a_nogo_zone_of_the_whole_turn_holds_the_axis(void **state)
+{
+    sim_model_t m;
+    (void)state;
+    sim_model_init(&m);
+    m.axis_pan.nogo_center = 90.0; /* the axis (at 0) inside it */
+    m.axis_pan.nogo_range = 360.0;
+    sim_model_command(&m, 50.0, 0.0, 0x10, 0.0);
+    run(&m, 2.0);
+    near(m.pan, 0.0, 1e-9);
+    sim_model_command(&m, 120.0, 0.0, 0x20, 0.0);
+    run(&m, 2.0);
+    near(m.pan, 0.0, 1e-9);
+}
+
+/* A review: after CAMERA_TYPE removed every camera, LEGACY_CAMERA_CMD set
+ * camera A's HFOV to NaN (a lens of 0..0 deg) and a CAMERA_CMD "no change
+ * of camera" set the removed one's HFOV to 0. */
+static void camera_commands_refuse_a_removed_camera(void **state)
+{
+    sim_model_t m;
+    const uint8_t none[SIM_CAMERAS] = {TASE_CAMTYPE_NONE, TASE_CAMTYPE_NONE, TASE_CAMTYPE_NONE};
+    (void)state;
+    sim_model_init(&m);
+    sim_model_camera_types(&m, none);
+    assert_int_equal(sim_model_camera_legacy_zoom(&m, 0x2000u), SIM_CAM_NO_CAMERA);
+    assert_int_equal(sim_model_camera_cmd(&m, TASE_CAMERA_NO_CHANGE, true, 10.0),
+                     SIM_CAM_NO_CAMERA);
+    assert_true(m.cam[0].hfov >= 0.0); /* not NaN: every comparison with it is false */
+    near(m.cam[0].hfov, 0.0, 0.0);
+    near(m.cam[m.active_cam].hfov, 0.0, 0.0);
+}
+
 static void unknown_gimbal_flags_are_rejected(void **state)
 {
     sim_model_t m;
@@ -842,6 +878,8 @@ int main(void)
         cmocka_unit_test(default_tilt_nogo_blocks_looking_above_60),
         cmocka_unit_test(position_goes_round_the_nogo_zone),
         cmocka_unit_test(position_target_inside_nogo_goes_to_nearest_edge),
+        cmocka_unit_test(a_nogo_zone_of_the_whole_turn_holds_the_axis),
+        cmocka_unit_test(camera_commands_refuse_a_removed_camera),
         cmocka_unit_test(unknown_gimbal_flags_are_rejected),
         cmocka_unit_test(spoi_error_forms_change_nothing_outside_spoi),
         cmocka_unit_test(spoi_angles_level_host),

@@ -120,8 +120,24 @@ void sim_on_frame(void *user, unsigned port, const tase_frame_t *f)
     case TASE_ID_GIMBAL_CMD: {
         const tase_gimbal_cmd_t *c = &msg.gimbal_cmd;
         bool spoi = s->m.mode == SIM_MODE_SPOI;
-        int rc = sim_model_command(&s->m, c->pan / 100.0, c->tilt / 100.0, c->flags,
-                                   c->impulse_time / 100.0);
+        tase_gimbal_cmd_t flags_only = *c;
+        int rc;
+        flags_only.pan = 0;
+        flags_only.tilt = 0;
+        if (tase_command_check(TASE_ID_GIMBAL_CMD, c) != TASE_OK &&
+            tase_command_check(TASE_ID_GIMBAL_CMD, &flags_only) == TASE_OK) {
+            /* flags of table 5, a position beyond the axes (G8): a
+             * gimbal must not move on it (wrapped, 200 deg went to -160) */
+            sim_log(s, now,
+                    "GIMBAL_CMD (flags 0x%02X, pan %.2f tilt %.2f) refused: a position beyond the "
+                    "axes' ranges (pan %d..%d, tilt %d..%d deg); still in %s mode",
+                    c->flags, c->pan / 100.0, c->tilt / 100.0, TASE_PAN_MIN_CDEG / 100,
+                    TASE_PAN_MAX_CDEG / 100, TASE_TILT_MIN_CDEG / 100, TASE_TILT_MAX_CDEG / 100,
+                    mode_name(&s->m));
+            break;
+        }
+        rc = sim_model_command(&s->m, c->pan / 100.0, c->tilt / 100.0, c->flags,
+                               c->impulse_time / 100.0);
         if (rc == SIM_CMD_UNKNOWN) {
             sim_log(s, now, "GIMBAL_CMD: unknown flags 0x%02X ignored", c->flags);
         } else if (rc == SIM_CMD_NOT_DEPLOYED) {
@@ -149,7 +165,15 @@ void sim_on_frame(void *user, unsigned port, const tase_frame_t *f)
         }
         break;
     }
-    case TASE_ID_GYRO_ZERO_CMD: sim_log(s, now, "GYRO_ZERO_CMD: gyros zeroed"); break;
+    case TASE_ID_GYRO_ZERO_CMD:
+        /* 4.1.2: only while the gimbal is not moving (a real one would
+         * take the motion for gyro bias) */
+        sim_log(s, now, "GYRO_ZERO_CMD: gyros zeroed%s",
+                s->m.pan_rate != 0.0 || s->m.tilt_rate != 0.0
+                    ? " while the gimbal was moving (4.1.2: send it only when it is still; a real "
+                      "gimbal's gyro biases would now be off)"
+                    : "");
+        break;
     case TASE_ID_CAMERA_CMD: camera_cmd(s, &msg.camera_cmd, len, now); break;
     case TASE_ID_LEGACY_CAMERA_CMD: {
         int rc = sim_model_camera_legacy_zoom(&s->m, msg.legacy_camera_cmd.zoom);
@@ -198,7 +222,14 @@ void sim_on_frame(void *user, unsigned port, const tase_frame_t *f)
         } else {
             const tase_spoi_cmd_t *c = &msg.spoi_cmd;
             sim_pos_t t = wire_pos(c->lat, c->lon, c->height, c->vnorth, c->veast, c->vdown);
-            if (sim_model_spoi(&s->m, &t) != SIM_CMD_OK) {
+            if (tase_command_check(TASE_ID_SPOI_CMD, c) != TASE_OK) {
+                /* no point on the Earth: never tracked (the echo, if
+                 * asked for, shows the SPOI in force) */
+                sim_log(s, now,
+                        "SPOI_CMD (%.6f, %.6f, %.1f m) refused: beyond 90 deg of latitude or 180 "
+                        "of longitude; the SPOI in force stays",
+                        t.lat, t.lon, t.height);
+            } else if (sim_model_spoi(&s->m, &t) != SIM_CMD_OK) {
                 sim_log(s, now, "SPOI_CMD (%.6f, %.6f, %.1f m) ignored: %s", t.lat, t.lon, t.height,
                         not_deployed);
             } else {

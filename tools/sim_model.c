@@ -44,9 +44,13 @@ static bool in_nogo(const sim_axis_t *ax, double pos)
 
 /* Distance travelled in direction dir (+1/-1) from pos before entering the
  * no-go zone. An axis already inside the zone (settings changed under it)
- * may leave it freely, so that case reports no obstacle. */
+ * may leave it freely, so that case reports no obstacle; a zone of the
+ * whole turn has no outside, and stops it where it is. */
 static double nogo_distance(const sim_axis_t *ax, double pos, double dir)
 {
+    if (ax->nogo_range >= 360.0) {
+        return 0.0; /* the whole turn is no-go (4.4.3's 360): nowhere to go */
+    }
     if (ax->nogo_range <= 0.0 || in_nogo(ax, pos)) {
         return HUGE_VAL;
     }
@@ -138,6 +142,10 @@ int sim_model_camera_cmd(sim_model_t *m, unsigned camera, bool set_hfov, double 
             return SIM_CAM_NO_CAMERA;
         }
         m->active_cam = camera;
+    } else if (!camera_present(m, m->active_cam)) {
+        return SIM_CAM_NO_CAMERA; /* CAMERA_TYPE removed every camera */
+    } else {
+        /* the active camera */
     }
     c = &m->cam[m->active_cam];
     if (set_hfov) {
@@ -158,6 +166,9 @@ int sim_model_camera_legacy_zoom(sim_model_t *m, unsigned zoom)
     double z = (zoom > 0x4000u ? 0x4000u : zoom) / 16384.0;
     if (m->pass_through) {
         return SIM_CAM_PASS_THROUGH;
+    }
+    if (!camera_present(m, 0u)) {
+        return SIM_CAM_NO_CAMERA; /* it has no lens: the HFOV was NaN */
     }
     c->hfov = c->max_hfov * pow(c->min_hfov / c->max_hfov, z);
     return SIM_CAM_OK;

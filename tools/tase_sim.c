@@ -141,6 +141,26 @@ static int apply_setup(void *user, unsigned port, uint16_t id, void *msg)
             sim_log(s, now, "AXIS_SETTING refused: a max rate of 0 would lock the axis");
             return -1;
         }
+        if (a->pan_pos_gain == 0 || a->tilt_pos_gain == 0) {
+            /* no feedback: a position or SPOI command would never move */
+            sim_log(s, now,
+                    "AXIS_SETTING refused: a position gain of 0 would lock the axis "
+                    "in position and SPOI modes");
+            return -1;
+        }
+        if (a->pan_nogo_center < TASE_PAN_MIN_CDEG || a->pan_nogo_center > TASE_PAN_MAX_CDEG ||
+            a->tilt_nogo_center < TASE_TILT_MIN_CDEG || a->tilt_nogo_center > TASE_TILT_MAX_CDEG ||
+            a->pan_nogo_range > 36000u || a->tilt_nogo_range > 36000u) {
+            /* 4.4.3: centres -180..180 (pan), -270..90 (tilt), ranges
+             * 0..360 deg */
+            sim_log(s, now,
+                    "AXIS_SETTING refused: a no-go zone beyond the spec's ranges (pan centre "
+                    "%.2f, tilt centre %.2f, ranges %.2f/%.2f deg; 4.4.3: centres -180..180 and "
+                    "-270..90, ranges 0..360)",
+                    a->pan_nogo_center / 100.0, a->tilt_nogo_center / 100.0,
+                    a->pan_nogo_range / 100.0, a->tilt_nogo_range / 100.0);
+            return -1;
+        }
         apply_axis(s, a);
         sim_log(s, now,
                 "AXIS_SETTING: pan no-go %.2f+-%.2f, tilt no-go %.2f+-%.2f, max rates "

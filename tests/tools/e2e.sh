@@ -116,6 +116,17 @@ fd = os.open(sys.argv[1], os.O_WRONLY | os.O_NOCTTY)
 os.write(fd, bytes([0x00, 0xFF, 0x5A, 0xFF]))
 os.close(fd)' "$dir/gimbal"
 }
+# frame_to_sim GROUP TYPE HEX: a frame the tools would refuse to send,
+# framed here (spec 3.1: sum of Size..data, big-endian), written to the
+# simulator's link
+frame_to_sim() {
+    python3 -c 'import os, sys
+body = bytes([len(sys.argv[4]) // 2 + 2, int(sys.argv[2], 0), int(sys.argv[3], 0)]) + bytes.fromhex(sys.argv[4])
+s = (0x00 + 0xFF + 0x5A + sum(body)) & 0xFFFF
+fd = os.open(sys.argv[1], os.O_WRONLY | os.O_NOCTTY)
+os.write(fd, bytes([0x00, 0xFF, 0x5A]) + body + bytes([s >> 8, s & 0xFF]))
+os.close(fd)' "$dir/gimbal" "$@"
+}
 ms() { date +%s%3N; }
 # The same query on a clean line first: what the tool itself takes (start-up,
 # open, the exchange; about 1 s under memcheck) is not the noise's delay.
@@ -148,6 +159,26 @@ quiet "$TASE" point 30 -15 "${L[@]}"
 # more bytes would never carry it out (how soon, for a query, is above).
 check "after noise tase point is carried out on a quiet line, not when 257 more bytes came" \
     sim_reaches $((n + 1)) "GIMBAL_CMD: position pan 30.00 tilt -15.00"
+
+# Commands beyond the spec's ranges (which the tools refuse to send) move
+# nothing: a review found pan 200.00 obeyed as -160 and a SPOI at 100 deg
+# of latitude tracked
+frame_to_sim 0x00 0x80 "4e2000000000a000"             # pan 200.00, tilt 0, 0xA0
+frame_to_sim 0x10 0x40 "15752a00000000000000271000000000000080"  # SPOI lat 100 deg, 100 m
+check "tase-sim refuses a GIMBAL_CMD position beyond the axes and a SPOI beyond 90 deg" \
+    eval 'sim_reaches 1 "GIMBAL_CMD (flags 0xA0, pan 200.00 tilt 0.00) refused: a position beyond the axes" &&
+          sim_reaches 1 "SPOI_CMD (100.000000, 0.000000, 100.0 m) refused: beyond 90 deg of latitude"'
+# ... and settings no axis can work with: a position gain of 0 (position
+# and SPOI commands never moved), a no-go zone beyond 4.4.3's ranges
+expect_error "AXIS_SETTING pan_pos_gain=0 refused by the gimbal: exit 3" 3 \
+    "AXIS_SETTING not applied as sent: pan_pos_gain sent 0, gimbal has 40" \
+    "$TASE" send AXIS_SETTING pan_pos_gain=0 "${L[@]}"
+expect_error "AXIS_SETTING pan_nogo_range=40000 (400 deg) refused by the gimbal: exit 3" 3 \
+    "AXIS_SETTING not applied as sent: pan_nogo_range sent 40000, gimbal has 0" \
+    "$TASE" send AXIS_SETTING pan_nogo_range=40000 "${L[@]}"
+check "tase-sim says why" \
+    eval 'sim_reaches 1 "AXIS_SETTING refused: a position gain of 0" &&
+          sim_reaches 1 "AXIS_SETTING refused: a no-go zone beyond the spec"'
 
 # SPOI error forms outside SPOI mode change nothing: the log says so (that
 # the model's state is unchanged is tests/test_sim_model.c's).
@@ -214,18 +245,26 @@ check "SPOI points at 90 deg pan, -45 deg tilt ($last)" \
 sq=$("$TASE" query SPOI_CMD "${L[@]}" --json)
 check "SPOI_CMD query returns the SPOI ($sq)" test "$(json_int "$sq" lon)" = 3234
 
+# GYRO_ZERO_CMD while the axes turn (4.1.2: only while still): said (tilt
+# only: the KLV check below reads the pan the SPOI set)
+quiet "$TASE" rate 0 20 "${L[@]}"
+check "GYRO_ZERO_CMD while the gimbal turns: tase-sim says it was moving (4.1.2)" \
+    eval 'sim_reaches 1 "GIMBAL_CMD: rate pan 0.00 tilt 20.00" && quiet "$TASE" gyro-zero "${L[@]}" &&
+          sim_reaches 1 "gyros zeroed while the gimbal was moving"'
+quiet "$TASE" rate 0 0 "${L[@]}"
+
 # ---- retract/deploy: echoed when the move completes ----
 out=$("$TASE" retract "${L[@]}" --wait 4)
 check "tase retract --wait: sent, then the echo when the move completed" \
     eval '[ "$(grep -c "RETRACT_DEPLOY_CMD deploy=0" <<<"$out")" = 2 ]'
 check "tase gyro-zero reaches the gimbal" \
-    eval '"$TASE" gyro-zero "${L[@]}" | grep -q "^sent GYRO_ZERO_CMD" && sim_reaches 1 GYRO_ZERO'
+    eval '"$TASE" gyro-zero "${L[@]}" | grep -q "^sent GYRO_ZERO_CMD" && sim_reaches 2 GYRO_ZERO'
 # Twenty programs back to back, each writing a command nobody answers and
 # exiting at once: the next one's open must not drop what the last one
 # left queued for the simulator (opening a port discards input only).
 for _ in $(seq 20); do quiet "$TASE" gyro-zero "${L[@]}"; done
 check "20 back-to-back gyro-zero commands from 20 programs all reach the gimbal" \
-    sim_reaches 21 GYRO_ZERO
+    sim_reaches 22 GYRO_ZERO
 
 # ---- camera: select, field of view ----
 quiet "$TASE" camera A --hfov 10 "${L[@]}"
