@@ -901,6 +901,26 @@ loop.join()
 os.close(m)
 os.close(sl)
 
+# A wrong baud: bytes come, never a frame. query said only "no answer"
+# (monitor gave its hint).
+class WrongBaud(FakeGimbal):
+    def run(self):
+        while not self.stop:
+            if select.select([self.master], [], [], 0.02)[0]:
+                try:
+                    os.read(self.master, 4096)
+                except OSError:
+                    continue
+                os.write(self.master, bytes(range(0x80, 0xC0)))  # what 8N1 at another rate reads
+
+
+wb = WrongBaud()
+rc, out, err = run(["query", "PACKET_RATE", "--retries", "1", "--timeout", "200", "--serial",
+                    wb.path])
+ok("query answered by bytes that make no frame: the timeout says a wrong --baud?",
+   rc == 1 and "bytes came, none of them a frame: a wrong --baud" in err, "exit %d %r" % (rc, err))
+wb.close()
+
 # ---- --units: "do not change" and "unavailable" have no engineering value ----
 # (AXIS_SETTING's 0xFF/0xFFFF showed as 1275 deg/s, -0.01 deg; TAS 0xFFFF as
 # 655.35 m/s)

@@ -125,15 +125,26 @@ static int transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t
         rc = 0;
     }
     if (rc == TASE_ETIMEOUT) {
-        /* our own queries coming back: a line that echoes, and nothing
-         * else answering on it */
-        unsigned long back = (unsigned long)s->h.stats.queries_rx;
+        /* what the line did say: our own queries coming back (a line that
+         * echoes, nothing else answering on it), or bytes that never made
+         * a frame (a wrong baud: monitor's hint) */
+        const tase_rx_stats_t *rx = &s->h.rx.stats;
+        char hint[160] = "";
+        if (s->h.stats.queries_rx != 0u) {
+            (void)snprintf(hint, sizeof hint,
+                           " (our own queries came back on this line: it echoes what is sent (a "
+                           "loop-back plug or a half-duplex adapter); is a gimbal on it?)");
+        } else if (rx->frames_ok == 0u && rx->bytes_in != 0u) {
+            (void)snprintf(hint, sizeof hint, " (%lu bytes came, none of them a frame: %s)",
+                           (unsigned long)rx->bytes_in,
+                           s->link.is_can ? "datalink frames that never formed a TASE frame"
+                                          : "a wrong --baud, or not the gimbal's datalink port?");
+        } else {
+            /* silence, or frames of other kinds only */
+        }
         tk_die("timeout: no answer to %s after %u attempt%s of %lu ms%s%s",
                tase_schema_packet_name(p), (unsigned)r->retries + 1u, r->retries ? "s" : "",
-               (unsigned long)r->timeout_ms, note != NULL ? note : "",
-               back != 0u ? " (our own queries came back on this line: it echoes what is sent "
-                            "(a loop-back plug or a half-duplex adapter); is a gimbal on it?)"
-                          : "");
+               (unsigned long)r->timeout_ms, note != NULL ? note : "", hint);
     }
     if (rc < 0) {
         tk_die("%s request failed on %s: %s", tase_schema_packet_name(p), s->name,
