@@ -945,6 +945,19 @@ class Link:
                     "%s: SPOI_CMD not applied as sent: %s sent %d, gimbal has %s"
                     % (self.url, k, sent[k], got.get(k))
                 )
+        # a gimbal that took the point tracks it (4.3.2); the echo's flags
+        # are its Mode byte (PROTOCOL-NOTES P4: the mode in bits 3-7, the
+        # low five bits); flags 0x80 as sent: our own packet from a line
+        # that echoes, most likely
+        mode = got["flags"] & 0x1F
+        if mode != lib.TASE_MODE_SPOI:
+            raise Error(
+                "%s: SPOI_CMD echoed with flags 0x%02X: the gimbal reports mode %d, not SPOI (%d), "
+                "so it is not tracking the point%s"
+                % (self.url, got["flags"], mode, lib.TASE_MODE_SPOI,
+                   " (flags as sent: our own packet back from a line that echoes?)"
+                   if got["flags"] == lib.TASE_SPOI_ECHO else "")
+            )
         return echo
 
     def _retract_deploy(self, deploy, wait):

@@ -292,6 +292,28 @@ def test_a_gimbal_answering_twice_leaves_no_query_behind(silent_pty):
         t.join()
 
 
+def test_spoi_on_a_line_that_echoes_is_not_taken_as_tracking(silent_pty):
+    # our own SPOI_CMD back from a loop-back plug read as the gimbal's echo
+    # (the same point): its flags are ours (0x80), not a SPOI mode
+    url, master = silent_pty
+    stop = threading.Event()
+
+    def loop_back():
+        while not stop.is_set():
+            if select.select([master], [], [], 0.02)[0]:
+                os.write(master, os.read(master, 4096))
+
+    t = threading.Thread(target=loop_back, daemon=True)
+    t.start()
+    try:
+        with tase.connect(url) as link:
+            with pytest.raises(tase.Error, match="mode 0, not SPOI .*line that echoes"):
+                link.spoi(45.01, 0.01, 100, timeout=0.2, retries=0)
+    finally:
+        stop.set()
+        t.join()
+
+
 def _rates(**kw):
     raw = dict(angle_1=10, rate_1=10, geo_ref_1=4, camera_1=0, angle_2=10, rate_2=10, geo_ref_2=4,
                camera_2=0, angle_3=10, rate_3=10, geo_ref_3=4, camera_3=0, temporary=1)

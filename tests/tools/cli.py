@@ -896,6 +896,13 @@ rc, out, err = run(["query", "PACKET_RATE", "--retries", "0", "--timeout", "200"
                     os.ttyname(sl)])
 ok("query on a loop-back plug: the timeout says our own queries came back",
    rc == 1 and "our own queries came back on this line" in err, "exit %d %r" % (rc, err))
+# spoi's own packet back reads as its echo (same point): the flags it
+# carries are ours (0x80), no gimbal's mode: exit 3 (it printed "echoed")
+rc, out, err = run(["spoi", "45.01", "0.01", "100", "--timeout", "200", "--serial",
+                    os.ttyname(sl)])
+ok("spoi on a loop-back plug: not tracking (mode 0, flags as sent), exit 3",
+   rc == 3 and "the gimbal reports mode 0, not SPOI (2)" in err and "line that echoes" in err,
+   "exit %d %r" % (rc, err))
 plugged.set()
 loop.join()
 os.close(m)

@@ -401,6 +401,18 @@ int cli_cmd_spoi(cli_args_t *a)
         cli_print_packet(p, reply, (size_t)n, v.r.json, "out", "echo");
         /* the echo's flags carry the gimbal's state, not our request */
         cli_confirm_echo(&fs, p->len, reply, n, "flags");
+        /* ... and a gimbal that took the point tracks it (4.3.2): any
+         * other mode is a point not taken (or, flags 0x80 as sent, our own
+         * packet back from a line that echoes) */
+        if (TASE_SPOI_MODE(reply[18]) != TASE_MODE_SPOI) {
+            tk_exit(TK_EXIT_MISMATCH,
+                    "SPOI_CMD echoed with flags 0x%02X: the gimbal reports mode %u, not SPOI (%u), "
+                    "so it is not tracking the point%s",
+                    reply[18], (unsigned)TASE_SPOI_MODE(reply[18]), (unsigned)TASE_MODE_SPOI,
+                    reply[18] == TASE_SPOI_ECHO
+                        ? " (flags as sent: our own packet back from a line that echoes?)"
+                        : "");
+        }
     }
     if (!v.r.json) {
         printf("  = SPOI at %.7f deg, %.7f deg, %.2f m%s\n",
