@@ -43,6 +43,17 @@ void nothing(void *ctx);
 /* Exact instructions of call(NULL) with no state to put back. */
 unsigned long measure_plain(measure_fn call);
 
+/* call(ctx) right after setup(ctx), timed once to the timer's tick
+ * (MEASURE_TICK_INSNS instructions): the first pass of a search, whose
+ * second counts exactly only the calls that came within a tick of the
+ * longest (no other can be longer), and the figure of a call too long to
+ * repeat. */
+unsigned long measure_once(measure_fn setup, measure_fn call, void *ctx);
+
+/* Every stream of PERFORMANCE.md (bench/streams.h), for the searches. */
+#define ALL_STREAMS 11u
+extern const char *const all_streams[ALL_STREAMS];
+
 /* The worst count seen so far over several inputs, and which input. */
 typedef struct {
     unsigned long insns;
