@@ -69,11 +69,14 @@ void worst_report(const char *fn, const worst_t *w, const char *how);
 
 /* The packet a per-packet measurement is on, and its longest typed
  * message: every member bytes 0xA5 except CAMERA_PASS, which carries
- * TASE_CAMERA_PASS_MAX camera bytes (253 data bytes). */
+ * TASE_CAMERA_PASS_MAX camera bytes (253 data bytes) from camera_bytes,
+ * at an address camera_off mod 4 (0 unless set_camera_off() moved it). */
 extern const tase_packet_desc_t *cur_pkt;
 extern size_t cur_len; /* its data length in the input's name */
 extern tase_packet_msg_t full_msg;
-extern uint8_t camera_bytes[TASE_CAMERA_PASS_MAX];
+extern const uint8_t *camera_bytes;
+extern size_t camera_off;
+void set_camera_off(size_t off); /* 0..3 */
 
 /* Fill full_msg for packet p; returns the data length of its full form. */
 size_t fill_full_msg(const tase_packet_desc_t *p);

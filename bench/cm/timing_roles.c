@@ -93,8 +93,38 @@ static const tase_port_ops_t fops0 = {f_write0, f_read, f_now};
 #define BYTEWISE "; the fake port's write() takes 1 byte a call"
 #define STALLED ", the fake port's clock standing still; timed once, to 40 instructions"
 
-static uint8_t payload[TASE_DATA_MAX];    /* 253 data bytes */
-static uint8_t big_frame[TASE_FRAME_MAX]; /* their frame, 0x00/0x42 */
+/* 253 data bytes (0xA5) and their frame (0x00/0x42), both at an address
+ * 0..3 mod 4 (place_payload(); the C library's copies take other paths
+ * at other alignments). */
+static uint8_t payload_mem[TASE_DATA_MAX + 4u] __attribute__((aligned(4)));
+static uint8_t frame_mem[TASE_FRAME_MAX + 4u] __attribute__((aligned(4)));
+static const uint8_t *payload = payload_mem;
+static const uint8_t *big_frame = frame_mem;
+
+static void place_payload(size_t off)
+{
+    memset(payload_mem, 0xA5, sizeof(payload_mem));
+    (void)tase_frame_build(0x00u, 0x42u, &payload_mem[off], TASE_DATA_MAX, &frame_mem[off],
+                           TASE_FRAME_MAX);
+    payload = &payload_mem[off];
+    big_frame = &frame_mem[off];
+}
+
+/* `call` after `setup` with the payload and its frame at each address
+ * 0..3 mod 4: the worst, reported as fn. */
+static void at_each_address(const char *fn, measure_fn setup, measure_fn call, const char *what,
+                            const char *how)
+{
+    worst_t w = {0, ""};
+    size_t off;
+    for (off = 0; off < 4u; off++) {
+        place_payload(off);
+        worst_try(&w, measure_exact(setup, call, NULL), "%s at an address %lu mod 4", what,
+                  (unsigned long)off);
+    }
+    place_payload(0u);
+    worst_report(fn, &w, how);
+}
 /* The worst of `call` over every packet's longest message. */
 static void roles_per_packet(const char *fn, bool (*prep)(const tase_packet_desc_t *p),
                              measure_fn setup, measure_fn call, const char *how)
@@ -113,23 +143,23 @@ static const tase_port_t port0 = {&fops0, &fp, BYTES_PER_S};
 static uint32_t a_now, a_since, a_sent, a_errors;
 static int a_r;
 
-MEASURED(c_write_all, tase_port_write_all(&port, big_frame, sizeof(big_frame)))
-MEASURED(c_send_frame, tase_port_send_frame(&port, 0x00u, 0x42u, payload, sizeof(payload)))
+MEASURED(c_write_all, tase_port_write_all(&port, big_frame, TASE_FRAME_MAX))
+MEASURED(c_send_frame, tase_port_send_frame(&port, 0x00u, 0x42u, payload, TASE_DATA_MAX))
 MEASURED(c_send_msg, tase_port_send_msg(&port, cur_pkt->id, &full_msg))
 MEASURED(c_elapsed, tase_port_elapsed_ms(a_now, a_since))
 MEASURED(c_count_tx, tase_port_count_tx(a_r, &a_sent, &a_errors))
-MEASURED(c_write_all1, tase_port_write_all(&port1, big_frame, sizeof(big_frame)))
-MEASURED(c_send_frame1, tase_port_send_frame(&port1, 0x00u, 0x42u, payload, sizeof(payload)))
+MEASURED(c_write_all1, tase_port_write_all(&port1, big_frame, TASE_FRAME_MAX))
+MEASURED(c_send_frame1, tase_port_send_frame(&port1, 0x00u, 0x42u, payload, TASE_DATA_MAX))
 MEASURED(c_send_msg1, tase_port_send_msg(&port1, cur_pkt->id, &full_msg))
-MEASURED(c_write_all0, tase_port_write_all(&port0, big_frame, sizeof(big_frame)))
+MEASURED(c_write_all0, tase_port_write_all(&port0, big_frame, TASE_FRAME_MAX))
 
 static void port_io(void)
 {
     static const int results[] = {261, TASE_EIO, TASE_ENOBUFS, TASE_EARG, TASE_EUNKNOWN};
     worst_t w = {0, ""};
     size_t i;
-    report("tase_port_write_all", measure_plain(c_write_all), "261 bytes (a whole frame)" PORT);
-    report("tase_port_send_frame", measure_plain(c_send_frame), "253 data bytes" PORT);
+    at_each_address("tase_port_write_all", nothing, c_write_all, "261 bytes (a whole frame)", PORT);
+    at_each_address("tase_port_send_frame", nothing, c_send_frame, "253 data bytes", PORT);
     roles_per_packet("tase_port_send_msg", prep_full_frame, nothing, c_send_msg,
                      ", every member set" PORT);
     for (i = 0; i < 2u; i++) {
@@ -144,10 +174,10 @@ static void port_io(void)
         worst_try(&w, measure_plain(c_count_tx), "r = %d", a_r);
     }
     worst_report("tase_port_count_tx", &w, ", both counters given");
-    report("tase_port_write_all/bytewise", measure_plain(c_write_all1),
-           "261 bytes (a whole frame) in 261 calls" BYTEWISE);
-    report("tase_port_send_frame/bytewise", measure_plain(c_send_frame1),
-           "253 data bytes" BYTEWISE);
+    at_each_address("tase_port_write_all/bytewise", nothing, c_write_all1,
+                    "261 bytes (a whole frame)", ", in 261 calls" BYTEWISE);
+    at_each_address("tase_port_send_frame/bytewise", nothing, c_send_frame1, "253 data bytes",
+                    BYTEWISE);
     roles_per_packet("tase_port_send_msg/bytewise", prep_full_frame, nothing, c_send_msg1,
                      ", every member set" BYTEWISE);
     w.insns = 0;
@@ -251,11 +281,12 @@ static void restore_g(void *ctx)
 }
 
 MEASURED(c_ginit, tase_gimbal_init(&g, gports, grx, TASE_GIMBAL_PORTS, &app_typed, 0u))
-MEASURED(c_gfeed, tase_gimbal_feed(&g, 0u, setup_frame, setup_n, 0u))
+static const uint8_t *feed_frame; /* setup_frame, in a variable as a caller's */
+MEASURED(c_gfeed, tase_gimbal_feed(&g, 0u, feed_frame, setup_n, 0u))
 MEASURED(c_ghandle, tase_gimbal_handle_frame(&g, 0u, &setup_f, 0u))
 MEASURED(c_gpoll, tase_gimbal_poll(&g, a_poll_now))
 MEASURED(c_gservice, tase_gimbal_service(&g, a_poll_now))
-MEASURED(c_gsend, tase_gimbal_send(&g, 2u, 0x00u, 0x42u, payload, sizeof(payload)))
+MEASURED(c_gsend, tase_gimbal_send(&g, 2u, 0x00u, 0x42u, payload, TASE_DATA_MAX))
 MEASURED(c_gsend_msg, tase_gimbal_send_msg(&g, 2u, cur_pkt->id, &full_msg))
 MEASURED(c_gset,
          tase_gimbal_setup_set(&g, a_type, setup_data, (size_t)tase_gimbal_setup_len(a_type), 0u))
@@ -289,6 +320,7 @@ static void gimbal_setups(void)
                     n = tase_frame_build(0x48u, (uint8_t)t, setup_data, lens[l], setup_frame,
                                          sizeof(setup_frame));
                     setup_n = (size_t)n;
+                    feed_frame = setup_frame;
                     setup_f.offset = 0u;
                     setup_f.group = 0x48u;
                     setup_f.type = (uint8_t)t;
@@ -511,7 +543,7 @@ static void gimbal(void)
     gimbal_poll(&now, &app, &cfg);
     gimbal_service(now, app, cfg);
     gimbal_snapshot(&app_typed);
-    report("tase_gimbal_send", measure_exact(restore_g, c_gsend, NULL), "253 data bytes" PORT);
+    at_each_address("tase_gimbal_send", restore_g, c_gsend, "253 data bytes", PORT);
     roles_per_packet("tase_gimbal_send_msg", prep_full_frame, restore_g, c_gsend_msg,
                      ", every member set" PORT);
     gimbal_setup_calls();
@@ -554,7 +586,7 @@ static void host_snapshot(void)
 }
 
 MEASURED(c_hinit, tase_host_init(&h, &hport, on_hframe, NULL))
-MEASURED(c_hsend, tase_host_send(&h, 0x00u, 0x42u, payload, sizeof(payload)))
+MEASURED(c_hsend, tase_host_send(&h, 0x00u, 0x42u, payload, TASE_DATA_MAX))
 MEASURED(c_hsend_msg, tase_host_send_msg(&h, cur_pkt->id, &full_msg))
 /* Requests without retries: a CAMERA_PASS (the longest, 253 data bytes)
  * may not have any (host.h: a re-send would repeat camera bytes), and the
@@ -563,7 +595,7 @@ MEASURED(c_hsend_msg, tase_host_send_msg(&h, cur_pkt->id, &full_msg))
  * echo flag, a query), at its longest and as a query (c_hrequest_any):
  * the longest is SYSTEM_VERSION with its 42 data bytes (sent as given
  * and answered with the version, host.h), not AXIS_SETTING's 23. */
-MEASURED(c_hrequest, tase_host_request_start(&h, 0x00u, 0x42u, payload, sizeof(payload), reply,
+MEASURED(c_hrequest, tase_host_request_start(&h, 0x00u, 0x42u, payload, TASE_DATA_MAX, reply,
                                              sizeof(reply), 100u, 0u, NOW_MS))
 static uint8_t req_group, req_type, req_data[TASE_DATA_MAX];
 static size_t req_len;
@@ -579,7 +611,7 @@ MEASURED(c_hhandle, tase_host_handle_frame(&h, &pkt_f))
 MEASURED(c_hservice, tase_host_service(&h, 100u))
 MEASURED(c_hbusy, tase_host_busy(&h))
 MEASURED(c_hcancel, tase_host_cancel(&h))
-MEASURED(c_htransact, tase_host_transact(&h, 0x00u, 0x42u, payload, sizeof(payload), reply,
+MEASURED(c_htransact, tase_host_transact(&h, 0x00u, 0x42u, payload, TASE_DATA_MAX, reply,
                                          sizeof(reply), 100u, 0u))
 MEASURED(c_htransact_msg, tase_host_transact_msg(&h, cur_pkt->id, &full_msg, &reply_msg, 100u, 0u))
 MEASURED(c_hquery_transact,
@@ -801,7 +833,7 @@ static void host_transact_ports(void)
     host_port = &hport1;
     host_snapshot();
     hfp_snap.in = big_frame;
-    hfp_snap.nin = sizeof(big_frame);
+    hfp_snap.nin = TASE_FRAME_MAX;
     report("tase_host_transact/bytewise", measure_exact(restore_h, c_htransact, NULL),
            "253 data bytes out, the port answers at once with 253 (261 reads)" BYTEWISE
            " and its read() hands over 1 byte a call");
@@ -822,12 +854,12 @@ static void host(void)
     worst_t w = {0, ""};
     report("tase_host_init", measure_plain(c_hinit), "a port with byte rate 5760 B/s");
     host_snapshot();
-    report("tase_host_send", measure_exact(restore_h, c_hsend, NULL), "253 data bytes" PORT);
+    at_each_address("tase_host_send", restore_h, c_hsend, "253 data bytes", PORT);
     roles_per_packet("tase_host_send_msg", prep_full_frame, restore_h, c_hsend_msg,
                      ", every member set" PORT);
     host_snapshot();
-    report("tase_host_request_start", measure_exact(restore_h, c_hrequest, NULL),
-           "253 data bytes, idle host" PORT);
+    at_each_address("tase_host_request_start", restore_h, c_hrequest, "253 data bytes",
+                    ", idle host" PORT);
     roles_per_packet("tase_host_request_msg_start", prep_full_frame, restore_h, c_hrequest_msg,
                      ", every member set, idle host" PORT);
     host_snapshot();
@@ -848,7 +880,7 @@ static void host(void)
     host_service();
     host_snapshot();
     hfp_snap.in = big_frame;
-    hfp_snap.nin = sizeof(big_frame);
+    hfp_snap.nin = TASE_FRAME_MAX;
     report("tase_host_transact", measure_exact(restore_h, c_htransact, NULL),
            "253 data bytes out, the port answers at once with 253 (five reads)" READS);
     roles_per_packet("tase_host_transact_msg", prep_transact, restore_h, c_htransact_msg,
@@ -858,8 +890,7 @@ static void host(void)
 
 void timing_roles(void)
 {
-    memset(payload, 0xA5, sizeof(payload));
-    (void)tase_frame_build(0x00u, 0x42u, payload, sizeof(payload), big_frame, sizeof(big_frame));
+    place_payload(0u);
     port_io();
     gimbal();
     host();
