@@ -226,9 +226,23 @@ both_inputs() {
     esac
     echo "M4: $a0; M0+: $b0$tail"
 }
+# per_call FN CALLS KEY: instructions a further port call costs, from FN's
+# /bytewise row less its own over CALLS further calls (one decimal)
+per_call() {
+    awk -v a="${tm[$3,$1/bytewise]}" -v b="${tm[$3,$1]}" -v n="$2" 'BEGIN {printf "%.1f", (a - b) / n}'
+}
+# per_read KEY: a further read() in tase_host_transact: its /bytewise row less
+# its own and less the writes' share (tase_port_send_frame's), over the 256
+# further reads of a 261-byte reply (64-byte reads: 5)
+per_read() {
+    awk -v t="${tm[$1,tase_host_transact/bytewise]}" -v t0="${tm[$1,tase_host_transact]}" \
+        -v w="${tm[$1,tase_port_send_frame/bytewise]}" -v w0="${tm[$1,tase_port_send_frame]}" \
+        'BEGIN {printf "%.1f", ((t - t0) - (w - w0)) / 256}'
+}
 # every public function of src/ and of the bare-metal port (the headers'
 # declarations), to list what is not measured
-mapfile -t public_fns < <(grep -ho '^[a-z][a-z0-9_ *]* \**tase_[a-z0-9_]*(' include/tase/*.h \
+# (a qualifier macro such as TASE_INLINE_ may stand before the name)
+mapfile -t public_fns < <(grep -ho '^[a-z][A-Za-z0-9_ *]* \**tase_[a-z0-9_]*(' include/tase/*.h \
                               port/baremetal/tase/*.h |
                           sed 's/($//; s/.*[ *]//' | sort -u)
 
@@ -466,18 +480,41 @@ echo "wrote $out"
     echo "  inside the count, as the input says; a real driver's write() and read() replace it."
     echo "  \`tase_host_transact*\` block on the port's read() by design; measured here with a port"
     echo "  that has the reply waiting, they are one request, its reply and the polls around it."
+    echo "  The rows without a suffix hold only for a port that takes whole writes and hands over"
+    echo "  whole reads: the \`/bytewise\` rows are the same calls on the same port taking 1 byte a"
+    echo "  write() and handing over 1 byte a read(), the \`/stalled\` ones on a port that takes"
+    echo "  nothing or reads nothing while its clock stands still (below the list)."
     echo "- **Roles**: the gimbal has three ports with receivers; every setup packet is tried at each"
     echo "  length it takes, with data bytes 0x01 and 0xFF (\"do not change\"), with typed and with byte"
     echo "  callbacks (trivial: accept, leave the data; telemetry is a struct left zero or a memset)."
-    echo "  \`tase_gimbal_service\` reads its cap: 64 reads of 64 bytes on each of the 3 ports"
+    echo "  \`tase_gimbal_poll\` is tried with the default rates and with rate 1, 3 or 255 on all nine"
+    echo "  streams at a capacity of 1 B/s or unlimited, at moments from 100 ms to 2^31 - 1 ms after"
+    echo "  init; \`tase_gimbal_service\` runs in the set-up and at the moment found worst for the"
+    echo "  poll, and reads its cap: 64 reads of 64 bytes on each of the 3 ports"
     echo "  (\`TASE_GIMBAL_SERVICE_READS\`, tase/config.h, at its default; at 1 a call reads 64 bytes a port)."
+    echo "  \`tase_host_poll\` re-sends every packet the host may re-send (at its longest and as a"
+    echo "  query) and fails the longest request, alone or just after an identical one timed out."
+    echo "- **Searches**: where a call's cost depends on what came before it, every state of a"
+    echo "  search is timed once (to the timer's 40-instruction tick) and those within a tick of the"
+    echo "  longest are counted exactly (no other can be longer): \`tase_can_rx_feed\` on every CAN"
+    echo "  frame of the first 3072 bytes of every stream of PERFORMANCE.md split from each of its bytes"
+    echo "  0..7, \`tase_host_feed\` with the reply after the first 16 * k bytes of every stream"
+    echo "  (k = 0..127), \`tase_gimbal_poll\` over its set-ups and moments."
+    echo "- **Addresses**: where a call sums, copies, compares or scans bytes (a word loop, or the C"
+    echo "  library's memcpy, memchr, strcmp: other paths at other alignments), its buffers are placed"
+    echo "  at each address mod 4 or mod 8 and the row names the worst (the sum and the frame encoders,"
+    echo "  the packet encoders' output and camera bytes, the senders' data, CAN frames, KLV packets and"
+    echo "  the scanner, candump lines, schema names); the other rows, the fake port's RAM among them,"
+    echo "  hold for the bench image's own placement."
     echo "- **O(n) calls** (feed, service, write_all, candump_parse, ...) have no worst case"
     echo "  independent of their input's length: the count holds for the input named (one frame, one"
-    echo "  read, the longest line), and grows with it as their headers state."
+    echo "  read, the costliest line tried), and grows with it as their headers state."
     echo "- **Numbers** (KLV units, \`tase/units.h\`, the GPS status word): the slowest of a spread of"
-    echo "  inputs (zero, signs, fractions, extremes, a subnormal, huge values, NaN, infinity); both"
-    echo "  cores here use soft-float, whose library calls are part of the call. Functions defined"
-    echo "  \`static inline\` in a header are called through a noinline wrapper, as said in the input."
+    echo "  inputs (zero, signs, fractions, extremes, a subnormal, huge values, NaN, infinity, angles"
+    echo "  of 360 to 1e9 degrees whose whole turns are taken off, and the slowest a review's random"
+    echo "  search found for each function); both cores here use soft-float, whose library calls are"
+    echo "  part of the call. Functions defined \`static inline\` in a header are called through a"
+    echo "  noinline wrapper, as said in the input."
     echo "- **Bare-metal port** (port/baremetal, \`bench/cm/timing_port.c\`): a 512-byte ring (the"
     echo "  example of tase/bm_uart.h) and a 256-byte DMA buffer (tase/bm_dma.h's), trivial hooks (tx"
     echo "  copies to RAM, millis reads a variable). \`tase_bm_uart_rx_isr\` is the cost of one byte:"
@@ -490,6 +527,33 @@ echo "wrote $out"
     echo "  holds for the size named, and a poll takes at most one size's worth of bytes. The port's"
     echo "  \`tase_bm_uart_ops\` functions (write, read, now_ms) are measured through the table;"
     echo "  the other ports (POSIX UART, SocketCAN) run on an OS and are not measured here."
+    echo
+    echo "**Partial writes and reads.** A port's write() may take part of what it is given and its"
+    echo "read() may hand over less than asked (tase/port.h); the library calls them again, so every"
+    echo "call that writes a frame (the senders, a request, its re-send, a gimbal's echo and telemetry)"
+    echo "or reads one (\`tase_host_transact*\`) costs more with such a port. Measured with the fake"
+    echo "port taking 1 byte a write() and handing over 1 byte a read() (the \`/bytewise\` rows):"
+    echo "every further write() call costs $(per_call tase_port_send_frame 244 cortex-m4-O2) instructions on M4 -O2 and"
+    echo "$(per_call tase_port_send_frame 244 cortex-m0plus-Os) on M0+ -Os (\`tase_port_send_frame\`: its \`/bytewise\` row less its own,"
+    echo "over the 244 further calls of a 261-byte frame it otherwise writes in 17 pieces; through"
+    echo "\`tase_port_write_all\`, over 260: $(per_call tase_port_write_all 260 cortex-m4-O2) and $(per_call tase_port_write_all 260 cortex-m0plus-Os)), this fake port's write() and"
+    echo "now_ms() included (a real driver's replace them). A call that writes a frame of n bytes in"
+    echo "k write() calls (1 for \`tase_port_write_all\`, n / 16 rounded up for the senders, which"
+    echo "write 16-byte pieces) costs about n - k times that more. Every further read() in"
+    echo "\`tase_host_transact\` (a \`tase_host_service\` of 1 byte and a poll) costs $(per_read cortex-m4-O2) on M4"
+    echo "-O2 and $(per_read cortex-m0plus-Os) on M0+ -Os (its \`/bytewise\` row less its own and less the writes' share,"
+    echo "\`tase_port_send_frame\`'s, over the 256 further reads of a 261-byte reply it otherwise"
+    echo "reads in 5)."
+    echo
+    echo "**A port that stalls.** A read() that returns nothing at once while the port's clock"
+    echo "stands still never lets the request of \`tase_host_transact*\` time out: the wait ends after"
+    echo "\`TASE_PORT_WRITE_SPINS\` such loops in a row (tase/config.h, default 2^20) with"
+    echo "TASE_ETIMEOUT; a write() that takes nothing under such a clock is called"
+    echo "\`TASE_PORT_WRITE_SPINS\` times by \`tase_port_write_all\` and the senders before they give"
+    echo "up (tase/port_io.h). These calls are bounded in loops, not by a fixed count of instructions:"
+    echo "the \`/stalled\` rows are one run of each at the default (timed once, to 40 instructions),"
+    echo "and scale with the setting. With a clock that moves, their time bounds end them instead"
+    echo "(the request's timeout, \`TASE_PORT_WRITE_TIMEOUT_MS\`), after as many loops as fit."
     echo
     unmeasured=()
     for f in "${public_fns[@]}"; do

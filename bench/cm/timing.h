@@ -43,6 +43,17 @@ void nothing(void *ctx);
 /* Exact instructions of call(NULL) with no state to put back. */
 unsigned long measure_plain(measure_fn call);
 
+/* call(ctx) right after setup(ctx), timed once to the timer's tick
+ * (MEASURE_TICK_INSNS instructions): the first pass of a search, whose
+ * second counts exactly only the calls that came within a tick of the
+ * longest (no other can be longer), and the figure of a call too long to
+ * repeat. */
+unsigned long measure_once(measure_fn setup, measure_fn call, void *ctx);
+
+/* Every stream of PERFORMANCE.md (bench/streams.h), for the searches. */
+#define ALL_STREAMS 11u
+extern const char *const all_streams[ALL_STREAMS];
+
 /* The worst count seen so far over several inputs, and which input. */
 typedef struct {
     unsigned long insns;
@@ -58,11 +69,14 @@ void worst_report(const char *fn, const worst_t *w, const char *how);
 
 /* The packet a per-packet measurement is on, and its longest typed
  * message: every member bytes 0xA5 except CAMERA_PASS, which carries
- * TASE_CAMERA_PASS_MAX camera bytes (253 data bytes). */
+ * TASE_CAMERA_PASS_MAX camera bytes (253 data bytes) from camera_bytes,
+ * at an address camera_off mod 4 (0 unless set_camera_off() moved it). */
 extern const tase_packet_desc_t *cur_pkt;
 extern size_t cur_len; /* its data length in the input's name */
 extern tase_packet_msg_t full_msg;
-extern uint8_t camera_bytes[TASE_CAMERA_PASS_MAX];
+extern const uint8_t *camera_bytes;
+extern size_t camera_off;
+void set_camera_off(size_t off); /* 0..3 */
 
 /* Fill full_msg for packet p; returns the data length of its full form. */
 size_t fill_full_msg(const tase_packet_desc_t *p);

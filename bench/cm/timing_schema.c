@@ -2,9 +2,10 @@
  * Worst case per call of the schema (tase/schema.h): lookups over every
  * packet and a few unknown ones, length checks over every packet and the
  * lengths its rules tell apart, the by-field functions over every field
- * of every packet (in both layouts of AXIS_SETTING), the names over every
- * name and every name with one character more (found last or not at
- * all). The header-inline helpers are called through a noinline wrapper.
+ * of every packet (in both layouts of AXIS_SETTING), the walk's moves
+ * from every position, the names over every name and every name with one
+ * character more (found last or not at all), each at every address mod
+ * 4. The header-inline helpers are called through a noinline wrapper.
  */
 #include <stdio.h>
 #include <string.h>
@@ -17,8 +18,14 @@ static uint8_t a_group, a_type;
 static int64_t a_value;
 static const char *a_name;
 static uint8_t a_data[TASE_DATA_MAX];
-static tase_field_iter_t a_it;
+static tase_field_iter_t a_it, it_snap;
 static uint32_t a_bits;
+
+static void restore_it(void *ctx)
+{
+    (void)ctx;
+    a_it = it_snap;
+}
 
 MEASURED(c_at, tase_schema_at(a_i))
 MEASURED(c_find, tase_schema_find(a_group, a_type))
@@ -38,6 +45,8 @@ MEASURED(c_iter_get, tase_field_iter_get(&a_it, a_data, &a_value))
 MEASURED(c_iter_bits, tase_field_iter_bits_(&a_it, a_data))
 MEASURED(c_iter_keep_bits, tase_field_iter_keep_bits(&a_it, &a_bits))
 MEASURED(c_field_at, tase_field_at_(a_it.field, a_it.short_layout))
+MEASURED(c_iter_seek, tase_field_iter_seek(&a_it, a_i))
+MEASURED(c_iter_next, tase_field_iter_next(&a_it))
 MEASURED(c_packet_name, tase_schema_packet_name(a_p))
 MEASURED(c_field_name, tase_schema_field_name(a_p, a_i))
 MEASURED(c_find_name, tase_schema_find_name(a_name))
@@ -142,6 +151,43 @@ static void lengths(void)
     report_all(pr, COUNT(pr));
 }
 
+/* The walk's two moves (header-inline, always inlined: through a
+ * noinline wrapper), from every position of a walk over every packet in
+ * each layout, the iterator put back before each call: next from the
+ * walk's start, from each field and from the last (false), and seek to
+ * each field and to one past the last (false). */
+static void walks(void)
+{
+    worst_t wn = {0, ""}, ws = {0, ""};
+    size_t i, f, layout;
+    for (i = 0; i < TASE_PKT_COUNT; i++) {
+        a_p = tase_schema_at(i);
+        for (layout = 0; layout < 2u; layout++) {
+            const char *lay = layout == 0u ? "" : " (short layout)";
+            if (layout == 1u && (a_p->flags & TASE_LEN_SHORT) == 0u) {
+                continue;
+            }
+            a_len = a_p->len - layout;
+            (void)tase_field_iter_init(&it_snap, a_p, a_len);
+            for (f = 0; f <= a_p->nfields; f++) {
+                a_i = f;
+                worst_try(&wn, measure_exact(restore_it, c_iter_next, NULL),
+                          "%s, %lu data bytes%s, from %s", tase_schema_packet_name(a_p),
+                          (unsigned long)a_len, lay,
+                          f == 0u ? "the walk's start" : tase_schema_field_name(a_p, f - 1u));
+                worst_try(&ws, measure_exact(restore_it, c_iter_seek, NULL),
+                          "%s, %lu data bytes%s, to %s", tase_schema_packet_name(a_p),
+                          (unsigned long)a_len, lay,
+                          f < a_p->nfields ? tase_schema_field_name(a_p, f)
+                                           : "one past the last field (false)");
+                (void)tase_field_iter_next(&it_snap);
+            }
+        }
+    }
+    worst_report("tase_field_iter_next", &wn, INLINE_NOTE);
+    worst_report("tase_field_iter_seek", &ws, INLINE_NOTE);
+}
+
 /* Every field of every packet, in each layout; data bytes 0xA5 (signed
  * fields negative: sign extension). */
 static void fields(void)
@@ -184,26 +230,35 @@ static void fields(void)
     report_all(pr, COUNT(pr));
 }
 
-/* Every name as it is and with one character more (not found). */
+/* Every name as it is and with one character more (not found), each at
+ * an address 0..3 mod 4 (the library's strcmp() takes a slower path for
+ * a string that is not word-aligned). */
 static void names(void)
 {
     static probe_t pn[] = {PROBE("tase_schema_packet_name", c_packet_name)};
     static probe_t pf[] = {PROBE("tase_schema_find_name", c_find_name)};
     static probe_t pi[] = {PROBE("tase_schema_field_index", c_field_index)};
-    static char name[40];
-    size_t i, f, x;
+    static char name_mem[40 + 4] __attribute__((aligned(4)));
+    static char at[48];
+    size_t i, f, x, off;
     for (i = 0; i < TASE_PKT_COUNT; i++) {
         a_p = tase_schema_at(i);
         probe_all(pn, 1u, "%s%s (index %lu)", tase_schema_packet_name(a_p), "", i);
         for (x = 0; x < 2u; x++) {
-            (void)snprintf(name, sizeof(name), "%s%s", tase_schema_packet_name(a_p),
-                           x != 0u ? "X" : "");
-            a_name = name;
-            probe_all(pf, 1u, "\"%s\"%s (index %lu)", name, x != 0u ? ", not found" : "", i);
-            for (f = 0; f < a_p->nfields; f++) {
-                (void)snprintf(name, sizeof(name), "%s%s", tase_schema_field_name(a_p, f),
+            for (off = 0; off < 4u; off++) {
+                char *name = &name_mem[off];
+                (void)snprintf(at, sizeof(at), "at an address %lu mod 4%s", (unsigned long)off,
+                               x != 0u ? ", not found" : "");
+                (void)snprintf(name, sizeof(name_mem) - off, "%s%s", tase_schema_packet_name(a_p),
                                x != 0u ? "X" : "");
-                probe_all(pi, 1u, "\"%s\" in %s", name, tase_schema_packet_name(a_p), 0ul);
+                a_name = name;
+                probe_all(pf, 1u, "\"%s\" %s (index %lu)", name, at, i);
+                for (f = 0; f < a_p->nfields; f++) {
+                    (void)snprintf(name, sizeof(name_mem) - off, "%s%s",
+                                   tase_schema_field_name(a_p, f), x != 0u ? "X" : "");
+                    probe_all(pi, 1u, "\"%s\" in %s at an address %lu mod 4", name,
+                              tase_schema_packet_name(a_p), (unsigned long)off);
+                }
             }
         }
     }
@@ -217,5 +272,6 @@ void timing_schema(void)
     lookups();
     lengths();
     fields();
+    walks();
     names();
 }
