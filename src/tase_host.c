@@ -321,7 +321,12 @@ static int handle(tase_host_t *h, const tase_frame_t *frame, bool answer)
         /* not of the pending request */
     }
     if (h->on_frame != NULL) {
+        /* a callback may reset rx.stats (frame.h allows it): later frames
+         * of the feed in progress are then counted from there, and the
+         * shift to the host's own count moves with them */
+        uint32_t before = h->rx.stats.bytes_in;
         h->on_frame(h->user, frame);
+        h->in_shift += before - h->rx.stats.bytes_in;
     }
     return 0;
 }
@@ -501,23 +506,23 @@ static int transact_wait(tase_host_t *h)
 
 /* Read and feed what the port has ready before a blocking request, so that
  * an answer that waited unread is not taken as this request's (host.h,
- * MATCHING): reads that do not wait, until one comes back short of a full
- * chunk, at most HOST_DRAIN_READS. Nothing is read while a request is
- * pending (request_start() refuses it anyway). TASE_OK or a read error. */
+ * MATCHING): reads that do not wait, until two in a row bring nothing (a
+ * port may return 0 early, port.h), at most HOST_DRAIN_READS. Nothing is
+ * read while a request is pending (request_start() refuses it anyway).
+ * TASE_OK or a read error. */
 static int drain(tase_host_t *h)
 {
     unsigned i;
+    unsigned empty = 0u;
     if (h->state != HOST_IDLE) {
         return TASE_OK;
     }
-    for (i = 0; i < HOST_DRAIN_READS; i++) {
+    for (i = 0; i < HOST_DRAIN_READS && empty < 2u; i++) {
         int n = tase_host_service(h, 0u);
         if (n < 0) {
             return n;
         }
-        if (n < (int)HOST_SERVICE_CHUNK) {
-            break;
-        }
+        empty = (n == 0) ? empty + 1u : 0u;
     }
     return TASE_OK;
 }

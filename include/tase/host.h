@@ -67,14 +67,18 @@
  * A frame that began before the request's first attempt was sent (its
  * first byte among those fed before; also a frame finished inside the
  * feed call from whose on_frame the request was started) never completes
- * it: it goes to on_frame and counts in stats.stale. tase_host_transact()
- * and tase_host_transact_msg() first read what the port has ready (up to
- * 256 reads of 64 bytes that come back full), so an answer to somebody
- * else's earlier request that waited unread is not taken either (a
- * gimbal that answered twice, a second gimbal on the line, or answers it
- * sent after a stall). An answer that begins after the send can still be
- * such a one: a setting's echo that differs from what was sent may be
- * stale (`tase send` then asks once more before it reports a mismatch).
+ * it: it goes to on_frame and counts in stats.stale (the host keeps its
+ * own count of the bytes fed; a reset of rx.stats, also from on_frame,
+ * does not move it). tase_host_transact() and tase_host_transact_msg()
+ * first read what the port has ready (reads that do not wait until two in
+ * a row bring nothing, at most 256 of 64 bytes), so an answer to an
+ * earlier request that waited unread is not taken either (a gimbal that
+ * answered twice, a second gimbal on the line, or answers it sent after a
+ * stall). An answer that begins after the send can still be such a one
+ * (a duplicate that comes just after the next request went out): a
+ * setting's echo that differs from what was sent may be stale (`tase
+ * send` then asks once more before it reports a mismatch; an application
+ * can do the same).
  * Zero-length frames received are counted in stats.queries_rx: a gimbal
  * sends none, so a line where they appear echoes what the host sends.
  * A request that ended after n attempts (completed by one answer: n - 1;
@@ -351,8 +355,8 @@ int tase_host_service(tase_host_t *h, uint32_t wait_ms);
  * TASE_EUNSUPPORTED for a port without read or now_ms, TASE_EBUSY called
  * from on_frame (nothing sent).
  * Before sending it reads and feeds what the port has ready (reads of 64
- * bytes that do not wait, until one comes back short, at most 256: see
- * MATCHING); a read error there is returned, nothing sent.
+ * bytes that do not wait, until two in a row bring nothing, at most 256:
+ * see MATCHING); a read error there is returned, nothing sent.
  * A broken port whose clock stands still while read() returns nothing at
  * once ends with TASE_ETIMEOUT after TASE_PORT_WRITE_SPINS such reads in a
  * row (tase/config.h), instead of never. */

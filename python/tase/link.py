@@ -561,6 +561,21 @@ def _seconds(what, v):
     return v
 
 
+def _setting_differs(t, sent, echo):
+    """Whether a setup packet's echo shows a setting other than the one
+    sent: fields sent as "do not change" and `temporary` (what to do with
+    the packet, no setting) are not compared; an echo of another length
+    (AXIS_SETTING's other layout) is the gimbal's own answer."""
+    if echo.size != sent.size:
+        return False
+    for f in t.fields:
+        v = sent.raw.get(f.name)
+        if f.name == "temporary" or v is None or v == f.keep:
+            continue
+        if echo.raw.get(f.name) != v:
+            return True
+    return False
+
 class Link:
     """A link to a gimbal, as the host. Made by tase.connect()."""
 
@@ -792,7 +807,17 @@ class Link:
             )
         if r < 0:
             raise error(r, "%s: %s" % (self.url, t.name))
-        return _with_meta(_from_data(req.id, ffi.buffer(self._reply, r)[:]), _now_us(), "out")
+        echo = _with_meta(_from_data(req.id, ffi.buffer(self._reply, r)[:]), _now_us(), "out")
+        if t.group == 0x48 and req.size > 0 and _setting_differs(t, req, echo):
+            # an answer that came after the send can be an earlier
+            # request's (a late or repeated one, another gimbal): the
+            # setting in force decides, asked once more (as `tase send`)
+            r = self._call(lib.tase_host_transact, self._host, req.group, req.type, ffi.NULL, 0,
+                           self._reply, lib.TASE_DATA_MAX, ms, retries)
+            if r > 0:
+                echo = _with_meta(_from_data(req.id, ffi.buffer(self._reply, r)[:]), _now_us(),
+                                  "out")
+        return echo
 
     # -- receiving
 

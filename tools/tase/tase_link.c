@@ -77,31 +77,26 @@ void cli_session_service(cli_session_t *s, uint32_t wait_ms)
     }
 }
 
-/* Wait for the answer to a request, servicing the port so a signal is
- * seen within 20 ms; dies with the reason on failure, `note` (or NULL)
- * added to a timeout's message. With `show_sent`, the packet is printed
- * ("sent ...") as soon as it has gone out, before the wait: a gimbal that
- * never answers leaves that line, as every other command that sends. */
-/* Read and feed what the port has ready (reads that do not wait, while
- * they come back full, at most 256), so that an answer to an earlier
+/* Read and feed what the port has ready (reads that do not wait, until
+ * two in a row bring nothing, at most 256), so that an answer to an earlier
  * request that waited unread is not taken as the next one's (tase/host.h,
  * MATCHING: tase_host_transact() does the same). */
 static void session_drain(cli_session_t *s)
 {
-    unsigned i;
-    for (i = 0; i < 256u; i++) {
+    unsigned i, empty = 0;
+    for (i = 0; i < 256u && empty < 2u; i++) {
         int n = tase_host_service(&s->h, 0u);
         if (n < 0) {
             session_read_failed(s, n);
         }
-        if (n < 64) {
-            break;
-        }
+        empty = (n == 0) ? empty + 1u : 0u;
     }
 }
 
-static int transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
-                    uint8_t *reply, const cli_req_opts_t *r, const char *note, bool show_sent)
+/* Start a request and wait for its outcome (the reply length or an
+ * error), servicing the port so a signal is seen within 20 ms. */
+static int request(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
+                   uint8_t *reply, const cli_req_opts_t *r, bool show_sent)
 {
     int rc;
     session_drain(s);
@@ -124,10 +119,18 @@ static int transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t
         }
         rc = 0;
     }
+    return rc;
+}
+
+/* Die with the reason a request failed (rc), `note` (or NULL) added to a
+ * timeout's message, with what the line did say. */
+static void request_failed(const cli_session_t *s, const tase_packet_desc_t *p,
+                           const cli_req_opts_t *r, const char *note, int rc)
+{
     if (rc == TASE_ETIMEOUT) {
-        /* what the line did say: our own queries coming back (a line that
-         * echoes, nothing else answering on it), or bytes that never made
-         * a frame (a wrong baud: monitor's hint) */
+        /* our own queries coming back (a line that echoes, nothing else
+         * answering on it), or bytes that never made a frame (a wrong
+         * baud: monitor's hint) */
         const tase_rx_stats_t *rx = &s->h.rx.stats;
         char hint[160] = "";
         if (s->h.stats.queries_rx != 0u) {
@@ -146,9 +149,21 @@ static int transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t
                tase_schema_packet_name(p), (unsigned)r->retries + 1u, r->retries ? "s" : "",
                (unsigned long)r->timeout_ms, note != NULL ? note : "", hint);
     }
+    tk_die("%s request failed on %s: %s", tase_schema_packet_name(p), s->name,
+           tk_link_error(&s->link, rc));
+}
+
+/* A request and its answer; dies with the reason on failure, `note` (or
+ * NULL) added to a timeout's message. With `show_sent`, the packet is
+ * printed ("sent ...") as soon as it has gone out, before the wait: a
+ * gimbal that never answers leaves that line, as every other command
+ * that sends. */
+static int transact(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
+                    uint8_t *reply, const cli_req_opts_t *r, const char *note, bool show_sent)
+{
+    int rc = request(s, p, data, len, reply, r, show_sent);
     if (rc < 0) {
-        tk_die("%s request failed on %s: %s", tase_schema_packet_name(p), s->name,
-               tk_link_error(&s->link, rc));
+        request_failed(s, p, r, note, rc);
     }
     return rc;
 }
@@ -253,13 +268,24 @@ static void confirm_setting(cli_session_t *s, const cli_fields_t *fs, size_t len
     const tase_packet_desc_t *p = fs->p;
     char first[1024], diff[1024];
     if ((size_t)n == len && echo_diff(fs, len, reply, n, "temporary", first, sizeof first) != 0) {
-        n = transact(s, p, NULL, 0, reply, &o->r, NULL, false);
+        int q = request(s, p, NULL, 0, reply, &o->r, false);
+        if (q == TASE_ETIMEOUT) {
+            /* the echo is all there is to go by */
+            tk_exit(TK_EXIT_MISMATCH,
+                    "%s not applied as sent: %s (and the query for the setting in force went "
+                    "unanswered)",
+                    tase_schema_packet_name(p), first);
+        }
+        if (q < 0) {
+            request_failed(s, p, &o->r, NULL, q);
+        }
+        n = q;
         cli_print_packet(p, reply, (size_t)n, o->r.json, "out", "echo");
         if (echo_diff(fs, len, reply, n, "temporary", diff, sizeof diff) == 0) {
             fprintf(stderr,
                     "tase: note: the first answer differed (%s) but the %s in force is as "
-                    "sent: that answer was an earlier request's (a late answer, a gimbal "
-                    "answering twice, or two gimbals on this line)\n",
+                    "sent (a late or repeated answer, another gimbal on this line, or one that "
+                    "answered before it applied the setting)\n",
                     first, tase_schema_packet_name(p));
         } else if (s->h.stats.retries + s->h.stats.late + s->h.stats.stale != 0u) {
             tk_exit(TK_EXIT_MISMATCH,
