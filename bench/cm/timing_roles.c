@@ -838,6 +838,16 @@ static void host_poll(void)
     worst_report("tase_host_poll", &w, PORT);
 }
 
+/* h_snap: an idle host whose port answers the 253-byte request with the
+ * 253-byte frame as soon as the request went out (the transact rows). */
+static void answer_after_send(void)
+{
+    host_snapshot();
+    hfp_snap.in = big_frame;
+    hfp_snap.nin = TASE_FRAME_MAX;
+    hfp_snap.after = 1u;
+}
+
 /* tase_host_transact() with the most its read before the send takes:
  * 256 full reads (16 KiB) of a stream that waited unread (every stream of
  * PERFORMANCE.md, the costliest kept), then the answer. */
@@ -848,12 +858,9 @@ static void host_transact_backlog(void)
     size_t s;
     for (s = 0; s < ALL_STREAMS; s++) {
         (void)bench_stream(all_streams[s], backlog, sizeof(backlog));
-        host_snapshot();
+        answer_after_send();
         hfp_snap.pre = backlog;
         hfp_snap.npre = sizeof(backlog);
-        hfp_snap.in = big_frame;
-        hfp_snap.nin = TASE_FRAME_MAX;
-        hfp_snap.after = 1u;
         worst_try(&w, measure_exact(restore_h, c_htransact, NULL),
                   "253 data bytes out after 16 KiB of %s waited unread (256 full reads before "
                   "the send, the most it reads), the port answers as soon as they went out",
@@ -871,10 +878,7 @@ static void host_transact_ports(void)
 {
     worst_t w = {0, ""};
     host_port = &hport1;
-    host_snapshot();
-    hfp_snap.in = big_frame;
-    hfp_snap.nin = TASE_FRAME_MAX;
-    hfp_snap.after = 1u;
+    answer_after_send();
     report("tase_host_transact/bytewise", measure_exact(restore_h, c_htransact, NULL),
            "253 data bytes out, the port answers as soon as they went out with 253 (two empty "
            "reads before, 261 after)" BYTEWISE " and its read() hands over 1 byte a call");
@@ -920,10 +924,7 @@ static void host(void)
     worst_report("tase_host_cancel", &w, "");
     host_replies();
     host_service();
-    host_snapshot();
-    hfp_snap.in = big_frame;
-    hfp_snap.nin = TASE_FRAME_MAX;
-    hfp_snap.after = 1u;
+    answer_after_send();
     report("tase_host_transact", measure_exact(restore_h, c_htransact, NULL),
            "253 data bytes out, the port answers as soon as they went out with 253 (two empty "
            "reads before, five after)" READS);
