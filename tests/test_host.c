@@ -135,6 +135,7 @@ static void a_late_answer_to_an_ended_request_never_completes_the_next(void **st
 
     memcpy(set, rates, sizeof set);
     set[5] = 15; /* angle_2 */
+
     query_rates(x, reply, 500, 2, 0);
     assert_int_equal(tase_host_poll(&x->host, 500), TASE_EAGAIN); /* attempt 2 */
     assert_int_equal(fake_frames_out(&x->port), 2);
@@ -170,6 +171,7 @@ static void a_frame_begun_before_the_request_never_completes_it(void **state)
 
     memcpy(set, rates, sizeof set);
     set[5] = 15; /* angle_2 */
+
     assert_true(n > 10);
     assert_int_equal(tase_host_feed(&x->host, fr, 10, 0), 0); /* the old answer's start */
     assert_int_equal(tase_host_request_start(&x->host, TASE_GROUP_SETUP, 0x00, set, sizeof set,
@@ -230,6 +232,24 @@ static void a_request_started_inside_a_feed_skips_the_rest_of_its_bytes(void **s
     assert_int_equal(tase_host_poll(&x->host, 3), 16);
 }
 
+/* set: the default rates with angle_2 15. The port holds an answer to an
+ * earlier PACKET_RATE request (the default rates) waiting unread, and
+ * echoes set once a frame has been written. */
+static void stale_then_echo(fix_t *x, uint8_t set[16])
+{
+    uint8_t fr[TASE_FRAME_MAX];
+    int n;
+    memcpy(set, rates, 16);
+    set[5] = 15; /* angle_2 */
+
+    fake_push_frame(&x->port, 0x48, 0x00, rates, sizeof rates); /* stale, waiting */
+    n = tase_frame_build(0x48, 0x00, set, 16, fr, sizeof fr);
+    assert_true(n > 0);
+    memcpy(x->port.reply, fr, (size_t)n);
+    x->port.nreply = (size_t)n;
+    x->port.reply_after = 1; /* the gimbal echoes the setting */
+}
+
 /* A review: after a stalled gimbal, answers to earlier requests waited
  * unread and each request took the oldest as its own (Python's query()
  * stayed three answers behind for good). tase_host_transact() reads what
@@ -238,18 +258,10 @@ static void a_request_started_inside_a_feed_skips_the_rest_of_its_bytes(void **s
 static void transact_reads_what_is_waiting_before_it_sends(void **state)
 {
     fix_t *x = *state;
-    uint8_t reply[64], set[16], fr[TASE_FRAME_MAX];
+    uint8_t reply[64], set[16];
     tase_packet_rate_t echo;
-    int n;
 
-    memcpy(set, rates, sizeof set);
-    set[5] = 15;
-    fake_push_frame(&x->port, 0x48, 0x00, rates, sizeof rates); /* stale, waiting */
-    n = tase_frame_build(0x48, 0x00, set, sizeof set, fr, sizeof fr);
-    assert_true(n > 0);
-    memcpy(x->port.reply, fr, (size_t)n);
-    x->port.nreply = (size_t)n;
-    x->port.reply_after = 1; /* the gimbal echoes the setting */
+    stale_then_echo(x, set);
     assert_int_equal(tase_host_transact(&x->host, TASE_GROUP_SETUP, 0x00, set, sizeof set, reply,
                                         sizeof reply, 100, 0),
                      16);
@@ -317,19 +329,11 @@ static void the_read_before_a_transact_goes_past_an_early_empty_read(void **stat
 {
     fix_t *x = *state;
     tase_port_t p = {&early_zero_ops, &x->port, 0};
-    uint8_t reply[64], set[16], fr[TASE_FRAME_MAX];
-    int n;
+    uint8_t reply[64], set[16];
 
-    memcpy(set, rates, sizeof set);
-    set[5] = 15;
     early_zero_calls = 0;
     assert_int_equal(tase_host_init(&x->host, &p, on_other, x), TASE_OK);
-    fake_push_frame(&x->port, 0x48, 0x00, rates, sizeof rates); /* stale, waiting */
-    n = tase_frame_build(0x48, 0x00, set, sizeof set, fr, sizeof fr);
-    assert_true(n > 0);
-    memcpy(x->port.reply, fr, (size_t)n);
-    x->port.nreply = (size_t)n;
-    x->port.reply_after = 1;
+    stale_then_echo(x, set);
     assert_int_equal(tase_host_transact(&x->host, TASE_GROUP_SETUP, 0x00, set, sizeof set, reply,
                                         sizeof reply, 100, 0),
                      16);
