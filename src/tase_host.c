@@ -10,9 +10,6 @@
 enum { HOST_IDLE = 0, HOST_WAITING = 1, HOST_COMPLETE = 2 };
 
 #define HOST_SERVICE_CHUNK 64u
-/* Reads of what the port has ready before a blocking request (host.h,
- * MATCHING): 16 KiB. */
-#define HOST_DRAIN_READS 256u
 
 int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on_frame, void *user)
 {
@@ -504,36 +501,41 @@ static int transact_wait(tase_host_t *h)
     }
 }
 
-/* Read and feed what the port has ready before a blocking request, so that
- * an answer that waited unread is not taken as this request's (host.h,
- * MATCHING): reads that do not wait, until two in a row bring nothing (a
- * port may return 0 early, port.h), at most HOST_DRAIN_READS. Nothing is
- * read while a request is pending (request_start() refuses it anyway).
- * TASE_OK or a read error. */
-static int drain(tase_host_t *h)
+int tase_host_drain(tase_host_t *h)
 {
     unsigned i;
     unsigned empty = 0u;
-    if (h->state != HOST_IDLE) {
-        return TASE_OK;
+    int total = 0;
+    int r = port_ok(h);
+    if (r != TASE_OK) {
+        return r;
     }
-    for (i = 0; i < HOST_DRAIN_READS && empty < 2u; i++) {
+    for (i = 0; i < TASE_HOST_DRAIN_READS && empty < 2u; i++) {
         int n = tase_host_service(h, 0u);
         if (n < 0) {
             return n;
         }
+        total += n;
         empty = (n == 0) ? empty + 1u : 0u;
     }
-    return TASE_OK;
+    return total;
+}
+
+/* The read before a blocking request (host.h, MATCHING): only when idle;
+ * with a request pending nothing is read (request_start() refuses it). */
+static int drain_idle(tase_host_t *h)
+{
+    int r = port_ok(h);
+    if (r == TASE_OK && h->state == HOST_IDLE) {
+        r = tase_host_drain(h);
+    }
+    return r < 0 ? r : TASE_OK;
 }
 
 int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len,
                        uint8_t *reply, size_t reply_cap, uint32_t timeout_ms, uint8_t retries)
 {
-    int r = port_ok(h);
-    if (r == TASE_OK) {
-        r = drain(h);
-    }
+    int r = drain_idle(h);
     if (r != TASE_OK) {
         return r;
     }
@@ -545,10 +547,7 @@ int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_
 int tase_host_transact_msg(tase_host_t *h, uint16_t id, const void *msg, void *reply_msg,
                            uint32_t timeout_ms, uint8_t retries)
 {
-    int r = port_ok(h);
-    if (r == TASE_OK) {
-        r = drain(h);
-    }
+    int r = drain_idle(h);
     if (r != TASE_OK) {
         return r;
     }

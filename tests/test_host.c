@@ -341,6 +341,64 @@ static void the_read_before_a_transact_goes_past_an_early_empty_read(void **stat
     assert_int_equal(x->others, 1);
 }
 
+/* tase_host_drain(): everything waiting is read and fed, past a port's
+ * early empty read (port.h), its frames handed on; it returns the bytes
+ * read, and two empty reads in a row end it without waiting. */
+static void drain_reads_everything_waiting_and_returns_its_length(void **state)
+{
+    fix_t *x = *state;
+    tase_port_t p = {&early_zero_ops, &x->port, 0};
+    uint8_t noise[1000];
+    unsigned k;
+
+    memset(noise, 0x11, sizeof noise);
+    early_zero_calls = 0;
+    assert_int_equal(tase_host_init(&x->host, &p, on_other, x), TASE_OK);
+    fake_push(&x->port, noise, sizeof noise);
+    for (k = 0; k < 3u; k++) {
+        fake_push_frame(&x->port, 0x48, 0x00, rates, sizeof rates);
+    }
+    x->port.now = 500;
+    assert_int_equal(tase_host_drain(&x->host), (int)sizeof noise + 3 * 24);
+    assert_int_equal(x->port.rin, x->port.nin);
+    assert_int_equal(x->others, 3);
+    assert_int_equal(x->host.rx.stats.bytes_in, sizeof noise + 3u * 24u);
+    /* the fake clock moves 1 ms a read that brings bytes (17 of 64), and
+     * no read waited */
+    assert_int_equal(x->port.now, 517);
+    assert_int_equal(tase_host_drain(&x->host), 0);
+    assert_int_equal(x->port.now, 517);
+}
+
+/* A line with more waiting than TASE_HOST_DRAIN_READS reads bring: the
+ * rest stays on the port for the next call. */
+static void drain_stops_after_its_bounded_number_of_reads(void **state)
+{
+    fix_t *x = *state;
+    static uint8_t noise[TASE_HOST_DRAIN_READS * 64u + 100u];
+
+    memset(noise, 0x11, sizeof noise);
+    fake_push(&x->port, noise, sizeof noise);
+    assert_int_equal(tase_host_drain(&x->host), (int)(TASE_HOST_DRAIN_READS * 64u));
+    assert_int_equal(x->port.nin - x->port.rin, 100);
+    assert_int_equal(tase_host_drain(&x->host), 100);
+    assert_int_equal(x->port.rin, x->port.nin);
+}
+
+/* With a request pending, a drain reads too, and an answer in what it
+ * reads completes the request (tase_host_service() would). */
+static void drain_with_a_request_pending_completes_it(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    query_rates(x, reply, 500, 0, 0);
+    fake_push_frame(&x->port, 0x48, 0x00, rates, sizeof rates);
+    assert_int_equal(tase_host_drain(&x->host), 24);
+    assert_int_equal(tase_host_poll(&x->host, 1), 16);
+    assert_memory_equal(reply, rates, sizeof rates);
+    assert_int_equal(x->others, 0);
+}
+
 /* Our own queries coming back (a loop-back plug, a half-duplex adapter)
  * are counted: a gimbal sends no zero-length frame. */
 static void zero_length_frames_are_counted_as_queries_received(void **state)
@@ -664,7 +722,7 @@ static void an_attempts_timeout_counts_from_the_end_of_its_write(void **state)
  * host's receiver. */
 typedef struct {
     tase_host_t *host;
-    int transact, service, start;
+    int transact, service, drain, start;
 } reentry_t;
 
 static void on_frame_reenters(void *user, const tase_frame_t *f)
@@ -674,6 +732,7 @@ static void on_frame_reenters(void *user, const tase_frame_t *f)
     (void)f;
     r->transact = tase_host_transact(r->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 200, 2);
     r->service = tase_host_service(r->host, 0);
+    r->drain = tase_host_drain(r->host);
     r->start = tase_host_query_start(r->host, 0x48, 0x00, NULL, 0, 200, 0, 0);
 }
 
@@ -686,7 +745,7 @@ static void on_frame_reenters(void *user, const tase_frame_t *f)
 static void calls_that_read_the_port_refuse_inside_on_frame(void **state)
 {
     fix_t *x = *state;
-    reentry_t r = {&x->host, 0, 0, 0};
+    reentry_t r = {&x->host, 0, 0, 0, 0};
     uint8_t angle[6] = {0};
     tase_port_t p = {&fake_ops, &x->port, TASE_UART_BYTES_PER_S(57600)};
     uint8_t reply[64];
@@ -695,6 +754,7 @@ static void calls_that_read_the_port_refuse_inside_on_frame(void **state)
     feed_frame(x, 0x08, 0x10, angle, 6, 0);           /* telemetry: on_frame */
     assert_int_equal(r.transact, TASE_EBUSY);
     assert_int_equal(r.service, TASE_EBUSY);
+    assert_int_equal(r.drain, TASE_EBUSY);
     assert_int_equal(r.start, TASE_OK);
     assert_int_equal(x->port.rin, 0);               /* nothing read */
     assert_int_equal(fake_frames_out(&x->port), 1); /* the started query only */
@@ -772,11 +832,13 @@ static void service_and_transact_need_a_readable_port_with_a_clock(void **state)
     uint8_t reply[8];
     assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_OK);
     assert_int_equal(tase_host_service(&h, 10), TASE_EUNSUPPORTED);
+    assert_int_equal(tase_host_drain(&h), TASE_EUNSUPPORTED);
     assert_int_equal(tase_host_transact(&h, 0x48, 0x00, NULL, 0, reply, sizeof reply, 100, 1),
                      TASE_EUNSUPPORTED);
     assert_int_equal(x->port.nout, 0); /* the request was not even sent */
     assert_false(tase_host_busy(&h));
     assert_int_equal(tase_host_service(NULL, 10), TASE_EARG);
+    assert_int_equal(tase_host_drain(NULL), TASE_EARG);
     assert_int_equal(tase_host_transact(NULL, 0x48, 0x00, NULL, 0, reply, 8, 100, 1), TASE_EARG);
 }
 
@@ -827,6 +889,7 @@ static void transact_sends_nothing_when_the_read_before_it_fails(void **state)
                      TASE_EIO);
     assert_int_equal(tase_host_transact_msg(&h, TASE_ID_SENSOR_FILTER, NULL, NULL, 100, 3),
                      TASE_EIO);
+    assert_int_equal(tase_host_drain(&h), TASE_EIO);
     assert_int_equal(fake_frames_out(&x->port), 0);
     assert_int_equal(h.stats.requests, 0);
     assert_false(tase_host_busy(&h));
@@ -1515,6 +1578,11 @@ int main(void)
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(transact_reads_what_is_waiting_before_it_sends, setup,
                                         teardown),
+        cmocka_unit_test_setup_teardown(drain_reads_everything_waiting_and_returns_its_length,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(drain_stops_after_its_bounded_number_of_reads, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(drain_with_a_request_pending_completes_it, setup, teardown),
         cmocka_unit_test_setup_teardown(zero_length_frames_are_counted_as_queries_received, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(a_stats_reset_from_on_frame_keeps_the_answer, setup,

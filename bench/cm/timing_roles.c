@@ -623,6 +623,7 @@ static const uint8_t *feed_p; /* pkt_frame */
 MEASURED(c_hfeed, tase_host_feed(&h, feed_p, pkt_frame_n, NOW_MS))
 MEASURED(c_hhandle, tase_host_handle_frame(&h, &pkt_f))
 MEASURED(c_hservice, tase_host_service(&h, 100u))
+MEASURED(c_hdrain, tase_host_drain(&h))
 MEASURED(c_hbusy, tase_host_busy(&h))
 MEASURED(c_hcancel, tase_host_cancel(&h))
 MEASURED(c_htransact, tase_host_transact(&h, 0x00u, 0x42u, payload, TASE_DATA_MAX, reply,
@@ -848,12 +849,13 @@ static void answer_after_send(void)
     hfp_snap.after = 1u;
 }
 
-/* tase_host_transact() with the most its read before the send takes:
- * 256 full reads (16 KiB) of a stream that waited unread (every stream of
- * PERFORMANCE.md, the costliest kept), then the answer. */
-static void host_transact_backlog(void)
+/* What tase_host_drain() reads at its most: 256 full reads (16 KiB) of a
+ * stream that waited unread (every stream of PERFORMANCE.md, the costliest
+ * kept), alone and as the read before tase_host_transact()'s send (the
+ * port then answers the request as soon as it went out). */
+static void host_backlog(const char *fn, measure_fn call, const char *before, const char *then)
 {
-    static uint8_t backlog[256u * 64u];
+    static uint8_t backlog[TASE_HOST_DRAIN_READS * 64u];
     worst_t w = {0, ""};
     size_t s;
     for (s = 0; s < ALL_STREAMS; s++) {
@@ -861,12 +863,11 @@ static void host_transact_backlog(void)
         answer_after_send();
         hfp_snap.pre = backlog;
         hfp_snap.npre = sizeof(backlog);
-        worst_try(&w, measure_exact(restore_h, c_htransact, NULL),
-                  "253 data bytes out after 16 KiB of %s waited unread (256 full reads before "
-                  "the send, the most it reads), the port answers as soon as they went out",
-                  all_streams[s]);
+        worst_try(&w, measure_exact(restore_h, call, NULL),
+                  "%s16 KiB of %s waited unread (256 full reads, the most it reads)%s", before,
+                  all_streams[s], then);
     }
-    worst_report("tase_host_transact/backlog", &w, READS);
+    worst_report(fn, &w, READS);
 }
 
 /* tase_host_transact() and tase_host_transact_msg() on the bytewise port
@@ -924,11 +925,13 @@ static void host(void)
     worst_report("tase_host_cancel", &w, "");
     host_replies();
     host_service();
+    host_backlog("tase_host_drain", c_hdrain, "", "");
     answer_after_send();
     report("tase_host_transact", measure_exact(restore_h, c_htransact, NULL),
            "253 data bytes out, the port answers as soon as they went out with 253 (two empty "
            "reads before, five after)" READS);
-    host_transact_backlog();
+    host_backlog("tase_host_transact/backlog", c_htransact, "253 data bytes out after ",
+                 "; the port answers as soon as they went out");
     roles_per_packet(
         "tase_host_transact_msg", prep_transact, restore_h, c_htransact_msg,
         ", every member set, the port answers with the same as soon as it went out" READS);

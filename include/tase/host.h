@@ -70,9 +70,9 @@
  * it: it goes to on_frame and counts in stats.stale (the host keeps its
  * own count of the bytes fed; a reset of rx.stats, also from on_frame,
  * does not move it). tase_host_transact() and tase_host_transact_msg()
- * first read what the port has ready (reads that do not wait until two in
- * a row bring nothing, at most 256 of 64 bytes), so an answer to an
- * earlier request that waited unread is not taken either (a gimbal that
+ * first read what the port has ready (tase_host_drain(): reads that do
+ * not wait until two in a row bring nothing, at most 256 of 64 bytes), so
+ * an answer to an earlier request that waited unread is not taken either (a gimbal that
  * answered twice, a second gimbal on the line, or answers it sent after a
  * stall). An answer that begins after the send can still be such a one
  * (a duplicate that comes just after the next request went out): a
@@ -345,6 +345,25 @@ bool tase_host_busy(const tase_host_t *h);
  * (called from on_frame: nothing read) or TASE_EARG (h NULL, or never
  * initialised: no port ops). Uses 64 bytes of stack. */
 int tase_host_service(tase_host_t *h, uint32_t wait_ms);
+
+/* The most reads tase_host_drain() makes (of 64 bytes each: 16 KiB). */
+#define TASE_HOST_DRAIN_READS 256u
+
+/* Read and feed what the port has ready, never waiting: reads with
+ * wait_ms 0 (tase_host_service()) until two in a row bring nothing (a
+ * port may return 0 early, port.h) or TASE_HOST_DRAIN_READS were made.
+ * Call it before starting a request, so that an answer to an earlier one
+ * that waited unread is not taken as this request's (MATCHING above);
+ * tase_host_transact() and tase_host_transact_msg() call it when no
+ * request is pending. It may also be called with a request pending (a
+ * frame read then completes it as tase_host_service() would). Returns the
+ * bytes read in all (0..16384), or the first error of
+ * tase_host_service() (what was read before it is fed). Worst case: 256
+ * 64-byte reads fed (docs/TIMING.md). Stack: tase_host_service()'s and a
+ * few words (docs/FOOTPRINT.md).
+ * (A firmware that feeds its own receive buffer with tase_host_feed()
+ * gets the same by feeding what it has before tase_host_request_start().) */
+int tase_host_drain(tase_host_t *h);
 
 /* Blocking convenience for tools: start a request, then service the port
  * and poll until it completes. Same arguments and results as

@@ -140,6 +140,7 @@ typedef struct {
 } tase_host_t;
 int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len);
 int tase_host_service(tase_host_t *h, uint32_t wait_ms);
+int tase_host_drain(tase_host_t *h);
 int tase_host_transact(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data,
                        size_t len, uint8_t *reply, size_t reply_cap, uint32_t timeout_ms,
                        uint8_t retries);

@@ -432,10 +432,6 @@ def py_port_write(ctx, data, n):
 # another thread ends a call waiting for an answer that does not come (it
 # waited out the whole timeout).
 _READ_SLICE_S = 0.2
-# tase_host_service() reads at most 64 bytes a call; a poll (timeout 0)
-# reads while they come back full, at most this many times (16 KiB)
-_SERVICE_CHUNK = 64
-_POLL_READS = 256
 
 
 @ffi.def_extern()
@@ -852,12 +848,9 @@ class Link:
                 if not self._call_lock.acquire(blocking=False):
                     continue
                 try:
-                    # everything the port has ready, not one 64-byte read
-                    # (a 10 Hz poll loop fell behind the line), bounded
-                    for _ in range(_POLL_READS):
-                        r = self._call(lib.tase_host_service, self._host, ms)
-                        if r < _SERVICE_CHUNK:
-                            break
+                    # everything the port has ready (at most 16 KiB), not
+                    # one 64-byte read: a 10 Hz poll loop fell behind
+                    r = self._call(lib.tase_host_drain, self._host)
                 finally:
                     self._call_lock.release()
             else:

@@ -77,29 +77,17 @@ void cli_session_service(cli_session_t *s, uint32_t wait_ms)
     }
 }
 
-/* Read and feed what the port has ready (reads that do not wait, until
- * two in a row bring nothing, at most 256), so that an answer to an earlier
- * request that waited unread is not taken as the next one's (tase/host.h,
- * MATCHING: tase_host_transact() does the same). */
-static void session_drain(cli_session_t *s)
-{
-    unsigned i, empty = 0;
-    for (i = 0; i < 256u && empty < 2u; i++) {
-        int n = tase_host_service(&s->h, 0u);
-        if (n < 0) {
-            session_read_failed(s, n);
-        }
-        empty = (n == 0) ? empty + 1u : 0u;
-    }
-}
-
 /* Start a request and wait for its outcome (the reply length or an
  * error), servicing the port so a signal is seen within 20 ms. */
 static int request(cli_session_t *s, const tase_packet_desc_t *p, const uint8_t *data, size_t len,
                    uint8_t *reply, const cli_req_opts_t *r, bool show_sent)
 {
-    int rc;
-    session_drain(s);
+    /* what waited unread is not this request's answer (tase/host.h,
+     * MATCHING) */
+    int rc = tase_host_drain(&s->h);
+    if (rc < 0) {
+        session_read_failed(s, rc);
+    }
     rc = tase_host_request_start(&s->h, TASE_ID_GROUP(p->id), TASE_ID_TYPE(p->id), data, len, reply,
                                  TASE_DATA_MAX, r->timeout_ms, r->retries,
                                  s->port.ops->now_ms(s->port.ctx));
