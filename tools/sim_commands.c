@@ -196,6 +196,13 @@ void sim_on_frame(void *user, unsigned port, const tase_frame_t *f)
         s->p = msg.host_sensor.roll;
         s->q = msg.host_sensor.pitch;
         s->r = msg.host_sensor.yaw;
+        if (!s->sensor_said) { /* 10-50 a second: the first one only */
+            sim_log(s, now,
+                    "HOST_SENSOR: the host's body rates (p %.2f, q %.2f, r %.2f deg/s) are "
+                    "reported in GIMBAL_RATE from now on",
+                    s->p / 100.0, s->q / 100.0, s->r / 100.0);
+            s->sensor_said = true;
+        }
         break;
     case TASE_ID_HOST_ATTITUDE: {
         sim_att_t a;

@@ -444,6 +444,23 @@ static void can_watch_look(sim_t *s, sim_can_watch_t *w, tk_link_t *dl, const ch
 
 /* ---- main ---- */
 
+/* Setup packets of a wrong length are dropped by the gimbal role (no
+ * echo; the host's request times out): say so, at most once a second, with
+ * how many since the last line (the role counts them, it does not say
+ * which). */
+static void say_bad_lengths(sim_t *s, uint32_t now)
+{
+    uint32_t n = s->g.stats.bad_length - s->bad_length_said;
+    if (n != 0u && (s->bad_length_said == 0u || now - s->bad_length_at >= 1000u)) {
+        sim_log(s, now,
+                "%lu setup packet%s of a wrong length ignored (each has its table's length or "
+                "0 for a query; nothing echoed)",
+                (unsigned long)n, n == 1u ? "" : "s");
+        s->bad_length_said = s->g.stats.bad_length;
+        s->bad_length_at = now;
+    }
+}
+
 int main(int argc, char **argv)
 {
     static sim_t s;
@@ -660,6 +677,7 @@ int main(int argc, char **argv)
             (void)tk_pty_drop_unread(slave_fd);
         }
         (void)tase_gimbal_service(&s.g, now);
+        say_bad_lengths(&s, now);
         if (can != NULL) {
             can_watch_look(&s, &watch, &dl, can, now);
         }
@@ -693,8 +711,9 @@ int main(int argc, char **argv)
     /* the links (only those that still point at our ptys) and their lock
      * files are removed at exit (tk_pty_open()) */
     {
-        /* what was dropped too: it was never logged (a bad checksum, a
-         * setup packet of a wrong length, a frame a pause cut short) */
+        /* what was dropped too: checksum errors and frames a pause cut
+         * short were never logged, wrong-length setup packets only as a
+         * count a second at most */
         const tase_rx_stats_t *rs = &s.rx[s.link].stats;
         sim_log(&s, tase_posix_now_ms(),
                 "stopped: %lu frames in, %lu out; dropped: %lu checksum errors, %lu setup "

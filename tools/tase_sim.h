@@ -25,6 +25,10 @@ typedef struct {
     bool spoi_valid;
     bool version_due;       /* the cameras changed: store SYSTEM_VERSION again */
     int gps_said, att_said; /* what the log last said of HOST_GPS_DATA/_ATTITUDE */
+    bool sensor_said;       /* the first HOST_SENSOR was logged */
+    /* wrong-length setup packets: the role's count when the log last said
+     * so, and when (at most one line a second) */
+    uint32_t bad_length_said, bad_length_at;
 } sim_t;
 
 /* One line "[seconds] message" on stdout, unless --quiet (tase_sim.c). */

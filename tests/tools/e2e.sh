@@ -179,6 +179,11 @@ expect_error "AXIS_SETTING pan_nogo_range=40000 (400 deg) refused by the gimbal:
 check "tase-sim says why" \
     eval 'sim_reaches 1 "AXIS_SETTING refused: a position gain of 0" &&
           sim_reaches 1 "AXIS_SETTING refused: a no-go zone beyond the spec"'
+# a setup packet of a wrong length (AXIS_SETTING of 5 bytes): the role
+# drops it without an echo; the simulator's log said nothing of it
+frame_to_sim 0x48 0x02 "0000000000"
+check "tase-sim logs a setup packet of a wrong length" \
+    sim_reaches 1 "1 setup packet of a wrong length ignored"
 
 # SPOI error forms outside SPOI mode change nothing: the log says so (that
 # the model's state is unchanged is tests/test_sim_model.c's).
@@ -205,6 +210,8 @@ check "... and both reached the gimbal" sim_reaches $((n + 2)) GIMBAL_CMD
 s1=$("$TASE" send HOST_SENSOR roll=010 pitch=+5 yaw=-0x10 --zero "${L[@]}" --json)
 check "send --json prints a packet without echo; 010 is ten, +5 five, -0x10 -16 ($s1)" \
     grep -q '"dir":"in",.*"name":"HOST_SENSOR",.*"fields":{"time":0,"roll":10,"pitch":5,"yaw":-16,' <<<"$s1"
+check "tase-sim logs the first HOST_SENSOR (it changes what GIMBAL_RATE reports)" \
+    sim_reaches 1 "HOST_SENSOR: the host's body rates (p 0.10, q 0.05, r -0.16 deg/s) are reported in GIMBAL_RATE"
 
 # ---- no-go zone: a rate command stops at its edge ----
 quiet "$TASE" send AXIS_SETTING pan_nogo_center=6000 pan_nogo_range=2000 "${L[@]}"
