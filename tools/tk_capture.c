@@ -881,10 +881,18 @@ int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap)
         return TK_CAP_END;
     }
     if (rc != 1) {
+        const char *err = pcap_geterr(r->pcap);
         /* a read a signal broke off (a pipe or FIFO): the signal's exit,
          * not libpcap's "Interrupted system call" */
         tk_exit_if_signalled();
-        tk_die("%s: after record %lu: %s", r->path, r->index, pcap_geterr(r->pcap));
+        /* libpcap reads a pcapng file's later sections only in the first
+         * one's byte order: another's header reads as a huge block */
+        snprintf(why, cap, "%s: after record %lu: %s%s", r->path, r->index, err,
+                 r->pcapng && strstr(err, "block size") != NULL
+                     ? " (a damaged file, or a pcapng section in the other byte order, which "
+                       "is not read)"
+                     : "");
+        return TK_CAP_ERROR;
     }
     memset(rec, 0, sizeof(*rec));
     rec->index = ++r->index;

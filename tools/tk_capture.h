@@ -180,11 +180,15 @@ typedef struct {
 
 #define TK_CAP_END 0
 #define TK_CAP_RECORD 1
-#define TK_CAP_BAD 2 /* malformed record: `why` says what; the next call goes on */
+#define TK_CAP_BAD 2       /* malformed record: `why` says what; the next call goes on */
+#define TK_CAP_ERROR 3     /* the file can be read no further: `why` says why, naming it */
+#define TK_CAP_WHY_MAX 400 /* room for any `why` (a path is in TK_CAP_ERROR's) */
 
-/* Next record. Returns TK_CAP_RECORD, TK_CAP_END, or TK_CAP_BAD with a
- * reason in why[0..cap) (rec->index set). Dies on a read error or a file
- * cut inside a record header. */
+/* Next record. Returns TK_CAP_RECORD, TK_CAP_END, TK_CAP_BAD with a
+ * reason in why[0..cap) (rec->index set), or TK_CAP_ERROR with the whole
+ * message ("PATH: after record N: ...") in why: a read error or a file cut
+ * inside a record (what came before it is good: a caller decodes it, then
+ * says this). A signal that broke off the read exits as that signal. */
 int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap);
 
 /* ---- record and replay loops ---- */

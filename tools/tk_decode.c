@@ -134,31 +134,36 @@ void tk_dec_tick(tk_dec_t *d, tk_stream_t *s, uint32_t now_ms)
     flush_out(d);
 }
 
-/* A record time on the receivers' millisecond clock (modulo 2^32). */
-static uint32_t time_ms(const tk_time_t *t)
+/* A record time in milliseconds (truncated). */
+static int64_t time_ms64(const tk_time_t *t)
 {
-    return (uint32_t)((uint64_t)t->sec * 1000u + t->usec / 1000u);
+    return t->sec * 1000 + (int64_t)(t->usec / 1000u);
 }
 
-/* Whether the pause from one record to the next is 2^31 ms (24.8 days) or
- * more, which reads as no time on the receivers' clock (modulo 2^32). */
-static bool long_pause(const tk_time_t *from, const tk_time_t *to)
+/* A record time on stream s's receiver clock (modulo 2^32): the record
+ * time plus the steps back before it. */
+static uint32_t rx_ms(const tk_stream_t *s, const tk_time_t *t)
 {
-    int64_t ms = ((int64_t)to->sec - (int64_t)from->sec) * 1000 +
-                 ((int64_t)to->usec / 1000 - (int64_t)from->usec / 1000);
-    return ms >= (int64_t)0x80000000LL;
+    return (uint32_t)(uint64_t)(time_ms64(t) + s->back_ms);
 }
 
 void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n, const tk_time_t *time)
 {
     if (d->by_time && time != NULL) {
-        if (s->timed && long_pause(&s->last, time)) {
-            /* told of 2^30 ms of quiet first (a capture appended to over
-             * weeks joined the sessions' cut frames) */
-            tk_dec_tick(d, s, time_ms(&s->last) + 0x40000000u);
+        int64_t step = s->timed ? time_ms64(time) - time_ms64(&s->last) : 0;
+        if (step < 0) {
+            /* a clock stepped back: no time passed (any step: one of
+             * 2^31..2^32 ms wrapped into a long pause on the receiver's
+             * 32-bit clock and cut a frame split across it) */
+            s->back_ms -= step;
+        } else if (step >= (int64_t)0x80000000LL) {
+            /* a pause of 2^31 ms (24.8 days) or more reads as no time on
+             * the 32-bit clock: told of 2^30 ms of quiet first (a capture
+             * appended to over weeks joined the sessions' cut frames) */
+            tk_dec_tick(d, s, rx_ms(s, &s->last) + 0x40000000u);
         }
         /* the line was quiet from the last record until this one */
-        tk_dec_tick(d, s, time_ms(time));
+        tk_dec_tick(d, s, rx_ms(s, time));
     }
     if (time != NULL) {
         s->last = *time;
@@ -182,7 +187,7 @@ void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n, co
         n -= k;
     }
     if (d->by_time && time != NULL) {
-        tk_dec_tick(d, s, time_ms(time)); /* notes the bytes' arrival */
+        tk_dec_tick(d, s, rx_ms(s, time)); /* notes the bytes' arrival */
     }
     flush_out(d);
 }

@@ -363,13 +363,15 @@ unsigned long tk_cap_check(tk_cap_reader_t *r, const tk_replay_opts_t *o, unsign
     tk_time_t last = {0, 0};
     bool any = false;
     unsigned long bad = 0, last_index = 0, long_waits = 0;
-    char why[160];
+    char why[TK_CAP_WHY_MAX];
     int rc;
     memset(&rp, 0, sizeof(rp));
     rp.o = o;
     *backward = 0;
-    /* tk_cap_next() dies on a file cut inside a record header, naming it */
     while ((rc = tk_cap_next(r, &rec, why, sizeof(why))) != TK_CAP_END) {
+        if (rc == TK_CAP_ERROR) {
+            tk_die("%s", why); /* a file cut inside a record: nothing sent yet */
+        }
         if (rc == TK_CAP_BAD) {
             tk_warn("%s: record %lu is bad: %s", r->path, rec.index, why);
             bad++;
@@ -411,7 +413,7 @@ unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
     bool started = false;
     double start = 0.0;
     double due = 0.0; /* seconds after the first record, at speed 1 */
-    char why[160];
+    char why[TK_CAP_WHY_MAX];
     int rc;
     memset(&rp, 0, sizeof(rp));
     rp.o = o;
@@ -428,6 +430,9 @@ unsigned long tk_cap_replay(tk_cap_reader_t *r, const tk_replay_opts_t *o)
      * short there would fail after the others had gone out). */
     while (tk_signal == 0 && r->index < o->records &&
            (rc = tk_cap_next(r, &rec, why, sizeof(why))) != TK_CAP_END) {
+        if (rc == TK_CAP_ERROR) {
+            tk_die("%s", why); /* it changed since the check read it */
+        }
         if (rc == TK_CAP_BAD) {
             tk_warn("%s: record %lu skipped: %s", r->path, rec.index, why);
             rp.bad++;

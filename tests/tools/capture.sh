@@ -157,6 +157,26 @@ expect_error "decode of an Ethernet pcap" 1 "link type 1 (EN10MB) is neither TAS
     "$TASE" decode "$dir/eth.pcap"
 head -c 30 "$dir/noisy.pcap" >"$dir/cut.pcap"
 expect_error "decode of a pcap cut inside a record header" 1 "cut.pcap" "$TASE" decode "$dir/cut.pcap"
+# A file cut inside a record (a copy of a capture being written, a killed
+# recorder): decode died at the cut, and a frame whole before it that the
+# receiver still held (behind a false start) was never printed.
+$U held-cut "$dir/held-cut.pcap"
+"$TASE" decode "$dir/held-cut.pcap" >"$dir/held-cut.json" 2>"$dir/held-cut.err"
+rc=$?
+check "decode of a capture cut inside a record: exit $rc (1), the frame whole before the cut printed, then the cut ($(cat "$dir/held-cut.err"))" \
+    eval '[ $rc = 1 ] && [ "$(grep -c "\"name\":\"GIMBAL_ANGLE\"" "$dir/held-cut.json")" = 1 ] &&
+          grep -q "\"offset\":6,.*\"fields\":{\"pan\":1,\"tilt\":2,\"roll\":0}" "$dir/held-cut.json" &&
+          grep -q "^tase: $dir/held-cut.pcap: after record 1: truncated dump file" "$dir/held-cut.err"'
+# A clock stepped back between two records is no pause, however far: 30
+# days (2^31..2^32 ms) read as a long pause in the receiver's 32-bit clock
+# and cut the frame split across the step.
+for days in 1 30 60; do
+    $U step-back "$dir/back$days.pcap" $days
+    "$TASE" decode "$dir/back$days.pcap" >"$dir/back$days.json" 2>&1
+    rc=$?
+    check "decode of a frame split across a clock stepped back $days days: exit $rc, the frame" \
+        eval '[ $rc = 0 ] && grep -q "\"fields\":{\"pan\":7,\"tilt\":8,\"roll\":0}" "$dir/back$days.json"'
+done
 expect_error "replay of a raw byte file" 1 "is not a pcap or pcapng capture" \
     "$TASE" replay "$DATA/decode_noisy.bin" --serial /dev/null --dir out
 expect_error "replay without a link" 2 "give either --serial DEV or --can IFACE" \

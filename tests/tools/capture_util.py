@@ -28,6 +28,10 @@ checked against a writer other than its own.
         fraction of 10^9 ns or more.
   replay-checks CUT BAD BACK       captures `tase replay` must refuse (cut,
         bad direction byte) or replay across a clock stepped back.
+  held-cut OUT                     a capture cut inside its second record,
+        a whole GIMBAL_ANGLE behind a false start in its first.
+  step-back OUT DAYS               a GIMBAL_ANGLE split over two records, the
+        second stamped DAYS days earlier.
   pty-pair A B                     two pseudo-terminals (symlinks A and B)
         joined like a null-modem cable, raw, until killed.
   compare-pdml PDML JSONL          the dissector's packets (tshark -T pdml)
@@ -496,6 +500,35 @@ def replay_checks(out_cut, out_bad, out_back):
             f.write(pcap_record(T0, ns, b"\x00" + gimbal_angle(i, 0)[1]))
 
 
+def held_cut(out):
+    """A review: a serial capture whose first record holds a false start
+    (Size 200) and then a whole GIMBAL_ANGLE (pan 1, tilt 2), the second
+    record two more, the file cut 5 bytes before its end (inside record 2).
+    The GIMBAL_ANGLE of record 1 is whole before the cut: `tase decode`
+    must print it (the held false start is decided at the end) before it
+    says where the file is cut."""
+    a = gimbal_angle(1, 2)[1]
+    data = (pcap_header(LINKTYPE_SERIAL)
+            + pcap_record(T0, 0, b"\x00" + false_start(200) + a)
+            + pcap_record(T0, 1000000, b"\x00" + gimbal_angle(3, 4)[1] + gimbal_angle(5, 6)[1]))
+    with open(out, "wb") as f:
+        f.write(data[:-5])
+
+
+def step_back(out, days):
+    """A review: a GIMBAL_ANGLE split 5 + 9 bytes over two records, the
+    second stamped `days` days before the first (a clock stepped back).
+    A step back is no pause: `tase decode` must give the frame for any
+    step (30 days, between 2^31 and 2^32 ms, wrapped the receiver's 32-bit
+    clock into a long pause that cut it)."""
+    a = gimbal_angle(7, 8)[1]
+    back = T0 - int(Decimal(days) * 86400)
+    with open(out, "wb") as f:
+        f.write(pcap_header(LINKTYPE_SERIAL))
+        f.write(pcap_record(T0, 0, b"\x00" + a[:5]))
+        f.write(pcap_record(back, 0, b"\x00" + a[5:]))
+
+
 def cut_records(streams, sizes):
     """Round-robin records of the given sizes (cycled) from each stream:
     [(dir, stream offset of the end, bytes)]."""
@@ -677,7 +710,7 @@ def main(argv):
     commands = {f.__name__.replace("_", "-"): f for f in (
         serial_pcap, expect_serial, can_pcap, replay_checks, times, quiet, bad_pcap, pty_pair,
         compare_pdml, greedy, expect_decode, expect_pdml, pdml_3ax, records, paced_angles,
-        timing)}
+        timing, held_cut, step_back)}
     if len(argv) < 2 or argv[1] not in commands:
         raise SystemExit("usage: capture_util.py COMMAND ARGS... (commands: %s)"
                          % ", ".join(commands))

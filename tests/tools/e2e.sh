@@ -660,14 +660,19 @@ sim_killed() {
 sim_killed USR1 "$dir/usr1"
 check "tase-sim ended by SIGUSR1: its link and lock file removed" \
     eval '[ ! -e "$dir/usr1" ] && [ ! -L "$dir/usr1" ] && [ ! -e "$dir/usr1.lock" ]'
+# usr1_at MOMENT=VALUE CMD...: CMD run under the signal shim, which sends
+# it SIGUSR1 at that moment (TASE_TEST_SIGNAL_*); its status in rc, its
+# output and the shell's note of the signal to /dev/null
+usr1_at() {
+    {
+        env LD_PRELOAD="$SHIM" TASE_TEST_SIGNAL="$(kill -l USR1)" "$@" >/dev/null 2>&1
+        rc=$?
+    } 2>/dev/null
+}
 # ... also when the signal comes the moment the link is made, before the
 # simulator has recorded it (the link was left behind: seen once in CI)
 if [ -n "$SHIM" ]; then
-    { # (the shell's note of the signal to /dev/null too)
-        LD_PRELOAD=$SHIM TASE_TEST_SIGNAL=$(kill -l USR1) TASE_TEST_SIGNAL_AFTER_SYMLINK=1 \
-            "$SIM" --quiet --link "$dir/usr1b" --seconds 30 >/dev/null 2>&1
-        rc=$?
-    } 2>/dev/null
+    usr1_at TASE_TEST_SIGNAL_AFTER_SYMLINK=1 "$SIM" --quiet --link "$dir/usr1b" --seconds 30
     check "tase-sim ended by SIGUSR1 as its link is made: exit $rc (138), its link and lock file removed" \
         eval '[ $rc = 138 ] && [ ! -e "$dir/usr1b" ] && [ ! -L "$dir/usr1b" ] && [ ! -e "$dir/usr1b.lock" ]'
 fi
@@ -679,11 +684,8 @@ fpid=$!
 wait_link "$dir/fatal"
 if [ -n "$SHIM" ]; then
     before=$(stty -F "$dir/fatal" -g)
-    {
-        LD_PRELOAD=$SHIM TASE_TEST_SIGNAL=$(kill -l USR1) TASE_TEST_SIGNAL_BEFORE_TCSETATTR=2 \
-            "$TASE" query SYSTEM_VERSION --serial "$dir/fatal" >/dev/null 2>"$dir/fatal.err"
-        rc=$?
-    } 2>/dev/null
+    usr1_at TASE_TEST_SIGNAL_BEFORE_TCSETATTR=2 \
+        "$TASE" query SYSTEM_VERSION --serial "$dir/fatal"
     after=$(stty -F "$dir/fatal" -g)
     "$TASE" query SYSTEM_VERSION --serial "$dir/fatal" >/dev/null 2>"$dir/fatal2.err"
     rc2=$?
@@ -705,11 +707,8 @@ check "retract killed by SIGUSR1 after the command went out: exit $rc (138), $(c
 # --record to a new file, killed by a fatal signal the moment the file is
 # made: it was left empty (0 bytes, no pcap header); now it has its header
 if [ -n "$SHIM" ]; then
-    {
-        LD_PRELOAD=$SHIM TASE_TEST_SIGNAL=$(kill -l USR1) TASE_TEST_SIGNAL_AFTER_CREATE=new.pcap \
-            "$TASE" query SYSTEM_VERSION --serial "$dir/fatal" --record "$dir/new.pcap" >/dev/null 2>&1
-        rc=$?
-    } 2>/dev/null
+    usr1_at TASE_TEST_SIGNAL_AFTER_CREATE=new.pcap \
+        "$TASE" query SYSTEM_VERSION --serial "$dir/fatal" --record "$dir/new.pcap"
     "$TASE" decode "$dir/new.pcap" >/dev/null 2>"$dir/new.err"
     rc2=$?
     check "--record to a new file, killed by SIGUSR1 as it is made: exit $rc (138), the file a capture ($(stat -c %s "$dir/new.pcap" 2>&1) bytes; decode exit $rc2)" \

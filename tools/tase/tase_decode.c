@@ -67,22 +67,30 @@ static void decode_raw(cli_input_t *in, tk_dec_t *d, uint8_t *buf, size_t cap, s
 /* Each good record of a pcap/pcapng capture of 'tase record' (tk_capture.h)
  * whose first bytes are head[0..n), to fn; bad ones are said (the first
  * BAD_LINES_SHOWN) and skipped. serial_only: a CAN capture is refused
- * (`what` says for what). Returns the number of bad records. */
+ * (`what` says for what). A file that can be read no further (cut inside
+ * a record, a read error) ends the records there with the message in
+ * err[0..TK_CAP_WHY_MAX), for the caller to say after it has decoded what
+ * came before (err[0] is 0 otherwise). Returns the number of bad records. */
 typedef void (*cap_record_fn)(void *ctx, int linktype, const tk_cap_rec_t *rec);
 
 static unsigned long each_record(cli_input_t *in, const uint8_t *head, size_t n, cap_record_fn fn,
-                                 void *ctx, const char *serial_only)
+                                 void *ctx, const char *serial_only, char *err)
 {
     tk_cap_reader_t r;
     tk_cap_rec_t rec;
     unsigned long bad = 0;
-    char why[160];
+    char why[TK_CAP_WHY_MAX];
     int rc;
     tk_cap_reader_open(&r, in->fd, head, n, in->name);
     if (serial_only != NULL && r.linktype != TK_CAP_LINKTYPE_SERIAL) {
         tk_exit(TK_EXIT_INPUT, "%s is a CAN capture: %s", in->name, serial_only);
     }
+    err[0] = '\0';
     while ((rc = tk_cap_next(&r, &rec, why, sizeof(why))) != TK_CAP_END) {
+        if (rc == TK_CAP_ERROR) {
+            (void)snprintf(err, TK_CAP_WHY_MAX, "%s", why);
+            break;
+        }
         if (rc == TK_CAP_BAD) {
             if (++bad <= BAD_LINES_SHOWN) {
                 tk_warn("%s: record %lu skipped: %s", in->name, rec.index, why);
@@ -119,9 +127,10 @@ static void decode_record(void *ctx, int linktype, const tk_cap_rec_t *rec)
 
 /* A capture whose first bytes are head[0..n), decoded. Returns the number
  * of bad records. */
-static unsigned long decode_capture(cli_input_t *in, tk_dec_t *d, const uint8_t *head, size_t n)
+static unsigned long decode_capture(cli_input_t *in, tk_dec_t *d, const uint8_t *head, size_t n,
+                                    char *err)
 {
-    return each_record(in, head, n, decode_record, d, NULL);
+    return each_record(in, head, n, decode_record, d, NULL, err);
 }
 
 typedef struct {
@@ -229,6 +238,7 @@ int cli_cmd_decode(cli_args_t *a)
     uint16_t margin = 0;
     cli_input_t in;
     static tk_dec_t d;
+    static char err[TK_CAP_WHY_MAX]; /* a capture that could be read no further */
     tk_fmt_t fmt = {true, false, true};
     while (a->i < a->argc) {
         if (cli_common_opt(a)) {
@@ -266,7 +276,7 @@ int cli_cmd_decode(cli_args_t *a)
                              : cli_input_head(&in, buf, sizeof(buf));
         if (!in.device && tk_cap_is_capture(buf, n)) {
             capture = true; /* --baud: the rate of its serial line */
-            bad = decode_capture(&in, &d, buf, n);
+            bad = decode_capture(&in, &d, buf, n, err);
         } else {
             cli_input_check_baud(&in, baud_given, " or a serial capture");
             decode_raw(&in, &d, buf, sizeof(buf), n);
@@ -277,6 +287,11 @@ int cli_cmd_decode(cli_args_t *a)
     tk_stdout_flush();
     if (stats) {
         tk_dec_summary(&d, stderr, "");
+    }
+    if (err[0] != '\0') {
+        /* what came before it is decoded (the frames a held candidate
+         * kept went out with the flush above) */
+        tk_die("%s", err);
     }
     cli_input_check_end(&in);
     if (bad > 0) {
@@ -379,6 +394,7 @@ int cli_cmd_klv(cli_args_t *a)
     size_t n;
     bool capture = false;
     unsigned long bad = 0;
+    static char err[TK_CAP_WHY_MAX]; /* a capture that could be read no further */
     while (a->i < a->argc) {
         if (cli_common_opt(a)) {
             continue;
@@ -405,7 +421,7 @@ int cli_cmd_klv(cli_args_t *a)
         k.rx = &rx;
         k.c = &c;
         capture = true;
-        bad = each_record(&in, buf, n, klv_record, &k, "the KLV line is a serial line");
+        bad = each_record(&in, buf, n, klv_record, &k, "the KLV line is a serial line", err);
     } else {
         while (n > 0) {
             klv_feed(&rx, &c, buf, n);
@@ -417,6 +433,9 @@ int cli_cmd_klv(cli_args_t *a)
     (void)tase_klv_rx_flush(&rx, print_klv, NULL, &c);
     cli_input_close(&in);
     tk_stdout_flush();
+    if (err[0] != '\0') {
+        tk_die("%s", err); /* after the packets that came before it */
+    }
     cli_input_check_end(&in);
     if (bad > 0) {
         tk_exit(TK_EXIT_INPUT, "%s: %lu bad record%s (the rest was decoded)", in.name, bad,
