@@ -32,6 +32,8 @@ checked against a writer other than its own.
         a whole GIMBAL_ANGLE behind a false start in its first.
   step-back OUT DAYS               a GIMBAL_ANGLE split over two records, the
         second stamped DAYS days earlier.
+  spb OUT                          a pcapng: a GEOREFERENCE_DATA split over
+        two timed records and a Simple Packet Block between them.
   pty-pair A B                     two pseudo-terminals (symlinks A and B)
         joined like a null-modem cable, raw, until killed.
   compare-pdml PDML JSONL          the dissector's packets (tshark -T pdml)
@@ -529,6 +531,34 @@ def step_back(out, days):
         f.write(pcap_record(back, 0, b"\x00" + a[5:]))
 
 
+def pcapng_block(btype, body):
+    """A little-endian pcapng block: type, total length, body padded to 4
+    bytes, total length again (the pcapng draft's general block)."""
+    body += bytes(-len(body) % 4)
+    return struct.pack("<II", btype, len(body) + 12) + body + struct.pack("<I", len(body) + 12)
+
+
+def spb(out):
+    """A review: a GEOREFERENCE_DATA (63 bytes of data 0..62) from the
+    gimbal split over three records of a pcapng, the middle one a Simple
+    Packet Block (no time): an Enhanced Packet Block at T, the SPB, an EPB
+    at T + 1 ms. Both tools must give the frame (the dissector took the
+    SPB's time as 1970, and the gap cut the frame)."""
+    f = tase.Packet.from_data(0x10, 0x41, bytes(range(63))).encode()
+    t0 = T0 * 10**6
+
+    def epb(t, data):
+        return pcapng_block(6, struct.pack("<IIIII", 0, t >> 32, t & 0xFFFFFFFF, len(data),
+                                           len(data)) + data)
+
+    with open(out, "wb") as fh:
+        fh.write(pcapng_block(0x0A0D0D0A, struct.pack("<IHHq", 0x1A2B3C4D, 1, 0, -1)))
+        fh.write(pcapng_block(1, struct.pack("<HHI", LINKTYPE_SERIAL, 0, 65535)))
+        fh.write(epb(t0, b"\x00" + f[:5]))
+        fh.write(pcapng_block(3, struct.pack("<I", 26) + b"\x00" + f[5:30]))
+        fh.write(epb(t0 + 1000, b"\x00" + f[30:]))
+
+
 def cut_records(streams, sizes):
     """Round-robin records of the given sizes (cycled) from each stream:
     [(dir, stream offset of the end, bytes)]."""
@@ -710,7 +740,7 @@ def main(argv):
     commands = {f.__name__.replace("_", "-"): f for f in (
         serial_pcap, expect_serial, can_pcap, replay_checks, times, quiet, bad_pcap, pty_pair,
         compare_pdml, greedy, expect_decode, expect_pdml, pdml_3ax, records, paced_angles,
-        timing, held_cut, step_back)}
+        timing, held_cut, step_back, spb)}
     if len(argv) < 2 or argv[1] not in commands:
         raise SystemExit("usage: capture_util.py COMMAND ARGS... (commands: %s)"
                          % ", ".join(commands))

@@ -214,6 +214,19 @@ compare margin250 "the same with a 250 ms margin (tshark -o tase.margin:250, dec
     "$dir/margin.log" --candump "$dir/margin.log" --margin 250
 check "... delivered: the GIMBAL_CMD" grep -q '"name":"GIMBAL_CMD"' "$dir/margin250.json"
 dissect_opts=()
+# A margin of 0 is the receiver's default (20 ms; decode refuses 0): the
+# dissector took it as no margin, and a 10 ms pause cut the packet.
+sed 's/1700000000.030000/1700000000.010000/' "$dir/margin.log" >"$dir/margin10.log"
+dissect_opts=(-o tase.margin:0)
+compare margin0 "a 10 ms pause inside a packet, margin 0 (tshark -o tase.margin:0, decode's default)" \
+    "$dir/margin10.log" --candump "$dir/margin10.log"
+check "... delivered: the GIMBAL_CMD" grep -q '"name":"GIMBAL_CMD"' "$dir/margin0.json"
+dissect_opts=()
+# A pcapng Simple Packet Block has no time (Wireshark gives 0): the gap
+# from 1970 ended the frame split across it in the dissector.
+$U spb "$dir/spb.pcapng"
+compare spb "a frame split across a pcapng Simple Packet Block" "$dir/spb.pcapng" "$dir/spb.pcapng"
+check "... the GEOREFERENCE_DATA" grep -q '"offset":0,.*"name":"GEOREFERENCE_DATA"' "$dir/spb.json"
 
 # A differential review: a valid 38-byte frame of an unknown type carrying
 # a whole GIMBAL_ANGLE, its last 18 bytes 20.9996 ms after its first 20
@@ -273,8 +286,9 @@ check "3AX move and status frames: position and speed as the spec lays them out"
 
 $U bad-pcap "$dir/bad.pcap"
 dissect "$dir/bad.pcap" -T fields -e frame.number -e _ws.expert.message -e tase.name >"$dir/bad.txt"
-check "serial record with direction byte 0x07 flagged, the good ones dissected" \
+check "serial records with direction byte 0x07 and with no bytes after it flagged, the good ones dissected" \
     eval 'grep -q "^2	unknown direction byte" "$dir/bad.txt" &&
+          grep -q "^3	no bytes after the direction byte" "$dir/bad.txt" &&
           [ "$(grep -c "GIMBAL_ANGLE" "$dir/bad.txt")" = 2 ]'
 n=$(dissect "$dir/noisy.pcap" -Y 'tase.gimbal_angle.tilt == -4500 && tase.dir == "in"' | grep -c .)
 check "display filter on a field and the direction: $n frame (the 'in' GIMBAL_ANGLE with tilt -4500)" \

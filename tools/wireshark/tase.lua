@@ -83,7 +83,7 @@ tase.prefs.baud = Pref.uint("Serial line baud rate", 57600,
 -- tshark: -o tase.margin:250.
 tase.prefs.margin = Pref.uint("Quiet margin (ms)", 20,
     "The least gap, in milliseconds, after which a pending candidate frame is judged false "
-        .. "(as tase decode --margin MS; default 20, the receiver's)")
+        .. "(as tase decode --margin MS; default 20, the receiver's; 0 is taken as 20)")
 
 -- BEGIN GENERATED (tools/wireshark/schema_lua.c; do not edit by hand)
 -- {group, type, name, data length, flags,
@@ -237,6 +237,9 @@ local E = {
         expert.group.MALFORMED, expert.severity.ERROR),
     wrong_length = ProtoExpert.new("tase.wrong_length", "wrong data length for this packet type",
         expert.group.MALFORMED, expert.severity.WARN),
+    no_bytes = ProtoExpert.new("tase_serial.no_bytes", "no bytes after the direction byte "
+        .. "(tase decode skips such a record as bad)", expert.group.MALFORMED,
+        expert.severity.ERROR),
     merged = ProtoExpert.new("tase.interfaces_merged", "reassembled with the streams of every " ..
         "capture interface merged: the first pass had no protocol tree (use tshark -2 -R frame)",
         expert.group.REASSEMBLE, expert.severity.WARN),
@@ -262,7 +265,7 @@ end
 tase.fields = field_list
 tase_serial.fields = {F.serial_dir, F.serial_bytes}
 tase.experts = {E.wrong_length, E.merged}
-tase_serial.experts = {E.bad_dir}
+tase_serial.experts = {E.bad_dir, E.no_bytes}
 
 -- Whether len selects the packet's short layout (tase/schema.h, TWO
 -- LAYOUTS; docs/PROTOCOL-NOTES.md S2).
@@ -381,7 +384,9 @@ local function quiet_limit(st, rate)
         end
         if left == nil then return nil end
     end
-    return math.max(math.floor((left * 1000 + rate - 1) / rate), tase.prefs.margin)
+    local margin = tase.prefs.margin
+    if margin == 0 then margin = 20 end -- the receiver takes 0 as its default
+    return math.max(math.floor((left * 1000 + rate - 1) / rate), margin)
 end
 
 -- First pass: append packet `num`'s bytes (arrived at `ts` on a line of
@@ -394,6 +399,12 @@ local function feed(key, chunk, num, ts, rate)
         streams[key] = st
     end
     local out, now = {}, ms_of(ts)
+    if ts == 0 and st.last_ms ~= nil then
+        -- a pcapng Simple Packet Block has no time (Wireshark gives 0):
+        -- the time of the stream's packet before, as tase decode takes it
+        -- (from 1970, the gap cut a frame split across it)
+        now = st.last_ms
+    end
     if st.last_ms ~= nil then
         local limit = quiet_limit(st, rate)
         if limit ~= nil and now - st.last_ms > limit then
@@ -600,7 +611,12 @@ function tase_serial.dissector(tvb, pinfo, tree)
         pinfo.cols.info = "bad direction byte"
         return tvb:len()
     end
-    if tvb:len() < 2 then return tvb:len() end
+    if tvb:len() < 2 then
+        t:add_proto_expert_info(E.no_bytes)
+        pinfo.cols.protocol = "TASE"
+        pinfo.cols.info = "no bytes after the direction byte"
+        return tvb:len()
+    end
     t:add(F.serial_bytes, tvb(1))
     dissect_chunk(tvb(1):tvb(), pinfo, tree, "serial", dir)
     return tvb:len()
