@@ -9,7 +9,9 @@
 #include <cmocka.h>
 
 #include "../tools/sim_words.h"
+#include "tase/codec.h"
 #include "tase/flags.h"
+#include "tase/ids.h"
 
 static void msb_first_bits_number_from_the_left(void **state)
 {
@@ -43,6 +45,27 @@ static void gimbal_cmd_flags_match_the_spec_table(void **state)
     assert_int_equal(TASE_GIMBAL_KIND(TASE_GIMBAL_FLAGS_LEGACY_POSITION_STAB), 0);
     assert_int_equal(TASE_GIMBAL_LEGACY_STAB | TASE_GIMBAL_LEGACY_POSITION, 0x03);
     assert_int_equal(TASE_GIMBAL_FLAGS_LEGACY_RATE_STAB, TASE_GIMBAL_LEGACY_STAB);
+}
+
+/* A review: TASE_GIMBAL_KIND_LAST was 3, so a range check with the pair
+ * refused the SPOI error commands 0xC0 and 0xD0. Every kind of the range
+ * makes a flags byte the spec defines (with stabilisation), the next one
+ * none. */
+static void gimbal_kinds_first_to_last_are_the_defined_ones(void **state)
+{
+    tase_gimbal_cmd_t c;
+    unsigned k;
+    (void)state;
+    memset(&c, 0, sizeof c);
+    for (k = TASE_GIMBAL_KIND_FIRST; k <= TASE_GIMBAL_KIND_LAST; k++) {
+        c.flags = TASE_GIMBAL_FLAGS(k, 1);
+        assert_int_equal(tase_command_check(TASE_ID_GIMBAL_CMD, &c), TASE_OK);
+    }
+    assert_int_equal(TASE_GIMBAL_KIND_LAST, TASE_GIMBAL_KIND_SPOI_ERROR_RATE);
+    c.flags = TASE_GIMBAL_FLAGS(TASE_GIMBAL_KIND_LAST + 1u, 1);
+    assert_int_equal(tase_command_check(TASE_ID_GIMBAL_CMD, &c), TASE_ERANGE);
+    c.flags = TASE_GIMBAL_FLAGS(TASE_GIMBAL_KIND_FIRST - 1u, 1); /* 0x80 */
+    assert_int_equal(tase_command_check(TASE_ID_GIMBAL_CMD, &c), TASE_ERANGE);
 }
 
 static void byte_flags_use_msb_first_numbering(void **state)
@@ -183,6 +206,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(msb_first_bits_number_from_the_left),
         cmocka_unit_test(gimbal_cmd_flags_match_the_spec_table),
+        cmocka_unit_test(gimbal_kinds_first_to_last_are_the_defined_ones),
         cmocka_unit_test(byte_flags_use_msb_first_numbering),
         cmocka_unit_test(gps_status_and_nav_health_fields_decode),
         cmocka_unit_test(spoi_flags_read_like_the_mode_byte_under_both_readings),

@@ -110,6 +110,12 @@ const tase_packet_desc_t *tk_packet_by_name(const char *name)
             return p;
         }
     }
+    if (strcasecmp(name, "GIMBAL_TELEMETRY") == 0) {
+        /* table 10's name, which 4.3.3 also gives GEOREFERENCE_DATA */
+        tk_usage_error("unknown packet name '%s': table 10 gives it to 0x08/0x40, GIMBAL_RATE "
+                       "(4.2.2); 4.3.3 calls GEOREFERENCE_DATA so too (PROTOCOL-NOTES D1)",
+                       name);
+    }
     tk_usage_error("unknown packet name '%s' (see 'tase list')", name);
     return NULL;
 }

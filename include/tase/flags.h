@@ -52,10 +52,13 @@
 #define TASE_GIMBAL_LEGACY_STAB TASE_BIT8(6)
 #define TASE_GIMBAL_LEGACY_POSITION TASE_BIT8(7)
 /* Current encoding: bit 0 stabilisation on, bits 1-3 the command kind,
- * bits 4-7 zero. SPOI error kinds are only defined with bit 0 set. */
+ * bits 4-7 zero. Kinds FIRST..LAST are defined (table 5); the SPOI error
+ * kinds (4, 5) only with bit 0 set (0xC0, 0xD0): tase_command_check()
+ * (codec.h) tells a defined flags byte. (LAST was 3 until 0.3.0, which
+ * left the SPOI error kinds out.) */
 #define TASE_GIMBAL_STAB TASE_BIT8(0)
 #define TASE_GIMBAL_KIND_FIRST 1u
-#define TASE_GIMBAL_KIND_LAST 3u
+#define TASE_GIMBAL_KIND_LAST 5u
 #define TASE_GIMBAL_KIND_RATE 1u
 #define TASE_GIMBAL_KIND_POSITION 2u
 #define TASE_GIMBAL_KIND_IMPULSE 3u

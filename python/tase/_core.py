@@ -367,6 +367,13 @@ def packet_type(name):
         t = _BY_NAME.get(name.upper())
         if t is not None:
             return t
+    if isinstance(name, str) and name.upper() == "GIMBAL_TELEMETRY":
+        # table 10's name, which 4.3.3 also gives GEOREFERENCE_DATA
+        raise UnknownPacketError(
+            "unknown packet name %r: table 10 gives it to 0x08/0x40, GIMBAL_RATE (4.2.2); "
+            "4.3.3 calls GEOREFERENCE_DATA so too (PROTOCOL-NOTES D1)" % name,
+            lib.TASE_EUNKNOWN,
+        )
     raise UnknownPacketError(
         "unknown packet name %r (known: %s)" % (name, ", ".join(sorted(_BY_NAME))),
         lib.TASE_EUNKNOWN,

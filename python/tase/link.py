@@ -999,7 +999,9 @@ class Link:
         finally:
             self._queue.extendleft(reversed(others))
         raise TimeoutError_(
-            "%s: no RETRACT_DEPLOY_CMD echo within %s s" % (self.url, wait), lib.TASE_ETIMEOUT
+            "%s: no RETRACT_DEPLOY_CMD echo within %s s (the move is not complete, or the "
+            "gimbal has no 3AX retract: it is an option, 4.1.6)" % (self.url, wait),
+            lib.TASE_ETIMEOUT,
         )
 
     def retract(self, wait=None):

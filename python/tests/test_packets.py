@@ -139,6 +139,9 @@ def test_defaults_are_do_not_change_values():
     "call, text",
     [
         (lambda: tase.Packet("GIMBAL_ANGEL"), "unknown packet name"),
+        # table 10's name for GIMBAL_RATE, 4.3.3's for GEOREFERENCE_DATA
+        (lambda: tase.Packet("gimbal_telemetry"), "unknown packet name .* GIMBAL_RATE .*"
+                                                   "GEOREFERENCE_DATA .*D1"),
         (lambda: tase.Packet("GIMBAL_ANGLE", pan=400, tilt=0, roll=0), "out of range"),
         (lambda: tase.Packet("GIMBAL_ANGLE", pan=float("nan"), tilt=0, roll=0), "finite"),
         (lambda: tase.Packet("GIMBAL_ANGLE", pan=1, tilt=0, rol=0), "has no field 'rol'"),

@@ -96,6 +96,14 @@ rc, out, _ = run(["help", "monitor"])
 ok("'tase help monitor' prints the monitor usage", rc == 0 and out.startswith("usage: tase monitor"))
 rc, out, _ = run(["--help"])
 ok("--help lists the exit codes", rc == 0 and "exit status" in out and "3 the gimbal's echo" in out)
+# every length a packet may have (PROTOCOL-NOTES C9, S2): list gave only
+# the table's, so the 22-byte AXIS_SETTING and the 1-byte CAMERA_CMD
+# looked like wrong lengths
+rc, out, _ = run(["list"])
+ok("list names the other lengths accepted: CAMERA_CMD 10 (or 1), AXIS_SETTING 23 (or 22; query)",
+   rc == 0 and re.search(r"^CAMERA_CMD +0x00/0x41 in +10 \(or 1\): camera:u8 ", out, re.M)
+   and re.search(r"^AXIS_SETTING +0x48/0x02 both +23 \(or 22; query\): ", out, re.M)
+   and re.search(r"^PACKET_RATE +0x48/0x00 both +16 \(query\): ", out, re.M), out)
 rc, out, _ = run(["send", "--help"])
 ok("send --help gives the timeout and retry defaults",
    rc == 0 and "default 500 ms" in out and "default 2" in out)
@@ -437,6 +445,7 @@ os.close(m)
 os.close(sl)
 ok("deploy --wait > /dev/full waits for the echo: a silent line is a timeout (exit 1)",
    rc == 1 and waited >= 0.5 and "timeout: no RETRACT_DEPLOY_CMD echo" in err
+   and "or the gimbal has no 3AX retract" in err
    and "(RETRACT_DEPLOY_CMD was sent)" in err, "exit %d after %.2f s: %s" % (rc, waited, err))
 
 # (more output than a pipe holds, so the write must meet the closed end)

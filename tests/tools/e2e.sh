@@ -797,6 +797,10 @@ expect_error "both links" 2 "either --serial or --can" \
     "$TASE" monitor --serial "$dir/gimbal" --can can0
 expect_error "unknown packet" 2 "unknown packet name 'GIMBAL_FOO'" \
     "$TASE" send GIMBAL_FOO "${L[@]}"
+# table 10's GIMBAL_TELEMETRY names two packets (PROTOCOL-NOTES D1): both said
+expect_error "table 10's GIMBAL_TELEMETRY" 2 \
+    "unknown packet name 'GIMBAL_TELEMETRY': table 10 gives it to 0x08/0x40, GIMBAL_RATE (4.2.2); 4.3.3 calls GEOREFERENCE_DATA so too" \
+    "$TASE" query GIMBAL_TELEMETRY "${L[@]}"
 expect_error "unknown field" 2 "GIMBAL_CMD has no field 'yaw'" \
     "$TASE" send GIMBAL_CMD yaw=3 "${L[@]}"
 expect_error "value out of range" 2 "bad value '40000' for GIMBAL_CMD.pan: out of range -32768..32767" \

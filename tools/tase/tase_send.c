@@ -458,11 +458,21 @@ int cli_cmd_list(cli_args_t *a)
     for (i = 0; i < TASE_PKT_COUNT; i++) {
         const tase_packet_desc_t *p = tase_schema_at(i);
         unsigned dir = p->flags & TASE_DIR_BOTH;
-        printf("%-19s 0x%02X/0x%02X %-4s %3u%s%s:", tase_schema_packet_name(p),
+        char other[32] = ""; /* the other lengths accepted */
+        if ((p->flags & TASE_LEN_SHORT1) != 0u) {
+            (void)snprintf(other, sizeof other, "or 1"); /* CAMERA_CMD: C9 */
+        } else if ((p->flags & TASE_LEN_SHORT) != 0u) {
+            (void)snprintf(other, sizeof other, "or %u", (unsigned)p->len - 1u); /* S2 */
+        }
+        if ((p->flags & TASE_LEN_QUERY) != 0u) {
+            (void)snprintf(other + strlen(other), sizeof other - strlen(other), "%squery",
+                           other[0] != '\0' ? "; " : "");
+        }
+        printf("%-19s 0x%02X/0x%02X %-4s %3u%s%s%s%s:", tase_schema_packet_name(p),
                (unsigned)TASE_ID_GROUP(p->id), (unsigned)TASE_ID_TYPE(p->id),
                dir == TASE_DIR_BOTH ? "both" : (dir == TASE_DIR_IN ? "in" : "out"),
-               (unsigned)p->len, tk_packet_has_tail(p) ? "+" : "",
-               (p->flags & TASE_LEN_QUERY) ? " (query)" : "");
+               (unsigned)p->len, tk_packet_has_tail(p) ? "+" : "", other[0] != '\0' ? " (" : "",
+               other, other[0] != '\0' ? ")" : "");
         for (j = 0; j < p->nfields; j++) {
             tk_field_t f;
             tk_field(p, j, p->len, &f);

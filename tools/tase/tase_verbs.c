@@ -347,7 +347,9 @@ static int retract_deploy(cli_args_t *a, bool deploy)
         cli_session_service(&s, 20);
     }
     if (wait > 0.0 && !e.seen) {
-        tk_die("timeout: no RETRACT_DEPLOY_CMD echo within %g s (the move is not complete)", wait);
+        tk_die("timeout: no RETRACT_DEPLOY_CMD echo within %g s (the move is not complete, or "
+               "the gimbal has no 3AX retract: it is an option, 4.1.6)",
+               wait);
     }
     if (e.seen) {
         cli_print_packet(p, (uint8_t[]){e.deploy, 0}, 2, v.r.json, "out", "echo");
