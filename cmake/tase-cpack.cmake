@@ -49,7 +49,10 @@ set(CPACK_DEBIAN_TOOLS_DESCRIPTION
 "TASE gimbal bench tools: tase and tase-sim
 tase talks to a Cloud Cap TASE gimbal over a serial port or SocketCAN:
 monitor telemetry, send commands, run queries, decode captures to JSON.
-tase-sim is a simulated gimbal on a pseudo-terminal or CAN interface.")
+tase-sim is a simulated gimbal on a pseudo-terminal or CAN interface.
+The Wireshark dissector is /usr/share/tase/tase.lua (wireshark -X
+lua_script:/usr/share/tase/tase.lua); the manual is
+/usr/share/doc/tase-tools/TOOLS.md.")
 
 # The Python package: its extension is built for the Python of the build
 # (TASE_PYTHON_VERSION, Debian 12: 3.11).
@@ -65,5 +68,36 @@ The tase package drives a Cloud Cap TASE gimbal from Python over the same
 C code the firmware links: packets from the library's schema, encode and
 decode, serial, SocketCAN and virtual CAN links with queries and retries,
 the simulator, captures of tase record and plots (docs/PYTHON.md).")
+
+# Programs and the Python extension stripped (lintian:
+# unstripped-binary-or-object); CMake never strips the static libraries,
+# whose symbol tables are their contents.
+set(CPACK_STRIP_FILES ON)
+
+# Debian's changelog.Debian.gz in each package's doc directory (lintian:
+# no-changelog): one entry for this version, naming the upstream changelog.
+# Compressed with gzip -9n as Debian's own tools do; without gzip there is
+# none (a package is still built).
+if(TASE_GZIP) # found by tase-install.cmake
+  string(TIMESTAMP tase_deb_date "%a, %d %b %Y %H:%M:%S +0000" UTC) # SOURCE_DATE_EPOCH if set
+  foreach(tase_comp IN LISTS CPACK_COMPONENTS_ALL)
+    string(TOUPPER ${tase_comp} tase_COMP)
+    set(tase_pkg ${CPACK_DEBIAN_${tase_COMP}_PACKAGE_NAME})
+    set(tase_cl ${PROJECT_BINARY_DIR}/debian/${tase_pkg}/changelog.Debian)
+    file(WRITE ${tase_cl}
+"${tase_pkg} (${PROJECT_VERSION}-${CPACK_DEBIAN_PACKAGE_RELEASE}) unstable; urgency=medium
+
+  * Built with CPack from the tase-gimbal-stack source, version
+    ${PROJECT_VERSION}. The changes are in the upstream changelog,
+    /usr/share/doc/libtase-dev/changelog.gz.
+
+ -- ${CPACK_PACKAGE_CONTACT}  ${tase_deb_date}
+")
+    execute_process(COMMAND ${CMAKE_COMMAND} -DGZIP=${TASE_GZIP} -DIN=${tase_cl} -DOUT=${tase_cl}.gz
+                            -P ${CMAKE_CURRENT_LIST_DIR}/tase-gzip.cmake)
+    install(FILES ${tase_cl}.gz DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/${tase_pkg}
+            COMPONENT ${tase_comp})
+  endforeach()
+endif()
 
 include(CPack)

@@ -100,8 +100,34 @@ endforeach()
 # Debian wants each package's copyright in /usr/share/doc/<package>/.
 install(FILES ${PROJECT_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/libtase-dev
         RENAME copyright COMPONENT dev)
-install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/CHANGELOG.md
-        DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/libtase-dev COMPONENT dev)
+install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/libtase-dev
+        COMPONENT dev)
+# The upstream changelog under the name Debian gives it (changelog.gz:
+# lintian's wrong-name-for-upstream-changelog), compressed when it is
+# installed (an install after building only the library has it too); as
+# CHANGELOG.md where there is no gzip.
+find_program(TASE_GZIP gzip)
+mark_as_advanced(TASE_GZIP)
+if(TASE_GZIP)
+  if(IS_ABSOLUTE "${CMAKE_INSTALL_DATADIR}")
+    set(tase_doc_dir "${CMAKE_INSTALL_DATADIR}/doc/libtase-dev")
+  else()
+    set(tase_doc_dir "\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/doc/libtase-dev")
+  endif()
+  install(CODE "
+    execute_process(COMMAND \"${CMAKE_COMMAND}\" -DGZIP=${TASE_GZIP}
+                            -DIN=${PROJECT_SOURCE_DIR}/CHANGELOG.md
+                            -DOUT=${PROJECT_BINARY_DIR}/doc/changelog.gz
+                            -P ${CMAKE_CURRENT_LIST_DIR}/tase-gzip.cmake RESULT_VARIABLE rc)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR \"changelog.gz: gzip failed\")
+    endif()
+    file(INSTALL DESTINATION \"${tase_doc_dir}\" TYPE FILE FILES \"${PROJECT_BINARY_DIR}/doc/changelog.gz\")"
+          COMPONENT dev)
+else()
+  install(FILES ${PROJECT_SOURCE_DIR}/CHANGELOG.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/libtase-dev
+          COMPONENT dev)
+endif()
 # The headers refer to docs/*.md (TIMING.md for the worst cases, FOOTPRINT.md
 # for stack, PORTS.md, ...): they go beside the README.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/libtase-dev/docs

@@ -61,11 +61,15 @@ for f in usr/include/tase/frame.h usr/include/tase/config.h usr/include/tase/ver
     "usr/lib/$triplet/cmake/tase/tase-config.cmake" "usr/lib/$triplet/cmake/tase/tase-config-version.cmake" \
     "usr/lib/$triplet/cmake/tase/tase-targets.cmake" "usr/lib/$triplet/pkgconfig/tase.pc" \
     "usr/lib/$triplet/pkgconfig/tase-socketcan.pc" usr/share/doc/libtase-dev/copyright \
-    usr/share/doc/libtase-dev/CHANGELOG.md usr/share/doc/libtase-dev/docs/TIMING.md \
+    usr/share/doc/libtase-dev/changelog.gz usr/share/doc/libtase-dev/changelog.Debian.gz \
+    usr/share/doc/libtase-dev/docs/TIMING.md \
     usr/share/doc/libtase-dev/docs/PORTS.md; do
     grep -qx "$f" "$out/dev.list" || tase_fail "libtase-dev lacks /$f"
 done
-for f in usr/bin/tase usr/bin/tase-sim usr/share/doc/tase-tools/copyright; do
+for f in usr/bin/tase usr/bin/tase-sim usr/share/doc/tase-tools/copyright \
+    usr/share/doc/tase-tools/changelog.Debian.gz usr/share/doc/tase-tools/TOOLS.md \
+    usr/share/doc/tase-tools/CAN.md usr/share/doc/tase-tools/PROTOCOL-NOTES.md \
+    usr/share/man/man1/tase.1.gz usr/share/man/man1/tase-sim.1.gz usr/share/tase/tase.lua; do
     grep -qx "$f" "$out/tools.list" || tase_fail "tase-tools lacks /$f"
 done
 if grep -q '^usr/bin/' "$out/dev.list" || grep -q '^usr/include/' "$out/tools.list"; then
@@ -74,6 +78,8 @@ fi
 echo "   libtase-dev: $(grep -c '[^/]$' "$out/dev.list") files; tase-tools: $(grep -c '[^/]$' "$out/tools.list") files"
 
 grep -q "^## \[$version\]" "$TASE_ROOT/CHANGELOG.md" || tase_fail "CHANGELOG.md has no section for $version"
+[ "$(dpkg-deb --fsys-tarfile "$dev" | tar -xOf - ./usr/share/doc/libtase-dev/changelog.gz | gzip -dc)" = \
+    "$(cat "$TASE_ROOT/CHANGELOG.md")" ] || tase_fail "libtase-dev: changelog.gz is not CHANGELOG.md"
 
 tase_step "unpack both and build consumers from the unpacked tree"
 root="$out/root"
@@ -130,4 +136,17 @@ site="/usr/local/lib/python$pyv/dist-packages"
 /usr/bin/python3 -c "import sys; sys.exit(0 if '$site' in sys.path else 1)" ||
     tase_fail "$site is not on /usr/bin/python3's path"
 echo "   prefix /usr/local: the Python package goes to $site, on python3's path"
+
+# Debian's own package check: no error or warning (a review found unstripped
+# programs, no changelog.Debian.gz, no manual pages, CHANGELOG.md misnamed).
+# initial-upload-closes-no-bugs is the Debian archive's rule for a first
+# upload (it closes an ITP bug); these packages are not uploaded there.
+tase_step "lintian"
+if ! lintian --fail-on error,warning --tag-display-limit 0 \
+    --suppress-tags initial-upload-closes-no-bugs "$dev" "$tools" "$py" \
+    >"$out/lintian.log" 2>&1; then
+    grep -v "root privileges" "$out/lintian.log"
+    tase_fail "lintian"
+fi
+{ grep -v "root privileges" "$out/lintian.log" || echo "no tag"; } | sed 's/^/   /'
 tase_step "packages: built, checked, unpacked and used"
