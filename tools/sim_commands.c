@@ -150,14 +150,19 @@ void sim_on_frame(void *user, unsigned port, const tase_frame_t *f)
                     c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR_RATE ? " rate" : "", c->flags,
                     c->pan / 100.0, c->tilt / 100.0, mode_name(&s->m),
                     s->m.stabilised ? ", stabilised" : "");
-        } else if (spoi && TASE_GIMBAL_KIND(c->flags) >= TASE_GIMBAL_KIND_IMPULSE) {
+        } else if (spoi && TASE_GIMBAL_KIND(c->flags) == TASE_GIMBAL_KIND_IMPULSE) {
+            /* the error moves over the impulse's time: where it starts */
+            sim_log(s, now,
+                    "GIMBAL_CMD: SPOI error impulse pan %.2f tilt %.2f deg/s for %.2f s; SPOI "
+                    "error %.2f/%.2f, moving by %.2f/%.2f",
+                    c->pan / 100.0, c->tilt / 100.0, c->impulse_time / 100.0, s->m.err_pan,
+                    s->m.err_tilt, c->pan / 100.0 * (c->impulse_time / 100.0),
+                    c->tilt / 100.0 * (c->impulse_time / 100.0));
+        } else if (spoi && TASE_GIMBAL_KIND(c->flags) > TASE_GIMBAL_KIND_IMPULSE) {
             sim_log(s, now,
                     "GIMBAL_CMD: SPOI error %s pan %.2f tilt %.2f%s; SPOI error now %.2f/%.2f",
-                    c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR
-                        ? "set to"
-                        : (c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR_RATE ? "rate" : "impulse"),
-                    c->pan / 100.0, c->tilt / 100.0,
-                    TASE_GIMBAL_KIND(c->flags) == TASE_GIMBAL_KIND_IMPULSE ? " deg/s" : "",
+                    c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR ? "set to" : "rate", c->pan / 100.0,
+                    c->tilt / 100.0, c->flags == TASE_GIMBAL_FLAGS_SPOI_ERROR ? "" : " deg/s",
                     s->m.err_pan, s->m.err_tilt);
         } else {
             sim_log(s, now, "GIMBAL_CMD: %s pan %.2f tilt %.2f%s", mode_name(&s->m), c->pan / 100.0,

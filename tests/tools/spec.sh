@@ -169,7 +169,7 @@ m=$(json_int "$gr" mode)
 check "2: GIMBAL_CMD impulse in SPOI: still SPOI (mode bits 3-7 = 2: $m)" \
     eval '[ -n "$m" ] && [ $((m & 0x1F)) -eq 2 ]'
 check "2: ... the impulse shifted the SPOI error by 4 deg/s x 0.5 s" \
-    grep -q "GIMBAL_CMD: SPOI error impulse pan 4.00 tilt 0.00 deg/s; SPOI error now" "$dir/sim.log"
+    grep -q "GIMBAL_CMD: SPOI error impulse pan 4.00 tilt 0.00 deg/s for 0.50 s; SPOI error [-0-9.]*/[-0-9.]*, moving by 2.00/0.00" "$dir/sim.log"
 
 # ---- 3: tilt -200 is inside the spec's range ----
 out=$("$TASE" point 0 -200 --stab off "${L[@]}" 2>&1)
