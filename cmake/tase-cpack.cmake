@@ -78,7 +78,9 @@ set(CPACK_STRIP_FILES ON)
 # no-changelog): one entry for this version, naming the upstream changelog.
 # Compressed with gzip -9n as Debian's own tools do; without gzip there is
 # none (a package is still built).
-if(TASE_GZIP) # found by tase-install.cmake
+# Only for a build for /usr, the packages' prefix: another install has no
+# Debian package to describe.
+if(TASE_GZIP AND CMAKE_INSTALL_PREFIX STREQUAL "/usr") # gzip found by tase-install.cmake
   string(TIMESTAMP tase_deb_date "%a, %d %b %Y %H:%M:%S +0000" UTC) # SOURCE_DATE_EPOCH if set
   foreach(tase_comp IN LISTS CPACK_COMPONENTS_ALL)
     string(TOUPPER ${tase_comp} tase_COMP)

@@ -3,8 +3,8 @@
 # or time in the header, so the same input gives the same bytes).
 get_filename_component(dir "${OUT}" DIRECTORY)
 file(MAKE_DIRECTORY "${dir}")
-execute_process(COMMAND ${GZIP} -9n -c ${IN} OUTPUT_FILE ${OUT} RESULT_VARIABLE rc)
+execute_process(COMMAND "${GZIP}" -9n -c "${IN}" OUTPUT_FILE "${OUT}" RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
-  file(REMOVE ${OUT})
+  file(REMOVE "${OUT}")
   message(FATAL_ERROR "tase-gzip.cmake: ${GZIP} -9n ${IN} failed (${rc})")
 endif()

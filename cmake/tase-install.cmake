@@ -115,10 +115,10 @@ if(TASE_GZIP)
     set(tase_doc_dir "\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/doc/libtase-dev")
   endif()
   install(CODE "
-    execute_process(COMMAND \"${CMAKE_COMMAND}\" -DGZIP=${TASE_GZIP}
-                            -DIN=${PROJECT_SOURCE_DIR}/CHANGELOG.md
-                            -DOUT=${PROJECT_BINARY_DIR}/doc/changelog.gz
-                            -P ${CMAKE_CURRENT_LIST_DIR}/tase-gzip.cmake RESULT_VARIABLE rc)
+    execute_process(COMMAND \"${CMAKE_COMMAND}\" \"-DGZIP=${TASE_GZIP}\"
+                            \"-DIN=${PROJECT_SOURCE_DIR}/CHANGELOG.md\"
+                            \"-DOUT=${PROJECT_BINARY_DIR}/doc/changelog.gz\"
+                            -P \"${CMAKE_CURRENT_LIST_DIR}/tase-gzip.cmake\" RESULT_VARIABLE rc)
     if(NOT rc EQUAL 0)
       message(FATAL_ERROR \"changelog.gz: gzip failed\")
     endif()

@@ -2,20 +2,26 @@
 # --help (and, for tase, `tase help COMMAND` of every command it lists), so
 # that the page says what the program says. Run at build time:
 #   cmake -DPROG=path/to/tase -DNAME=tase -DSUMMARY="..." -DVERSION=0.3.0
-#         -DOUT=tase.1 [-DGZIP=/usr/bin/gzip] -P tase-manpage.cmake
+#         -DOUT=tase.1 [-DGZIP=/usr/bin/gzip] [-DDOCDIR=/usr/share/doc/tase-tools]
+#         -P tase-manpage.cmake
 # writes OUT (roff) and, with GZIP, OUT.gz (gzip -9n, as Debian installs
 # manual pages). The full manual is docs/TOOLS.md (the tase-tools package
 # installs it in /usr/share/doc/tase-tools/).
+if(NOT DEFINED DOCDIR)
+  set(DOCDIR /usr/share/doc/tase-tools)
+endif()
 foreach(v PROG NAME SUMMARY VERSION OUT)
   if(NOT DEFINED ${v})
     message(FATAL_ERROR "tase-manpage.cmake: -D${v}= is missing")
   endif()
 endforeach()
 
-# Text as roff that prints it as it is: a backslash is \e, a line that
-# would start a request (a dot or an apostrophe first) is protected with \&.
+# Text as roff that prints it as it is: a backslash is \e, a hyphen \- (an
+# option's, not a typographic hyphen), a line that would start a request (a
+# dot or an apostrophe first) is protected with \&.
 function(tase_roff_text text out)
   string(REPLACE "\\" "\\e" text "${text}")
+  string(REPLACE "-" "\\-" text "${text}")
   string(REGEX REPLACE "(^|\n)([.'])" "\\1\\\\&\\2" text "${text}")
   set(${out} "${text}" PARENT_SCOPE)
 endfunction()
@@ -32,6 +38,7 @@ function(tase_help out)
 endfunction()
 
 string(TOUPPER "${NAME}" upper)
+tase_roff_text("${DOCDIR}/TOOLS.md" manual)
 string(TIMESTAMP date "%Y-%m-%d" UTC)
 tase_help(usage --help)
 set(page ".TH ${upper} 1 \"${date}\" \"${NAME} ${VERSION}\" \"TASE gimbal bench tools\"
@@ -40,7 +47,7 @@ ${NAME} \\- ${SUMMARY}
 .SH DESCRIPTION
 This page is the program's own help (\\fB${NAME} \\-\\-help\\fR).
 The full manual, with examples, is
-\\fI/usr/share/doc/tase\\-tools/TOOLS.md\\fR (docs/TOOLS.md in the source).
+\\fI${manual}\\fR (docs/TOOLS.md in the source).
 .PP
 .nf
 ${usage}
@@ -67,7 +74,7 @@ if(usage MATCHES "\ncommands:\n")
 endif()
 string(APPEND page ".SH SEE ALSO
 \\fBtase\\fR(1), \\fBtase\\-sim\\fR(1);
-\\fI/usr/share/doc/tase\\-tools/TOOLS.md\\fR
+\\fI${manual}\\fR
 ")
 
 file(WRITE "${OUT}" "${page}")

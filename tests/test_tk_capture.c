@@ -208,12 +208,52 @@ static void append_writes_in_the_files_own_format(void **state)
     unlink(path);
 }
 
+/* A review: a pcapng's if_tsoffset can give a record time of 2^62 s and
+ * more; the decoder's millisecond arithmetic on such times overflowed a
+ * signed 64-bit number (undefined: the sanitize check runs this test under
+ * UBSan). A GIMBAL_ANGLE split across the largest and smallest times, a
+ * step back (no time), and across a step forward as large, is decoded;
+ * the pause forward cuts the one split across it. */
+static void record_times_at_the_ends_of_int64_overflow_nothing(void **state)
+{
+    static tk_dec_t d;
+    static const uint8_t angle[14] = {0x00, 0xFF, 0x5A, 0x08, 0x08, 0x10, 0x00,
+                                      0x01, 0x00, 0x02, 0x00, 0x03, 0x00, 0x00};
+    uint8_t f[14];
+    unsigned sum = 0, i;
+    const tk_fmt_t fmt = {true, false, true};
+    const tk_time_t hi = {INT64_MAX, 999999}, lo = {INT64_MIN, 0}, mid = {1700000000, 0};
+    FILE *out = tmpfile();
+    tk_stream_t *s;
+    (void)state;
+    assert_non_null(out);
+    memcpy(f, angle, sizeof f);
+    for (i = 0; i < 12u; i++) {
+        sum += f[i];
+    }
+    f[12] = (uint8_t)(sum >> 8); /* checksum of sync..data (spec 3.1) */
+    f[13] = (uint8_t)sum;
+    tk_dec_init(&d, &fmt, out);
+    d.by_time = true;
+    d.serial_rate = 5760u;
+    s = tk_dec_stream(&d, "", "out");
+    assert_non_null(s);
+    tk_dec_bytes(&d, s, f, 5, &hi);
+    tk_dec_bytes(&d, s, &f[5], sizeof f - 5u, &lo); /* a step back: no time */
+    tk_dec_bytes(&d, s, f, 5, &mid);                /* forward, by 2^63 s */
+    tk_dec_bytes(&d, s, &f[5], sizeof f - 5u, &hi); /* again: a long pause */
+    tk_dec_finish(&d);
+    assert_int_equal(d.n.frames, 1u);
+    assert_int_equal(fclose(out), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(tap_times_are_the_port_clocks_steps_across_its_wrap),
         cmocka_unit_test(tap_times_follow_the_wall_clock_when_the_port_clock_jumps),
         cmocka_unit_test(append_writes_in_the_files_own_format),
+        cmocka_unit_test(record_times_at_the_ends_of_int64_overflow_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

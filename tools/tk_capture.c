@@ -825,8 +825,9 @@ static int parse_serial(const struct pcap_pkthdr *h, const uint8_t *d, tk_cap_re
                         size_t cap)
 {
     if (h->caplen < 2u) {
-        snprintf(why, cap, "%s bytes after the direction byte",
-                 h->caplen == 0 ? "no header, no" : "no");
+        snprintf(why, cap, "%s",
+                 h->caplen == 0 ? "empty (no direction byte, no bytes)"
+                                : "no bytes after the direction byte");
         return TK_CAP_BAD;
     }
     if (d[0] != TK_CAP_FROM_GIMBAL && d[0] != TK_CAP_TO_GIMBAL) {

@@ -134,17 +134,21 @@ void tk_dec_tick(tk_dec_t *d, tk_stream_t *s, uint32_t now_ms)
     flush_out(d);
 }
 
-/* A record time in milliseconds (truncated). */
+/* A record time in milliseconds (truncated); seconds held to +-2^50 (35
+ * million years), so that no product or difference of two overflows (a
+ * hostile pcapng's if_tsoffset can give 2^62 s). */
 static int64_t time_ms64(const tk_time_t *t)
 {
-    return t->sec * 1000 + (int64_t)(t->usec / 1000u);
+    const int64_t lim = (int64_t)1 << 50;
+    int64_t sec = t->sec > lim ? lim : (t->sec < -lim ? -lim : t->sec);
+    return sec * 1000 + (int64_t)(t->usec / 1000u);
 }
 
 /* A record time on stream s's receiver clock (modulo 2^32): the record
  * time plus the steps back before it. */
 static uint32_t rx_ms(const tk_stream_t *s, const tk_time_t *t)
 {
-    return (uint32_t)(uint64_t)(time_ms64(t) + s->back_ms);
+    return (uint32_t)((uint64_t)time_ms64(t) + s->back_ms);
 }
 
 void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n, const tk_time_t *time)
@@ -155,7 +159,7 @@ void tk_dec_bytes(tk_dec_t *d, tk_stream_t *s, const uint8_t *data, size_t n, co
             /* a clock stepped back: no time passed (any step: one of
              * 2^31..2^32 ms wrapped into a long pause on the receiver's
              * 32-bit clock and cut a frame split across it) */
-            s->back_ms -= step;
+            s->back_ms += (uint32_t)(0u - (uint64_t)step);
         } else if (step >= (int64_t)0x80000000LL) {
             /* a pause of 2^31 ms (24.8 days) or more reads as no time on
              * the 32-bit clock: told of 2^30 ms of quiet first (a capture

@@ -349,9 +349,10 @@ typedef struct {
     tase_rx_stats_t seen;                /* rx.stats already added up */
     tk_time_t last;                      /* time of the last chunk */
     bool timed;                          /* last is known */
-    /* The record clock's steps back so far, added to the times fed to the
-     * receiver: a step back is no time (and no pause), as in replay. */
-    int64_t back_ms;
+    /* The record clock's steps back so far (modulo 2^32), added to the
+     * times fed to the receiver: a step back is no time (and no pause), as
+     * in replay. */
+    uint32_t back_ms;
     /* When the recent chunks ended (stream offset after each, and its
      * time): the receiver may decide a frame up to 253 bytes after its last
      * byte (a frame inside a longer candidate waits for that one to fail),

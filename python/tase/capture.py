@@ -496,6 +496,10 @@ class _Stream:
         self.dir = dir
         self.hist = collections.deque(maxlen=_HIST)
         self.last = None
+        # the record clock's steps back so far, added to the times fed to
+        # the receiver (as tase decode): a step back is no time, however
+        # far (one of 2^31..2^32 ms wrapped into a long pause)
+        self.back_ms = 0
 
     def _timed(self, packets, fallback):
         out = []
@@ -510,13 +514,16 @@ class _Stream:
         return out
 
     def bytes(self, data, t):
-        ms = (t // 1000) & 0xFFFFFFFF
+        step = 0 if self.last is None else t // 1000 - self.last // 1000
         out = []
-        if self.last is not None and t // 1000 - self.last // 1000 >= 1 << 31:
+        if step < 0:
+            self.back_ms -= step
+        elif step >= 1 << 31:
             # 2^31 ms or more reads as no time on the receiver's clock
             # (modulo 2^32): it is told of 2^30 ms of quiet first
-            quiet = (self.last // 1000 + (1 << 30)) & 0xFFFFFFFF
+            quiet = (self.last // 1000 + self.back_ms + (1 << 30)) & 0xFFFFFFFF
             out += self._timed(self.dec.tick(quiet), self.last)
+        ms = (t // 1000 + self.back_ms) & 0xFFFFFFFF
         out += self._timed(self.dec.tick(ms), self.last)
         self.last = t
         self.hist.append((self.dec.bytes + len(data), t))
@@ -590,6 +597,21 @@ class Capture:
         self.streams = {}
         self.records = 0
         frame = ffi.new("tase_can_frame_t *")
+        try:
+            yield from self._records(recs, frame)
+        except CaptureError:
+            # a file cut inside a record (a copy of one being written):
+            # what came before it first, the frames its receivers hold
+            # included, then the error (as tase decode)
+            for s in self.streams.values():
+                for p in s.finish():
+                    yield p.time, p
+            raise
+        for s in self.streams.values():
+            for p in s.finish():
+                yield p.time, p
+
+    def _records(self, recs, frame):
         for index, linktype, t, data, damage in recs:
             self.records += 1
             if damage:
@@ -597,7 +619,9 @@ class Capture:
                 continue
             if linktype == LINKTYPE_SERIAL:
                 if len(data) < 2:
-                    self.bad.append((index, "no bytes"))
+                    # tase decode's words
+                    self.bad.append((index, "no bytes after the direction byte" if data
+                                     else "empty (no direction byte, no bytes)"))
                     continue
                 if data[0] not in (0, 1):
                     self.bad.append((index, "bad direction byte 0x%02X" % data[0]))
@@ -638,9 +662,6 @@ class Capture:
                     % (self.path, linktype)
                 )
             for p in got:
-                yield p.time, p
-        for s in self.streams.values():
-            for p in s.finish():
                 yield p.time, p
 
 

@@ -783,12 +783,14 @@ class Link:
         timeout, retries = self._request_opts(timeout, retries)
         ms = min(max(1, int(round(timeout * 1000))), 2**31 - 1)
 
-        def ask(data):
+        def ask(data, second=False):
             # the answer of one transact (a Packet), or None after a timeout
+            # (the second look: after any error the library returns; a
+            # closed link or a transport error still raises)
             r = self._call(lib.tase_host_transact, self._host, req.group, req.type,
                            data if data else ffi.NULL, len(data), self._reply,
                            lib.TASE_DATA_MAX, ms, retries)
-            if r == lib.TASE_ETIMEOUT:
+            if r == lib.TASE_ETIMEOUT or (second and r < 0):
                 return None
             if r < 0:
                 raise error(r, "%s: %s" % (self.url, t.name))
@@ -805,11 +807,8 @@ class Link:
             # an answer that came after the send can be an earlier
             # request's (a late or repeated one, another gimbal): the
             # setting in force decides, asked once more (as `tase send`);
-            # when that fails, the echo that came stands
-            try:
-                echo = ask(b"") or echo
-            except Error:
-                pass
+            # when that goes unanswered, the echo that came stands
+            echo = ask(b"", second=True) or echo
         return echo
 
     # -- receiving

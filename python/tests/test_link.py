@@ -300,6 +300,42 @@ def test_a_gimbal_answering_twice_leaves_no_query_behind(silent_pty):
         t.join()
 
 
+def test_a_link_closed_during_the_second_look_raises(silent_pty):
+    # a review: the second look at a differing echo swallowed every error,
+    # so a link closed meanwhile returned the differing echo as success
+    url, master = silent_pty
+    link = tase.connect(url)
+    stop = threading.Event()
+
+    def gimbal():
+        buf, n = b"", 0
+        while not stop.is_set():
+            if not select.select([master], [], [], 0.05)[0]:
+                continue
+            buf += os.read(master, 4096)
+            got = tase.decode(buf)
+            for p in got[n:]:
+                if p.size > 0:  # the setting: an echo that differs
+                    d = bytearray(p.payload)
+                    d[0] += 1
+                    os.write(master, tase.Packet.from_data(p.group, p.type, bytes(d)).encode())
+                else:  # the second look: the link closed instead of an answer
+                    threading.Thread(target=link.close).start()
+                    return
+            n = len(got)
+
+    t = threading.Thread(target=gimbal, daemon=True)
+    t.start()
+    try:
+        with pytest.raises(tase.Error, match="closed"):
+            link.query(tase.Packet("SENSOR_FILTER", cutoff=10, decimation=5), timeout=0.5,
+                       retries=0)
+    finally:
+        stop.set()
+        t.join()
+        link.close()
+
+
 def test_spoi_on_a_line_that_echoes_is_not_taken_as_tracking(silent_pty):
     # our own SPOI_CMD back from a loop-back plug read as the gimbal's echo
     # (the same point): its flags are ours (0x80), not a SPOI mode

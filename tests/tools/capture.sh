@@ -145,11 +145,12 @@ check "decode --candump gives each packet its line's time (6 decimals): all $(wc
 $U bad-pcap "$dir/bad.pcap"
 "$TASE" decode "$dir/bad.pcap" >"$dir/bad.json" 2>"$dir/bad.err"
 rc=$?
-check "malformed records: exit 4, records 2 and 3 named, the two good ones decoded ($(tr '\n' '|' <"$dir/bad.err"))" \
-    eval '[ $rc -eq 4 ] && [ "$(wc -l <"$dir/bad.err")" -eq 3 ] &&
+check "malformed records: exit 4, records 2, 3 and 5 named, the two good ones decoded ($(tr '\n' '|' <"$dir/bad.err"))" \
+    eval '[ $rc -eq 4 ] && [ "$(wc -l <"$dir/bad.err")" -eq 4 ] &&
           grep -q "record 2 skipped: direction byte 0x07" "$dir/bad.err" &&
           grep -q "record 3 skipped: no bytes after the direction byte" "$dir/bad.err" &&
-          grep -q "2 bad records (the rest was decoded)" "$dir/bad.err" &&
+          grep -q "record 5 skipped: empty (no direction byte, no bytes)$" "$dir/bad.err" &&
+          grep -q "3 bad records (the rest was decoded)" "$dir/bad.err" &&
           [ "$(grep -c "\"name\":\"GIMBAL_ANGLE\",\"size\":6,\"fields\":{\"pan\":1000,\"tilt\":-500,\"roll\":0}" "$dir/bad.json")" = 2 ] &&
           grep -q "\"dir\":\"out\"" "$dir/bad.json" && grep -q "\"dir\":\"in\"" "$dir/bad.json"'
 python3 -c 'import struct,sys; open(sys.argv[1],"wb").write(struct.pack("<IHHiIII",0xA1B2C3D4,2,4,0,0,65535,1))' "$dir/eth.pcap"

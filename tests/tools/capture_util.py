@@ -32,8 +32,9 @@ checked against a writer other than its own.
         a whole GIMBAL_ANGLE behind a false start in its first.
   step-back OUT DAYS               a GIMBAL_ANGLE split over two records, the
         second stamped DAYS days earlier.
-  spb OUT                          a pcapng: a GEOREFERENCE_DATA split over
-        two timed records and a Simple Packet Block between them.
+  spb OUT [yes]                    a pcapng: a GEOREFERENCE_DATA split over
+        two timed records and a Simple Packet Block between them (yes: a
+        record of the other direction 500 ms later before the SPB).
   pty-pair A B                     two pseudo-terminals (symlinks A and B)
         joined like a null-modem cable, raw, until killed.
   compare-pdml PDML JSONL          the dissector's packets (tshark -T pdml)
@@ -200,6 +201,7 @@ def bad_pcap(out):
         f.write(pcap_record(T0, 2, b"\x07" + angle))  # record 2: direction 7
         f.write(pcap_record(T0, 3, b"\x00"))  # record 3: no bytes
         f.write(pcap_record(T0, 4, b"\x01" + angle))
+        f.write(pcap_record(T0, 5, b""))  # record 5: not even a direction byte
 
 
 def pty_pair(a, b):
@@ -538,12 +540,16 @@ def pcapng_block(btype, body):
     return struct.pack("<II", btype, len(body) + 12) + body + struct.pack("<I", len(body) + 12)
 
 
-def spb(out):
+def spb(out, other="no"):
     """A review: a GEOREFERENCE_DATA (63 bytes of data 0..62) from the
     gimbal split over three records of a pcapng, the middle one a Simple
     Packet Block (no time): an Enhanced Packet Block at T, the SPB, an EPB
     at T + 1 ms. Both tools must give the frame (the dissector took the
-    SPB's time as 1970, and the gap cut the frame)."""
+    SPB's time as 1970, and the gap cut the frame). other "yes": a record
+    to the gimbal at T + 500 ms comes before the SPB, whose time is then
+    that one's (the record before it, any direction): a 500 ms pause in
+    the frame, which both tools must judge alike (the dissector took its
+    own stream's time, T, and kept the frame)."""
     f = tase.Packet.from_data(0x10, 0x41, bytes(range(63))).encode()
     t0 = T0 * 10**6
 
@@ -555,6 +561,8 @@ def spb(out):
         fh.write(pcapng_block(0x0A0D0D0A, struct.pack("<IHHq", 0x1A2B3C4D, 1, 0, -1)))
         fh.write(pcapng_block(1, struct.pack("<HHI", LINKTYPE_SERIAL, 0, 65535)))
         fh.write(epb(t0, b"\x00" + f[:5]))
+        if other == "yes":
+            fh.write(epb(t0 + 500000, b"\x01" + gimbal_angle(1, 1)[1]))
         fh.write(pcapng_block(3, struct.pack("<I", 26) + b"\x00" + f[5:30]))
         fh.write(epb(t0 + 1000, b"\x00" + f[30:]))
 

@@ -227,6 +227,12 @@ dissect_opts=()
 $U spb "$dir/spb.pcapng"
 compare spb "a frame split across a pcapng Simple Packet Block" "$dir/spb.pcapng" "$dir/spb.pcapng"
 check "... the GEOREFERENCE_DATA" grep -q '"offset":0,.*"name":"GEOREFERENCE_DATA"' "$dir/spb.json"
+# ... and its time is the record's before it, of any direction (decode's):
+# a record to the gimbal 500 ms later before it is a pause in the frame
+$U spb "$dir/spb2.pcapng" yes
+compare spb2 "a Simple Packet Block after a record of the other direction 500 ms later" \
+    "$dir/spb2.pcapng" "$dir/spb2.pcapng"
+check "... a pause: no GEOREFERENCE_DATA" eval '! grep -q GEOREFERENCE_DATA "$dir/spb2.json"'
 
 # A differential review: a valid 38-byte frame of an unknown type carrying
 # a whole GIMBAL_ANGLE, its last 18 bytes 20.9996 ms after its first 20
@@ -288,7 +294,8 @@ $U bad-pcap "$dir/bad.pcap"
 dissect "$dir/bad.pcap" -T fields -e frame.number -e _ws.expert.message -e tase.name >"$dir/bad.txt"
 check "serial records with direction byte 0x07 and with no bytes after it flagged, the good ones dissected" \
     eval 'grep -q "^2	unknown direction byte" "$dir/bad.txt" &&
-          grep -q "^3	no bytes after the direction byte" "$dir/bad.txt" &&
+          grep -q "^3	no datalink bytes in the record" "$dir/bad.txt" &&
+          grep -q "^5	no datalink bytes in the record" "$dir/bad.txt" &&
           [ "$(grep -c "GIMBAL_ANGLE" "$dir/bad.txt")" = 2 ]'
 n=$(dissect "$dir/noisy.pcap" -Y 'tase.gimbal_angle.tilt == -4500 && tase.dir == "in"' | grep -c .)
 check "display filter on a field and the direction: $n frame (the 'in' GIMBAL_ANGLE with tilt -4500)" \

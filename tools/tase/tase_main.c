@@ -175,7 +175,8 @@ static const char usage_record[] =
     "  --tap-in DEV2  a second device on the other line of a tap: its bytes are\n"
     "                 recorded as sent to the gimbal\n"
     "  --can IFACE    every frame on the bus, as SocketCAN records\n"
-    "'tase decode FILE' decodes it; Wireshark reads it (tools/wireshark/tase.lua).\n";
+    "'tase decode FILE' decodes it; Wireshark reads it with the dissector tase.lua\n"
+    "(tools/wireshark/ in the source, /usr/share/tase/ from the tase-tools package).\n";
 
 static const char usage_replay[] =
     "usage: tase replay FILE (--serial DEV [--baud N] | --can IFACE) --dir out|in|all\n"

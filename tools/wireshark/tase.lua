@@ -237,7 +237,7 @@ local E = {
         expert.group.MALFORMED, expert.severity.ERROR),
     wrong_length = ProtoExpert.new("tase.wrong_length", "wrong data length for this packet type",
         expert.group.MALFORMED, expert.severity.WARN),
-    no_bytes = ProtoExpert.new("tase_serial.no_bytes", "no bytes after the direction byte "
+    no_bytes = ProtoExpert.new("tase_serial.no_bytes", "no datalink bytes in the record "
         .. "(tase decode skips such a record as bad)", expert.group.MALFORMED,
         expert.severity.ERROR),
     merged = ProtoExpert.new("tase.interfaces_merged", "reassembled with the streams of every " ..
@@ -291,11 +291,13 @@ end
 -- flush of its stream would give, recomputed while the capture grows.
 local streams, ended, decided, tails
 local ifaces -- packet number -> the capture interface its stream was keyed by
+local last_ts -- the time of the last packet fed (any stream), for one without
 
 -- Called by Wireshark before each (re)dissection of a capture.
 local function reset()
     streams = {} -- key -> {buf, base, pos, hist, dirty, tail_nums}
     ended, decided, tails, ifaces = {}, {}, {}, {}
+    last_ts = nil
 end
 tase.init = reset
 reset()
@@ -398,13 +400,15 @@ local function feed(key, chunk, num, ts, rate)
         st = {buf = "", base = 0, pos = 0, hist = {}, tail_nums = {}}
         streams[key] = st
     end
-    local out, now = {}, ms_of(ts)
-    if ts == 0 and st.last_ms ~= nil then
+    if ts == 0 and last_ts ~= nil then
         -- a pcapng Simple Packet Block has no time (Wireshark gives 0):
-        -- the time of the stream's packet before, as tase decode takes it
-        -- (from 1970, the gap cut a frame split across it)
-        now = st.last_ms
+        -- the time of the packet before it, of any stream, as tase decode
+        -- takes it (the packet came after that one; from 1970, the gap cut
+        -- a frame split across it)
+        ts = last_ts
     end
+    last_ts = ts
+    local out, now = {}, ms_of(ts)
     if st.last_ms ~= nil then
         local limit = quiet_limit(st, rate)
         if limit ~= nil and now - st.last_ms > limit then
@@ -602,7 +606,12 @@ end
 
 function tase_serial.dissector(tvb, pinfo, tree)
     local t = tree:add(tase_serial, tvb(), "TASE serial capture record")
-    if tvb:len() < 1 then return 0 end
+    if tvb:len() < 1 then -- not even a direction byte
+        t:add_proto_expert_info(E.no_bytes)
+        pinfo.cols.protocol = "TASE"
+        pinfo.cols.info = "empty record"
+        return 0
+    end
     t:add(F.serial_dir, tvb(0, 1))
     local dir = DIR_NAMES[tvb(0, 1):uint()]
     if dir == nil then
