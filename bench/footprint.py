@@ -193,6 +193,7 @@ ROLE_ROOTS = [
     ("tase_gimbal_send_msg", None, None),
     ("tase_host_feed", "host_rx", None),
     ("tase_host_service", "host_rx", None),
+    ("tase_host_drain", "host_rx", None),
     ("tase_host_poll", None, None),
     ("tase_host_send_msg", None, None),
     ("tase_port_send_frame", None, None),
