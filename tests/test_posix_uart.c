@@ -37,17 +37,6 @@ static bool in_storm(int fd)
     return fd >= 0 && fd == storm_fd && (int32_t)(tase_posix_now_ms() - storm_until_ms) < 0;
 }
 
-ssize_t read(int fd, void *buf, size_t n)
-{
-    ssize_t (*real)(int, void *, size_t);
-    if (in_storm(fd)) {
-        errno = EINTR;
-        return -1;
-    }
-    *(void **)&real = dlsym(RTLD_NEXT, "read");
-    return real(fd, buf, n);
-}
-
 ssize_t write(int fd, const void *buf, size_t n)
 {
     ssize_t (*real)(int, const void *, size_t);
@@ -57,6 +46,62 @@ ssize_t write(int fd, const void *buf, size_t n)
     }
     *(void **)&real = dlsym(RTLD_NEXT, "write");
     return real(fd, buf, n);
+}
+
+/* ---- a review's faults: a descriptor whose read() brings nothing
+ * although poll() says it is readable (another reader of a shared line
+ * took the bytes), a clock that stands still or cannot be read, an output
+ * queue that never drains (TIOCOUTQ). */
+static int empty_reads_fd = -1;
+static int stuck_outq_fd = -1;
+static int clock_mode; /* 0 the system's, 1 frozen, 2 failing */
+
+ssize_t read(int fd, void *buf, size_t n)
+{
+    ssize_t (*real)(int, void *, size_t);
+    if (in_storm(fd)) {
+        errno = EINTR;
+        return -1;
+    }
+    if (fd >= 0 && fd == empty_reads_fd) {
+        return 0;
+    }
+    *(void **)&real = dlsym(RTLD_NEXT, "read");
+    return real(fd, buf, n);
+}
+
+int clock_gettime(clockid_t id, struct timespec *ts)
+{
+    int (*real)(clockid_t, struct timespec *);
+    if (clock_mode == 1) {
+        ts->tv_sec = 1000;
+        ts->tv_nsec = 0;
+        return 0;
+    }
+    if (clock_mode == 2) {
+        ts->tv_sec = 12345; /* what an unchecked caller would take */
+        ts->tv_nsec = 678000000L;
+        errno = EPERM;
+        return -1;
+    }
+    *(void **)&real = dlsym(RTLD_NEXT, "clock_gettime");
+    return real(id, ts);
+}
+
+int ioctl(int fd, unsigned long req, ...)
+{
+    int (*real)(int, unsigned long, void *);
+    void *arg;
+    va_list ap;
+    va_start(ap, req);
+    arg = va_arg(ap, void *);
+    va_end(ap);
+    if (fd >= 0 && fd == stuck_outq_fd && req == TIOCOUTQ) {
+        *(int *)arg = 100;
+        return 0;
+    }
+    *(void **)&real = dlsym(RTLD_NEXT, "ioctl");
+    return real(fd, req, arg);
 }
 
 /* glibc declares poll()'s array write-only (access attribute), so gcc
@@ -146,6 +191,98 @@ static void bytes_cross_the_pty_unchanged_in_both_directions(void **state)
     assert_int_equal(a.fd, -1);
     assert_int_equal(tase_posix_uart_close(&a), TASE_OK); /* idempotent */
     close(p.slave);
+}
+
+/* Wall-clock milliseconds, from the real clock whatever clock_mode says. */
+static uint32_t real_ms(void)
+{
+    struct timespec ts;
+    int (*real)(clockid_t, struct timespec *);
+    *(void **)&real = dlsym(RTLD_NEXT, "clock_gettime");
+    assert_int_equal(real(CLOCK_MONOTONIC, &ts), 0);
+    return (uint32_t)((uint64_t)ts.tv_sec * 1000u + (uint64_t)ts.tv_nsec / 1000000u);
+}
+
+/* A review: poll() said readable but read() brought nothing (another
+ * reader of a shared line takes the bytes): the read looped for ever. It
+ * ends as an idle line at its timeout, and with a clock that stands still
+ * after a bounded number of looks. (alarm(): a hang kills the test.) */
+static void a_readable_line_that_reads_nothing_ends_the_read(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a;
+    tase_port_t pa;
+    uint8_t buf[16];
+    uint32_t t0;
+    int mode;
+    (void)state;
+    pty_open(&p);
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 57600), TASE_OK);
+    pa = tase_posix_uart_port(&a);
+    assert_int_equal(write(p.master, "abc", 3), 3); /* readable for good */
+    empty_reads_fd = a.fd;
+    alarm(10);
+    for (mode = 0; mode <= 1; mode++) {
+        clock_mode = mode;
+        t0 = real_ms();
+        assert_int_equal(pa.ops->read(pa.ctx, buf, sizeof buf, 100), 0);
+        clock_mode = 0;
+        assert_true(real_ms() - t0 < 2000u);
+    }
+    alarm(0);
+    empty_reads_fd = -1;
+    assert_int_equal(pa.ops->read(pa.ctx, buf, sizeof buf, 100), 3); /* the bytes are there */
+    assert_int_equal(tase_posix_uart_close(&a), TASE_OK);
+    pty_close(&p);
+}
+
+/* A review: with a clock that stands still a write to a full line waited
+ * for ever (only the clock ended the wait, not poll() timing out), and so
+ * did close() on an output queue that does not drain. Both end within
+ * their bound in real time. */
+static void a_clock_that_stands_still_ends_a_blocked_write_and_close(void **state)
+{
+    pty_t p;
+    tase_posix_uart_t a;
+    tase_port_t pa;
+    static uint8_t big[1 << 16];
+    uint32_t t0;
+    int r;
+    (void)state;
+    pty_open(&p);
+    assert_int_equal(tase_posix_uart_open(&a, p.name, 57600), TASE_OK);
+    pa = tase_posix_uart_port(&a);
+    a.write_timeout_ms = 100;
+    alarm(10);
+    /* fill the line: nobody reads the master */
+    while (pa.ops->write(pa.ctx, big, sizeof big) == (int)sizeof big) {
+    }
+    clock_mode = 1;
+    t0 = real_ms();
+    r = pa.ops->write(pa.ctx, big, sizeof big);
+    clock_mode = 0;
+    assert_true(r == TASE_EAGAIN || (r >= 0 && r < (int)sizeof big));
+    assert_true(real_ms() - t0 < 2000u);
+    stuck_outq_fd = a.fd; /* bytes queued that never leave */
+    clock_mode = 1;
+    t0 = real_ms();
+    assert_int_equal(tase_posix_uart_close(&a), TASE_OK);
+    clock_mode = 0;
+    stuck_outq_fd = -1;
+    assert_true(real_ms() - t0 < 2000u);
+    alarm(0);
+    pty_close(&p);
+}
+
+/* A review: a clock_gettime() that fails (a sandbox refusing it) left the
+ * time computed from an uninitialised timespec: it reads as 0. */
+static void a_clock_that_cannot_be_read_is_0(void **state)
+{
+    (void)state;
+    clock_mode = 2;
+    assert_int_equal(tase_posix_now_ms(), 0u);
+    clock_mode = 0;
+    assert_true(tase_posix_now_ms() != 0u || real_ms() == 0u);
 }
 
 static void read_waits_for_the_timeout_and_no_longer(void **state)
@@ -853,6 +990,9 @@ int main(void)
         cmocka_unit_test(the_kernel_refuses_other_opens_while_the_port_is_open),
         cmocka_unit_test(another_programs_tiocexcl_is_busy_and_left_alone),
         cmocka_unit_test(close_gives_the_device_back_with_the_settings_it_had),
+        cmocka_unit_test(a_readable_line_that_reads_nothing_ends_the_read),
+        cmocka_unit_test(a_clock_that_stands_still_ends_a_blocked_write_and_close),
+        cmocka_unit_test(a_clock_that_cannot_be_read_is_0),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -43,9 +43,9 @@
  *  still holds, then TASE_EIO; write() returns TASE_EIO. (A Linux tty's
  *  hang-up discards its input queue, so bytes that came just before it
  *  can be gone; a pty master keeps them. A write to a pty master whose
- *  peer closed is taken until the kernel's queue is full, about 12 KB,
- *  then fails.) The port does not reopen anything: close it, and open it
- *  again when the device is back.
+ *  peer closed is taken until the kernel's queue is full (12 to 20 KB
+ *  measured, by kernel), then fails.) The port does not reopen anything:
+ *  close it, and open it again when the device is back.
  *
  *  CLOCK. now_ms is monotonic milliseconds that wrap modulo 2^32. Compare
  *  times with unsigned subtraction, and treat a difference of 2^31 or more

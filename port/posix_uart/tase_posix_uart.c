@@ -100,7 +100,9 @@ bool tase_posix_uart_baud_supported(uint32_t baud)
 uint32_t tase_posix_now_ms(void)
 {
     struct timespec ts;
-    (void)clock_gettime(CLOCK_MONOTONIC, &ts);
+    if (clock_gettime(CLOCK_MONOTONIC, &ts) != 0) {
+        return 0u; /* no clock (a sandbox refusing it): time stands still */
+    }
     return (uint32_t)((uint64_t)ts.tv_sec * 1000u + (uint64_t)ts.tv_nsec / 1000000u);
 }
 
@@ -217,10 +219,11 @@ static void drain_bounded(int fd, uint32_t timeout_ms)
 {
 #ifdef TIOCOUTQ
     uint32_t start = tase_posix_now_ms();
+    uint32_t naps = 0; /* 2 ms each: the bound also when the clock stands still */
     int queued = 0;
     while (ioctl(fd, TIOCOUTQ, &queued) == 0 && queued > 0) {
         struct timespec ts = {0, 2000000L};
-        if ((uint32_t)(tase_posix_now_ms() - start) >= timeout_ms) {
+        if ((uint32_t)(tase_posix_now_ms() - start) >= timeout_ms || naps++ >= timeout_ms / 2u) {
             (void)tcflush(fd, TCOFLUSH);
             return;
         }
@@ -329,6 +332,10 @@ int tase_posix_uart_close(tase_posix_uart_t *u)
     return r == 0 ? TASE_OK : TASE_EIO;
 }
 
+/* Times read() may find nothing after poll() said the line is readable
+ * before the call ends as an idle line, when the clock does not move. */
+#define POSIX_UART_READY_SPINS 1024u
+
 /* Milliseconds left of `total` since `start`, 0 when spent. */
 static int time_left(uint32_t start, uint32_t total)
 {
@@ -380,6 +387,9 @@ static int uart_write(void *ctx, const uint8_t *data, size_t n)
         if (pr < 0 && errno != EINTR) {
             return TASE_EIO;
         }
+        if (pr == 0) {
+            break; /* poll() waited the time left (also when the clock stands still) */
+        }
         /* A pty master whose peer closed reports POLLHUP without POLLOUT
          * at once: without this test the loop spun until the bound. */
         if (pr > 0 && (pfd.revents & POLLOUT) == 0 &&
@@ -395,6 +405,7 @@ static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
     tase_posix_uart_t *u = ctx;
     uint32_t start = tase_posix_now_ms();
     bool hangup = false;
+    unsigned ready_empty = 0; /* poll() said readable, read() brought nothing */
 
     if (u == NULL || u->fd < 0 || buf == NULL || cap == 0) {
         return TASE_EARG;
@@ -440,6 +451,13 @@ static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
          * bytes still queued, then fail. */
         if (pr > 0 && (pfd.revents & (POLLHUP | POLLERR | POLLNVAL)) != 0) {
             hangup = true;
+        } else if (pr > 0 && ++ready_empty > 1u &&
+                   (left == 0 || ready_empty > POSIX_UART_READY_SPINS)) {
+            /* readable, yet read() brought nothing again (another reader
+             * of a shared line took the bytes): with no time left, or a
+             * clock that stands still, it ends as an idle line (it spun
+             * for ever) */
+            return 0;
         }
     }
 }

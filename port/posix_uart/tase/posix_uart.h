@@ -54,7 +54,9 @@
  *          still queued, and also with timeout_ms 0) or TASE_EARG (ctx
  *          NULL or closed, buf NULL, cap 0). A cap above INT32_MAX reads at most
  *          INT32_MAX bytes.
- *  now_ms  CLOCK_MONOTONIC in milliseconds, modulo 2^32.
+ *  now_ms  CLOCK_MONOTONIC in milliseconds, modulo 2^32; 0 when the clock
+ *          cannot be read (clock_gettime() fails: time stands still, and
+ *          every wait above still ends, bounded by poll()).
  * One instance is used from one thread at a time; separate instances are
  * independent.
  */
