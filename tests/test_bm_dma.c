@@ -259,11 +259,19 @@ static void overruns_far_behind_and_past_2_32_resume_at_the_dmas_index(void **st
     got.n = 0;
     (void)tase_rx_init(&rx);
     assert_int_equal(tase_bm_dma_init(&rd, buf, sizeof buf), TASE_OK);
-    /* the DMA ran on alone for 2^32 - 1000 bytes (more than 2^31) */
-    dma.total = 0x100000000u - 1000u - 300u;
+    /* the DMA ran on alone for 2^31 bytes (`written` 2^31 behind the
+     * reader reads as far ahead: the farthest overrun), then for another
+     * 2^31 - 1000 (2^32 - 1000 in all: in one step it would read as 1000
+     * behind, a stale sample) */
+    dma.total = 0x80000000u - 300u;
     dma64_write(&dma, 300);
     assert_true(tase_bm_dma_poll(&rd, (uint32_t)dma.total, 0, &rx, on_frame, &got) >= 0);
     assert_int_equal(rd.stats.overruns, 1);
+    assert_true(rd.stats.lost_bytes == 0x80000000u);
+    dma.total = 0x100000000u - 1000u - 300u;
+    dma64_write(&dma, 300);
+    assert_true(tase_bm_dma_poll(&rd, (uint32_t)dma.total, 0, &rx, on_frame, &got) >= 0);
+    assert_int_equal(rd.stats.overruns, 2);
     assert_true(rd.stats.lost_bytes == 0x100000000u - 1000u);
     frames = dma64_run(&dma, &rd, &rx, &got, 50); /* 2,000 bytes: across 2^32 */
     assert_true(frames >= 2000u / 16u - 2u);
@@ -271,16 +279,98 @@ static void overruns_far_behind_and_past_2_32_resume_at_the_dmas_index(void **st
     /* an overrun after the wrap: the reader resumes at the DMA's index */
     dma64_write(&dma, 350);
     assert_true(tase_bm_dma_poll(&rd, (uint32_t)dma.total, 60, &rx, on_frame, &got) >= 0);
-    assert_int_equal(rd.stats.overruns, 2);
+    assert_int_equal(rd.stats.overruns, 3);
     frames = dma64_run(&dma, &rd, &rx, &got, 100); /* 4,000 bytes */
     assert_true(frames >= 4000u / 16u - 2u);
-    assert_int_equal(rd.stats.overruns, 2);
+    assert_int_equal(rd.stats.overruns, 3);
     /* and every frame delivered is one of the stream's (data[0] = type) */
     for (i = 0; i < got.n; i++) {
         assert_int_equal(got.f[i].group, 0x08);
         assert_int_equal(got.f[i].len, 8);
         assert_int_equal(got.f[i].sum, got.f[i].type);
     }
+}
+
+/* The reader's state (its stats included) is what it was. */
+static void assert_unchanged(const tase_bm_dma_t *a, const tase_bm_dma_t *b)
+{
+    assert_ptr_equal(a->buf, b->buf);
+    assert_int_equal(a->size, b->size);
+    assert_int_equal(a->pos, b->pos);
+    assert_int_equal(a->read, b->read);
+    assert_int_equal(a->stats.bytes_fed, b->stats.bytes_fed);
+    assert_int_equal(a->stats.overruns, b->stats.overruns);
+    assert_int_equal(a->stats.lost_bytes, b->stats.lost_bytes);
+}
+
+/* A review: a sample more than `size` (but under 2^31) behind the reader
+ * (a lap count read one lap off) was taken for an overrun of about 2^32
+ * bytes (lost_bytes + 4294967231 at 65 behind on 64 bytes), moved the
+ * reader back to it, and the next good sample, 10 bytes on, was a second
+ * overrun. Any sample behind is stale: nothing read, nothing counted. */
+static void a_sample_behind_by_under_2_31_is_stale_however_far(void **state)
+{
+    static uint8_t stream[1024];
+    static uint8_t buf[64];
+    static log_t got;
+    uint8_t d[8] = {0};
+    tase_rx_t rx;
+    tase_bm_dma_t rd, was;
+    dma_t dma = {buf, sizeof buf, 0};
+    uint32_t in;
+    size_t n = 0;
+    unsigned i;
+    (void)state;
+    for (i = 0; i < 60u; i++) { /* 16-byte frames, type = index */
+        d[0] = (uint8_t)i;
+        n += (size_t)tase_frame_build(0x08, (uint8_t)i, d, 8, &stream[n], sizeof stream - n);
+    }
+    got.n = 0;
+    (void)tase_rx_init(&rx);
+    assert_int_equal(tase_bm_dma_init(&rd, buf, sizeof buf), TASE_OK);
+    dma_write(&dma, stream, 48);
+    assert_int_equal(tase_bm_dma_poll(&rd, dma.written, 0, &rx, on_frame, &got), 3);
+    dma_write(&dma, stream, 54); /* frames 3..5 and 6 bytes of frame 6 */
+    assert_int_equal(tase_bm_dma_poll(&rd, dma.written, 0, &rx, on_frame, &got), 3);
+    assert_int_equal(rd.read, 102);
+    was = rd;
+    in = rx.stats.bytes_in;
+    /* 65 behind (more than the 64 of the buffer): stale */
+    assert_int_equal(tase_bm_dma_poll(&rd, 102u - 65u, 0, &rx, on_frame, &got), 0);
+    assert_unchanged(&rd, &was);
+    assert_int_equal(rx.stats.bytes_in, in);
+    assert_int_equal(got.n, 6);
+    /* the next good sample, 10 bytes on from the real position: those 10
+     * bytes, which end frame 6 */
+    dma_write(&dma, stream, 10);
+    assert_int_equal(tase_bm_dma_poll(&rd, dma.written, 0, &rx, on_frame, &got), 1);
+    assert_int_equal(got.n, 7);
+    assert_int_equal(got.f[6].type, 6);
+    assert_int_equal(got.f[6].offset, 96);
+    assert_int_equal(rx.stats.bytes_in, in + 10u);
+    assert_int_equal(rd.stats.bytes_fed, 112);
+    assert_int_equal(rd.stats.overruns, 0);
+    assert_int_equal(rd.stats.lost_bytes, 0);
+    /* 2^31 - 1 behind, the farthest stale sample: nothing either */
+    was = rd;
+    assert_int_equal(tase_bm_dma_poll(&rd, 112u - 0x7FFFFFFFu, 0, &rx, on_frame, &got), 0);
+    assert_unchanged(&rd, &was);
+    /* a stale sample, then the DMA really laps (100 > 64 bytes on): that
+     * sample is an overrun of those 100 bytes */
+    assert_int_equal(tase_bm_dma_poll(&rd, 112u - 100u, 0, &rx, on_frame, &got), 0);
+    assert_unchanged(&rd, &was);
+    dma_write(&dma, stream, 100);
+    assert_int_equal(tase_bm_dma_poll(&rd, dma.written, 0, &rx, on_frame, &got), 0);
+    assert_int_equal(rd.stats.overruns, 1);
+    assert_int_equal(rd.stats.lost_bytes, 100);
+    assert_int_equal(rd.read, 212);
+    assert_int_equal(rd.pos, 212u % 64u);
+    /* exactly 2^31 behind reads as 2^31 ahead: an overrun */
+    assert_int_equal(tase_bm_dma_poll(&rd, 212u - 0x80000000u, 0, &rx, on_frame, &got), 0);
+    assert_int_equal(rd.stats.overruns, 2);
+    assert_true(rd.stats.lost_bytes == 100u + 0x80000000u);
+    assert_true(rd.read == 212u + 0x80000000u);
+    assert_int_equal(rd.stats.bytes_fed, 112);
 }
 
 /* The time bound: noise then a frame, then nothing: the frame comes out
@@ -364,6 +454,7 @@ int main(void)
         cmocka_unit_test(any_split_gives_the_frames_of_one_feed),
         cmocka_unit_test(a_lap_is_reported_and_loses_only_what_was_overwritten),
         cmocka_unit_test(overruns_far_behind_and_past_2_32_resume_at_the_dmas_index),
+        cmocka_unit_test(a_sample_behind_by_under_2_31_is_stale_however_far),
         cmocka_unit_test(an_empty_poll_ticks_the_time_bound),
         cmocka_unit_test(bad_arguments_and_a_busy_receiver_read_nothing),
     };

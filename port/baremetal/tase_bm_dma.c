@@ -50,11 +50,14 @@ int tase_bm_dma_poll(tase_bm_dma_t *d, uint32_t written, uint32_t now_ms, tase_r
     }
     frames = r; /* the probe may finish a scan the last call left pending */
     fresh = written - d->read;
-    if (fresh > d->size && (uint32_t)(d->read - written) <= d->size) {
-        /* A stale sample (at most a lap behind what was read: the DMA
-         * cannot run backwards). A lag beyond that is an overrun below: 2^31
-         * bytes or more behind read as "stale" and nothing was read for
-         * another 2^31 bytes. */
+    if (fresh > 0x80000000u) {
+        /* `written` 1..2^31-1 behind what was read: a stale sample (a lap
+         * count one lap off), as the DMA cannot run backwards, however far
+         * behind (also more than `size`). Nothing is read or counted and
+         * the reader stays where it is: the next good sample catches up,
+         * and if the DMA really lapped, that one is more than `size` ahead
+         * (below). 2^31 or more behind reads as far ahead (the count wraps
+         * at 2^32; size <= 2^31): an overrun if more than `size`. */
         fresh = 0;
     }
     if (fresh > d->size) {

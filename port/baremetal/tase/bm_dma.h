@@ -25,8 +25,8 @@
  *         tase_bm_dma_init(&rxd, dma_buf, sizeof dma_buf);
  *         HAL_UART_Receive_DMA(&huart3, dma_buf, sizeof dma_buf);  // circular
  *     }
- *     // from the main loop (or the IDLE-line interrupt, with on_frame
- *     // safe there):
+ *     // from the main loop, or an interrupt (IDLE line) below the TC
+ *     // interrupt's priority with on_frame safe there (see below):
  *     void uart_rx_poll(uint32_t now_ms)
  *     {
  *         uint32_t laps;
@@ -43,9 +43,19 @@
  * modulo 2^32: laps * size + its position. Read the two consistently (a
  * transfer-complete interrupt between reading the counter and the laps
  * gives a position one lap off: read laps, the counter, laps again, and
- * retry if the laps changed). A DMA without a lap count can pass its
- * position alone, as long as the caller polls at least once per `size`
- * bytes (then a lap cannot be detected, only avoided).
+ * retry if the laps changed). The laps must also be current: a poll that
+ * the transfer-complete (TC) interrupt cannot preempt (an interrupt at
+ * its priority or above) can run while a TC is pending, the counter
+ * wrapped and dma_laps not yet counted: its samples are a lap behind,
+ * stale (nothing read; the bytes come with the first poll after the TC
+ * ran), and what overfills the buffer meanwhile is lost. Poll from the
+ * main loop or a context below the TC interrupt's priority, or read the
+ * TC pending flag with the counter (STM32: the channel's TCIF; read it,
+ * the counter, it again, retry if it changed; if set, the counter has
+ * wrapped and laps + 1 is the count). A DMA without a lap count can keep
+ * `written` itself, adding the position's advance modulo `size` at each
+ * poll, as long as it polls at least once per `size` bytes (then a lap
+ * cannot be detected, only avoided).
  *
  * SPLITS ARE INVISIBLE. Feeding a stream in any split (one span, two at
  * the wrap, a byte at a time) gives the receiver exactly the same frames,
@@ -77,9 +87,10 @@
  * loop, also when nothing arrived, so that noise cannot hold a command.
  *
  * CONTEXT: one context per instance (the main loop, or the one interrupt
- * that polls); on_frame runs inside tase_bm_dma_poll(). No heap, no
- * globals; two 32-bit remainders on an overrun, no other division.
- * O(bytes fed) per call plus the receiver's costs.
+ * that polls, below the TC interrupt's priority: WIRING IT UP); on_frame
+ * runs inside tase_bm_dma_poll(). No heap, no globals; two 32-bit
+ * remainders on an overrun, no other division. O(bytes fed) per call
+ * plus the receiver's costs.
  */
 #ifndef TASE_BM_DMA_H
 #define TASE_BM_DMA_H
@@ -119,10 +130,13 @@ int tase_bm_dma_init(tase_bm_dma_t *d, const uint8_t *buf, uint32_t size);
  * of frames delivered (by the feed, an overrun's flush and the tick), or
  * TASE_EARG (d, rx NULL or d not initialised; nothing read), or the
  * receiver's error (TASE_EBUSY when called from rx's own callback:
- * nothing read, call again later). `written` going backwards by at most
- * `size` (a stale sample) reads nothing; more than `size` ahead, however
- * far (the count wraps at 2^32: 2^31 or more behind is far ahead), is an
- * overrun. */
+ * nothing read, call again later). `written` behind what was read by
+ * any amount under 2^31 (a stale sample: the DMA cannot run backwards)
+ * reads nothing: nothing fed or counted, d unchanged, rx ticked as on an
+ * empty poll; the next good sample catches up. More than `size` ahead
+ * is an overrun (OVERRUN above), up to 2^31 ahead (the count wraps at
+ * 2^32: 2^31 or more behind reads as ahead, more than 2^31 ahead as
+ * behind: poll at least once per 2^31 bytes). */
 int tase_bm_dma_poll(tase_bm_dma_t *d, uint32_t written, uint32_t now_ms, tase_rx_t *rx,
                      tase_rx_handler_t on_frame, void *user);
 
