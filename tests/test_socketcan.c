@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include <errno.h>
+#include <limits.h>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/syscall.h>
@@ -57,6 +58,27 @@ ssize_t recvmsg(int fd, struct msghdr *msg, int flags)
 ssize_t write(int fd, const void *buf, size_t n)
 {
     return injected(&inject_write) ? -1 : (ssize_t)syscall(SYS_write, fd, buf, n);
+}
+
+/* The clock: CLOCK_MONOTONIC stands still at 1000 s with frozen_clock,
+ * and every clock fails with failing_clock (after writing garbage into
+ * *ts, as a caller must not read it). Unarmed, the system call. */
+static bool frozen_clock, failing_clock;
+
+int clock_gettime(clockid_t id, struct timespec *ts)
+{
+    if (failing_clock) {
+        ts->tv_sec = 12345;
+        ts->tv_nsec = 678000000L;
+        errno = EINVAL;
+        return -1;
+    }
+    if (frozen_clock && id == CLOCK_MONOTONIC) {
+        ts->tv_sec = 1000;
+        ts->tv_nsec = 0;
+        return 0;
+    }
+    return (int)syscall(SYS_clock_gettime, id, ts);
 }
 
 static void open_pair(pair_t *p, tase_can_role_t role)
@@ -621,6 +643,176 @@ static void a_signal_storm_does_not_turn_a_full_queue_into_an_io_error(void **st
     close_pair(&p);
 }
 
+/* ---- every wait ends ------------------------------------------------- */
+
+#define HUNG (-1000)
+
+static long real_ms(void)
+{
+    struct timespec ts;
+    assert_int_equal(syscall(SYS_clock_gettime, CLOCK_MONOTONIC, &ts), 0);
+    return (long)ts.tv_sec * 1000L + ts.tv_nsec / 1000000L;
+}
+
+/* Runs call(p) in a child process, so that a call that never returns
+ * cannot hang the suite (and the clock and fault flags it sets stay
+ * there): the call's result, or HUNG when it had not returned after
+ * limit_ms (the child is killed). *took_ms: the real time it took. */
+static int bounded_call(int (*call)(pair_t *), pair_t *p, long limit_ms, long *took_ms)
+{
+    int fds[2];
+    int rc = HUNG;
+    int status = 0;
+    long t0 = real_ms();
+    pid_t pid, done = 0;
+    assert_int_equal(pipe(fds), 0);
+    pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        int r = call(p);
+        inject_write.count = 0; /* the result goes through write() */
+        close(fds[0]);
+        _exit(write(fds[1], &r, sizeof r) == (ssize_t)sizeof r ? 0 : 1);
+    }
+    close(fds[1]);
+    while (real_ms() - t0 < limit_ms) {
+        done = waitpid(pid, &status, WNOHANG);
+        if (done != 0) {
+            break;
+        }
+        usleep(2000);
+    }
+    *took_ms = real_ms() - t0;
+    if (done == 0) {
+        kill(pid, SIGKILL);
+        assert_int_equal(waitpid(pid, &status, 0), pid);
+    } else {
+        assert_int_equal(done, pid);
+        if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+            assert_int_equal(read(fds[0], &rc, sizeof rc), (ssize_t)sizeof rc);
+        }
+    }
+    close(fds[0]);
+    return rc;
+}
+
+static int idle_read_frozen(pair_t *p)
+{
+    uint8_t b[16];
+    frozen_clock = true;
+    return tase_socketcan_read(&p->s, b, sizeof b, 100);
+}
+
+static int write_full_frozen(pair_t *p)
+{
+    uint8_t wire[TASE_FRAME_MAX];
+    int n = make_packet(wire, 0x42, 10);
+    frozen_clock = true;
+    p->s.tx_timeout_ms = 100;
+    return tase_socketcan_write(&p->s, wire, (size_t)n);
+}
+
+static int write_enobufs_frozen(pair_t *p)
+{
+    static const uint8_t d[3] = {0x00, 0xFF, 0x5A};
+    frozen_clock = true;
+    inject_write.err = ENOBUFS;
+    inject_write.count = INT_MAX;
+    p->s.tx_timeout_ms = 50;
+    return tase_socketcan_write(&p->s, d, 3);
+}
+
+static int read_eintr_storm(pair_t *p)
+{
+    uint8_t b[16];
+    inject_recvmsg.err = EINTR;
+    inject_recvmsg.count = INT_MAX;
+    return tase_socketcan_read(&p->s, b, sizeof b, 50);
+}
+
+static int write_eintr_storm(pair_t *p)
+{
+    static const uint8_t d[3] = {0x00, 0xFF, 0x5A};
+    inject_write.err = EINTR;
+    inject_write.count = INT_MAX;
+    p->s.tx_timeout_ms = 50;
+    return tase_socketcan_write(&p->s, d, 3);
+}
+
+/* A clock that stands still: a poll() that timed out after the time left
+ * went round again with the same time left, for ever (an idle read, a
+ * write to a peer that never reads), and the ENOBUFS sleeps waited for the
+ * clock to reach the deadline. Each ends after its bound now. */
+static void an_idle_read_ends_with_a_clock_that_stands_still(void **state)
+{
+    pair_t p;
+    long took;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    assert_int_equal(bounded_call(idle_read_frozen, &p, 3000, &took), 0);
+    assert_true(took >= 90);
+    close_pair(&p);
+}
+
+static void a_write_to_a_full_queue_ends_with_a_clock_that_stands_still(void **state)
+{
+    pair_t p;
+    uint8_t wire[TASE_FRAME_MAX];
+    long took;
+    (void)state;
+    (void)open_full_pair(&p, wire);
+    assert_int_equal(bounded_call(write_full_frozen, &p, 3000, &took), TASE_ENOBUFS);
+    assert_true(took >= 90);
+    close_pair(&p);
+}
+
+static void enobufs_sleeps_end_with_a_clock_that_stands_still(void **state)
+{
+    pair_t p;
+    long took;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    assert_int_equal(bounded_call(write_enobufs_frozen, &p, 3000, &took), TASE_ENOBUFS);
+    assert_true(took >= 45);
+    close_pair(&p);
+}
+
+/* An interrupted recvmsg() or write() was retried without a look at the
+ * deadline: a storm of them held the call. It ends as its timeout does. */
+static void a_storm_of_interrupted_reads_ends_at_the_deadline(void **state)
+{
+    pair_t p;
+    long took;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    assert_int_equal(bounded_call(read_eintr_storm, &p, 3000, &took), 0);
+    assert_true(took >= 45 && took < 3000);
+    close_pair(&p);
+}
+
+static void a_storm_of_interrupted_writes_ends_at_the_deadline(void **state)
+{
+    pair_t p;
+    long took;
+    (void)state;
+    open_pair(&p, TASE_CAN_ROLE_HOST);
+    assert_int_equal(bounded_call(write_eintr_storm, &p, 3000, &took), TASE_ENOBUFS);
+    assert_true(took >= 45 && took < 3000);
+    close_pair(&p);
+}
+
+/* clock_gettime() failing left its struct timespec as it was (garbage
+ * here): now_ms() reads as 0, time standing still. */
+static void a_failing_clock_reads_as_zero(void **state)
+{
+    uint32_t t;
+    (void)state;
+    failing_clock = true;
+    t = tase_socketcan_now_ms(NULL);
+    failing_clock = false;
+    assert_int_equal(t, 0);
+}
+
 /* ---- bus health, FD frames, timestamps -------------------------------- */
 
 static void peer_error(pair_t *p, uint32_t classes, uint8_t ctrl, uint8_t tec, uint8_t rec)
@@ -859,6 +1051,12 @@ int main(void)
         cmocka_unit_test(port_table_moves_bytes_both_ways),
         cmocka_unit_test(a_signal_storm_neither_fails_nor_shortens_a_read),
         cmocka_unit_test(a_signal_storm_does_not_turn_a_full_queue_into_an_io_error),
+        cmocka_unit_test(an_idle_read_ends_with_a_clock_that_stands_still),
+        cmocka_unit_test(a_write_to_a_full_queue_ends_with_a_clock_that_stands_still),
+        cmocka_unit_test(enobufs_sleeps_end_with_a_clock_that_stands_still),
+        cmocka_unit_test(a_storm_of_interrupted_reads_ends_at_the_deadline),
+        cmocka_unit_test(a_storm_of_interrupted_writes_ends_at_the_deadline),
+        cmocka_unit_test(a_failing_clock_reads_as_zero),
         cmocka_unit_test(error_frames_report_the_bus_state_and_are_never_data),
         cmocka_unit_test(fd_frames_are_rejected_and_classic_frames_still_read),
         cmocka_unit_test(receive_timestamps_are_the_kernels_not_the_read_time),

@@ -102,7 +102,9 @@ uint32_t tase_socketcan_now_ms(void *ctx)
 {
     struct timespec ts;
     (void)ctx;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    if (clock_gettime(CLOCK_MONOTONIC, &ts) != 0) {
+        return 0u; /* time standing still: every wait still ends (wait_fd()) */
+    }
     return (uint32_t)((uint64_t)ts.tv_sec * 1000u + (uint64_t)ts.tv_nsec / 1000000u);
 }
 
@@ -132,9 +134,16 @@ static void sleep_ms(uint32_t ms)
     }
 }
 
-/* Wait for events up to timeout_ms. 0 also when a signal interrupted the
- * wait: every caller loops on its own deadline, so the wait resumes with
- * the time left instead of failing. */
+/* wait_fd()'s results besides TASE_EIO (errno set). */
+#define WAIT_READY 1   /* an event came */
+#define WAIT_TIMEOUT 0 /* poll() waited all of timeout_ms: the time left is spent */
+#define WAIT_INTR 2    /* a signal interrupted the wait: resume with the time left */
+
+/* Wait for events up to timeout_ms, the caller's time left (remaining()
+ * gives at most 0x7FFFFFFF). A wait that ran its full time ends the
+ * caller's wait whatever the clock says, so that a clock that stands
+ * still (or fails, tase_socketcan_now_ms()) cannot hold a call for ever;
+ * a signal only interrupts it (the caller resumes with the time left). */
 static int wait_fd(int fd, short events, uint32_t timeout_ms)
 {
     struct pollfd p;
@@ -144,9 +153,9 @@ static int wait_fd(int fd, short events, uint32_t timeout_ms)
     p.revents = 0;
     rc = poll(&p, 1, timeout_ms > 0x7FFFFFFFu ? 0x7FFFFFFF : (int)timeout_ms);
     if (rc < 0) {
-        return errno == EINTR ? 0 : TASE_EIO;
+        return errno == EINTR ? WAIT_INTR : TASE_EIO;
     }
-    return rc;
+    return rc == 0 ? WAIT_TIMEOUT : WAIT_READY;
 }
 
 static void init_instance(tase_socketcan_t *s, int fd, tase_can_role_t role, unsigned flags)
@@ -311,15 +320,38 @@ static bool from_linux(const struct can_frame *cf, tase_can_frame_t *f)
     return true;
 }
 
-/* One frame out, retrying a full queue until `deadline`. */
-static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, uint32_t deadline)
+/* The time a write() or send_frame() may take: its deadline, and what it
+ * has slept on ENOBUFS against the bound it started with, so that the
+ * sleeps end even with a clock that stands still. */
+typedef struct {
+    uint32_t deadline;
+    uint32_t budget; /* the bound at entry (clamped as deadline_in()) */
+    uint32_t slept;  /* ms slept on ENOBUFS so far, all frames together */
+} tx_time_t;
+
+static tx_time_t tx_time(uint32_t timeout_ms)
+{
+    tx_time_t t;
+    t.deadline = deadline_in(timeout_ms);
+    t.budget = timeout_ms > TASE_SOCKETCAN_TIMEOUT_MAX ? TASE_SOCKETCAN_TIMEOUT_MAX : timeout_ms;
+    t.slept = 0;
+    return t;
+}
+
+/* One frame out, retrying a full queue until the deadline. Every wait
+ * ends: a POLLOUT wait that ran the time left, or ENOBUFS sleeps adding up
+ * to the budget, end the retries after one last try, and an interrupted
+ * write() is retried only while time is left. */
+static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, tx_time_t *t)
 {
     struct can_frame cf;
     bool refused = false;
+    bool spent = false; /* the last wait used up the time left */
     to_linux(f, &cf);
     for (;;) {
         ssize_t n = write(s->fd, &cf, sizeof(cf));
         int e = errno;
+        uint32_t left;
         if (n == (ssize_t)sizeof(cf)) {
             s->stats.frames_tx++;
             return TASE_OK;
@@ -328,57 +360,70 @@ static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, uint32_t d
             s->stats.last_errno = EMSGSIZE;
             return TASE_EIO;
         }
-        if (e == EINTR) {
-            continue;
-        }
-        if (!would_block(e) && e != ENOBUFS) {
+        if (e != EINTR && !would_block(e) && e != ENOBUFS) {
             return io_error(s, e);
         }
         if (e == ENOBUFS && !refused) {
             refused = true; /* the frame, not each retry */
             s->bus.enobufs++;
         }
-        if (remaining(deadline) == 0u) {
+        left = remaining(t->deadline);
+        if (left == 0u || spent) {
             s->stats.tx_full++;
             return TASE_ENOBUFS;
+        }
+        if (e == EINTR) {
+            continue; /* resumed with the time left */
         }
         s->stats.tx_retries++;
         /* ENOBUFS comes from the interface queue, which poll() does not
          * see, so sleep a little too rather than spin on POLLOUT. */
         if (e == ENOBUFS) {
-            sleep_ms(remaining(deadline) < RETRY_SLEEP_MS ? remaining(deadline) : RETRY_SLEEP_MS);
-        } else if (wait_fd(s->fd, POLLOUT, remaining(deadline)) < 0) {
-            s->stats.last_errno = errno;
-            return TASE_EIO;
+            uint32_t slice = left < RETRY_SLEEP_MS ? left : RETRY_SLEEP_MS;
+            if (slice > t->budget - t->slept) {
+                slice = t->budget - t->slept;
+            }
+            sleep_ms(slice);
+            t->slept += slice;
+            spent = t->slept >= t->budget;
+        } else {
+            int w = wait_fd(s->fd, POLLOUT, left);
+            if (w < 0) {
+                s->stats.last_errno = errno;
+                return TASE_EIO;
+            }
+            spent = w == WAIT_TIMEOUT;
         }
     }
 }
 
 int tase_socketcan_send_frame(tase_socketcan_t *s, const tase_can_frame_t *f)
 {
+    tx_time_t t;
     if (!usable(s) || tase_can_frame_check(f) != TASE_OK) {
         return TASE_EARG;
     }
-    return send_until(s, f, deadline_in(s->tx_timeout_ms));
+    t = tx_time(s->tx_timeout_ms);
+    return send_until(s, f, &t);
 }
 
 int tase_socketcan_write(tase_socketcan_t *s, const uint8_t *data, size_t n)
 {
     tase_can_split_t sp;
     tase_can_frame_t f;
-    uint32_t deadline;
+    tx_time_t t;
     if (!usable(s) || n > (size_t)0x7FFFFFFF ||
         tase_can_split_init(&sp, s->role, data, n) != TASE_OK) {
         return TASE_EARG;
     }
-    deadline = deadline_in(s->tx_timeout_ms);
+    t = tx_time(s->tx_timeout_ms);
     for (;;) {
         size_t before = sp.pos;
         int rc;
         if (tase_can_split_next(&sp, &f) <= 0) {
             return (int)n;
         }
-        rc = send_until(s, &f, deadline);
+        rc = send_until(s, &f, &t);
         if (rc != TASE_OK) {
             return before > 0u ? (int)before : rc;
         }
@@ -531,6 +576,9 @@ static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint
 {
     can_record_t cf;
     for (;;) {
+        uint32_t left;
+        int e;
+        int w;
         ssize_t n = recv_record(s->fd, &cf, ns);
         if (n >= 0) {
             int rc = take_record(s, n, &cf, f);
@@ -542,18 +590,24 @@ static int raw_recv(tase_socketcan_t *s, tase_can_frame_t *f, uint64_t *ns, uint
             }
             continue;
         }
-        if (errno == EINTR) {
-            continue;
+        e = errno; /* before the clock is read */
+        if (e != EINTR && !would_block(e)) {
+            return io_error(s, e);
         }
-        if (!would_block(errno)) {
-            return io_error(s, errno);
+        left = remaining(deadline);
+        if (left == 0u) {
+            return 0; /* also for an interrupted recvmsg(): a storm of them ends */
         }
-        if (remaining(deadline) == 0u) {
-            return 0;
+        if (e == EINTR) {
+            continue; /* resumed with the time left */
         }
-        if (wait_fd(s->fd, POLLIN, remaining(deadline)) < 0) {
+        w = wait_fd(s->fd, POLLIN, left);
+        if (w < 0) {
             s->stats.last_errno = errno;
             return TASE_EIO;
+        }
+        if (w == WAIT_TIMEOUT) {
+            return 0; /* the time left is spent, whatever the clock says */
         }
     }
 }

@@ -42,11 +42,19 @@
  *
  * LONGEST BLOCK (the port contract of tase/port.h): write() and
  * send_frame() tx_timeout_ms in total; read() and recv_frame() timeout_ms
- * in total, and then at most 63 more frames handled that carry nothing
- * for the caller (a flood of other nodes' frames, error frames or 3AX
- * status is looked through 64 at a time, the clock read between: read()
- * with timeout 0 takes at most 64 such frames and returns 0). A signal (EINTR) never ends a wait early or makes it fail: the
- * wait resumes with the time left.
+ * in total, and then at most 63 more frames handled that carry nothing for
+ * the caller (a flood of other nodes' frames, error frames or 3AX status is
+ * looked through 64 at a time, the clock read between: read() with timeout
+ * 0 takes at most 64 such frames and returns 0). A signal (EINTR) never
+ * ends a wait early or makes it fail: the wait resumes with the time left;
+ * an interrupted read or write once the time is spent ends the call as its
+ * timeout does (read() 0, write() TASE_ENOBUFS), so a storm of signals
+ * cannot hold it. The waits end even with a clock that stands still (or
+ * fails, tase_socketcan_now_ms()): a poll() that waited all the time left
+ * ends the call, and the sleeps on a full interface queue (ENOBUFS) add up
+ * to tx_timeout_ms at most. (With such a clock a call can still be held by
+ * signals that never let a poll() run its time, or by frames arriving
+ * without pause.)
  *
  * BUS HEALTH. open() (and adopt() with TASE_SOCKETCAN_SET_FILTER) asks the
  * kernel for error frames (CAN_RAW_ERR_FILTER: controller state, bus-off,
@@ -223,7 +231,9 @@ int tase_socketcan_bus(const tase_socketcan_t *s, tase_socketcan_bus_t *out);
  * timestamps, or for s NULL. O(1). */
 uint64_t tase_socketcan_rx_time_ns(const tase_socketcan_t *s);
 
-/* Monotonic milliseconds (CLOCK_MONOTONIC), for the port table. */
+/* Monotonic milliseconds (CLOCK_MONOTONIC), for the port table. A failed
+ * clock_gettime() reads as 0 ms (time standing still: every wait of the
+ * port still ends, LONGEST BLOCK). */
 uint32_t tase_socketcan_now_ms(void *ctx);
 
 #ifdef __cplusplus
