@@ -125,6 +125,11 @@ static uint32_t remaining(uint32_t deadline)
     return left > 0x7FFFFFFFu ? 0u : left;
 }
 
+static uint32_t min_u32(uint32_t a, uint32_t b)
+{
+    return a < b ? a : b;
+}
+
 static void sleep_ms(uint32_t ms)
 {
     struct timespec ts;
@@ -379,10 +384,7 @@ static int send_until(tase_socketcan_t *s, const tase_can_frame_t *f, tx_time_t 
         /* ENOBUFS comes from the interface queue, which poll() does not
          * see, so sleep a little too rather than spin on POLLOUT. */
         if (e == ENOBUFS) {
-            uint32_t slice = left < RETRY_SLEEP_MS ? left : RETRY_SLEEP_MS;
-            if (slice > t->budget - t->slept) {
-                slice = t->budget - t->slept;
-            }
+            uint32_t slice = min_u32(min_u32(left, RETRY_SLEEP_MS), t->budget - t->slept);
             sleep_ms(slice);
             t->slept += slice;
             spent = t->slept >= t->budget;
