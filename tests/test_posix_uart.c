@@ -205,8 +205,9 @@ static uint32_t real_ms(void)
 
 /* A review: poll() said readable but read() brought nothing (another
  * reader of a shared line takes the bytes): the read looped for ever. It
- * ends as an idle line at its timeout, and with a clock that stands still
- * after a bounded number of looks. (alarm(): a hang kills the test.) */
+ * ends as an idle line after a bounded number of such looks (port.h: a
+ * read may return 0 early), with the clock running and standing still.
+ * (alarm(): a hang kills the test.) */
 static void a_readable_line_that_reads_nothing_ends_the_read(void **state)
 {
     pty_t p;

@@ -219,15 +219,20 @@ static void drain_bounded(int fd, uint32_t timeout_ms)
 {
 #ifdef TIOCOUTQ
     uint32_t start = tase_posix_now_ms();
-    uint32_t naps = 0; /* 2 ms each: the bound also when the clock stands still */
+    uint32_t naps = 0; /* whole 2 ms naps: the bound also when the clock stands still */
     int queued = 0;
     while (ioctl(fd, TIOCOUTQ, &queued) == 0 && queued > 0) {
         struct timespec ts = {0, 2000000L};
-        if ((uint32_t)(tase_posix_now_ms() - start) >= timeout_ms || naps++ >= timeout_ms / 2u) {
+        if ((uint32_t)(tase_posix_now_ms() - start) >= timeout_ms ||
+            naps >= (timeout_ms + 1u) / 2u) {
             (void)tcflush(fd, TCOFLUSH);
             return;
         }
-        (void)nanosleep(&ts, NULL);
+        while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
+            /* a signal: the rest of the nap (a nap cut short by signals
+             * would make the count end the drain early) */
+        }
+        naps++;
     }
 #else
     (void)fd;
@@ -333,7 +338,8 @@ int tase_posix_uart_close(tase_posix_uart_t *u)
 }
 
 /* Times read() may find nothing after poll() said the line is readable
- * before the call ends as an idle line, when the clock does not move. */
+ * before the call ends as an idle line (early: a busy loop otherwise, and
+ * one without end when the clock does not move). */
 #define POSIX_UART_READY_SPINS 1024u
 
 /* Milliseconds left of `total` since `start`, 0 when spent. */
@@ -454,9 +460,11 @@ static int uart_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
         } else if (pr > 0 && ++ready_empty > 1u &&
                    (left == 0 || ready_empty > POSIX_UART_READY_SPINS)) {
             /* readable, yet read() brought nothing again (another reader
-             * of a shared line took the bytes): with no time left, or a
-             * clock that stands still, it ends as an idle line (it spun
-             * for ever) */
+             * of a shared line took the bytes): with no time left, or
+             * after POSIX_UART_READY_SPINS such looks, it ends as an idle
+             * line, possibly before its timeout (port.h allows a read to
+             * return 0 early; it spun for ever with a clock that stands
+             * still, and would spin until the timeout otherwise) */
             return 0;
         }
     }

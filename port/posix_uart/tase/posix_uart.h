@@ -56,7 +56,12 @@
  *          INT32_MAX bytes.
  *  now_ms  CLOCK_MONOTONIC in milliseconds, modulo 2^32; 0 when the clock
  *          cannot be read (clock_gettime() fails: time stands still, and
- *          every wait above still ends, bounded by poll()).
+ *          every wait above still ends, bounded by poll() and a count of
+ *          looks; only signals that never let a poll() run its time can
+ *          then hold a call).
+ * A read on a line where poll() says readable but read() brings nothing
+ * (another reader of a shared line takes the bytes) returns 0 after 1024
+ * such looks, possibly before its timeout.
  * One instance is used from one thread at a time; separate instances are
  * independent.
  */
