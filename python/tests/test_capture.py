@@ -178,24 +178,13 @@ def test_module_decode_of_bad_records_is_tase_decode(recorded, tase_cli, tmp_pat
 
 
 def _serial_pcap(path, records):
-    """A nanosecond serial pcap (link type 147) of (seconds, bytes from the
-    gimbal) records, written here from the format, not by the package."""
-    out = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 147)
-    for sec, data in records:
-        rec = b"\x00" + data
-        out += struct.pack("<IIII", sec, 0, len(rec), len(rec)) + rec
-    path.write_bytes(out)
+    """A serial capture of (seconds, bytes from the gimbal) records
+    (_pcap_ns below)."""
+    path.write_bytes(_pcap_ns(147, [(sec * 10**9, b"\x00" + data, None) for sec, data in records]))
 
 
 def _angle(pan, tilt):
     return tase.Packet("GIMBAL_ANGLE", raw={"pan": pan, "tilt": tilt, "roll": 0}).encode()
-
-
-def _decode_both(tase_cli, path):
-    c = subprocess.run([tase_cli, "decode", str(path)], capture_output=True, text=True, timeout=30)
-    p = subprocess.run([sys.executable, "-m", "tase", "decode", str(path)],
-                       capture_output=True, text=True, timeout=60)
-    return c, p
 
 
 def test_a_capture_cut_inside_a_record_gives_what_came_before(tase_cli, tmp_path):
@@ -220,10 +209,8 @@ def test_a_capture_cut_inside_a_record_gives_what_came_before(tase_cli, tmp_path
 def test_records_without_datalink_bytes_are_named_as_tase_decode_names_them(tase_cli, tmp_path):
     # python -m tase decode said "no bytes" for both, decode names which
     path = tmp_path / "empty.pcap"
-    out = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 147)
-    for rec in (b"\x00" + _angle(1, 1), b"\x00", b"", b"\x01" + _angle(2, 2)):
-        out += struct.pack("<IIII", 1700000000, 0, len(rec), len(rec)) + rec
-    path.write_bytes(out)
+    recs = (b"\x00" + _angle(1, 1), b"\x00", b"", b"\x01" + _angle(2, 2))
+    path.write_bytes(_pcap_ns(147, [(1700000000 * 10**9, rec, None) for rec in recs]))
     c, p = _decode_both(tase_cli, path)
     assert c.returncode == 4 and p.returncode == 4, (c.stderr, p.stderr)
     assert "record 2 skipped: no bytes after the direction byte" in c.stderr
