@@ -2,10 +2,9 @@
 # --help (and, for tase, `tase help COMMAND` of every command it lists), so
 # that the page says what the program says. Run at build time:
 #   cmake -DPROG=path/to/tase -DNAME=tase -DSUMMARY="..." -DVERSION=0.3.0
-#         -DOUT=tase.1 [-DGZIP=/usr/bin/gzip] [-DDOCDIR=/usr/share/doc/tase-tools]
-#         -P tase-manpage.cmake
-# writes OUT (roff) and, with GZIP, OUT.gz (gzip -9n, as Debian installs
-# manual pages). The full manual is docs/TOOLS.md (the tase-tools package
+#         -DOUT=tase.1 [-DDOCDIR=/usr/share/doc/tase-tools] -P tase-manpage.cmake
+# writes OUT (roff); tools/CMakeLists.txt compresses it with
+# tase-gzip.cmake, as Debian installs manual pages. The full manual is docs/TOOLS.md (the tase-tools package
 # installs it in /usr/share/doc/tase-tools/).
 if(NOT DEFINED DOCDIR)
   set(DOCDIR /usr/share/doc/tase-tools)
@@ -78,9 +77,3 @@ string(APPEND page ".SH SEE ALSO
 ")
 
 file(WRITE "${OUT}" "${page}")
-if(GZIP)
-  execute_process(COMMAND ${GZIP} -9n -c "${OUT}" OUTPUT_FILE "${OUT}.gz" RESULT_VARIABLE rc)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "tase-manpage.cmake: ${GZIP} failed (${rc})")
-  endif()
-endif()
