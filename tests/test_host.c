@@ -250,6 +250,19 @@ static void stale_then_echo(fix_t *x, uint8_t set[16])
     x->port.reply_after = 1; /* the gimbal echoes the setting */
 }
 
+/* stale_then_echo() (set as it says), then a transact of the setting: it
+ * completes with the echo, and the answer that waited goes to on_frame. */
+static void transact_takes_the_echo_not_the_waiting_answer(fix_t *x, uint8_t set[16])
+{
+    uint8_t reply[64];
+    stale_then_echo(x, set);
+    assert_int_equal(
+        tase_host_transact(&x->host, TASE_GROUP_SETUP, 0x00, set, 16, reply, sizeof reply, 100, 0),
+        16);
+    assert_memory_equal(reply, set, 16);
+    assert_int_equal(x->others, 1);
+}
+
 /* A review: after a stalled gimbal, answers to earlier requests waited
  * unread and each request took the oldest as its own (Python's query()
  * stayed three answers behind for good). tase_host_transact() reads what
@@ -258,15 +271,10 @@ static void stale_then_echo(fix_t *x, uint8_t set[16])
 static void transact_reads_what_is_waiting_before_it_sends(void **state)
 {
     fix_t *x = *state;
-    uint8_t reply[64], set[16];
+    uint8_t set[16];
     tase_packet_rate_t echo;
 
-    stale_then_echo(x, set);
-    assert_int_equal(tase_host_transact(&x->host, TASE_GROUP_SETUP, 0x00, set, sizeof set, reply,
-                                        sizeof reply, 100, 0),
-                     16);
-    assert_memory_equal(reply, set, sizeof set);
-    assert_int_equal(x->others, 1);
+    transact_takes_the_echo_not_the_waiting_answer(x, set);
     /* the typed call too */
     fake_push_frame(&x->port, 0x48, 0x00, rates, sizeof rates);
     x->port.reply_after = 2;
@@ -329,16 +337,11 @@ static void the_read_before_a_transact_goes_past_an_early_empty_read(void **stat
 {
     fix_t *x = *state;
     tase_port_t p = {&early_zero_ops, &x->port, 0};
-    uint8_t reply[64], set[16];
+    uint8_t set[16];
 
     early_zero_calls = 0;
     assert_int_equal(tase_host_init(&x->host, &p, on_other, x), TASE_OK);
-    stale_then_echo(x, set);
-    assert_int_equal(tase_host_transact(&x->host, TASE_GROUP_SETUP, 0x00, set, sizeof set, reply,
-                                        sizeof reply, 100, 0),
-                     16);
-    assert_memory_equal(reply, set, sizeof set);
-    assert_int_equal(x->others, 1);
+    transact_takes_the_echo_not_the_waiting_answer(x, set);
 }
 
 /* tase_host_drain(): everything waiting is read and fed, past a port's
