@@ -739,6 +739,16 @@ static int write_eintr_storm(pair_t *p)
     return tase_socketcan_write(&p->s, d, 3);
 }
 
+/* call on p ends (within bounded_call()'s 3 s) with want, after at least
+ * min_ms and less than max_ms; p is closed. */
+static void ends_with(pair_t *p, int (*call)(pair_t *), int want, long min_ms, long max_ms)
+{
+    long took;
+    assert_int_equal(bounded_call(call, p, 3000, &took), want);
+    assert_true(took >= min_ms && took < max_ms);
+    close_pair(p);
+}
+
 /* A clock that stands still: a poll() that timed out after the time left
  * went round again with the same time left, for ever (an idle read, a
  * write to a peer that never reads), and the ENOBUFS sleeps waited for the
@@ -746,35 +756,26 @@ static int write_eintr_storm(pair_t *p)
 static void an_idle_read_ends_with_a_clock_that_stands_still(void **state)
 {
     pair_t p;
-    long took;
     (void)state;
     open_pair(&p, TASE_CAN_ROLE_HOST);
-    assert_int_equal(bounded_call(idle_read_frozen, &p, 3000, &took), 0);
-    assert_true(took >= 90);
-    close_pair(&p);
+    ends_with(&p, idle_read_frozen, 0, 90, LONG_MAX);
 }
 
 static void a_write_to_a_full_queue_ends_with_a_clock_that_stands_still(void **state)
 {
     pair_t p;
     uint8_t wire[TASE_FRAME_MAX];
-    long took;
     (void)state;
     (void)open_full_pair(&p, wire);
-    assert_int_equal(bounded_call(write_full_frozen, &p, 3000, &took), TASE_ENOBUFS);
-    assert_true(took >= 90);
-    close_pair(&p);
+    ends_with(&p, write_full_frozen, TASE_ENOBUFS, 90, LONG_MAX);
 }
 
 static void enobufs_sleeps_end_with_a_clock_that_stands_still(void **state)
 {
     pair_t p;
-    long took;
     (void)state;
     open_pair(&p, TASE_CAN_ROLE_HOST);
-    assert_int_equal(bounded_call(write_enobufs_frozen, &p, 3000, &took), TASE_ENOBUFS);
-    assert_true(took >= 45);
-    close_pair(&p);
+    ends_with(&p, write_enobufs_frozen, TASE_ENOBUFS, 45, LONG_MAX);
 }
 
 /* An interrupted recvmsg() or write() was retried without a look at the
@@ -782,23 +783,17 @@ static void enobufs_sleeps_end_with_a_clock_that_stands_still(void **state)
 static void a_storm_of_interrupted_reads_ends_at_the_deadline(void **state)
 {
     pair_t p;
-    long took;
     (void)state;
     open_pair(&p, TASE_CAN_ROLE_HOST);
-    assert_int_equal(bounded_call(read_eintr_storm, &p, 3000, &took), 0);
-    assert_true(took >= 45 && took < 3000);
-    close_pair(&p);
+    ends_with(&p, read_eintr_storm, 0, 45, 3000);
 }
 
 static void a_storm_of_interrupted_writes_ends_at_the_deadline(void **state)
 {
     pair_t p;
-    long took;
     (void)state;
     open_pair(&p, TASE_CAN_ROLE_HOST);
-    assert_int_equal(bounded_call(write_eintr_storm, &p, 3000, &took), TASE_ENOBUFS);
-    assert_true(took >= 45 && took < 3000);
-    close_pair(&p);
+    ends_with(&p, write_eintr_storm, TASE_ENOBUFS, 45, 3000);
 }
 
 /* clock_gettime() failing left its struct timespec as it was (garbage
