@@ -220,8 +220,10 @@ rc=$?
 check "--record: three commands appended into one capture, decoded" \
     eval '[ $rc -eq 0 ] && [ -s "$dir/session.json" ]'
 $U records "$dir/session.pcap" >"$dir/session.rec"
-check "--record: the first record is the query as sent, byte for byte (to the gimbal: 00 FF 5A 02 48 03 01 A6)" \
-    eval '[ "$(head -1 "$dir/session.rec" | cut -d" " -f2-)" = "1 00FF5A02480301A6" ]'
+# What the gimbal sent before the query (its telemetry, read and recorded by
+# the read before a request) may come first: a slow start (valgrind) sees it.
+check "--record: the first record to the gimbal is the query as sent, byte for byte (00 FF 5A 02 48 03 01 A6)" \
+    eval '[ "$(grep -m1 "^[^ ]* 1 " "$dir/session.rec" | cut -d" " -f2-)" = "1 00FF5A02480301A6" ]'
 q=$(grep -m1 '"name":"SYSTEM_VERSION"' "$dir/session.json")
 a=$(grep '"dir":"out"' "$dir/session.json" | grep -m1 '"name":"SYSTEM_VERSION"')
 check "--record: query (in, size 0) and answer (out) equal to what query printed" \
