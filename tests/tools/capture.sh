@@ -67,33 +67,7 @@ check "decode: times past 2038 and unnormalised fractions ($t)" \
 # pcapng Simple Packet Block (no time) was at 1970, and the gap cut a frame
 # split across it; a CAN capture of only remote frames exited 0 silently,
 # one of only 3AX frames was "not a capture of a TASE serial line?".
-"${TASE_PYTHON:-python3}" - "$dir" <<'PY'
-import struct, sys
-d = sys.argv[1]
-f = bytes.fromhex("00FF5A08081004D2EE6C000003A9")  # GIMBAL_ANGLE
-def pcap(magic, link, recs):
-    return struct.pack("<IHHiIII", magic, 2, 4, 0, 0, 65535, link) + b"".join(recs)
-def rec(sec, frac, data, orig=None):
-    return struct.pack("<IIII", sec, frac, len(data), len(data) if orig is None else orig) + data
-open(d + "/usfrac.pcap", "wb").write(pcap(0xA1B2C3D4, 147, [rec(1700000000, 5000000, b"\0" + f)]))
-open(d + "/capbig.pcap", "wb").write(pcap(0xA1B23C4D, 147, [rec(1700000000, 0, b"\0" + f, 3)]))
-def block(t, body):
-    body += b"\0" * (-len(body) % 4)
-    return struct.pack("<II", t, len(body) + 12) + body + struct.pack("<I", len(body) + 12)
-shb = block(0x0A0D0D0A, struct.pack("<IHHq", 0x1A2B3C4D, 1, 0, -1))
-def idb(offset):
-    opts = struct.pack("<HHB3x", 9, 1, 6) + struct.pack("<HHq", 14, 8, offset) + b"\0\0\0\0"
-    return block(1, struct.pack("<HHI", 147, 0, 65535) + opts)
-def epb(us, data):
-    return block(6, struct.pack("<IIIII", 0, us >> 32, us & 0xFFFFFFFF, len(data), len(data)) + data)
-def spb(data):
-    return block(3, struct.pack("<I", len(data)) + data)
-open(d + "/negtime.pcapng", "wb").write(shb + idb(-1700000001) + epb(1700000000250000, b"\0" + f))
-open(d + "/spb.pcapng", "wb").write(shb + idb(0) + epb(1700000000250000, b"\0" + f[:6]) + spb(b"\0" + f[6:]))
-can = lambda cid, dlc, data: rec(1700000000, 0, struct.pack(">IBBBB", cid, dlc, 0, 0, 0) + data.ljust(8, b"\0"))
-open(d + "/rtr.pcap", "wb").write(pcap(0xA1B23C4D, 227, [can(0xD0000000, 0, b"")]))
-open(d + "/3ax.pcap", "wb").write(pcap(0xA1B23C4D, 227, [can(0x92010000 | 0x80000000, 2, b"\1\2")]))
-PY
+$U reader-edges "$dir"
 t=$("$TASE" decode "$dir/usfrac.pcap" 2>&1 | sed -n 's/.*"time":\([0-9.-]*\),.*/\1/p')
 check "decode: a microsecond fraction of 5,000,000 carries 5 s ($t)" test "$t" = "1700000005.000000"
 "$TASE" decode "$dir/capbig.pcap" >"$dir/capbig.out" 2>"$dir/capbig.err"

@@ -35,6 +35,9 @@ checked against a writer other than its own.
   spb OUT [yes]                    a pcapng: a GEOREFERENCE_DATA split over
         two timed records and a Simple Packet Block between them (yes: a
         record of the other direction 500 ms later before the SPB).
+  reader-edges DIR                 the captures of a fuzzing review of the
+        readers (usfrac.pcap, capbig.pcap, negtime.pcapng, spb.pcapng,
+        rtr.pcap, 3ax.pcap; capture.sh says what each must give).
   pty-pair A B                     two pseudo-terminals (symlinks A and B)
         joined like a null-modem cable, raw, until killed.
   compare-pdml PDML JSONL          the dissector's packets (tshark -T pdml)
@@ -567,6 +570,46 @@ def spb(out, other="no"):
         fh.write(epb(t0 + 1000, b"\x00" + f[30:]))
 
 
+def reader_edges(d):
+    """A fuzzing review's captures of the readers' edges, each a
+    GIMBAL_ANGLE from the gimbal: a microsecond pcap whose fraction is
+    5,000,000 us (usfrac); a record claiming more bytes captured than its
+    packet had (capbig); a pcapng whose if_tsoffset puts it before 1970
+    (negtime); a frame split over an Enhanced and a Simple Packet Block
+    (spb); CAN captures of only a remote frame (rtr) and of only a 3AX
+    frame (3ax)."""
+    f = bytes.fromhex("00FF5A08081004D2EE6C000003A9")
+    usec = struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, LINKTYPE_SERIAL)
+    with open(d + "/usfrac.pcap", "wb") as fh:
+        fh.write(usec + pcap_record(T0, 5000000, b"\0" + f))
+    with open(d + "/capbig.pcap", "wb") as fh:
+        fh.write(pcap_header(LINKTYPE_SERIAL) + struct.pack("<IIII", T0, 0, 15, 3) + b"\0" + f)
+    shb = pcapng_block(0x0A0D0D0A, struct.pack("<IHHq", 0x1A2B3C4D, 1, 0, -1))
+
+    def idb(offset):  # if_tsresol 6 (microseconds), if_tsoffset
+        opts = struct.pack("<HHB3x", 9, 1, 6) + struct.pack("<HHq", 14, 8, offset) + bytes(4)
+        return pcapng_block(1, struct.pack("<HHI", LINKTYPE_SERIAL, 0, 65535) + opts)
+
+    def epb(us, data):
+        return pcapng_block(6, struct.pack("<IIIII", 0, us >> 32, us & 0xFFFFFFFF, len(data),
+                                           len(data)) + data)
+
+    t = (T0 * 10**6) + 250000
+    with open(d + "/negtime.pcapng", "wb") as fh:
+        fh.write(shb + idb(-T0 - 1) + epb(t, b"\0" + f))
+    with open(d + "/spb.pcapng", "wb") as fh:
+        fh.write(shb + idb(0) + epb(t, b"\0" + f[:6]) +
+                 pcapng_block(3, struct.pack("<I", 9) + b"\0" + f[6:]))
+
+    def can(cid, dlc, data):
+        return pcap_record(T0, 0, struct.pack(">IBBBB", cid, dlc, 0, 0, 0) + data.ljust(8, b"\0"))
+
+    with open(d + "/rtr.pcap", "wb") as fh:
+        fh.write(pcap_header(LINKTYPE_CAN) + can(0xD0000000, 0, b""))
+    with open(d + "/3ax.pcap", "wb") as fh:
+        fh.write(pcap_header(LINKTYPE_CAN) + can(0x92010000 | 0x80000000, 2, b"\1\2"))
+
+
 def cut_records(streams, sizes):
     """Round-robin records of the given sizes (cycled) from each stream:
     [(dir, stream offset of the end, bytes)]."""
@@ -748,7 +791,7 @@ def main(argv):
     commands = {f.__name__.replace("_", "-"): f for f in (
         serial_pcap, expect_serial, can_pcap, replay_checks, times, quiet, bad_pcap, pty_pair,
         compare_pdml, greedy, expect_decode, expect_pdml, pdml_3ax, records, paced_angles,
-        timing, held_cut, step_back, spb)}
+        timing, held_cut, step_back, spb, reader_edges)}
     if len(argv) < 2 or argv[1] not in commands:
         raise SystemExit("usage: capture_util.py COMMAND ARGS... (commands: %s)"
                          % ", ".join(commands))
