@@ -38,6 +38,8 @@ checked against a writer other than its own.
   reader-edges DIR                 the captures of a fuzzing review of the
         readers (usfrac.pcap, capbig.pcap, negtime.pcapng, spb.pcapng,
         rtr.pcap, 3ax.pcap; capture.sh says what each must give).
+  unknown OUT                      a serial capture of packets of an unknown
+        type, of no data and of 2 bytes.
   pty-pair A B                     two pseudo-terminals (symlinks A and B)
         joined like a null-modem cable, raw, until killed.
   compare-pdml PDML JSONL          the dissector's packets (tshark -T pdml)
@@ -271,7 +273,7 @@ def proto_object(proto):
             o[short] = show
             name = show if short == "name" else name
         elif short == "data":
-            o["data"] = list(bytes.fromhex(f.get("value")))
+            o["data"] = list(bytes.fromhex(f.get("value", "")))  # none: no value
         elif short not in ("checksum",) + HELD_FIELDS:
             pkt, field = short.split(".", 1)
             assert pkt == name.lower(), (key, name)
@@ -279,8 +281,8 @@ def proto_object(proto):
     obj = {k: o[k] for k in ("offset", "dir", "group", "type", "name", "size") if k in o}
     if "error" in o:
         obj["error"] = o["error"]
-    elif name == "UNKNOWN":
-        obj["fields"] = {"data": o.get("data", [])}
+    elif name == "UNKNOWN":  # its data field, even of none (decode's "data":[])
+        obj["fields"] = {"data": o["data"]} if "data" in o else {}
     else:
         obj["fields"] = fields
         if "data" in o:
@@ -610,6 +612,15 @@ def reader_edges(d):
         fh.write(pcap_header(LINKTYPE_CAN) + can(0x92010000 | 0x80000000, 2, b"\1\2"))
 
 
+def unknown(out):
+    """A serial capture (from the gimbal) of packets of a type the schema
+    does not know, 0x77/0x01, with no data, 2 bytes and none again."""
+    with open(out, "wb") as fh:
+        fh.write(pcap_header(LINKTYPE_SERIAL))
+        for i, data in enumerate((b"", b"\1\2", b"")):
+            fh.write(pcap_record(T0 + i, 0, b"\0" + tase.Packet.from_data(0x77, 0x01, data).encode()))
+
+
 def cut_records(streams, sizes):
     """Round-robin records of the given sizes (cycled) from each stream:
     [(dir, stream offset of the end, bytes)]."""
@@ -791,7 +802,8 @@ def main(argv):
     commands = {f.__name__.replace("_", "-"): f for f in (
         serial_pcap, expect_serial, can_pcap, replay_checks, times, quiet, bad_pcap, pty_pair,
         compare_pdml, greedy, expect_decode, expect_pdml, pdml_3ax, records, paced_angles,
-        timing, held_cut, step_back, spb, reader_edges)}
+        timing, held_cut, step_back, spb, reader_edges,
+        unknown)}
     if len(argv) < 2 or argv[1] not in commands:
         raise SystemExit("usage: capture_util.py COMMAND ARGS... (commands: %s)"
                          % ", ".join(commands))

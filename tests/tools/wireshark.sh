@@ -234,6 +234,11 @@ compare spb2 "a Simple Packet Block after a record of the other direction 500 ms
     "$dir/spb2.pcapng" "$dir/spb2.pcapng"
 check "... a pause: no GEOREFERENCE_DATA" eval '! grep -q GEOREFERENCE_DATA "$dir/spb2.json"'
 
+# An unknown packet with no data showed no data field (decode: "data":[]).
+$U unknown "$dir/unknown.pcap"
+compare unknown "packets of an unknown type, of no data and of 2 bytes" "$dir/unknown.pcap" \
+    "$dir/unknown.pcap"
+check "... three of them" [ "$(grep -c '"name":"UNKNOWN"' "$dir/unknown.json")" = 3 ]
 # A differential review: a valid 38-byte frame of an unknown type carrying
 # a whole GIMBAL_ANGLE, its last 18 bytes 20.9996 ms after its first 20
 # (a nanosecond pcap), at the 20 ms margin: tase decode truncates to 20 ms

@@ -458,6 +458,13 @@ end
 
 -- ---- display ----
 
+-- A data field, also of no bytes (shown as "none", not Wireshark's
+-- <MISSING>): the unknown packet's and CAMERA_PASS's camera bytes.
+local function add_data(t, range)
+    local item = t:add(F.data, range)
+    if range:len() == 0 then item:set_text("data: none") end
+end
+
 local function add_frame(tree, fr, dir)
     local ftvb = ByteArray.new(fr.raw, true):tvb("TASE frame")
     local group, ptype, sizeb = ftvb(4, 1):uint(), ftvb(5, 1):uint(), ftvb(3, 1):uint()
@@ -472,9 +479,8 @@ local function add_frame(tree, fr, dir)
     t:add(F.type, ftvb(5, 1))
     t:add(F.name, ftvb(4, 2), name)
     t:add(F.size, ftvb(3, 1), len)
-    local data = len > 0 and ftvb(6, len) or nil
-    if p == nil then
-        if data then t:add(F.data, data) end
+    if p == nil then -- its data, however short (none: an empty field, as decode's "data":[])
+        add_data(t, ftvb(6, len))
     elseif not length_ok(p, len) then
         t:add(F.error, ftvb(3, 1), "wrong length")
         t:add_proto_expert_info(E.wrong_length)
@@ -486,7 +492,7 @@ local function add_frame(tree, fr, dir)
             t:add(f.pf, ftvb(6 + at, f.width))
         end
         if p.flags:find("t", 1, true) then -- CAMERA_PASS: its camera bytes, maybe none
-            t:add(F.data, ftvb(6 + p.len, len - p.len))
+            add_data(t, ftvb(6 + p.len, len - p.len))
         end
     end
     t:add(F.checksum, ftvb(6 + len, 2))
