@@ -245,6 +245,34 @@ OF_DBL(tase_units_mps_to_cmps)
 OF_DBL(tase_units_mps2_to_accel)
 OF_DBL(tase_units_pdop_to_raw)
 
+/* The *_checked forms: the value through its out-parameter, the result
+ * (TASE_OK or TASE_ERANGE) beside it. */
+#define OF_CHK(name, type)                                                                         \
+    NOINLINE static void c_##name(void *ctx)                                                       \
+    {                                                                                              \
+        type out = 0;                                                                              \
+        (void)ctx;                                                                                 \
+        dsink = (double)name(a_dbl, &out) + (double)out;                                           \
+    }
+OF_CHK(tase_units_checked_i16, int16_t)
+OF_CHK(tase_units_checked_u16, uint16_t)
+OF_CHK(tase_units_checked_i32, int32_t)
+OF_CHK(tase_units_checked_u8, uint8_t)
+OF_CHK(tase_units_deg_to_cdeg_checked, int16_t)
+OF_CHK(tase_units_deg_to_cdeg_u16_checked, uint16_t)
+OF_CHK(tase_units_deg_to_mas_checked, int32_t)
+OF_CHK(tase_units_m_to_cm_checked, int32_t)
+OF_CHK(tase_units_mps_to_cmps_checked, int16_t)
+OF_CHK(tase_units_mps2_to_accel_checked, int16_t)
+OF_CHK(tase_units_pdop_to_raw_checked, uint8_t)
+
+NOINLINE static void c_tase_units_round_checked(void *ctx)
+{
+    double out = 0.0;
+    (void)ctx;
+    dsink = (double)tase_units_round_checked(a_dbl, -32768.0, 32767.0, &out) + out;
+}
+
 NOINLINE static void c_tase_units_round_clamp(void *ctx)
 {
     (void)ctx;
@@ -298,6 +326,12 @@ static const number_fn_t number_fns[] = {
     INT_FN(tase_units_cmps_to_mps),   DBL_FN(tase_units_mps_to_cmps),
     INT_FN(tase_units_accel_to_mps2), DBL_FN(tase_units_mps2_to_accel),
     INT_FN(tase_units_raw_to_pdop),   DBL_FN(tase_units_pdop_to_raw),
+    DBL_FN(tase_units_round_checked), DBL_FN(tase_units_checked_i16),
+    DBL_FN(tase_units_checked_u16),   DBL_FN(tase_units_checked_i32),
+    DBL_FN(tase_units_checked_u8),    DBL_FN(tase_units_deg_to_cdeg_checked),
+    DBL_FN(tase_units_deg_to_cdeg_u16_checked), DBL_FN(tase_units_deg_to_mas_checked),
+    DBL_FN(tase_units_m_to_cm_checked), DBL_FN(tase_units_mps_to_cmps_checked),
+    DBL_FN(tase_units_mps2_to_accel_checked), DBL_FN(tase_units_pdop_to_raw_checked),
 };
 
 /* d as the shortest "%.Ng" (N = 15..17) that reads back as d. */

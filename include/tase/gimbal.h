@@ -360,9 +360,12 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
  * the gimbal was initialised without receivers. A port read error is
  * skipped (the port may
  * recover), counted nowhere else: check the port; so is a read() that
- * claims more bytes than asked (none of them is fed). Uses 64 bytes of stack
- * plus a bounded number of reads: at most TASE_GIMBAL_SERVICE_READS
- * (tase/config.h, default 64) of at most 64 bytes per port per call,
+ * claims more bytes than asked (none of them is fed). Stack: a 64-byte
+ * read buffer and the receive path, 360 B on Cortex-M4 and 400 B on M0+
+ * with a setup packet handled, plus the callbacks' and the port's own
+ * (docs/FOOTPRINT.md, "Role entry points"). It makes a bounded number of
+ * reads: at most TASE_GIMBAL_SERVICE_READS (tase/config.h, default 64) of
+ * at most 64 bytes per port per call,
  * after which it moves on and the rest waits for the next call. */
 int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms);
 

@@ -343,7 +343,10 @@ bool tase_host_busy(const tase_host_t *h);
  * port error, TASE_EIO (the port's read() claimed more bytes than asked;
  * nothing fed), TASE_EUNSUPPORTED (port has no read or now_ms), TASE_EBUSY
  * (called from on_frame: nothing read) or TASE_EARG (h NULL, or never
- * initialised: no port ops). Uses 64 bytes of stack. */
+ * initialised: no port ops). Stack: a 64-byte read buffer and the receive
+ * path, 436 B on Cortex-M4 and 504 B on M0+ with the host's own frame
+ * handling, plus on_frame's and the port's own (docs/FOOTPRINT.md, "Role
+ * entry points"). */
 int tase_host_service(tase_host_t *h, uint32_t wait_ms);
 
 /* The most reads tase_host_drain() makes (of 64 bytes each: 16 KiB). */

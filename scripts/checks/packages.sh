@@ -112,6 +112,14 @@ for p in tase tase-sim; do
         echo "   $p: no --version option in tools/ yet (issue 15); --help runs"
     fi
 done
+# The manual page has a section for every command `tase --help` lists
+# (gyro-zero had none: its hyphen, roff's \-, did not match the name).
+cmds=$("$root/usr/bin/tase" --help | sed -n '/^commands:$/,/^[^ ]/s/^  \([a-z][-a-z]*\) .*/\1/p')
+[ "$(wc -w <<<"$cmds")" -ge 10 ] || tase_fail "tase --help lists no commands: '$cmds'"
+gzip -dc "$root/usr/share/man/man1/tase.1.gz" | sed -n 's/^\.SS //p' | sed 's/\\-/-/g' >"$out/man.ss"
+[ "$(tr ' ' '\n' <<<"$cmds" | grep .)" = "$(cat "$out/man.ss")" ] ||
+    tase_fail "tase.1's sections ($(tr '\n' ' ' <"$out/man.ss")) are not tase --help's commands ($(tr '\n' ' ' <<<"$cmds"))"
+echo "   tase.1: a section for each of the $(wc -w <<<"$cmds") commands of tase --help"
 tase_step "python3-tase (issue 22): fields, contents, import from the unpacked tree"
 py="$out/build/packages/python3-tase_${version}-1_${arch}.deb"
 [ -f "$py" ] || tase_fail "no $(basename "$py") (python3-cffi, python3-dev installed?)"

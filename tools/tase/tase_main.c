@@ -150,7 +150,10 @@ static const char usage_decode[] =
     "rate (a capture's: --baud; CAN: 1 Mbit/s), at least 20 ms (--margin MS: at\n"
     "least MS, 1..65535, for a sender that pauses inside a packet, such as CAN\n"
     "frames sent one at a time): on a device by the clock, in a capture or candump\n"
-    "log by the gaps in the record times. --stats counts the frames so cut short.\n";
+    "log by the gaps in the record times (a record time stepped back is no time).\n"
+    "--stats counts the frames so cut short. A capture cut inside a record (a\n"
+    "recorder killed, a copy of one still being written) is decoded up to the cut,\n"
+    "then the cut is said (exit 1).\n";
 
 static const char usage_klv[] =
     "usage: tase klv [FILE|-] [--baud N]\n"

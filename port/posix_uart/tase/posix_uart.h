@@ -129,7 +129,7 @@ int tase_posix_uart_open_flags(tase_posix_uart_t *u, const char *path, uint32_t 
  * decides who else may). The descriptor is made non-blocking and is
  * closed by tase_posix_uart_close(). Returns as tase_posix_uart_open()
  * (TASE_ENODEV when fd is not a tty; the fd is then left open and
- * untouched). */
+ * untouched). A fixed number of system calls; never waits. */
 int tase_posix_uart_attach(tase_posix_uart_t *u, int fd, uint32_t baud);
 
 /* Close the device: wait up to write_timeout_ms for the bytes written to
@@ -144,14 +144,15 @@ int tase_posix_uart_close(tase_posix_uart_t *u);
 
 /* The tase_port_t of an open instance: {&tase_posix_uart_ops, u, the
  * byte rate of its baud (TASE_UART_BYTES_PER_S(u->baud))}. With u NULL or
- * closed its write/read return TASE_EARG. */
+ * closed its write/read return TASE_EARG. O(1). */
 tase_port_t tase_posix_uart_port(tase_posix_uart_t *u);
 
 /* True if `baud` is a rate tase_posix_uart_open() accepts (any value may
- * be asked). */
+ * be asked). O(1). */
 bool tase_posix_uart_baud_supported(uint32_t baud);
 
-/* CLOCK_MONOTONIC milliseconds modulo 2^32 (the ops' now_ms). */
+/* CLOCK_MONOTONIC milliseconds modulo 2^32 (the ops' now_ms); 0 when the
+ * clock cannot be read (see now_ms above). One system call. */
 uint32_t tase_posix_now_ms(void);
 
 #ifdef __cplusplus

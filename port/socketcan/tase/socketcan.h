@@ -168,7 +168,8 @@ typedef struct {
 
 /* Open a raw CAN socket on interface `ifname` for `role`, non-blocking,
  * with the role's receive filters. Returns TASE_OK or a code listed under
- * ERRORS above (s untouched, nothing left open). */
+ * ERRORS above (s untouched, nothing left open). A fixed number of
+ * system calls; never waits. */
 int tase_socketcan_open(tase_socketcan_t *s, const char *ifname, tase_can_role_t role);
 
 /* Use an already-open descriptor that carries struct can_frame records
@@ -176,10 +177,11 @@ int tase_socketcan_open(tase_socketcan_t *s, const char *ifname, tase_can_role_t
  * socketpair(AF_UNIX, SOCK_SEQPACKET)). Sets O_NONBLOCK. flags:
  * TASE_SOCKETCAN_OWN_FD, TASE_SOCKETCAN_SET_FILTER. Returns TASE_OK,
  * TASE_EARG (s NULL, fd < 0, bad role or flags) or TASE_EIO (fcntl or
- * setsockopt failed; s untouched, fd not closed). */
+ * setsockopt failed; s untouched, fd not closed). Never waits. */
 int tase_socketcan_adopt(tase_socketcan_t *s, int fd, tase_can_role_t role, unsigned flags);
 
-/* Close the descriptor if owned. Safe to call twice; s NULL is ignored. */
+/* Close the descriptor if owned. Safe to call twice; s NULL is ignored.
+ * Never waits (frames still queued in the kernel are its to send). */
 void tase_socketcan_close(tase_socketcan_t *s);
 
 /* The longest wait of any call: timeouts (read(), recv_frame()'s
@@ -193,7 +195,7 @@ void tase_socketcan_close(tase_socketcan_t *s);
 #define TASE_SOCKETCAN_BYTES_PER_S 50000u
 
 /* The port view: ops = &tase_socketcan_ops, ctx = s, bytes_per_s
- * TASE_SOCKETCAN_BYTES_PER_S. */
+ * TASE_SOCKETCAN_BYTES_PER_S. O(1). */
 tase_port_t tase_socketcan_port(tase_socketcan_t *s);
 extern const tase_port_ops_t tase_socketcan_ops;
 
@@ -202,7 +204,9 @@ extern const tase_port_ops_t tase_socketcan_ops;
  * went down before any byte went out). Both
  * return TASE_EARG, touching nothing, for s NULL, closed or corrupted
  * (role or private queue indices out of range), n or cap > INT32_MAX,
- * data NULL with n > 0, buf NULL. read() with cap 0 returns 0. */
+ * data NULL with n > 0, buf NULL. read() with cap 0 reads nothing: it
+ * returns 0, or the error an earlier read met after the bytes it returned
+ * (said once, whatever the cap). */
 int tase_socketcan_write(tase_socketcan_t *s, const uint8_t *data, size_t n);
 int tase_socketcan_read(tase_socketcan_t *s, uint8_t *buf, size_t cap, uint32_t timeout_ms);
 
