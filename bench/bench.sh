@@ -239,12 +239,9 @@ per_read() {
         -v w="${tm[$1,tase_port_send_frame/bytewise]}" -v w0="${tm[$1,tase_port_send_frame]}" \
         'BEGIN {printf "%.1f", ((t - t0) - (w - w0)) / 256}'
 }
-# every public function of src/ and of the bare-metal port (the headers'
-# declarations), to list what is not measured
-# (a qualifier macro such as TASE_INLINE_ may stand before the name)
-mapfile -t public_fns < <(grep -ho '^[a-z][A-Za-z0-9_ *]* \**tase_[a-z0-9_]*(' include/tase/*.h \
-                              port/baremetal/tase/*.h |
-                          sed 's/($//; s/.*[ *]//' | sort -u)
+# every public function of src/ and of the bare-metal port, to list what
+# is not measured
+mapfile -t public_fns < <(bench/public-fns.sh "$PWD")
 
 # 5. Framing flash: init/push/feed/flush linked alone, M4 -Os.
 fl="$bdir/flash"

@@ -19,3 +19,7 @@ set_tests_properties(footprint_report PROPERTIES LABELS check TIMEOUT 600)
 add_test(NAME bench_search COMMAND ${PROJECT_SOURCE_DIR}/bench/search.sh push --iters 30
   --build ${CMAKE_BINARY_DIR}/search)
 set_tests_properties(bench_search PROPERTIES LABELS check TIMEOUT 300)
+# Every public function has a row in docs/TIMING.md (bench/bench.sh writes
+# it under QEMU; this only compares the table with the headers).
+add_test(NAME timing_rows COMMAND ${PROJECT_SOURCE_DIR}/scripts/checks/timing-rows.sh)
+set_tests_properties(timing_rows PROPERTIES LABELS check TIMEOUT 60)
