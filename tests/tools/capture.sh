@@ -32,6 +32,17 @@ tol=0.250 fast_ms=350
 [ -n "${TASE_UNDER_VALGRIND:-}" ] && tol=0.300 fast_ms=5000
 # json_int LINE KEY: the integer value of "KEY": in a JSON line
 json_int() { sed -n "s/.*\"$2\":\(-\{0,1\}[0-9][0-9]*\).*/\1/p" <<<"$1"; }
+# holds PID LINK: wait up to 5 s (times slow) for process PID to have the
+# device LINK leads to open (a tool's open discards the input before it)
+holds() {
+    local dev f
+    dev=$(readlink -f "$2")
+    for _ in $(seq $((100 * slow))); do
+        for f in /proc/"$1"/fd/*; do [ "$(readlink "$f")" = "$dev" ] && return 0; done
+        sleep 0.05
+    done
+    return 1
+}
 # same_lines A B: files equal, or the diff shown
 same_lines() { diff -u "$1" "$2" | head -20; cmp -s "$1" "$2"; }
 # Each direction in stream order, exactly. Across directions the order is
@@ -723,10 +734,15 @@ check "record --tap-in: both lines decoded, each direction exactly the generator
     eval 'same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.out" && same_lines "$DATA/decode_noisy.jsonl" "$dir/tap.in"'
 
 # monitor --margin MS (as decode's): a sender that pauses inside a packet
-# (40 ms here) is waited for; without it each such frame is cut
-"$TASE" monitor --serial "$dir/C" --json --seconds 2.5 --margin 100 >"$dir/margin.mon" 2>/dev/null &
+# (40 ms here) is waited for; without it each such frame is cut. The
+# monitor ends at its tenth frame (--seconds only bounds a wrong one): a
+# 2.5 s window cut the last frames off when the writer (1 s of frames after
+# a Python start-up) started late on a loaded machine. The writer starts
+# once the monitor has the line (its open discards what came before).
+"$TASE" monitor --serial "$dir/C" --json --count 10 --seconds $((10 * slow)) --margin 100 \
+    >"$dir/margin.mon" 2>/dev/null &
 mp=$!
-sleep 0.5
+holds $mp "$dir/C"
 $U paced-angles "$dir/D" 10 40 0 60
 wait $mp
 if [ -z "${TASE_UNDER_VALGRIND:-}" ]; then # (timing, as above)

@@ -270,10 +270,14 @@ check "9: deployed again, it moves ($(json_int "$after" pan)/$(json_int "$after"
 # whole must agree with the packet's sample_rate (+-1); a reader held up by
 # a busy machine loses bytes as on a real line (tase-sim keeps 2 KB for
 # it), so only windows without a gap are judged (gap: more than 1.5 times
-# the median period). Under memcheck the run is longer.
-"$TASE" monitor "${L[@]}" --json --seconds $((slow == 1 ? 3 : 8)) 2>/dev/null |
-    grep '"GEOREFERENCE_DATA"' >"$dir/geo.jsonl"
-read -r said judged agreed worst <<<"$(python3 - "$dir/geo.jsonl" <<'PY'
+# the median period). Under memcheck the run is longer. Only the last
+# second of a 3 s run has whole windows: one gap there (a loaded machine
+# holds the simulator or the reader up) left none to judge, so up to three
+# runs, until one has a window to judge.
+for try in 1 2 3; do
+    "$TASE" monitor "${L[@]}" --json --seconds $((slow == 1 ? 3 : 8)) 2>/dev/null |
+        grep '"GEOREFERENCE_DATA"' >"$dir/geo.jsonl"
+    read -r said judged agreed worst <<<"$(python3 - "$dir/geo.jsonl" <<'PY'
 import json, sys
 rows = [json.loads(l)["fields"] for l in open(sys.argv[1]) if l.strip()]
 ts = [r["time"] for r in rows]
@@ -298,7 +302,9 @@ for i, r in enumerate(rows):
 print(rows[-1]["sample_rate"] if rows else -1, judged, agreed, worst or "-")
 PY
 )"
-check "5: PACKET_RATE 255/255/255: sample_rate $said; it agrees with the rate on the gimbal's clock in $agreed of $judged whole 2 s windows (first disagreement, said@measured: $worst)" \
+    [ "$judged" -ge 1 ] && break
+done
+check "5: PACKET_RATE 255/255/255: sample_rate $said; it agrees with the rate on the gimbal's clock in $agreed of $judged whole 2 s windows (run $try; first disagreement, said@measured: $worst)" \
     eval '[ "$said" -gt 0 ] && [ "$said" -lt 255 ] && [ "$judged" -ge 1 ] && [ "$agreed" = "$judged" ]'
 
 check "tase-sim ran through every check (it was started at $sim_start s, the script is at $SECONDS s)" \
