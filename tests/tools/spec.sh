@@ -146,6 +146,24 @@ last() {
         grep "\"name\":\"$1\"" | tail -1
 }
 near() { local d=$(($1 - $2)); [ "${d#-}" -le "$3" ]; }
+# settle NAME TOL FIELD WANT...: the last NAME of a monitor run once every
+# FIELD is within TOL of its WANT, up to three runs (a loaded machine that
+# holds the simulator up a moment makes a move end later than its time);
+# else the last one seen, for the check to judge
+settle() {
+    local name=$1 tol=$2 p k ok
+    shift 2
+    local pairs=("$@")
+    for _ in 1 2 3; do
+        p=$(last "$name")
+        ok=1
+        for ((k = 0; k + 1 < ${#pairs[@]}; k += 2)); do
+            near "$(json_int "$p" "${pairs[k]}")" "${pairs[k + 1]}" "$tol" || ok=0
+        done
+        [ $ok = 1 ] && break
+    done
+    echo "$p"
+}
 
 # ---- 6: camera control is disabled after the CAMERA_PASS above ----
 "$TASE" camera A --hfov 10 "${L[@]}" >/dev/null 2>&1
@@ -175,7 +193,7 @@ check "2: ... the impulse shifted the SPOI error by 4 deg/s x 0.5 s" \
 out=$("$TASE" point 0 -200 --stab off "${L[@]}" 2>&1)
 check "3: tase point 0 -200 is sent ($(head -1 <<<"$out"))" grep -q "^sent GIMBAL_CMD pan=0 tilt=-20000" <<<"$out"
 sleep 1.5
-ga=$(last GIMBAL_ANGLE)
+ga=$(settle GIMBAL_ANGLE 2 tilt -20000)
 check "3: the gimbal reports tilt -200.00 (-270..90), not 160 ($(json_int "$ga" tilt))" \
     near "$(json_int "$ga" tilt)" -20000 2
 expect_error "3: tase point 0 150 is outside -270..90: refused" 2 "bad tilt '150': out of range -270..90 deg" \
@@ -249,7 +267,7 @@ check "11: SPOI at $wr m: pan/tilt $(json_int "$ga" pan)/$(json_int "$ga" tilt),
 before=$(last GIMBAL_ANGLE)
 "$TASE" point 30 -20 "${L[@]}" >/dev/null 2>&1
 sleep 1
-after=$(last GIMBAL_ANGLE)
+after=$(settle GIMBAL_ANGLE 2 pan 3000 tilt -2000)
 check "9: retracted: a point command moves nothing ($(json_int "$before" pan)/$(json_int "$before" tilt) -> $(json_int "$after" pan)/$(json_int "$after" tilt))" \
     eval '[ -n "$before" ] && [ "$(json_int "$before" pan)/$(json_int "$before" tilt)" = "$(json_int "$after" pan)/$(json_int "$after" tilt)" ]'
 check "9: ... and the simulator says why" \
