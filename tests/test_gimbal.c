@@ -1851,6 +1851,45 @@ static void axis_setting_defaults_are_the_specs(void **state)
     free(x);
 }
 
+/* The bytes fill_telemetry writes are the data of the frame that goes
+ * out, byte for byte (the frame is built around them in place). */
+static int fill_pattern(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
+                        uint32_t now)
+{
+    const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
+    size_t k;
+    (void)user;
+    (void)port;
+    (void)now;
+    assert_true(cap >= p->len);
+    for (k = 0; k < p->len; k++) {
+        data[k] = (uint8_t)(TASE_ID_TYPE(id) + 3u * k + 1u);
+    }
+    return (int)p->len;
+}
+
+static void telemetry_carries_the_bytes_fill_telemetry_wrote(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    size_t pos = 0, k;
+    unsigned frames = 0;
+    (void)state;
+    x->g.app.fill_telemetry = fill_pattern;
+    assert_int_equal(tase_gimbal_poll(&x->g, 1000), 3);
+    while (pos < x->port[0].nout) {
+        const uint8_t *f = &x->port[0].out[pos];
+        size_t len = (size_t)f[3] - 2u;
+        for (k = 0; k < len; k++) {
+            assert_int_equal(f[6 + k], (uint8_t)(f[5] + 3u * k + 1u));
+        }
+        pos += len + 8u;
+        frames++;
+    }
+    assert_int_equal(frames, 3);
+    assert_int_equal(fake_frames_out(&x->port[0]), 3);
+    free(x);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1865,6 +1904,7 @@ int main(void)
         cmocka_unit_test(axis_do_not_change_values_keep_the_stored_settings),
         cmocka_unit_test(every_setup_packet_is_stored_apart_from_the_others),
         cmocka_unit_test(axis_setting_defaults_are_the_specs),
+        cmocka_unit_test(telemetry_carries_the_bytes_fill_telemetry_wrote),
         cmocka_unit_test(camera_type_zero_keeps_and_the_default_is_no_camera),
         cmocka_unit_test(the_default_system_version_has_no_cameras),
         cmocka_unit_test(a_22_byte_axis_setting_is_applied_and_echoed_in_its_layout),
