@@ -603,10 +603,25 @@ static void can_api_rejects_bad_arguments(void **state)
     assert_memory_equal(&crx, &ccopy, sizeof crx);
 }
 
+/* tase_can_split() with no array: TASE_EARG for any byte count above 0
+ * (a single byte too), whatever capacity is claimed. */
+static void split_into_no_array_is_an_argument_error(void **state)
+{
+    static const uint8_t data[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+    size_t n;
+    (void)state;
+    for (n = 1; n <= sizeof data; n++) {
+        assert_int_equal(tase_can_split(TASE_CAN_ROLE_HOST, data, n, NULL, 0), TASE_EARG);
+        assert_int_equal(tase_can_split(TASE_CAN_ROLE_HOST, data, n, NULL, 4), TASE_EARG);
+    }
+    assert_int_equal(tase_can_split(TASE_CAN_ROLE_HOST, data, 0, NULL, 0), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(can_api_rejects_bad_arguments),
+        cmocka_unit_test(split_into_no_array_is_an_argument_error),
         cmocka_unit_test(split_refuses_counts_an_int_result_cannot_carry),
         cmocka_unit_test(null_and_unknown_roles_are_rejected_without_counting),
         cmocka_unit_test(role_ids_follow_the_spec),

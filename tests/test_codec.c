@@ -786,6 +786,112 @@ static void init_keep_fills_a_packet_that_changes_nothing(void **state)
     }
 }
 
+/* A query (length 0) decodes to a zeroed struct, also for a packet whose
+ * fields have "do not change" values (AXIS_SETTING); NULL data is an
+ * argument error at any length above 0, also 1; a length above
+ * TASE_DATA_MAX is refused like any wrong one, also for CAMERA_PASS,
+ * which takes every length from 4 to TASE_DATA_MAX. */
+static void queries_null_data_and_lengths_past_the_maximum(void **state)
+{
+    tase_axis_setting_t ax;
+    tase_camera_pass_t cp;
+    tase_packet_rate_t pr;
+    uint8_t data[TASE_DATA_MAX + 2u];
+    uint8_t out[TASE_FRAME_MAX];
+    const tase_packet_desc_t *p = tase_schema_find(0x48, 0x00);
+    size_t k;
+    (void)state;
+    memset(&ax, 0xA5, sizeof ax);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_AXIS_SETTING, NULL, 0, &ax), 0);
+    for (k = 0; k < sizeof ax; k++) {
+        assert_int_equal(((const uint8_t *)&ax)[k], 0);
+    }
+    memset(&pr, 0xA5, sizeof pr);
+    assert_int_equal(tase_packet_decode_desc(p, NULL, 0, &pr), 0);
+    assert_int_equal(pr.angle_1, 0);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_PACKET_RATE, NULL, 1, &pr), TASE_EARG);
+    assert_int_equal(tase_packet_decode_desc(p, NULL, 1, &pr), TASE_EARG);
+    assert_int_equal(tase_packet_encode_data_len(TASE_ID_SENSOR_FILTER, NULL, 1, out, sizeof out),
+                     TASE_EARG);
+    memset(&cp, 0, sizeof cp);
+    cp.len = 1;
+    assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, out, sizeof out), TASE_EARG);
+    /* codec.h's order: the tail's NULL data before the length given */
+    assert_int_equal(tase_packet_encode_data_len(TASE_ID_CAMERA_PASS, &cp, 1, out, sizeof out),
+                     TASE_EARG);
+
+    memset(data, 0x11, sizeof data);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_CAMERA_PASS, data, TASE_DATA_MAX, &cp),
+                     (int)TASE_DATA_MAX);
+    for (k = TASE_DATA_MAX + 1u; k <= TASE_DATA_MAX + 2u; k++) {
+        assert_int_equal(tase_packet_decode_data(TASE_ID_CAMERA_PASS, data, k, &cp), TASE_ELENGTH);
+    }
+    assert_int_equal(tase_packet_decode_data(TASE_ID_CAMERA_PASS, data, SIZE_MAX, &cp),
+                     TASE_ELENGTH);
+}
+
+/* tase_packet_decode_iter(): the walk is restarted, so the same iterator
+ * decodes the same struct again; NULL, a walk bound to no packet and NULL
+ * data with a length are TASE_EARG. */
+static void decode_iter_restarts_the_walk_and_checks_its_arguments(void **state)
+{
+    tase_field_iter_t it;
+    tase_packet_rate_t a, b;
+    tase_camera_cmd_t cam;
+    uint8_t data[16];
+    size_t k;
+    (void)state;
+    for (k = 0; k < sizeof data; k++) {
+        data[k] = (uint8_t)(k + 1u);
+    }
+    assert_non_null(tase_field_iter_find(&it, 0x48, 0x00, sizeof data));
+    memset(&a, 0xA5, sizeof a);
+    memset(&b, 0x5A, sizeof b);
+    assert_int_equal(tase_packet_decode_iter(&it, data, &a), 16);
+    assert_int_equal(tase_packet_decode_iter(&it, data, &b), 16);
+    assert_memory_equal(&a, &b, sizeof a);
+    assert_int_equal(a.angle_1, 1);
+    assert_int_equal(a.temporary, 16);
+    assert_int_equal(tase_packet_decode_iter(&it, NULL, &a), TASE_EARG);
+    assert_int_equal(tase_packet_decode_iter(NULL, data, &a), TASE_EARG);
+    assert_null(tase_field_iter_find(&it, 0x48, 0x7F, 0));
+    assert_int_equal(tase_packet_decode_iter(&it, NULL, &a), TASE_EARG);
+    /* NULL data: a query decodes, the 1-byte form of CAMERA_CMD does not */
+    assert_non_null(tase_field_iter_find(&it, 0x48, 0x00, 0));
+    assert_int_equal(tase_packet_decode_iter(&it, NULL, &a), 0);
+    assert_non_null(tase_field_iter_find(&it, 0x00, 0x41, 1));
+    assert_true(it.accepted);
+    assert_int_equal(tase_packet_decode_iter(&it, NULL, &cam), TASE_EARG);
+}
+
+/* SPOI_CMD's limits are inclusive (90 and 180 degrees either way), and
+ * each of the four bounds is checked on its own; tase_command_check_data()
+ * refuses a 1-byte GIMBAL_CMD or SPOI_CMD as a wrong length. */
+static void spoi_limits_are_inclusive_and_checked_one_by_one(void **state)
+{
+    static const int32_t lat[][2] = {
+        {324000000, 1}, {-324000000, 1}, {324000001, 0}, {-324000001, 0}};
+    static const int32_t lon[][2] = {
+        {648000000, 1}, {-648000000, 1}, {648000001, 0}, {-648000001, 0}};
+    tase_spoi_cmd_t sp;
+    uint8_t data[TASE_DATA_MAX];
+    size_t k;
+    (void)state;
+    for (k = 0; k < 4; k++) {
+        memset(&sp, 0, sizeof sp);
+        sp.lat = lat[k][0];
+        assert_int_equal(tase_command_check(TASE_ID_SPOI_CMD, &sp),
+                         lat[k][1] ? TASE_OK : TASE_ERANGE);
+        memset(&sp, 0, sizeof sp);
+        sp.lon = lon[k][0];
+        assert_int_equal(tase_command_check(TASE_ID_SPOI_CMD, &sp),
+                         lon[k][1] ? TASE_OK : TASE_ERANGE);
+    }
+    memset(data, 0, sizeof data);
+    assert_int_equal(tase_command_check_data(TASE_ID_SPOI_CMD, data, 1), TASE_ELENGTH);
+    assert_int_equal(tase_command_check_data(TASE_ID_GIMBAL_CMD, data, 1), TASE_ELENGTH);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -806,6 +912,9 @@ int main(void)
         cmocka_unit_test(data_only_codec_rejects_bad_arguments),
         cmocka_unit_test(command_check_takes_what_the_spec_defines_and_nothing_else),
         cmocka_unit_test(init_keep_fills_a_packet_that_changes_nothing),
+        cmocka_unit_test(queries_null_data_and_lengths_past_the_maximum),
+        cmocka_unit_test(decode_iter_restarts_the_walk_and_checks_its_arguments),
+        cmocka_unit_test(spoi_limits_are_inclusive_and_checked_one_by_one),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

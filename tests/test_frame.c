@@ -388,6 +388,30 @@ static void encode_in_place_payload_needs_no_copy(void **state)
     assert_memory_equal(a, b, 13);
 }
 
+/* Every payload length 0..TASE_DATA_MAX is copied into the frame (a
+ * 1-byte payload too), and the frame carries the checksum of its bytes. */
+static void encode_copies_every_payload_length(void **state)
+{
+    uint8_t data[TASE_DATA_MAX];
+    uint8_t out[TASE_FRAME_MAX];
+    size_t len, i;
+    (void)state;
+    for (i = 0; i < sizeof(data); i++) {
+        data[i] = (uint8_t)(0x30u + i);
+    }
+    for (len = 0; len <= TASE_DATA_MAX; len++) {
+        uint16_t sum;
+        memset(out, 0xA5, sizeof(out));
+        assert_int_equal(tase_frame_build(0x10, 0x41, data, len, out, sizeof(out)),
+                         (int)(len + TASE_FRAME_OVERHEAD));
+        assert_int_equal(out[3], len + 2u);
+        assert_memory_equal(out + TASE_FRAME_HEADER, data, len);
+        sum = tase_checksum(0, out, len + TASE_FRAME_HEADER);
+        assert_int_equal(out[len + TASE_FRAME_HEADER], sum >> 8);
+        assert_int_equal(out[len + TASE_FRAME_HEADER + 1u], sum & 0xFFu);
+    }
+}
+
 static void checksum_helper_matches_definition(void **state)
 {
     static const uint8_t p[] = {0xFF, 0xFF, 0x02};
@@ -395,6 +419,35 @@ static void checksum_helper_matches_definition(void **state)
     assert_int_equal(tase_checksum(0, p, 3), 0x0200);
     assert_int_equal(tase_checksum(0xFFFF, p, 1), 0x00FE);
     assert_int_equal(tase_checksum(7, NULL, 0), 7);
+}
+
+/* The checksum of buffers far longer than a frame (tase_checksum() takes
+ * any size_t): the same as adding the bytes one by one, for every
+ * alignment, with all bytes 0xFF (the largest partial sums) and with
+ * varied bytes, across the lengths where a word-at-a-time sum has to
+ * fold its partial sums (about 1 KiB of 0xFF on a 64-bit host). */
+static void checksum_of_long_buffers_is_the_byte_sum(void **state)
+{
+    static uint8_t buf[4100];
+    static const size_t lens[] = {0,    1,    7,    8,    9,    15,   16,   17,   255,  1016,
+                                  1023, 1024, 1025, 1031, 1032, 1033, 1040, 2048, 2063, 4096};
+    size_t pattern, off, k, i;
+    (void)state;
+    for (pattern = 0; pattern < 2; pattern++) {
+        rng_state = 99;
+        for (i = 0; i < sizeof(buf); i++) {
+            buf[i] = pattern == 0 ? 0xFFu : (uint8_t)rnd();
+        }
+        for (off = 0; off < 4; off++) {
+            for (k = 0; k < sizeof(lens) / sizeof(lens[0]); k++) {
+                uint32_t want = 0x1234u;
+                for (i = 0; i < lens[k]; i++) {
+                    want += buf[off + i];
+                }
+                assert_int_equal(tase_checksum(0x1234u, buf + off, lens[k]), want & 0xFFFFu);
+            }
+        }
+    }
 }
 
 /* ---- receiver: basics ------------------------------------------------- */
@@ -2343,17 +2396,143 @@ static void frame_api_rejects_bad_arguments(void **state)
     }
 }
 
+/* A receiver whose scan lags (rx->lag 1, `end` RX_BLOCKED): issue 21's
+ * burst and the last 9 bytes of its false candidate, whose failure
+ * releases more frames than the credit of those bytes pays for. */
+static void make_lagging(tase_rx_t *rx)
+{
+    static uint8_t s[261];
+    size_t n = put_burst(s, 0), k;
+    for (k = 0; k < 9; k++) {
+        s[n++] = (uint8_t)(0x11 + k);
+    }
+    assert_int_equal(tase_rx_init(rx), TASE_OK);
+    assert_true(tase_rx_feed(rx, s, n, NULL, NULL) >= 0);
+    assert_int_equal(rx->lag, 1);
+}
+
+/* frame_api_rejects_bad_arguments() for the other states: a receiver
+ * whose scan lags with an index out of range, a flag out of range, or
+ * an `end` that does not say it lags; a stop flag or a busy flag left
+ * set outside a call; a caught-up receiver whose `end` disagrees with
+ * the candidate it holds or lies outside the window. Every entry point
+ * refuses them with TASE_EARG (busy 1 reads as a call in progress:
+ * TASE_EBUSY) and changes nothing. */
+static void a_corrupted_receiver_in_any_state_is_refused(void **state)
+{
+    static const uint8_t bytes[4] = {0x00, 0xFF, 0x5A, 0x04};
+    tase_rx_t lagging, held, bad, copy;
+    int k;
+    (void)state;
+    make_lagging(&lagging);
+    assert_int_equal(tase_rx_init(&held), TASE_OK);
+    assert_int_equal(tase_rx_feed(&held, bytes, 4, NULL, NULL), 0); /* a candidate held */
+    assert_int_equal(held.end, 9);
+    for (k = 0; k < 13; k++) {
+        int busy_code = TASE_EARG;
+        bool push = true;
+        memcpy(&bad, &lagging, sizeof bad);
+        switch (k) {
+        case 0: bad.len = (uint16_t)(TASE_RX_WINDOW + 1u); break;
+        case 1: bad.len = 0xFFFFu; break;
+        case 2: bad.scan = (uint16_t)(bad.len + 1u); break;
+        case 3: bad.lag = 2u; break;
+        case 4: bad.lag = 0u; break; /* `end` still says it lags */
+        case 5: bad.stop = 1u; break;
+        case 6: bad.busy = 2u; break;
+        case 7:
+            bad.busy = 1u;
+            busy_code = TASE_EBUSY;
+            break;
+        case 8: bad.end = 0u; break;
+        case 9: /* caught up, holding a candidate, but a stop left set (a
+                 * byte inside the candidate is simply stored: not pushed) */
+            memcpy(&bad, &held, sizeof bad);
+            bad.stop = 1u;
+            push = false;
+            break;
+        case 10: /* the candidate's 4 bytes held, but hunting (end 0) */
+            memcpy(&bad, &held, sizeof bad);
+            bad.end = 0u;
+            break;
+        case 11: /* an end one past the window, its last byte but one held */
+            memcpy(&bad, &held, sizeof bad);
+            bad.buf[3] = 0xFFu;
+            bad.len = (uint16_t)(TASE_RX_WINDOW - 1u);
+            bad.end = (uint16_t)TASE_RX_WINDOW;
+            break;
+        default: /* a 261-byte candidate at scan 36 whose Size agrees with
+                  * `end`, but `end` (its last byte) is one past the window */
+            memcpy(&bad, &held, sizeof bad);
+            bad.scan = (uint16_t)(TASE_RX_WINDOW - TASE_FRAME_MAX + 1u);
+            memcpy(&bad.buf[bad.scan], bytes, 3);
+            bad.buf[bad.scan + 3u] = 0xFFu;
+            bad.len = (uint16_t)TASE_RX_WINDOW;
+            bad.end = (uint16_t)TASE_RX_WINDOW;
+            break;
+        }
+        memcpy(&copy, &bad, sizeof bad);
+        assert_int_equal(tase_rx_feed(&bad, bytes, sizeof bytes, NULL, NULL), busy_code);
+        if (push) {
+            assert_int_equal(tase_rx_push(&bad, 0x5A, NULL, NULL), busy_code);
+        }
+        assert_int_equal(tase_rx_flush(&bad, NULL, NULL), busy_code);
+        assert_memory_equal(&bad, &copy, sizeof bad);
+    }
+}
+
+/* A frame a lagging scan delivers from tase_rx_push(): the callback's
+ * own tase_rx_push() and tase_rx_feed() are refused (TASE_EBUSY) and
+ * change nothing, as for the frames of a caught-up receiver. */
+static int lag_push_ret = 1;
+static int lag_feed_ret = 1;
+static size_t lag_frames;
+
+static void push_back_from_callback(void *user, const tase_frame_t *fr)
+{
+    tase_rx_t *rx = user;
+    tase_rx_t before;
+    const uint8_t b = 0x00;
+    (void)fr;
+    memcpy(&before, rx, sizeof before);
+    lag_push_ret = tase_rx_push(rx, 0x00, NULL, NULL);
+    lag_feed_ret = tase_rx_feed(rx, &b, 1, NULL, NULL);
+    assert_memory_equal(rx, &before, sizeof before);
+    lag_frames++;
+}
+
+static void a_push_from_the_callback_of_a_lagging_scan_is_refused(void **state)
+{
+    tase_rx_t rx;
+    size_t k;
+    (void)state;
+    make_lagging(&rx);
+    lag_frames = 0;
+    for (k = 0; k < 64 && rx.lag != 0u; k++) {
+        assert_true(tase_rx_push(&rx, 0x11, push_back_from_callback, &rx) >= 0);
+        if (lag_frames > 0u) {
+            assert_int_equal(lag_push_ret, TASE_EBUSY);
+            assert_int_equal(lag_feed_ret, TASE_EBUSY);
+        }
+    }
+    assert_true(lag_frames > 0u); /* frames came while the scan lagged */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(frame_api_rejects_bad_arguments),
+        cmocka_unit_test(a_corrupted_receiver_in_any_state_is_refused),
+        cmocka_unit_test(a_push_from_the_callback_of_a_lagging_scan_is_refused),
         cmocka_unit_test(encode_zero_length_frame_matches_hand_computed_bytes),
         cmocka_unit_test(encode_with_data_matches_hand_computed_bytes),
         cmocka_unit_test(deprecated_frame_encode_is_frame_build_in_the_old_order),
         cmocka_unit_test(encode_checksum_wraps_modulo_65536),
         cmocka_unit_test(encode_rejects_bad_arguments_without_writing),
         cmocka_unit_test(encode_in_place_payload_needs_no_copy),
+        cmocka_unit_test(encode_copies_every_payload_length),
         cmocka_unit_test(checksum_helper_matches_definition),
+        cmocka_unit_test(checksum_of_long_buffers_is_the_byte_sum),
         cmocka_unit_test(receiver_rejects_null_arguments),
         cmocka_unit_test(api_extreme_lengths_give_error_codes_and_change_nothing),
         cmocka_unit_test(receiver_size_fits_budget),

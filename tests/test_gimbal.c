@@ -1797,6 +1797,99 @@ static void telemetry_of_a_length_the_packet_does_not_have_is_skipped(void **sta
     free(x);
 }
 
+/* Every setup packet is stored apart from the others: each of the eight
+ * set to its own bytes (fields 0x10 + type + offset, reserved bytes 0,
+ * no "do not change" value) reads back unchanged after all were set. */
+static void every_setup_packet_is_stored_apart_from_the_others(void **state)
+{
+    fix_t *x = make(0, 1, false);
+    uint8_t want[8][TASE_DATA_MAX], got[TASE_DATA_MAX];
+    uint8_t type;
+    (void)state;
+    for (type = 0; type < 8u; type++) {
+        const tase_packet_desc_t *p = tase_schema_find(TASE_GROUP_SETUP, type);
+        size_t k;
+        assert_non_null(p);
+        assert_int_equal(tase_gimbal_setup_len(type), p->len);
+        memset(want[type], 0, sizeof want[type]);
+        for (k = 0; k < p->nfields; k++) {
+            const tase_field_t *f = tase_schema_field(p, k);
+            size_t b;
+            for (b = 0; b < TASE_FIELD_WIDTH(f); b++) {
+                want[type][f->offset + b] = (uint8_t)(0x10u + 8u * type + f->offset + b);
+            }
+        }
+        assert_int_equal(tase_gimbal_setup_set(&x->g, type, want[type], p->len, 0), TASE_OK);
+    }
+    for (type = 0; type < 8u; type++) {
+        int n = tase_gimbal_setup_len(type);
+        memset(got, 0xA5, sizeof got);
+        assert_int_equal(tase_gimbal_setup_get(&x->g, type, got, sizeof got), n);
+        assert_memory_equal(got, want[type], (size_t)n);
+    }
+    free(x);
+}
+
+/* AXIS_SETTING's defaults as the spec states them (written out here, not
+ * taken from the code): tilt no-go centre 90 deg and range 60 deg (0.01
+ * deg units), pan and tilt max rate 300 deg/s (5 deg/s units), max
+ * acceleration 10000 deg/s^2 (200 units), position gain 4 (0.1 units). */
+static void axis_setting_defaults_are_the_specs(void **state)
+{
+    fix_t *x = make(0, 1, false);
+    uint8_t d[23];
+    (void)state;
+    assert_int_equal(tase_gimbal_setup_get(&x->g, 0x02, d, sizeof d), 23);
+    assert_int_equal((d[4] << 8) | d[5], 9000);
+    assert_int_equal((d[6] << 8) | d[7], 6000);
+    assert_int_equal(d[12], 300 / 5);     /* pan max rate */
+    assert_int_equal(d[14], 300 / 5);     /* tilt max rate */
+    assert_int_equal(d[16], 10000 / 200); /* pan max acceleration */
+    assert_int_equal(d[17], 10000 / 200); /* tilt */
+    assert_int_equal(d[19], 4 * 10);      /* pan position gain */
+    assert_int_equal(d[20], 4 * 10);      /* tilt */
+    free(x);
+}
+
+/* The bytes fill_telemetry writes are the data of the frame that goes
+ * out, byte for byte (the frame is built around them in place). */
+static int fill_pattern(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
+                        uint32_t now)
+{
+    const tase_packet_desc_t *p = tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id));
+    size_t k;
+    (void)user;
+    (void)port;
+    (void)now;
+    assert_true(cap >= p->len);
+    for (k = 0; k < p->len; k++) {
+        data[k] = (uint8_t)(TASE_ID_TYPE(id) + 3u * k + 1u);
+    }
+    return (int)p->len;
+}
+
+static void telemetry_carries_the_bytes_fill_telemetry_wrote(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    size_t pos = 0, k;
+    unsigned frames = 0;
+    (void)state;
+    x->g.app.fill_telemetry = fill_pattern;
+    assert_int_equal(tase_gimbal_poll(&x->g, 1000), 3);
+    while (pos < x->port[0].nout) {
+        const uint8_t *f = &x->port[0].out[pos];
+        size_t len = (size_t)f[3] - 2u;
+        for (k = 0; k < len; k++) {
+            assert_int_equal(f[6 + k], (uint8_t)(f[5] + 3u * k + 1u));
+        }
+        pos += len + 8u;
+        frames++;
+    }
+    assert_int_equal(frames, 3);
+    assert_int_equal(fake_frames_out(&x->port[0]), 3);
+    free(x);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1809,6 +1902,9 @@ int main(void)
         cmocka_unit_test(system_version_is_query_only_and_answers_the_application_bytes),
         cmocka_unit_test(reserved_bytes_are_zero_in_what_is_applied_stored_and_echoed),
         cmocka_unit_test(axis_do_not_change_values_keep_the_stored_settings),
+        cmocka_unit_test(every_setup_packet_is_stored_apart_from_the_others),
+        cmocka_unit_test(axis_setting_defaults_are_the_specs),
+        cmocka_unit_test(telemetry_carries_the_bytes_fill_telemetry_wrote),
         cmocka_unit_test(camera_type_zero_keeps_and_the_default_is_no_camera),
         cmocka_unit_test(the_default_system_version_has_no_cameras),
         cmocka_unit_test(a_22_byte_axis_setting_is_applied_and_echoed_in_its_layout),

@@ -437,6 +437,206 @@ static void a_failed_request_owes_its_answers_for_one_timeout(void **state)
     assert_int_equal(x->others, 1);
 }
 
+/* Two requests of one type that end owing answers, the second inside the
+ * first's window: what both owe adds up, until the later of their two
+ * windows ends (here the first's, 1000: the second's alone ends at 710). */
+static void answers_owed_by_two_ended_requests_of_a_type_add_up(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    query_rates(x, reply, 500, 0, 0);
+    assert_int_equal(tase_host_poll(&x->host, 500), TASE_ETIMEOUT); /* owes 1 until 1000 */
+    query_rates(x, reply, 100, 0, 510);
+    assert_int_equal(tase_host_poll(&x->host, 610), TASE_ETIMEOUT); /* 1 more, until 710 */
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 800);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 900);
+    assert_int_equal(x->host.stats.late, 2);
+    assert_int_equal(x->others, 2);
+    /* both paid: the next answer completes the next request */
+    query_rates(x, reply, 500, 0, 950);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 960);
+    assert_int_equal(tase_host_poll(&x->host, 960), 16);
+    assert_int_equal(x->host.stats.late, 2);
+}
+
+/* A request of another type that is answered at its first attempt owes
+ * nothing, so it does not forget what an earlier request is owed. */
+static void a_request_answered_at_once_keeps_what_another_type_is_owed(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    query_rates(x, reply, 500, 0, 0);
+    assert_int_equal(tase_host_poll(&x->host, 500), TASE_ETIMEOUT); /* owes 1 until 1000 */
+    assert_int_equal(
+        tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x01, reply, sizeof reply, 500, 0, 510),
+        TASE_OK);
+    feed_frame(x, 0x48, 0x01, rates, 4, 520); /* answered at once: owes nothing */
+    assert_int_equal(tase_host_poll(&x->host, 520), 4);
+    query_rates(x, reply, 500, 0, 530);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 540); /* the first query's answer */
+    assert_int_equal(tase_host_poll(&x->host, 540), TASE_EAGAIN);
+    assert_int_equal(x->host.stats.late, 1);
+    assert_int_equal(x->others, 1);
+}
+
+/* Only a frame of the owed group and type with data is an owed answer: a
+ * zero-length one (our query, echoed) and one of another type of the same
+ * group are not counted late (and the owed type is the request's, here
+ * not PACKET_RATE). */
+static void only_frames_of_the_owed_type_with_data_are_owed(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    assert_int_equal(
+        tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x01, reply, sizeof reply, 500, 0, 0),
+        TASE_OK);
+    assert_int_equal(tase_host_poll(&x->host, 500), TASE_ETIMEOUT); /* owes 1 until 1000 */
+    feed_frame(x, 0x48, 0x01, NULL, 0, 600);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 610);
+    assert_int_equal(x->host.stats.late, 0);
+    assert_int_equal(x->host.stats.queries_rx, 1);
+    feed_frame(x, 0x48, 0x01, rates, 4, 620);
+    assert_int_equal(x->host.stats.late, 1);
+    assert_int_equal(x->others, 3);
+}
+
+/* The owed window is judged by the time of the feed that brings the
+ * answer: one after the window is not late, though nothing was polled or
+ * started since the request failed. */
+static void an_answer_fed_after_the_owed_window_is_not_late(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    query_rates(x, reply, 500, 0, 0);
+    assert_int_equal(tase_host_poll(&x->host, 500), TASE_ETIMEOUT); /* owes 1 until 1000 */
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 1200);
+    assert_int_equal(x->host.stats.late, 0);
+    assert_int_equal(x->others, 1);
+}
+
+/* A cancelled request owes every attempt it sent, for one attempt
+ * timeout from the cancel: its answer never completes the next request. */
+static void a_cancelled_request_owes_its_attempts(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    query_rates(x, reply, 500, 1, 0);
+    assert_int_equal(tase_host_poll(&x->host, 500), TASE_EAGAIN); /* attempt 2 */
+    assert_int_equal(tase_host_poll(&x->host, 600), TASE_EAGAIN);
+    assert_int_equal(tase_host_cancel(&x->host), TASE_OK); /* owes 2 until 1100 */
+    assert_false(tase_host_busy(&x->host));
+    query_rates(x, reply, 500, 0, 700);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 800);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 1050);
+    assert_int_equal(tase_host_poll(&x->host, 1050), TASE_EAGAIN);
+    assert_int_equal(x->host.stats.late, 2);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 1110); /* after the window: the answer */
+    assert_int_equal(tase_host_poll(&x->host, 1110), 16);
+    /* a cancel with nothing pending owes nothing */
+    assert_int_equal(tase_host_cancel(&x->host), TASE_OK);
+    query_rates(x, reply, 500, 0, 1200);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 1210);
+    assert_int_equal(tase_host_poll(&x->host, 1210), 16);
+    assert_int_equal(x->host.stats.late, 2);
+}
+
+/* A query that failed after n attempts owes n answers (counted up to
+ * 255: its 256th attempt is owed no answer). */
+static void owed_answers_after_many_attempts(fix_t *x, uint8_t retries, uint32_t want_late)
+{
+    uint8_t reply[64];
+    uint32_t t = 0, late0 = x->host.stats.late;
+    unsigned k;
+
+    query_rates(x, reply, 10, retries, t);
+    for (k = 0; k < retries; k++) {
+        t += 10;
+        assert_int_equal(tase_host_poll(&x->host, t), TASE_EAGAIN);
+    }
+    t += 10;
+    assert_int_equal(tase_host_poll(&x->host, t), TASE_ETIMEOUT); /* owed until t + 10 */
+    for (k = 0; k <= want_late; k++) {
+        feed_frame(x, 0x48, 0x00, rates, sizeof rates, t + 1u);
+    }
+    assert_int_equal(x->host.stats.late - late0, want_late);
+}
+
+static void the_count_of_owed_answers_stops_at_255(void **state)
+{
+    fix_t *x = *state;
+    owed_answers_after_many_attempts(x, 253, 254); /* 254 attempts */
+    owed_answers_after_many_attempts(x, 255, 255); /* 256 attempts */
+}
+
+/* A request of another type that owes answers forgets what an earlier
+ * one was owed; answers of a type whose window has ended are not added
+ * to those of the next request of that type that ends; and when two
+ * windows are joined, the later end holds (here the second's, 1310). */
+static void owed_answers_follow_the_last_type_and_the_later_window(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    query_rates(x, reply, 500, 0, 0);
+    assert_int_equal(tase_host_poll(&x->host, 500), TASE_ETIMEOUT); /* 1 of 48 00 until 1000 */
+    assert_int_equal(
+        tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x01, reply, sizeof reply, 100, 0, 510),
+        TASE_OK);
+    assert_int_equal(tase_host_poll(&x->host, 610), TASE_ETIMEOUT); /* 1 of 48 01 until 710 */
+    feed_frame(x, 0x48, 0x01, rates, 4, 620);
+    feed_frame(x, 0x48, 0x01, rates, 4, 630);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 640); /* 48 00 forgotten */
+    assert_int_equal(x->host.stats.late, 1);
+
+    query_rates(x, reply, 100, 0, 2000);
+    assert_int_equal(tase_host_poll(&x->host, 2100), TASE_ETIMEOUT); /* 1 until 2200 */
+    query_rates(x, reply, 100, 0, 2300);
+    assert_int_equal(tase_host_poll(&x->host, 2400), TASE_ETIMEOUT); /* the first ended: 1 */
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 2410);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 2420);
+    assert_int_equal(x->host.stats.late, 2);
+
+    query_rates(x, reply, 500, 0, 3000);
+    assert_int_equal(tase_host_poll(&x->host, 3500), TASE_ETIMEOUT); /* 1 until 4000 */
+    query_rates(x, reply, 400, 0, 3510);
+    assert_int_equal(tase_host_poll(&x->host, 3910), TASE_ETIMEOUT); /* 2 until 4310 */
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 4100);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 4200);
+    assert_int_equal(x->host.stats.late, 4);
+}
+
+/* The fake port, its reads counted. */
+static unsigned counted_reads;
+
+static int counting_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    counted_reads++;
+    return fake_read(ctx, buf, cap, timeout_ms);
+}
+
+static const tase_port_ops_t counting_ops = {fake_write, counting_read, fake_now};
+
+/* tase_host_drain() reads until two reads in a row bring nothing: two
+ * reads of an empty port, three when one read takes all that waits. */
+static void drain_stops_after_two_empty_reads_in_a_row(void **state)
+{
+    fix_t *x = *state;
+    static const uint8_t noise[10] = {0x11, 0x12, 0x13, 0x14, 0x15, 0x16, 0x17, 0x18, 0x19, 0x1A};
+    x->host.port.ops = &counting_ops;
+    counted_reads = 0;
+    assert_int_equal(tase_host_drain(&x->host), 0);
+    assert_int_equal(counted_reads, 2);
+    fake_push(&x->port, noise, sizeof noise);
+    counted_reads = 0;
+    assert_int_equal(tase_host_drain(&x->host), (int)sizeof noise);
+    assert_int_equal(counted_reads, 3);
+}
+
 static void an_echo_of_another_type_does_not_complete_the_query(void **state)
 {
     fix_t *x = *state;
@@ -1543,6 +1743,20 @@ int main(void)
         cmocka_unit_test_setup_teardown(a_late_answer_to_an_ended_request_never_completes_the_next,
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(a_failed_request_owes_its_answers_for_one_timeout, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(answers_owed_by_two_ended_requests_of_a_type_add_up, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(a_request_answered_at_once_keeps_what_another_type_is_owed,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(only_frames_of_the_owed_type_with_data_are_owed, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(an_answer_fed_after_the_owed_window_is_not_late, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(a_cancelled_request_owes_its_attempts, setup, teardown),
+        cmocka_unit_test_setup_teardown(the_count_of_owed_answers_stops_at_255, setup, teardown),
+        cmocka_unit_test_setup_teardown(owed_answers_follow_the_last_type_and_the_later_window,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(drain_stops_after_two_empty_reads_in_a_row, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(an_echo_of_another_type_does_not_complete_the_query, setup,
                                         teardown),

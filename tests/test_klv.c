@@ -1032,6 +1032,27 @@ static void klv_api_rejects_bad_arguments(void **state)
     assert_int_equal(st & 0x0401u, 0); /* reserved bits 5 and 15 stay clear */
 }
 
+/* Rounding is half away from zero, exactly at a half too (a raw value
+ * and a half is exact in double arithmetic); a longitude within 1e9 deg
+ * but past 2^53 raw (7.5e8 deg on) is still the nearest raw value (its
+ * whole turns taken off first: scaled in one piece it is a double
+ * rounded to 2, one LSB off; expected values by exact fractions); a
+ * magnitude of exactly 1e9 deg gives 0, as klv.h says. */
+static void units_to_raw_ties_far_longitudes_and_the_limit(void **state)
+{
+    const double half = 90.0 / 4294967296.0; /* lat_raw: 0.5 raw */
+    (void)state;
+    assert_int_equal(tase_klv_lat_raw(half), 1);
+    assert_int_equal(tase_klv_lat_raw(-half), -1);
+    assert_int_equal(tase_klv_lat_raw(5.0 * half), 3);
+    assert_int_equal(tase_klv_lon_raw(943305908.5543873), 817885699);
+    assert_int_equal(tase_klv_lon_raw(-943305908.5543873), -817885699);
+    assert_int_equal(tase_klv_lon_raw(821216566.1774611), 550918571);
+    assert_int_equal(tase_klv_lon_raw(-821216566.1774611), -550918571);
+    assert_int_equal(tase_klv_lon_raw(1e9), 0);
+    assert_int_equal(tase_klv_lon_raw(-1e9), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1066,6 +1087,7 @@ int main(void)
         cmocka_unit_test(units_to_raw_round_to_nearest),
         cmocka_unit_test(units_to_raw_saturate_where_the_range_ends),
         cmocka_unit_test(circular_units_to_raw_wrap),
+        cmocka_unit_test(units_to_raw_ties_far_longitudes_and_the_limit),
         cmocka_unit_test(every_16_bit_raw_value_survives_units_and_back),
         cmocka_unit_test(gps_status_uses_msb_first_bit_numbers),
     };

@@ -732,10 +732,55 @@ static void the_field_walk_rejects_bad_arguments(void **state)
     assert_false(it.accepted);
 }
 
+/* A walk bound to a packet, then to one the schema does not know (by
+ * group and type, NULL, or a copy of a descriptor): schema.h says it is
+ * then bound to no packet, walks nothing and has accepted false. */
+static void a_walk_rebound_to_no_packet_forgets_the_last_one(void **state)
+{
+    tase_field_iter_t it;
+    tase_packet_desc_t copy;
+    int k;
+    (void)state;
+    memcpy(&copy, tase_schema_find(0x48, 0x02), sizeof copy);
+    for (k = 0; k < 3; k++) {
+        assert_non_null(tase_field_iter_find(&it, 0x48, 0x02, 22)); /* AXIS_SETTING, short */
+        assert_true(it.accepted);
+        assert_true(it.short_layout);
+        switch (k) {
+        case 0: assert_null(tase_field_iter_find(&it, 0x48, 0x7F, 22)); break;
+        case 1: assert_int_equal(tase_field_iter_init(&it, NULL, 22), TASE_EUNKNOWN); break;
+        default: assert_int_equal(tase_field_iter_init(&it, &copy, 22), TASE_EARG); break;
+        }
+        assert_null(it.packet);
+        assert_false(it.accepted);
+        assert_false(it.short_layout);
+        assert_int_equal(it.count, 0);
+        assert_false(tase_field_iter_next(&it));
+    }
+}
+
+/* tase_field_iter_get() with NULL data: TASE_EARG whenever the walk's
+ * length is above 0 (1 too), TASE_ETRUNC for a query's walk. */
+static void field_get_with_no_data_is_an_argument_error_at_any_length(void **state)
+{
+    tase_field_iter_t it;
+    int64_t v = 7;
+    (void)state;
+    assert_non_null(tase_field_iter_find(&it, 0x00, 0x41, 1)); /* CAMERA_CMD's 1-byte form */
+    assert_true(tase_field_iter_next(&it));
+    assert_int_equal(tase_field_iter_get(&it, NULL, &v), TASE_EARG);
+    assert_non_null(tase_field_iter_find(&it, 0x48, 0x00, 0)); /* a query */
+    assert_true(tase_field_iter_next(&it));
+    assert_int_equal(tase_field_iter_get(&it, NULL, &v), TASE_ETRUNC);
+    assert_int_equal(v, 7);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(schema_api_rejects_bad_arguments),
+        cmocka_unit_test(a_walk_rebound_to_no_packet_forgets_the_last_one),
+        cmocka_unit_test(field_get_with_no_data_is_an_argument_error_at_any_length),
         cmocka_unit_test(reserved_flags_are_the_specs),
         cmocka_unit_test(schema_matches_spec_transcription),
         cmocka_unit_test(fields_are_in_range_ordered_disjoint_and_cover_all_but_reserved),
