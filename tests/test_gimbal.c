@@ -1890,6 +1890,99 @@ static void telemetry_carries_the_bytes_fill_telemetry_wrote(void **state)
     free(x);
 }
 
+/* ---- schedule and capacity edges (mutation testing) ------------------- */
+
+/* SCHEDULE: the j-th packet (j >= 1) of a stream anchored at 0 with
+ * `rate` is due at (j / rate) * 1000 + floor((j % rate) * 1000 / rate);
+ * how many are due at t. */
+static uint32_t slots_due(uint32_t rate, uint32_t t)
+{
+    uint32_t j = 0;
+    while ((j + 1u) / rate * 1000u + (j + 1u) % rate * 1000u / rate <= t) {
+        j++;
+    }
+    return j;
+}
+
+static const uint8_t grid_rates[9] = {3, 7, 1, 0, 0, 0, 0, 0, 0};
+
+static void each_slot_is_sent_at_t0_plus_floor_k_1000_over_rate(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    uint32_t t;
+    unsigned s;
+    (void)state;
+
+    x->port[0].discard = 1;
+    set_rates(x, grid_rates, 0);
+    for (t = 0; t <= 3000u; t++) {
+        tase_gimbal_poll(&x->g, t);
+        for (s = 0; s < NSTREAM; s++) {
+            assert_int_equal(x->count[0][s], slots_due(grid_rates[s], t));
+        }
+    }
+    free(x);
+}
+
+/* A single late poll at any time sends one packet per stream with a slot
+ * passed, counts the other passed slots in stats.slots_skipped, and the
+ * stream goes on on its grid from the first slot after it. */
+static void a_late_poll_at_any_time_skips_exactly_the_slots_passed(void **state)
+{
+    uint32_t late;
+    (void)state;
+
+    for (late = 1; late <= 2010u; late++) {
+        fix_t *x = make(0, 1, true);
+        uint32_t sent[NSTREAM], skipped = 0, t;
+        unsigned s;
+        x->port[0].discard = 1;
+        set_rates(x, grid_rates, 0);
+        tase_gimbal_poll(&x->g, late);
+        for (s = 0; s < NSTREAM; s++) {
+            uint32_t due = slots_due(grid_rates[s], late);
+            sent[s] = due > 0u ? 1u : 0u;
+            skipped += due - sent[s];
+            assert_int_equal(x->count[0][s], sent[s]);
+        }
+        assert_int_equal(x->g.stats.slots_skipped, skipped);
+        for (t = late + 1u; t <= late + 1000u; t++) {
+            tase_gimbal_poll(&x->g, t);
+            for (s = 0; s < NSTREAM; s++) {
+                assert_int_equal(x->count[0][s], sent[s] + slots_due(grid_rates[s], t) -
+                                                     slots_due(grid_rates[s], late));
+            }
+        }
+        assert_int_equal(x->g.stats.slots_skipped, skipped);
+        free(x);
+    }
+}
+
+/* SCHEDULE: only a next slot MORE than a second ahead of now_ms (the
+ * clock stepped back) re-anchors the stream; one exactly a second ahead is
+ * waited for. */
+static void only_a_slot_more_than_a_second_ahead_restarts_its_stream(void **state)
+{
+    static const uint8_t two[9] = {2, 0, 0, 0, 0, 0, 0, 0, 0};
+    fix_t *x = make(10000, 1, true);
+    (void)state;
+
+    x->port[0].discard = 1;
+    set_rates(x, two, 10000); /* next slot at 10500 */
+    run(x, 9500, 1000, 0);    /* the clock went back to exactly 1000 ms before it */
+    assert_int_equal(x->count[0][0], 1);
+    assert_int_equal(x->first[0][0], 10500);
+    free(x);
+
+    x = make(10000, 1, true);
+    x->port[0].discard = 1;
+    set_rates(x, two, 10000);
+    run(x, 9499, 501, 0); /* 1001 ms before it: restarted at 9499 */
+    assert_int_equal(x->count[0][0], 1);
+    assert_int_equal(x->first[0][0], 9999);
+    free(x);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1938,6 +2031,9 @@ int main(void)
         cmocka_unit_test(every_setup_in_a_long_buffer_gets_its_echo),
         cmocka_unit_test(frames_are_handled_after_the_receiver_returns_in_stream_order),
         cmocka_unit_test(telemetry_longer_than_its_room_is_skipped),
+        cmocka_unit_test(each_slot_is_sent_at_t0_plus_floor_k_1000_over_rate),
+        cmocka_unit_test(a_late_poll_at_any_time_skips_exactly_the_slots_passed),
+        cmocka_unit_test(only_a_slot_more_than_a_second_ahead_restarts_its_stream),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
