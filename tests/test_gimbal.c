@@ -1983,6 +1983,119 @@ static void only_a_slot_more_than_a_second_ahead_restarts_its_stream(void **stat
     free(x);
 }
 
+/* Telemetry's bytes per second at rates r (port 0's three streams): each
+ * frame is its packet's data plus TASE_FRAME_OVERHEAD. */
+static uint32_t telemetry_demand(const uint8_t r[3])
+{
+    static const uint16_t ids[NSTREAM] = {TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE,
+                                          TASE_ID_GEOREFERENCE_DATA};
+    uint32_t d = 0;
+    unsigned s;
+    for (s = 0; s < NSTREAM; s++) {
+        d += r[s] * (tase_schema_find(TASE_ID_GROUP(ids[s]), TASE_ID_TYPE(ids[s]))->len +
+                     TASE_FRAME_OVERHEAD);
+    }
+    return d;
+}
+
+/* Over 30 s at rates r and capacity c: whether every slot was sent (the
+ * pacing may let a slot over the budget through at first: 30 s is long
+ * enough for the rates below to show that they do not fit). */
+static bool all_slots_sent(const uint8_t r[9], uint32_t c)
+{
+    fix_t *x = make(0, 1, true);
+    bool all;
+    unsigned s;
+    x->port[0].discard = 1;
+    set_rates(x, r, 0);
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 0, c), TASE_OK);
+    run(x, 0, 30000, 0);
+    all = x->g.stats.slots_over_capacity == 0u;
+    for (s = 0; s < NSTREAM; s++) {
+        assert_true(x->count[0][s] <= 30u * r[s]);
+        all = all && x->count[0][s] == 30u * r[s];
+    }
+    free(x);
+    return all;
+}
+
+/* PRIORITY AND CAPACITY: telemetry may use TASE_GIMBAL_TELEMETRY_SHARE
+ * percent of the capacity: rates asking exactly that much are all sent,
+ * with one byte per second of capacity less some slots are skipped. */
+static void telemetry_may_use_exactly_its_share_of_the_capacity(void **state)
+{
+    static const uint8_t rates_a[9] = {30, 0, 0, 0, 0, 0, 0, 0, 0};
+    static const uint8_t rates_b[9] = {52, 1, 1, 0, 0, 0, 0, 0, 0};
+    const uint8_t *r[2] = {rates_a, rates_b};
+    unsigned i;
+    (void)state;
+
+    for (i = 0; i < 2u; i++) {
+        uint32_t d = telemetry_demand(r[i]);
+        /* the least capacity whose share is d */
+        uint32_t c = (d * 100u + TASE_GIMBAL_TELEMETRY_SHARE - 1u) / TASE_GIMBAL_TELEMETRY_SHARE;
+        assert_true(all_slots_sent(r[i], c));
+        assert_false(all_slots_sent(r[i], c - 1u));
+    }
+}
+
+/* PRIORITY AND CAPACITY, a rate change while over capacity: a stream keeps
+ * at most one slot of what it had earned, so the second after the change
+ * stays within the budget (the pacing of 255/255/255 could otherwise
+ * carry a large credit into a slower schedule and send it as a burst). */
+static void a_rate_change_over_capacity_carries_no_burst_into_the_next_second(void **state)
+{
+    static const uint8_t fast[9] = {255, 255, 255, 0, 0, 0, 0, 0, 0};
+    static const uint8_t slow[9] = {60, 0, 0, 0, 0, 0, 0, 0, 0};
+    const uint32_t budget = 960u * TASE_GIMBAL_TELEMETRY_SHARE / 100u;
+    fix_t *x = make(0, 1, true);
+    uint32_t before;
+    (void)state;
+
+    x->port[0].discard = 1;
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 0, 960u), TASE_OK);
+    set_rates(x, fast, 0);
+    run(x, 0, 1000, 0);
+    assert_true(x->g.stats.slots_over_capacity > 0u);
+    assert_true(telemetry_demand(slow) > budget); /* still over */
+    before = x->count[0][0];
+    set_rates(x, slow, 1000);
+    run(x, 1001, 999, 0);
+    assert_true((x->count[0][0] - before) * 14u <= budget + 14u);
+    free(x);
+}
+
+/* A port that states no byte rate gets the slowest line's capacity (960
+ * B/s, the default rates' 684 B/s fit its share), and
+ * tase_gimbal_set_capacity(0) goes back to it. */
+static void a_port_without_a_byte_rate_has_the_slowest_lines_capacity(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL, NULL, NULL, NULL};
+    tase_port_t p = {&fake_ops, NULL, 0};
+    (void)state;
+
+    if (684u * 100u > 960u * TASE_GIMBAL_TELEMETRY_SHARE) {
+        free(x);
+        skip();
+    }
+    app.user = x;
+    p.ctx = &x->port[0];
+    x->port[0].discard = 1;
+    assert_int_equal(tase_gimbal_init(&x->g, &p, x->rx, 1, &app, 0), TASE_OK);
+    run(x, 0, 2000, 0);
+    assert_int_equal(x->count[0][0], 20);
+    assert_int_equal(x->count[0][2], 8);
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 0, 100u), TASE_OK);
+    run(x, 2001, 1999, 0);
+    assert_true(x->g.stats.slots_over_capacity > 0u);
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 0, 0u), TASE_OK);
+    x->g.stats.slots_over_capacity = 0;
+    run(x, 4001, 1999, 0);
+    assert_int_equal(x->g.stats.slots_over_capacity, 0);
+    free(x);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -2034,6 +2147,9 @@ int main(void)
         cmocka_unit_test(each_slot_is_sent_at_t0_plus_floor_k_1000_over_rate),
         cmocka_unit_test(a_late_poll_at_any_time_skips_exactly_the_slots_passed),
         cmocka_unit_test(only_a_slot_more_than_a_second_ahead_restarts_its_stream),
+        cmocka_unit_test(telemetry_may_use_exactly_its_share_of_the_capacity),
+        cmocka_unit_test(a_port_without_a_byte_rate_has_the_slowest_lines_capacity),
+        cmocka_unit_test(a_rate_change_over_capacity_carries_no_burst_into_the_next_second),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
