@@ -2096,6 +2096,65 @@ static void a_port_without_a_byte_rate_has_the_slowest_lines_capacity(void **sta
     free(x);
 }
 
+/* Setup types are 0x00..0x07: a frame of group 0x48 type 0x08 is the
+ * application's (EVERYTHING ELSE), not a setup to answer. */
+static void a_setup_group_frame_of_type_8_goes_to_the_application(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    const uint8_t d[3] = {1, 2, 3};
+    (void)state;
+
+    feed(x, 0, TASE_GROUP_SETUP, 0x08, d, sizeof d, 1);
+    feed(x, 0, TASE_GROUP_SETUP, 0x08, NULL, 0, 2);
+    assert_int_equal(x->others, 2);
+    assert_int_equal(x->other_group, TASE_GROUP_SETUP);
+    assert_int_equal(x->other_type, 0x08);
+    assert_int_equal(x->applies, 0);
+    assert_int_equal(x->g.stats.bad_length, 0);
+    assert_int_equal(x->g.stats.setup_queries, 0);
+    assert_int_equal(x->port[0].nout, 0);
+    free(x);
+}
+
+/* tase_gimbal_feed(): one byte at a time is fine (bytes NULL with n 1 is
+ * not); it never reads past bytes[n); and a feed on another port than the
+ * first handles every frame of one call. */
+static void feed_takes_single_bytes_and_nothing_past_n(void **state)
+{
+    fix_t *x = make(0, 2, true);
+    uint8_t buf[3 * TASE_FRAME_MAX];
+    const uint8_t angle[6] = {0, 1, 0, 2, 0, 3};
+    int a = tase_frame_build(TASE_GROUP_SETUP, 0x00, NULL, 0, buf, sizeof buf);
+    size_t i;
+    int b;
+    (void)state;
+
+    assert_true(a > 0);
+    for (i = 0; i + 1u < (size_t)a; i++) {
+        assert_int_equal(tase_gimbal_feed(&x->g, 0, &buf[i], 1, 1), 0);
+    }
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, &buf[i], 1, 1), 1);
+    assert_int_equal(fake_frames_out(&x->port[0]), 1);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, NULL, 1, 1), TASE_EARG);
+
+    /* the query, two noise bytes, then (not given) a frame for on_frame */
+    buf[a] = 0x11;
+    buf[a + 1] = 0x22;
+    b = tase_frame_build(0x08, 0x10, angle, sizeof angle, &buf[a + 2], sizeof buf - (size_t)a - 2u);
+    assert_true(b > 0);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, buf, (size_t)a + 2u, 2), 1);
+    assert_int_equal(x->others, 0);
+    assert_int_equal(fake_frames_out(&x->port[0]), 2);
+
+    /* port 1: two queries in one call, both answered there */
+    x->port[1].nout = 0;
+    memcpy(&buf[a], buf, (size_t)a);
+    assert_int_equal(tase_gimbal_feed(&x->g, 1, buf, 2u * (size_t)a, 3), 2);
+    assert_int_equal(fake_frames_out(&x->port[1]), 2);
+    assert_int_equal(x->g.stats.setup_queries, 4);
+    free(x);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -2149,6 +2208,8 @@ int main(void)
         cmocka_unit_test(only_a_slot_more_than_a_second_ahead_restarts_its_stream),
         cmocka_unit_test(telemetry_may_use_exactly_its_share_of_the_capacity),
         cmocka_unit_test(a_port_without_a_byte_rate_has_the_slowest_lines_capacity),
+        cmocka_unit_test(a_setup_group_frame_of_type_8_goes_to_the_application),
+        cmocka_unit_test(feed_takes_single_bytes_and_nothing_past_n),
         cmocka_unit_test(a_rate_change_over_capacity_carries_no_burst_into_the_next_second),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
