@@ -1964,7 +1964,7 @@ static int ticking_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms
     (void)cap;
     (void)timeout_ms;
     tick_reads++;
-    if (tick_reads > 4ul * TASE_PORT_WRITE_SPINS) {
+    if (tick_reads / 4u >= TASE_PORT_WRITE_SPINS) {
         return TASE_EIO;
     }
     if (tick_reads % tick_every == 0u && tick_reads <= tick_last) {
