@@ -1890,6 +1890,271 @@ static void telemetry_carries_the_bytes_fill_telemetry_wrote(void **state)
     free(x);
 }
 
+/* ---- schedule and capacity edges (mutation testing) ------------------- */
+
+/* SCHEDULE: the j-th packet (j >= 1) of a stream anchored at 0 with
+ * `rate` is due at (j / rate) * 1000 + floor((j % rate) * 1000 / rate);
+ * how many are due at t. */
+static uint32_t slots_due(uint32_t rate, uint32_t t)
+{
+    uint32_t j = 0;
+    while ((j + 1u) / rate * 1000u + (j + 1u) % rate * 1000u / rate <= t) {
+        j++;
+    }
+    return j;
+}
+
+static const uint8_t grid_rates[9] = {3, 7, 1, 0, 0, 0, 0, 0, 0};
+
+static void each_slot_is_sent_at_t0_plus_floor_k_1000_over_rate(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    uint32_t t;
+    unsigned s;
+    (void)state;
+
+    x->port[0].discard = 1;
+    set_rates(x, grid_rates, 0);
+    for (t = 0; t <= 3000u; t++) {
+        tase_gimbal_poll(&x->g, t);
+        for (s = 0; s < NSTREAM; s++) {
+            assert_int_equal(x->count[0][s], slots_due(grid_rates[s], t));
+        }
+    }
+    free(x);
+}
+
+/* A single late poll at any time sends one packet per stream with a slot
+ * passed, counts the other passed slots in stats.slots_skipped, and the
+ * stream goes on on its grid from the first slot after it. */
+static void a_late_poll_at_any_time_skips_exactly_the_slots_passed(void **state)
+{
+    uint32_t late;
+    (void)state;
+
+    for (late = 1; late <= 2010u; late++) {
+        fix_t *x = make(0, 1, true);
+        uint32_t sent[NSTREAM], skipped = 0, t;
+        unsigned s;
+        x->port[0].discard = 1;
+        set_rates(x, grid_rates, 0);
+        tase_gimbal_poll(&x->g, late);
+        for (s = 0; s < NSTREAM; s++) {
+            uint32_t due = slots_due(grid_rates[s], late);
+            sent[s] = due > 0u ? 1u : 0u;
+            skipped += due - sent[s];
+            assert_int_equal(x->count[0][s], sent[s]);
+        }
+        assert_int_equal(x->g.stats.slots_skipped, skipped);
+        for (t = late + 1u; t <= late + 1000u; t++) {
+            tase_gimbal_poll(&x->g, t);
+            for (s = 0; s < NSTREAM; s++) {
+                assert_int_equal(x->count[0][s], sent[s] + slots_due(grid_rates[s], t) -
+                                                     slots_due(grid_rates[s], late));
+            }
+        }
+        assert_int_equal(x->g.stats.slots_skipped, skipped);
+        free(x);
+    }
+}
+
+/* SCHEDULE: only a next slot MORE than a second ahead of now_ms (the
+ * clock stepped back) re-anchors the stream; one exactly a second ahead is
+ * waited for. */
+static void only_a_slot_more_than_a_second_ahead_restarts_its_stream(void **state)
+{
+    static const uint8_t two[9] = {2, 0, 0, 0, 0, 0, 0, 0, 0};
+    fix_t *x = make(10000, 1, true);
+    (void)state;
+
+    x->port[0].discard = 1;
+    set_rates(x, two, 10000); /* next slot at 10500 */
+    run(x, 9500, 1000, 0);    /* the clock went back to exactly 1000 ms before it */
+    assert_int_equal(x->count[0][0], 1);
+    assert_int_equal(x->first[0][0], 10500);
+    free(x);
+
+    x = make(10000, 1, true);
+    x->port[0].discard = 1;
+    set_rates(x, two, 10000);
+    run(x, 9499, 501, 0); /* 1001 ms before it: restarted at 9499 */
+    assert_int_equal(x->count[0][0], 1);
+    assert_int_equal(x->first[0][0], 9999);
+    free(x);
+}
+
+/* Telemetry's bytes per second at rates r (port 0's three streams): each
+ * frame is its packet's data plus TASE_FRAME_OVERHEAD. */
+static uint32_t telemetry_demand(const uint8_t r[3])
+{
+    static const uint16_t ids[NSTREAM] = {TASE_ID_GIMBAL_ANGLE, TASE_ID_GIMBAL_RATE,
+                                          TASE_ID_GEOREFERENCE_DATA};
+    uint32_t d = 0;
+    unsigned s;
+    for (s = 0; s < NSTREAM; s++) {
+        d += r[s] * (tase_schema_find(TASE_ID_GROUP(ids[s]), TASE_ID_TYPE(ids[s]))->len +
+                     TASE_FRAME_OVERHEAD);
+    }
+    return d;
+}
+
+/* Over 30 s at rates r and capacity c: whether every slot was sent (the
+ * pacing may let a slot over the budget through at first: 30 s is long
+ * enough for the rates below to show that they do not fit). */
+static bool all_slots_sent(const uint8_t r[9], uint32_t c)
+{
+    fix_t *x = make(0, 1, true);
+    bool all;
+    unsigned s;
+    x->port[0].discard = 1;
+    set_rates(x, r, 0);
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 0, c), TASE_OK);
+    run(x, 0, 30000, 0);
+    all = x->g.stats.slots_over_capacity == 0u;
+    for (s = 0; s < NSTREAM; s++) {
+        assert_true(x->count[0][s] <= 30u * r[s]);
+        all = all && x->count[0][s] == 30u * r[s];
+    }
+    free(x);
+    return all;
+}
+
+/* PRIORITY AND CAPACITY: telemetry may use TASE_GIMBAL_TELEMETRY_SHARE
+ * percent of the capacity: rates asking exactly that much are all sent,
+ * with one byte per second of capacity less some slots are skipped. */
+static void telemetry_may_use_exactly_its_share_of_the_capacity(void **state)
+{
+    static const uint8_t rates_a[9] = {30, 0, 0, 0, 0, 0, 0, 0, 0};
+    static const uint8_t rates_b[9] = {52, 1, 1, 0, 0, 0, 0, 0, 0};
+    const uint8_t *r[2] = {rates_a, rates_b};
+    unsigned i;
+    (void)state;
+
+    for (i = 0; i < 2u; i++) {
+        uint32_t d = telemetry_demand(r[i]);
+        /* the least capacity whose share is d */
+        uint32_t c = (d * 100u + TASE_GIMBAL_TELEMETRY_SHARE - 1u) / TASE_GIMBAL_TELEMETRY_SHARE;
+        assert_true(all_slots_sent(r[i], c));
+        assert_false(all_slots_sent(r[i], c - 1u));
+    }
+}
+
+/* PRIORITY AND CAPACITY, a rate change while over capacity: a stream keeps
+ * at most one slot of what it had earned, so the second after the change
+ * stays within the budget (the pacing of 255/255/255 could otherwise
+ * carry a large credit into a slower schedule and send it as a burst). */
+static void a_rate_change_over_capacity_carries_no_burst_into_the_next_second(void **state)
+{
+    static const uint8_t fast[9] = {255, 255, 255, 0, 0, 0, 0, 0, 0};
+    static const uint8_t slow[9] = {60, 0, 0, 0, 0, 0, 0, 0, 0};
+    const uint32_t budget = 960u * TASE_GIMBAL_TELEMETRY_SHARE / 100u;
+    fix_t *x = make(0, 1, true);
+    uint32_t before;
+    (void)state;
+
+    x->port[0].discard = 1;
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 0, 960u), TASE_OK);
+    set_rates(x, fast, 0);
+    run(x, 0, 1000, 0);
+    assert_true(x->g.stats.slots_over_capacity > 0u);
+    assert_true(telemetry_demand(slow) > budget); /* still over */
+    before = x->count[0][0];
+    set_rates(x, slow, 1000);
+    run(x, 1001, 999, 0);
+    assert_true((x->count[0][0] - before) * 14u <= budget + 14u);
+    free(x);
+}
+
+/* A port that states no byte rate gets the slowest line's capacity (960
+ * B/s, the default rates' 684 B/s fit its share), and
+ * tase_gimbal_set_capacity(0) goes back to it. */
+static void a_port_without_a_byte_rate_has_the_slowest_lines_capacity(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    tase_gimbal_app_t app = {app_apply, app_fill, app_other, NULL, NULL, NULL, NULL};
+    tase_port_t p = {&fake_ops, NULL, 0};
+    (void)state;
+
+    if (684u * 100u > 960u * TASE_GIMBAL_TELEMETRY_SHARE) {
+        free(x);
+        skip();
+    }
+    app.user = x;
+    p.ctx = &x->port[0];
+    x->port[0].discard = 1;
+    assert_int_equal(tase_gimbal_init(&x->g, &p, x->rx, 1, &app, 0), TASE_OK);
+    run(x, 0, 2000, 0);
+    assert_int_equal(x->count[0][0], 20);
+    assert_int_equal(x->count[0][2], 8);
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 0, 100u), TASE_OK);
+    run(x, 2001, 1999, 0);
+    assert_true(x->g.stats.slots_over_capacity > 0u);
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 0, 0u), TASE_OK);
+    x->g.stats.slots_over_capacity = 0;
+    run(x, 4001, 1999, 0);
+    assert_int_equal(x->g.stats.slots_over_capacity, 0);
+    free(x);
+}
+
+/* Setup types are 0x00..0x07: a frame of group 0x48 type 0x08 is the
+ * application's (EVERYTHING ELSE), not a setup to answer. */
+static void a_setup_group_frame_of_type_8_goes_to_the_application(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    const uint8_t d[3] = {1, 2, 3};
+    (void)state;
+
+    feed(x, 0, TASE_GROUP_SETUP, 0x08, d, sizeof d, 1);
+    feed(x, 0, TASE_GROUP_SETUP, 0x08, NULL, 0, 2);
+    assert_int_equal(x->others, 2);
+    assert_int_equal(x->other_group, TASE_GROUP_SETUP);
+    assert_int_equal(x->other_type, 0x08);
+    assert_int_equal(x->applies, 0);
+    assert_int_equal(x->g.stats.bad_length, 0);
+    assert_int_equal(x->g.stats.setup_queries, 0);
+    assert_int_equal(x->port[0].nout, 0);
+    free(x);
+}
+
+/* tase_gimbal_feed(): one byte at a time is fine (bytes NULL with n 1 is
+ * not); it never reads past bytes[n); and a feed on another port than the
+ * first handles every frame of one call. */
+static void feed_takes_single_bytes_and_nothing_past_n(void **state)
+{
+    fix_t *x = make(0, 2, true);
+    uint8_t buf[3 * TASE_FRAME_MAX];
+    const uint8_t angle[6] = {0, 1, 0, 2, 0, 3};
+    int a = tase_frame_build(TASE_GROUP_SETUP, 0x00, NULL, 0, buf, sizeof buf);
+    size_t i;
+    int b;
+    (void)state;
+
+    assert_true(a > 0);
+    for (i = 0; i + 1u < (size_t)a; i++) {
+        assert_int_equal(tase_gimbal_feed(&x->g, 0, &buf[i], 1, 1), 0);
+    }
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, &buf[i], 1, 1), 1);
+    assert_int_equal(fake_frames_out(&x->port[0]), 1);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, NULL, 1, 1), TASE_EARG);
+
+    /* the query, two noise bytes, then (not given) a frame for on_frame */
+    buf[a] = 0x11;
+    buf[a + 1] = 0x22;
+    b = tase_frame_build(0x08, 0x10, angle, sizeof angle, &buf[a + 2], sizeof buf - (size_t)a - 2u);
+    assert_true(b > 0);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, buf, (size_t)a + 2u, 2), 1);
+    assert_int_equal(x->others, 0);
+    assert_int_equal(fake_frames_out(&x->port[0]), 2);
+
+    /* port 1: two queries in one call, both answered there */
+    x->port[1].nout = 0;
+    memcpy(&buf[a], buf, (size_t)a);
+    assert_int_equal(tase_gimbal_feed(&x->g, 1, buf, 2u * (size_t)a, 3), 2);
+    assert_int_equal(fake_frames_out(&x->port[1]), 2);
+    assert_int_equal(x->g.stats.setup_queries, 4);
+    free(x);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1938,6 +2203,14 @@ int main(void)
         cmocka_unit_test(every_setup_in_a_long_buffer_gets_its_echo),
         cmocka_unit_test(frames_are_handled_after_the_receiver_returns_in_stream_order),
         cmocka_unit_test(telemetry_longer_than_its_room_is_skipped),
+        cmocka_unit_test(each_slot_is_sent_at_t0_plus_floor_k_1000_over_rate),
+        cmocka_unit_test(a_late_poll_at_any_time_skips_exactly_the_slots_passed),
+        cmocka_unit_test(only_a_slot_more_than_a_second_ahead_restarts_its_stream),
+        cmocka_unit_test(telemetry_may_use_exactly_its_share_of_the_capacity),
+        cmocka_unit_test(a_port_without_a_byte_rate_has_the_slowest_lines_capacity),
+        cmocka_unit_test(a_setup_group_frame_of_type_8_goes_to_the_application),
+        cmocka_unit_test(feed_takes_single_bytes_and_nothing_past_n),
+        cmocka_unit_test(a_rate_change_over_capacity_carries_no_burst_into_the_next_second),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -197,6 +197,7 @@ typedef struct {
     fix_t *x;
     uint8_t reply[64];
     int started;
+    int fed; /* what a feed from on_frame returned */
 } midfeed_t;
 
 static void start_on_angle(void *user, const tase_frame_t *f)
@@ -1027,6 +1028,9 @@ static void bad_arguments_are_rejected(void **state)
 /* A port that can only write: no read, no clock. */
 static const tase_port_ops_t write_only_ops = {fake_write, NULL, NULL};
 
+/* A port that reads but has no clock. */
+static const tase_port_ops_t clockless_ops = {fake_write, fake_read, NULL};
+
 static void service_and_transact_need_a_readable_port_with_a_clock(void **state)
 {
     fix_t *x = *state;
@@ -1039,6 +1043,15 @@ static void service_and_transact_need_a_readable_port_with_a_clock(void **state)
     assert_int_equal(tase_host_transact(&h, 0x48, 0x00, NULL, 0, reply, sizeof reply, 100, 1),
                      TASE_EUNSUPPORTED);
     assert_int_equal(x->port.nout, 0); /* the request was not even sent */
+    assert_false(tase_host_busy(&h));
+    /* read alone is not enough: the clock is needed too */
+    p.ops = &clockless_ops;
+    assert_int_equal(tase_host_init(&h, &p, NULL, NULL), TASE_OK);
+    assert_int_equal(tase_host_service(&h, 10), TASE_EUNSUPPORTED);
+    assert_int_equal(tase_host_drain(&h), TASE_EUNSUPPORTED);
+    assert_int_equal(tase_host_transact(&h, 0x48, 0x00, NULL, 0, reply, sizeof reply, 100, 1),
+                     TASE_EUNSUPPORTED);
+    assert_int_equal(x->port.nout, 0);
     assert_false(tase_host_busy(&h));
     assert_int_equal(tase_host_service(NULL, 10), TASE_EARG);
     assert_int_equal(tase_host_drain(NULL), TASE_EARG);
@@ -1352,6 +1365,11 @@ static void a_typed_reply_of_a_wrong_length_is_elength_and_writes_nothing(void *
     /* without a struct the length is still checked */
     assert_int_equal(
         tase_host_request_msg_start(&x->host, TASE_ID_PACKET_RATE, NULL, NULL, 100, 1, 20),
+        TASE_OK);
+    feed_frame(x, 0x48, 0x00, rates, 15, 25);
+    assert_int_equal(tase_host_poll(&x->host, 25), TASE_ELENGTH);
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_PACKET_RATE, NULL, NULL, 100, 1, 26),
         TASE_OK);
     feed_frame(x, 0x48, 0x00, rates, 16, 30);
     assert_int_equal(tase_host_poll(&x->host, 30), 16);
@@ -1734,6 +1752,287 @@ static void transact_keeps_its_contract_under_random_faults(void **state)
     }
 }
 
+/* ---- contract edges (mutation testing) -------------------------------- */
+
+/* host.h: TASE_ETOOLONG only for len > 253: the longest data goes out,
+ * as a command and as a request, whole. */
+static void data_of_the_full_253_bytes_is_sent_and_requested(void **state)
+{
+    fix_t *x = *state;
+    uint8_t data[TASE_DATA_MAX], d[TASE_DATA_MAX];
+    uint8_t reply[8];
+    tase_frame_t f;
+    unsigned i;
+
+    for (i = 0; i < sizeof data; i++) {
+        data[i] = (uint8_t)(i * 7u + 1u);
+    }
+    /* 0x00/0x99: a packet the schema does not know, sent as given */
+    assert_int_equal(tase_host_send(&x->host, 0x00, 0x99, data, sizeof data), (int)TASE_FRAME_MAX);
+    assert_int_equal(tase_host_request_start(&x->host, 0x00, 0x99, data, sizeof data, reply,
+                                             sizeof reply, 10, 0, 0),
+                     TASE_OK);
+    assert_int_equal(fake_frames_out(&x->port), 2);
+    for (i = 0; i < 2u; i++) {
+        f = written_frame(x, i, d);
+        assert_int_equal(f.len, TASE_DATA_MAX);
+        assert_memory_equal(d, data, sizeof data);
+    }
+    assert_int_equal(tase_host_cancel(&x->host), TASE_OK);
+}
+
+/* host.h: only timeout_ms 0 (and >= 2^31) is refused; 1 ms is an attempt
+ * that times out 1 ms after its sending. */
+static void a_timeout_of_1_ms_is_accepted_and_expires_after_1_ms(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    tase_packet_rate_t pr;
+
+    query_rates(x, reply, 1, 0, 100);
+    assert_int_equal(tase_host_poll(&x->host, 100), TASE_EAGAIN);
+    assert_int_equal(tase_host_poll(&x->host, 101), TASE_ETIMEOUT);
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_PACKET_RATE, NULL, &pr, 1, 0, 200), TASE_OK);
+    assert_int_equal(tase_host_poll(&x->host, 201), TASE_ETIMEOUT);
+    assert_int_equal(fake_frames_out(&x->port), 2);
+}
+
+/* host.h: RETRACT_DEPLOY_CMD, CAMERA_PASS and unknown packets "need
+ * retries 0": a single retry is refused as well, nothing sent. */
+static void one_retry_is_refused_for_packets_a_repeat_would_change(void **state)
+{
+    fix_t *x = *state;
+    tase_retract_deploy_cmd_t rd = {TASE_DEPLOY};
+    tase_camera_pass_t pass = {0, 0, 3, (const uint8_t *)"\x81\x01\x04"};
+    tase_packet_msg_t m;
+    uint8_t data[3] = {1, 2, 3};
+    uint8_t reply[8];
+
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_RETRACT_DEPLOY_CMD, &rd, &m, 10, 1, 0),
+        TASE_EARG);
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_CAMERA_PASS, &pass, &m, 10, 1, 0), TASE_EARG);
+    assert_int_equal(tase_host_request_start(&x->host, 0x00, 0x99, data, 3, reply, 8, 10, 1, 0),
+                     TASE_EARG);
+    assert_int_equal(tase_host_transact(&x->host, 0x00, 0x99, data, 3, reply, 8, 10, 1), TASE_EARG);
+    assert_int_equal(x->port.nout, 0);
+    assert_int_equal(x->host.stats.requests, 0);
+}
+
+/* host.h: TASE_ENOSPC only for a reply LONGER than reply_cap. */
+static void a_reply_that_exactly_fills_the_buffer_is_copied_whole(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[sizeof rates + 1u];
+
+    memset(reply, 0xCC, sizeof reply);
+    assert_int_equal(
+        tase_host_query_start(&x->host, TASE_GROUP_SETUP, 0x00, reply, sizeof rates, 100, 0, 0),
+        TASE_OK);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 5);
+    assert_int_equal(tase_host_poll(&x->host, 5), (int)sizeof rates);
+    assert_memory_equal(reply, rates, sizeof rates);
+    assert_int_equal(reply[sizeof rates], 0xCC);
+}
+
+/* stats.frames_rx counts every valid frame: the reply, other frames,
+ * zero-length queries, and those handed over with handle_frame(); noise
+ * does not count. */
+static void frames_rx_counts_every_valid_frame_received(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    static const uint8_t noise[5] = {0x01, 0x02, 0x03, 0x04, 0x05};
+    const uint8_t angle[6] = {0, 1, 0, 2, 0, 3};
+    tase_frame_t f = {0, 0x08, 0x10, sizeof angle, angle};
+
+    query_rates(x, reply, 100, 0, 0);
+    assert_int_equal(tase_host_feed(&x->host, noise, sizeof noise, 1), 0);
+    feed_frame(x, 0x08, 0x10, angle, sizeof angle, 2);
+    feed_frame(x, 0x48, 0x00, NULL, 0, 3);
+    assert_int_equal(x->host.stats.frames_rx, 2);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 4);
+    assert_int_equal(tase_host_poll(&x->host, 4), 16);
+    assert_int_equal(tase_host_handle_frame(&x->host, &f), 0);
+    assert_int_equal(x->host.stats.frames_rx, 4);
+}
+
+/* host.h: handle_frame() "Returns 1 if it completed the pending request,
+ * 0 if it went to on_frame". */
+static void handle_frame_returns_0_for_a_frame_that_goes_to_on_frame(void **state)
+{
+    fix_t *x = *state;
+    const uint8_t two[2] = {1, 0};
+    tase_frame_t other = {0, 0x48, 0x04, sizeof two, two};
+    tase_frame_t answer = {0, 0x48, 0x00, sizeof rates, rates};
+    uint8_t reply[64];
+
+    assert_int_equal(tase_host_handle_frame(&x->host, &answer), 0); /* nothing pending */
+    query_rates(x, reply, 100, 0, 0);
+    assert_int_equal(tase_host_handle_frame(&x->host, &other), 0); /* another type */
+    assert_int_equal(x->others, 2);
+    assert_int_equal(tase_host_handle_frame(&x->host, &answer), 1);
+    assert_int_equal(x->others, 2);
+    assert_int_equal(tase_host_poll(&x->host, 1), 16);
+}
+
+/* A raw request after a typed one copies its reply as bytes: nothing of
+ * the typed request (its struct, its length check) carries over. */
+static void a_raw_request_after_a_typed_one_copies_the_reply_undecoded(void **state)
+{
+    fix_t *x = *state;
+    tase_packet_rate_t pr;
+    tase_packet_rate_t first;
+    uint8_t reply[64];
+
+    assert_int_equal(
+        tase_host_request_msg_start(&x->host, TASE_ID_PACKET_RATE, NULL, &pr, 100, 0, 0), TASE_OK);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 1);
+    assert_int_equal(tase_host_poll(&x->host, 1), 16);
+    first = pr;
+    /* 15 bytes: a length the typed request would refuse */
+    query_rates(x, reply, 100, 0, 2);
+    feed_frame(x, 0x48, 0x00, &rates[1], 15, 3);
+    assert_int_equal(tase_host_poll(&x->host, 3), 15);
+    assert_memory_equal(reply, &rates[1], 15);
+    assert_memory_equal(&pr, &first, sizeof pr);
+}
+
+/* on_frame that starts a query (as start_on_angle) and then tries to feed
+ * the host from inside its receiver (refused). */
+static void start_then_feed_on_angle(void *user, const tase_frame_t *f)
+{
+    midfeed_t *m = user;
+    start_on_angle(user, f);
+    if (f->group == 0x08 && f->type == 0x10) {
+        m->fed = tase_host_feed(&m->x->host, rates, sizeof rates, 0);
+    }
+}
+
+/* A feed refused from on_frame changes nothing for the feed in progress:
+ * the frame after, begun before the request was sent, is still stale. */
+static void a_feed_refused_inside_on_frame_leaves_the_feed_in_progress_as_it_was(void **state)
+{
+    fix_t *x = *state;
+    midfeed_t m;
+    tase_port_t p = {&fake_ops, &x->port, 0};
+    uint8_t buf[2 * TASE_FRAME_MAX];
+    const uint8_t angle[6] = {0, 1, 0, 2, 0, 3};
+    int a = tase_frame_build(0x08, 0x10, angle, sizeof angle, buf, sizeof buf);
+    int b = tase_frame_build(0x48, 0x00, rates, sizeof rates, &buf[a], sizeof buf - (size_t)a);
+
+    memset(&m, 0, sizeof m);
+    m.x = x;
+    assert_int_equal(tase_host_init(&x->host, &p, start_then_feed_on_angle, &m), TASE_OK);
+    assert_true(a > 0 && b > 0);
+    assert_int_equal(tase_host_feed(&x->host, buf, (size_t)(a + b), 1), 2);
+    assert_int_equal(m.started, 1);
+    assert_int_equal(m.fed, TASE_EBUSY);
+    assert_int_equal(x->host.stats.stale, 1);
+    assert_int_equal(tase_host_poll(&x->host, 2), TASE_EAGAIN);
+    feed_frame(x, 0x48, 0x00, rates, sizeof rates, 3);
+    assert_int_equal(tase_host_poll(&x->host, 3), 16);
+}
+
+/* host.h: a port whose clock stands still ends a transact "after
+ * TASE_PORT_WRITE_SPINS such reads in a row" (after the two empty reads
+ * of the drain before the send). */
+static void a_frozen_clock_ends_a_transact_after_exactly_the_spin_limit_of_reads(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+
+    x->host.port.ops = &counting_ops;
+    x->port.frozen = 1;
+    counted_reads = 0;
+    assert_int_equal(tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 100, 0),
+                     TASE_ETIMEOUT);
+    assert_int_equal(counted_reads, 2u + TASE_PORT_WRITE_SPINS);
+}
+
+/* A port whose read() returns 0 at once while its clock ticks 1 ms every
+ * `tick_every` reads, up to read `tick_last`; from read 4 * SPINS on it
+ * fails (a transact that never ends is cut short). */
+static unsigned long tick_reads, tick_every, tick_last;
+
+static int ticking_read(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms)
+{
+    fake_port_t *f = ctx;
+    (void)buf;
+    (void)cap;
+    (void)timeout_ms;
+    tick_reads++;
+    if (tick_reads / 4u >= TASE_PORT_WRITE_SPINS) {
+        return TASE_EIO;
+    }
+    if (tick_reads % tick_every == 0u && tick_reads <= tick_last) {
+        f->now++;
+    }
+    return 0;
+}
+
+static const tase_port_ops_t ticking_ops = {fake_write, ticking_read, fake_now};
+
+/* A coarse clock that moves only every TASE_PORT_WRITE_SPINS reads is not
+ * standing still: the transact waits its whole timeout. */
+static void a_clock_that_moves_between_empty_reads_is_not_standing_still(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    uint32_t t0 = x->port.now;
+
+    x->host.port.ops = &ticking_ops;
+    tick_reads = 0;
+    tick_every = TASE_PORT_WRITE_SPINS;
+    tick_last = (unsigned long)-1;
+    assert_int_equal(tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 2, 0),
+                     TASE_ETIMEOUT);
+    assert_int_equal(x->port.now - t0, 2u);
+    assert_int_equal(x->host.stats.timeouts, 1);
+    assert_int_equal(fake_frames_out(&x->port), 1);
+}
+
+/* A clock that moves once and then stands still ends the transact after
+ * TASE_PORT_WRITE_SPINS reads from its last move. */
+static void a_clock_that_stops_after_moving_still_ends_the_transact(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    uint32_t t0 = x->port.now;
+
+    x->host.port.ops = &ticking_ops;
+    tick_reads = 0;
+    tick_every = 10;
+    tick_last = 10;
+    assert_int_equal(tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 100, 0),
+                     TASE_ETIMEOUT);
+    assert_int_equal(tick_reads, 10u + TASE_PORT_WRITE_SPINS);
+    assert_int_equal(x->port.now - t0, 1u);
+    assert_false(tase_host_busy(&x->host));
+}
+
+/* A frame that comes during an attempt (not its answer) leaves the
+ * transact waiting only what is left of the attempt's timeout: it ends at
+ * its sending + timeout_ms, not later. */
+static void transact_waits_only_the_rest_of_the_attempt_after_another_frame(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    const uint8_t angle[6] = {0, 1, 0, 2, 0, 3};
+    uint32_t t0 = x->port.now;
+
+    x->port.nreply = (size_t)tase_frame_build(0x08, 0x10, angle, sizeof angle, x->port.reply,
+                                              sizeof x->port.reply);
+    x->port.reply_after = 1;
+    x->port.reply_delay_ms = 40;
+    assert_int_equal(tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 100, 0),
+                     TASE_ETIMEOUT);
+    assert_int_equal(x->others, 1);
+    assert_int_equal(x->port.now - t0, 100u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1840,6 +2139,30 @@ int main(void)
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(transact_keeps_its_contract_under_random_faults, setup,
                                         teardown),
+        cmocka_unit_test_setup_teardown(data_of_the_full_253_bytes_is_sent_and_requested, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(a_timeout_of_1_ms_is_accepted_and_expires_after_1_ms, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(one_retry_is_refused_for_packets_a_repeat_would_change,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(a_reply_that_exactly_fills_the_buffer_is_copied_whole,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(frames_rx_counts_every_valid_frame_received, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(handle_frame_returns_0_for_a_frame_that_goes_to_on_frame,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(a_raw_request_after_a_typed_one_copies_the_reply_undecoded,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(
+            a_feed_refused_inside_on_frame_leaves_the_feed_in_progress_as_it_was, setup, teardown),
+        cmocka_unit_test_setup_teardown(
+            a_frozen_clock_ends_a_transact_after_exactly_the_spin_limit_of_reads, setup, teardown),
+        cmocka_unit_test_setup_teardown(
+            a_clock_that_moves_between_empty_reads_is_not_standing_still, setup, teardown),
+        cmocka_unit_test_setup_teardown(a_clock_that_stops_after_moving_still_ends_the_transact,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(
+            transact_waits_only_the_rest_of_the_attempt_after_another_frame, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
