@@ -9,13 +9,10 @@ set -euo pipefail
 . "$(dirname "$0")/../lib.sh"
 timing="$TASE_ROOT/docs/TIMING.md"
 rows=$(sed -n 's/^| `\(tase_[a-z0-9_]*\)[`/].*/\1/p' "$timing" | sort -u)
-missing=() gone=()
-while read -r f; do
-    grep -qx "$f" <<<"$rows" || missing+=("$f")
-done < <("$TASE_ROOT/bench/public-fns.sh" "$TASE_ROOT")
-while read -r f; do
-    "$TASE_ROOT/bench/public-fns.sh" "$TASE_ROOT" | grep -qx "$f" || gone+=("$f")
-done <<<"$rows"
+fns=$("$TASE_ROOT/bench/public-fns.sh" "$TASE_ROOT")
+# both lists sorted: comm -23 what only the headers have, -13 only the table
+mapfile -t missing < <(comm -23 <(echo "$fns") <(echo "$rows"))
+mapfile -t gone < <(comm -13 <(echo "$fns") <(echo "$rows"))
 [ ${#missing[@]} -eq 0 ] || tase_fail "docs/TIMING.md has no row for: ${missing[*]} (measure them in bench/cm/timing_*.c and run bench/bench.sh)"
 [ ${#gone[@]} -eq 0 ] || tase_fail "docs/TIMING.md has rows for functions no header declares: ${gone[*]}"
 echo "docs/TIMING.md: a row for each of the $(wc -l <<<"$rows") public functions"
