@@ -7,23 +7,36 @@
 # programs it starts from the build tree (tools/tase, tase-sim, ...) are
 # checked too; system programs (/usr, /bin, ...) are skipped. Tests see
 # TASE_UNDER_VALGRIND=1 and may scale their timeouts by it.
-# Usage: scripts/checks/valgrind.sh [BUILDDIR] (default build)
+# Usage: scripts/checks/valgrind.sh [BUILDDIR] [all|serial|parallel]
+#   (default build, all). `serial` takes only the tests ctest runs alone
+#   (RUN_SERIAL: on the real clock), `parallel` the others; ctest registers
+#   the two halves as valgrind_serial and valgrind, so that they run side by
+#   side while each half keeps its tests one after another.
 set -euo pipefail
 . "$(dirname "$0")/../lib.sh"
 build=$(cd "${1:-$TASE_ROOT/build}" && pwd)
+part=${2:-all}
+case $part in
+    all | serial | parallel) ;;
+    *) echo "usage: $0 [BUILDDIR] [all|serial|parallel]" >&2; exit 2 ;;
+esac
+# shellcheck disable=SC2054 # the commas are in valgrind's own option values
 vg=(valgrind -q --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect
     --show-leak-kinds=definite,indirect --track-origins=yes)
 skip='/usr/*,/bin/*,/sbin/*,/lib/*,/lib64/*,/etc/*'
 list=$(cd "$build" && ctest --show-only=json-v1 | python3 -c '
 import json, sys
+part = sys.argv[1]
 for t in json.load(sys.stdin)["tests"]:
     props = {p["name"]: p["value"] for p in t.get("properties", [])}
     labels = props.get("LABELS", [])
+    if part != "all" and bool(props.get("RUN_SERIAL")) != (part == "serial"):
+        continue
     if ("unit" in labels or "e2e" in labels) and t.get("command"):
         wd = props.get("WORKING_DIRECTORY", "")
         env = props.get("ENVIRONMENT", [])
         print("\x1f".join([t["name"], wd, "\x1e".join(env)] + t["command"]))
-')
+' "$part")
 n=0; failed=()
 while IFS=$'\x1f' read -r -a f; do
     [ ${#f[@]} -ge 4 ] || continue
@@ -51,6 +64,6 @@ while IFS=$'\x1f' read -r -a f; do
         failed+=("$name")
     fi
 done <<<"$list"
-[ "$n" -gt 0 ] || { echo "no unit/e2e tests found in $build"; exit 1; }
+[ "$n" -gt 0 ] || { echo "no unit/e2e tests ($part) found in $build"; exit 1; }
 if [ ${#failed[@]} -gt 0 ]; then echo "memcheck failed: ${failed[*]}"; exit 1; fi
-echo "valgrind memcheck: $n test(s) clean"
+echo "valgrind memcheck ($part): $n test(s) clean"
