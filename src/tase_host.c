@@ -352,9 +352,12 @@ int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_
     int t;
     uint32_t count;
     uint32_t shift;
+    uint32_t was;
     if (h == NULL) {
         return TASE_EARG;
     }
+    /* set before the feed: the frames it delivers judge owed answers by it */
+    was = h->now;
     h->now = now_ms;
     /* the host's own count of the bytes it was fed, which nothing resets
      * (rx.stats may be): frames are placed on it for MATCHING */
@@ -366,6 +369,7 @@ int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_
     if (r < 0) {
         /* nothing fed (bad arguments, or a call from on_frame: the feed
          * in progress goes on with its own shift) */
+        h->now = was;
         h->in_count = count;
         h->in_shift = shift;
         return r;

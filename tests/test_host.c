@@ -1909,6 +1909,48 @@ static void a_feed_refused_inside_on_frame_leaves_the_feed_in_progress_as_it_was
     assert_int_equal(m.fed, TASE_EBUSY);
 }
 
+/* on_frame that feeds the host it is called from (refused: TASE_EBUSY)
+ * at a time far from the outer feed's, and notes whether the host
+ * changed. */
+typedef struct {
+    tase_host_t *h;
+    int fed;
+    int same;
+} refeed_t;
+
+static void refeed(void *user, const tase_frame_t *f)
+{
+    refeed_t *r = user;
+    tase_host_t before;
+    (void)f;
+    memcpy(&before, r->h, sizeof before);
+    r->fed = tase_host_feed(r->h, rates, sizeof rates, 99999u);
+    r->same = memcmp(&before, r->h, sizeof before) == 0;
+}
+
+/* common.h: a failing call leaves its instance unchanged. A refused
+ * tase_host_feed() (bytes NULL; called from on_frame) used to keep its
+ * now_ms all the same: the time the feed in progress judges owed answers
+ * by (MATCHING), and the next owe() starts from. */
+static void a_refused_feed_leaves_the_host_as_it_was(void **state)
+{
+    fix_t *x = *state;
+    tase_port_t p = {&fake_ops, &x->port, 0};
+    const uint8_t angle[6] = {0, 1, 0, 2, 0, 3};
+    tase_host_t copy;
+    refeed_t r = {NULL, 0, 0};
+
+    memcpy(&copy, &x->host, sizeof copy);
+    assert_int_equal(tase_host_feed(&x->host, NULL, 5, 7777u), TASE_EARG);
+    assert_memory_equal(&x->host, &copy, sizeof copy);
+
+    r.h = &x->host;
+    assert_int_equal(tase_host_init(&x->host, &p, refeed, &r), TASE_OK);
+    feed_frame(x, 0x08, 0x10, angle, sizeof angle, 10u);
+    assert_int_equal(r.fed, TASE_EBUSY);
+    assert_true(r.same);
+}
+
 /* host.h: a port whose clock stands still ends a transact "after
  * TASE_PORT_WRITE_SPINS such reads in a row" (after the two empty reads
  * of the drain before the send). */
@@ -2126,6 +2168,7 @@ int main(void)
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(
             a_feed_refused_inside_on_frame_leaves_the_feed_in_progress_as_it_was, setup, teardown),
+        cmocka_unit_test_setup_teardown(a_refused_feed_leaves_the_host_as_it_was, setup, teardown),
         cmocka_unit_test_setup_teardown(
             a_frozen_clock_ends_a_transact_after_exactly_the_spin_limit_of_reads, setup, teardown),
         cmocka_unit_test_setup_teardown(

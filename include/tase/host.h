@@ -297,7 +297,9 @@ int tase_host_query_start(tase_host_t *h, uint8_t group, uint8_t type, uint8_t *
  * complete the pending request or go to on_frame. now_ms is not used for
  * matching (a reply fed before the deadline poll always wins). Returns the
  * number of
- * frames received (>= 0) or TASE_EARG (h NULL, bytes NULL with n > 0).
+ * frames received (>= 0), TASE_EARG (h NULL, bytes NULL with n > 0) or
+ * TASE_EBUSY (called from on_frame: the feed in progress goes on); on
+ * either error nothing is fed and h is unchanged.
  * now_ms is when the bytes arrived: it drives the receiver's time bound
  * (tase/frame.h, TIME BOUND), so call it with n == 0 too whenever a look
  * at your receive buffer found it empty; frames held behind noise are then
