@@ -1951,6 +1951,24 @@ static void a_refused_feed_leaves_the_host_as_it_was(void **state)
     assert_true(r.same);
 }
 
+/* host.h, tase_host_poll(): now_ms is noted even when no request is
+ * pending (TASE_ESTATE), so that an answer owed by a request that timed
+ * out stops being owed once its window has passed, also for a frame
+ * handed over by tase_host_handle_frame(), which takes no time. */
+static void a_poll_with_no_request_still_ends_the_owed_window(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    tase_frame_t f = {0, 0x48, 0x00, sizeof rates, rates};
+
+    query_rates(x, reply, 100, 0, 0);
+    assert_int_equal(tase_host_poll(&x->host, 100), TASE_ETIMEOUT); /* owed until 200 */
+    assert_int_equal(tase_host_poll(&x->host, 500), TASE_ESTATE);
+    assert_int_equal(tase_host_handle_frame(&x->host, &f), 0);
+    assert_int_equal(x->host.stats.late, 0); /* no longer owed at 500 */
+    assert_int_equal(x->others, 1);
+}
+
 /* host.h: a port whose clock stands still ends a transact "after
  * TASE_PORT_WRITE_SPINS such reads in a row" (after the two empty reads
  * of the drain before the send). */
@@ -2169,6 +2187,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(
             a_feed_refused_inside_on_frame_leaves_the_feed_in_progress_as_it_was, setup, teardown),
         cmocka_unit_test_setup_teardown(a_refused_feed_leaves_the_host_as_it_was, setup, teardown),
+        cmocka_unit_test_setup_teardown(a_poll_with_no_request_still_ends_the_owed_window, setup,
+                                        teardown),
         cmocka_unit_test_setup_teardown(
             a_frozen_clock_ends_a_transact_after_exactly_the_spin_limit_of_reads, setup, teardown),
         cmocka_unit_test_setup_teardown(

@@ -310,7 +310,10 @@ int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_
 
 /* Hand over one frame received some other way (e.g. reassembled from
  * CAN). Returns 1 if it completed the pending request, 0 if it went to
- * on_frame, TASE_EARG if h or frame (or frame->data) is NULL. O(len). */
+ * on_frame, TASE_EARG if h or frame (or frame->data) is NULL. Whether it
+ * is an owed answer (MATCHING) is judged by the latest now_ms the host
+ * was given (tase_host_feed(), tase_host_poll(), a request's start), so
+ * call tase_host_poll() as time passes. O(len). */
 int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame);
 
 /* Drive the pending request. Re-sends it when its attempt timed out and
@@ -324,6 +327,9 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame);
  *                 host idle again);
  *   TASE_ESTATE   no request was started (or its outcome was reported);
  *   TASE_EARG     h NULL.
+ * now_ms is noted whatever the result (TASE_ESTATE too): it is the time
+ * by which answers owed by ended requests expire (MATCHING), also for
+ * frames given to tase_host_handle_frame(), which takes no time.
  * A re-send the port refuses still uses up the attempt (counted in
  * stats.tx_errors). O(request length). */
 int tase_host_poll(tase_host_t *h, uint32_t now_ms);
