@@ -1551,6 +1551,8 @@ static void motion_commands_the_spec_does_not_define_are_not_sent(void **state)
     assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, NULL, 0), TASE_ELENGTH);
     assert_int_equal(tase_host_send(&x->host, 0x00, 0x43, NULL, 0), TASE_ELENGTH);
     assert_int_equal(tase_host_send(&x->host, 0x00, 0x43, data, 3), TASE_ELENGTH);
+    assert_int_equal(tase_host_request_start(&x->host, 0x00, 0x43, data, 3, reply, 8, 10, 0, 0),
+                     TASE_ELENGTH);
     memset(&spoi, 0, sizeof spoi);
     spoi.flags = TASE_SPOI_ECHO;
     spoi.lat = 324000001;

@@ -205,7 +205,9 @@ int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on
  * degrees, the packet's length): nothing moves on a value the spec gives
  * no meaning. Returns the frame length, or TASE_EARG (h NULL, data NULL
  * with len > 0), TASE_ETOOLONG (len > 253), TASE_ERANGE / TASE_ELENGTH
- * (such a GIMBAL_CMD or SPOI_CMD), all checked before anything is sent,
+ * (such a GIMBAL_CMD or SPOI_CMD; TASE_ELENGTH also for a
+ * RETRACT_DEPLOY_CMD of a length it does not accept, 0 included), all
+ * checked before anything is sent,
  * or a port error from tase_port_write_all() (port_io.h). O(len). */
 int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len);
 
@@ -254,7 +256,10 @@ int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg);
  *   TASE_ERANGE   a SPOI_CMD tase_command_check_data() refuses;
  *   TASE_ELENGTH  len 0 for a known packet without a query form
  *                 (GYRO_ZERO_CMD: a command, never sent as a request), a
- *                 SPOI_CMD of a length it does not accept;
+ *                 SPOI_CMD or RETRACT_DEPLOY_CMD of a length it does not
+ *                 accept (other packets' lengths are not checked: a
+ *                 setup packet of a wrong length goes out, and the
+ *                 gimbal does not answer it);
  *   TASE_ETOOLONG len > 253;
  *   TASE_EBUSY    a request is pending (it is left untouched; checked
  *                 before what the request is);
