@@ -1175,23 +1175,40 @@ static int bytes_fill(void *user, unsigned port, uint16_t id, uint8_t *data, siz
     return 0;
 }
 
+/* Init refuses an app with both forms of a callback (or both on_frame
+ * and a dispatcher) with TASE_EARG, and then writes neither the instance
+ * nor the receivers it was given (common.h). */
 static void init_refuses_both_forms_of_a_callback(void **state)
 {
     static tase_gimbal_t g;
+    static tase_gimbal_t g_before;
+    static tase_rx_t rx;
+    static tase_rx_t rx_before;
+    tase_dispatch_t d;
     fake_port_t *fp = calloc(1, sizeof *fp);
     tase_port_t port = {&fake_ops, fp, 0};
     tase_gimbal_app_t app;
     (void)state;
+    memset(&g, 0xC3, sizeof g);
+    memcpy(&g_before, &g, sizeof g);
+    memset(&rx, 0x3C, sizeof rx);
+    memcpy(&rx_before, &rx, sizeof rx);
     memset(&app, 0, sizeof app);
     app.fill_telemetry = bytes_fill;
     app.fill_telemetry_msg = typed_fill;
-    assert_int_equal(tase_gimbal_init(&g, &port, NULL, 1, &app, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(&g, &port, &rx, 1, &app, 0), TASE_EARG);
     app.fill_telemetry = NULL;
     app.apply_setup = app_apply;
     app.apply_setup_msg = typed_apply;
-    assert_int_equal(tase_gimbal_init(&g, &port, NULL, 1, &app, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(&g, &port, &rx, 1, &app, 0), TASE_EARG);
     app.apply_setup_msg = NULL;
-    assert_int_equal(tase_gimbal_init(&g, &port, NULL, 1, &app, 0), TASE_OK);
+    app.on_frame = app_other;
+    app.dispatch = &d;
+    assert_int_equal(tase_gimbal_init(&g, &port, &rx, 1, &app, 0), TASE_EARG);
+    assert_memory_equal(&g, &g_before, sizeof g);
+    assert_memory_equal(&rx, &rx_before, sizeof rx);
+    app.dispatch = NULL;
+    assert_int_equal(tase_gimbal_init(&g, &port, &rx, 1, &app, 0), TASE_OK);
     free(fp);
 }
 
