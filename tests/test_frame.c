@@ -2392,6 +2392,8 @@ static void frame_api_rejects_bad_arguments(void **state)
         assert_int_equal(tase_rx_feed(&bad, bytes, sizeof bytes, NULL, NULL), TASE_EARG);
         assert_int_equal(tase_rx_push(&bad, 0x5A, NULL, NULL), TASE_EARG);
         assert_int_equal(tase_rx_flush(&bad, NULL, NULL), TASE_EARG);
+        assert_int_equal(tase_rx_tick(&bad, 999999u, NULL, NULL), TASE_EARG);
+        assert_int_equal(tase_rx_set_timing(&bad, 1u, 1u), TASE_EARG);
         assert_memory_equal(&bad, &copy, sizeof bad);
     }
 }
@@ -2416,7 +2418,8 @@ static void make_lagging(tase_rx_t *rx)
  * an `end` that does not say it lags; a stop flag or a busy flag left
  * set outside a call; a caught-up receiver whose `end` disagrees with
  * the candidate it holds or lies outside the window. Every entry point
- * refuses them with TASE_EARG (busy 1 reads as a call in progress:
+ * (tick and set_timing too) refuses them with TASE_EARG (busy 1 reads as
+ * a call in progress:
  * TASE_EBUSY) and changes nothing. */
 static void a_corrupted_receiver_in_any_state_is_refused(void **state)
 {
@@ -2477,6 +2480,8 @@ static void a_corrupted_receiver_in_any_state_is_refused(void **state)
             assert_int_equal(tase_rx_push(&bad, 0x5A, NULL, NULL), busy_code);
         }
         assert_int_equal(tase_rx_flush(&bad, NULL, NULL), busy_code);
+        assert_int_equal(tase_rx_tick(&bad, 999999u, NULL, NULL), busy_code);
+        assert_int_equal(tase_rx_set_timing(&bad, 1u, 1u), busy_code);
         assert_memory_equal(&bad, &copy, sizeof bad);
     }
 }
