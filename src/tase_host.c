@@ -6,6 +6,7 @@
 #include "tase/codec.h"
 #include "tase/flags.h"
 #include "tase/port_io.h"
+#include "tase_frame_private.h"
 
 enum { HOST_IDLE = 0, HOST_WAITING = 1, HOST_COMPLETE = 2 };
 
@@ -431,8 +432,10 @@ bool tase_host_busy(const tase_host_t *h)
 }
 
 /* The checks of the calls that read the port (service, transact): TASE_OK
- * when it can be used. Inside a callback of the host's receiver (on_frame)
- * they cannot feed it: the bytes they read would be lost (TASE_EBUSY). */
+ * when it can be used. A receiver that could not take what they read
+ * refuses them before the read, as tase_rx_feed() would after it (the
+ * bytes would be lost): TASE_EBUSY inside its callback (on_frame),
+ * TASE_EARG when it is visibly corrupted. */
 static int port_ok(const tase_host_t *h)
 {
     if (h == NULL || h->port.ops == NULL) {
@@ -441,7 +444,7 @@ static int port_ok(const tase_host_t *h)
     if (h->port.ops->read == NULL || h->port.ops->now_ms == NULL) {
         return TASE_EUNSUPPORTED;
     }
-    return (h->rx.busy != 0u) ? TASE_EBUSY : TASE_OK;
+    return tase_rx_state_check(&h->rx);
 }
 
 int tase_host_service(tase_host_t *h, uint32_t wait_ms)

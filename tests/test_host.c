@@ -1971,6 +1971,39 @@ static void a_poll_with_no_request_still_ends_the_owed_window(void **state)
     assert_int_equal(x->others, 1);
 }
 
+/* The calls that read the port (service, drain, transact) refuse a host
+ * whose receiver is visibly corrupted before they read: TASE_EARG, as
+ * tase_host_feed() gives, nothing read from the port (the bytes would be
+ * lost: read, then refused by the receiver), the host unchanged. A busy
+ * byte other than 0 and 1 is such corruption, not a call from on_frame
+ * (TASE_EBUSY, which a caller retries for ever). */
+static void a_corrupted_receiver_is_refused_before_the_port_is_read(void **state)
+{
+    fix_t *x = *state;
+    tase_host_t copy;
+    uint8_t reply[64];
+    int k;
+
+    fake_push_frame(&x->port, 0x48, 0x00, rates, sizeof rates);
+    for (k = 0; k < 2; k++) {
+        if (k == 0) {
+            x->host.rx.len = 0xFFFFu;
+        } else {
+            x->host.rx.len = 0u;
+            x->host.rx.busy = 2u;
+        }
+        memcpy(&copy, &x->host, sizeof copy);
+        assert_int_equal(tase_host_service(&x->host, 0), TASE_EARG);
+        assert_int_equal(tase_host_drain(&x->host), TASE_EARG);
+        assert_int_equal(
+            tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 10, 0),
+            TASE_EARG);
+        assert_memory_equal(&x->host, &copy, sizeof copy);
+        assert_int_equal(x->port.rin, 0); /* nothing read */
+        assert_int_equal(x->port.nout, 0);
+    }
+}
+
 /* host.h: a port whose clock stands still ends a transact "after
  * TASE_PORT_WRITE_SPINS such reads in a row" (after the two empty reads
  * of the drain before the send). */
@@ -2189,6 +2222,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(
             a_feed_refused_inside_on_frame_leaves_the_feed_in_progress_as_it_was, setup, teardown),
         cmocka_unit_test_setup_teardown(a_refused_feed_leaves_the_host_as_it_was, setup, teardown),
+        cmocka_unit_test_setup_teardown(a_corrupted_receiver_is_refused_before_the_port_is_read,
+                                        setup, teardown),
         cmocka_unit_test_setup_teardown(a_poll_with_no_request_still_ends_the_owed_window, setup,
                                         teardown),
         cmocka_unit_test_setup_teardown(

@@ -355,8 +355,9 @@ bool tase_host_busy(const tase_host_t *h);
  * never late. Returns bytes read (>= 0), a
  * port error, TASE_EIO (the port's read() claimed more bytes than asked;
  * nothing fed), TASE_EUNSUPPORTED (port has no read or now_ms), TASE_EBUSY
- * (called from on_frame: nothing read) or TASE_EARG (h NULL, or never
- * initialised: no port ops). Stack: a 64-byte read buffer and the receive
+ * (called from on_frame: nothing read) or TASE_EARG (h NULL, never
+ * initialised: no port ops, or its receiver h->rx visibly corrupted, as
+ * tase_rx_feed() says: nothing read). Stack: a 64-byte read buffer and the receive
  * path, 436 B on Cortex-M4 and 504 B on M0+ with the host's own frame
  * handling, plus on_frame's and the port's own (docs/FOOTPRINT.md, "Role
  * entry points"). */
@@ -386,8 +387,8 @@ int tase_host_drain(tase_host_t *h);
  * tase_host_request_start() + tase_host_poll(): returns the reply length
  * or a negative code (TASE_ETIMEOUT after 1 + retries attempts). Waits at
  * most about (1 + retries) * timeout_ms. Frames that arrive meanwhile go
- * to on_frame. TASE_EARG also for h without port ops (never initialised),
- * TASE_EUNSUPPORTED for a port without read or now_ms, TASE_EBUSY called
+ * to on_frame. TASE_EARG also for h without port ops (never initialised)
+ * or with a corrupted receiver (as tase_host_service()), TASE_EUNSUPPORTED for a port without read or now_ms, TASE_EBUSY called
  * from on_frame (nothing sent).
  * Before sending it reads and feeds what the port has ready (reads of 64
  * bytes that do not wait, until two in a row bring nothing, at most 256:
