@@ -388,6 +388,31 @@ static void encode_in_place_payload_needs_no_copy(void **state)
     assert_memory_equal(a, b, 13);
 }
 
+/* frame.h: besides out + TASE_FRAME_HEADER, "any other overlap is
+ * allowed too": a payload that lies anywhere in out, from its first byte
+ * (under the header the build writes) to past the payload's place, gives
+ * the frame built from a separate copy. */
+static void a_payload_anywhere_in_out_gives_the_same_frame(void **state)
+{
+    uint8_t data[20];
+    uint8_t want[20 + TASE_FRAME_OVERHEAD];
+    uint8_t buf[64];
+    size_t at;
+    (void)state;
+    for (at = 0; at < sizeof data; at++) {
+        data[at] = (uint8_t)(0xC0u + at);
+    }
+    assert_int_equal(tase_frame_build(0x08, 0x40, data, sizeof data, want, sizeof want),
+                     (int)sizeof want);
+    for (at = 0; at + sizeof data <= sizeof buf; at++) {
+        memset(buf, 0xEE, sizeof buf);
+        memcpy(&buf[at], data, sizeof data);
+        assert_int_equal(tase_frame_build(0x08, 0x40, &buf[at], sizeof data, buf, sizeof buf),
+                         (int)sizeof want);
+        assert_memory_equal(buf, want, sizeof want);
+    }
+}
+
 /* Every payload length 0..TASE_DATA_MAX is copied into the frame (a
  * 1-byte payload too), and the frame carries the checksum of its bytes. */
 static void encode_copies_every_payload_length(void **state)
@@ -2535,6 +2560,7 @@ int main(void)
         cmocka_unit_test(encode_checksum_wraps_modulo_65536),
         cmocka_unit_test(encode_rejects_bad_arguments_without_writing),
         cmocka_unit_test(encode_in_place_payload_needs_no_copy),
+        cmocka_unit_test(a_payload_anywhere_in_out_gives_the_same_frame),
         cmocka_unit_test(encode_copies_every_payload_length),
         cmocka_unit_test(checksum_helper_matches_definition),
         cmocka_unit_test(checksum_of_long_buffers_is_the_byte_sum),
