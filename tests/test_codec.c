@@ -422,6 +422,38 @@ static void camera_pass_carries_249_bytes_and_may_be_encoded_in_place(void **sta
     assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), 12);
 }
 
+/* codec.h: CAMERA_PASS's camera bytes may lie anywhere in the output,
+ * also under the frame header or the 4 fixed bytes the encoders write:
+ * at every offset, tase_packet_encode() and tase_packet_encode_data()
+ * give what they give from a separate copy. */
+static void camera_bytes_anywhere_in_the_output_encode_the_same(void **state)
+{
+    static const uint8_t cam[10] = {0x81, 1, 6, 1, 0x30, 0x30, 3, 3, 0xFF, 0x5A};
+    tase_camera_pass_t cp = {2, 8, sizeof cam, cam};
+    uint8_t want[sizeof cam + 4u + TASE_FRAME_OVERHEAD];
+    uint8_t want_data[sizeof cam + 4u];
+    uint8_t buf[48];
+    size_t at;
+    (void)state;
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, want, sizeof want),
+                     (int)sizeof want);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, want_data, sizeof want_data),
+                     (int)sizeof want_data);
+    for (at = 0; at + sizeof cam <= sizeof buf; at++) {
+        memset(buf, 0xEE, sizeof buf);
+        memcpy(&buf[at], cam, sizeof cam);
+        cp.data = &buf[at];
+        assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, buf, sizeof buf),
+                         (int)sizeof want);
+        assert_memory_equal(buf, want, sizeof want);
+        memset(buf, 0xEE, sizeof buf);
+        memcpy(&buf[at], cam, sizeof cam);
+        assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, buf, sizeof buf),
+                         (int)sizeof want_data);
+        assert_memory_equal(buf, want_data, sizeof want_data);
+    }
+}
+
 static void unknown_ids_and_missing_structs_are_told_apart_from_missing_buffers(void **state)
 {
     uint8_t out[TASE_FRAME_MAX];
@@ -939,6 +971,7 @@ int main(void)
         cmocka_unit_test(every_wrong_length_is_rejected_on_decode_and_encode),
         cmocka_unit_test(argument_errors_are_reported_and_write_nothing),
         cmocka_unit_test(camera_pass_carries_249_bytes_and_may_be_encoded_in_place),
+        cmocka_unit_test(camera_bytes_anywhere_in_the_output_encode_the_same),
         cmocka_unit_test(data_only_codec_matches_the_frame_codec_for_every_packet),
         cmocka_unit_test(data_only_codec_rejects_bad_arguments),
         cmocka_unit_test(command_check_takes_what_the_spec_defines_and_nothing_else),
