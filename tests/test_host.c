@@ -1396,6 +1396,8 @@ static void typed_request_errors_send_nothing_and_leave_the_host_idle(void **sta
                      TASE_ELENGTH); /* no query form */
     assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID(0x28, 0), &cmd, &m, 10, 0, 0),
                      TASE_EUNKNOWN);
+    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID(0x28, 0), &cmd, &m, 10, 2, 0),
+                     TASE_EARG); /* retries for a packet nothing says a repeat of is safe */
     assert_int_equal(tase_host_transact_msg(NULL, TASE_ID_PACKET_RATE, NULL, &m, 10, 0), TASE_EARG);
     assert_int_equal(x->port.nout, 0);
     assert_false(tase_host_busy(&x->host));

@@ -285,7 +285,9 @@ int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const u
  *                 the codec: a CAMERA_PASS tail NULL with len > 0;
  *   TASE_EBUSY    a request is pending (checked before the packet is
  *                 encoded; the pending one is left untouched);
- *   TASE_EUNKNOWN id is not in the schema;
+ *   TASE_EUNKNOWN id is not in the schema (with retries 0: with
+ *                 retries > 0 it is TASE_EARG, as an unknown packet is
+ *                 for tase_host_request_start());
  *   TASE_ELENGTH  msg NULL for a packet without a query form (and
  *                 GYRO_ZERO_CMD, which has no data: a command);
  *   TASE_ETOOLONG CAMERA_PASS tail over 249 bytes;
