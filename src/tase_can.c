@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "tase_frame_private.h"
+
 static bool role_valid(tase_can_role_t role)
 {
     return role == TASE_CAN_ROLE_HOST || role == TASE_CAN_ROLE_GIMBAL;
@@ -126,8 +128,12 @@ int tase_can_rx_feed(tase_can_rx_t *crx, const tase_can_frame_t *f, tase_rx_hand
     if (crx == NULL || f == NULL) {
         return TASE_EARG;
     }
-    if (crx->rx.busy != 0u) {
-        return TASE_EBUSY; /* from inside its own frame callback: count nothing */
+    /* What tase_rx_feed() would refuse, refused before anything is
+     * counted: a call from inside its own frame callback (TASE_EBUSY), a
+     * visibly corrupted receiver (TASE_EARG). */
+    n = tase_rx_state_check(&crx->rx);
+    if (n != TASE_OK) {
+        return n;
     }
     n = tase_can_accept(crx->role, f);
     if (n == TASE_EARG) {

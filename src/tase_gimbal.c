@@ -7,6 +7,7 @@
 #include "tase/ids.h"
 #include "tase/port_io.h"
 #include "tase/schema.h"
+#include "tase_frame_private.h"
 #include "tase_schema_layout.h"
 
 #define SETUP_SYSTEM_VERSION 0x03u
@@ -521,6 +522,13 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
         return TASE_EARG;
     }
     rx = &g->rx[port];
+    {
+        /* a receiver its feed would refuse (corrupted) changes nothing */
+        int r = tase_rx_state_check(rx);
+        if (r != TASE_OK) {
+            return r;
+        }
+    }
     g->feed_port = (uint8_t)port;
     /* Each frame ends the receiver's call (gimbal_rx()) and is handled
      * here, between calls; after it a 0-byte call goes on with the scan

@@ -6,6 +6,7 @@
 #include "tase/codec.h"
 #include "tase/flags.h"
 #include "tase/port_io.h"
+#include "tase_frame_private.h"
 
 enum { HOST_IDLE = 0, HOST_WAITING = 1, HOST_COMPLETE = 2 };
 
@@ -352,9 +353,12 @@ int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_
     int t;
     uint32_t count;
     uint32_t shift;
+    uint32_t was;
     if (h == NULL) {
         return TASE_EARG;
     }
+    /* set before the feed: the frames it delivers judge owed answers by it */
+    was = h->now;
     h->now = now_ms;
     /* the host's own count of the bytes it was fed, which nothing resets
      * (rx.stats may be): frames are placed on it for MATCHING */
@@ -366,6 +370,7 @@ int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_
     if (r < 0) {
         /* nothing fed (bad arguments, or a call from on_frame: the feed
          * in progress goes on with its own shift) */
+        h->now = was;
         h->in_count = count;
         h->in_shift = shift;
         return r;
@@ -427,8 +432,10 @@ bool tase_host_busy(const tase_host_t *h)
 }
 
 /* The checks of the calls that read the port (service, transact): TASE_OK
- * when it can be used. Inside a callback of the host's receiver (on_frame)
- * they cannot feed it: the bytes they read would be lost (TASE_EBUSY). */
+ * when it can be used. A receiver that could not take what they read
+ * refuses them before the read, as tase_rx_feed() would after it (the
+ * bytes would be lost): TASE_EBUSY inside its callback (on_frame),
+ * TASE_EARG when it is visibly corrupted. */
 static int port_ok(const tase_host_t *h)
 {
     if (h == NULL || h->port.ops == NULL) {
@@ -437,7 +444,7 @@ static int port_ok(const tase_host_t *h)
     if (h->port.ops->read == NULL || h->port.ops->now_ms == NULL) {
         return TASE_EUNSUPPORTED;
     }
-    return (h->rx.busy != 0u) ? TASE_EBUSY : TASE_OK;
+    return tase_rx_state_check(&h->rx);
 }
 
 int tase_host_service(tase_host_t *h, uint32_t wait_ms)

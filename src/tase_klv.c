@@ -354,10 +354,11 @@ static bool rx_scan(tase_klv_rx_t *rx, int final, klv_call_t *c)
 static int rx_begin(tase_klv_rx_t *rx, tase_klv_handler_t on_packet,
                     tase_klv_error_handler_t on_error, void *user, klv_call_t *c)
 {
-    /* the held length first: a corrupted or never initialised scanner is
-     * TASE_EARG even when its `busy` byte happens to be set (TASE_EBUSY
-     * would have a caller retry for ever) */
-    if (rx == NULL || rx->len > TASE_KLV_PACKET_MAX) {
+    /* the held length and a busy byte other than 0 and 1 first: a
+     * corrupted or never initialised scanner is TASE_EARG even when its
+     * `busy` byte happens to be set (TASE_EBUSY would have a caller retry
+     * for ever) */
+    if (rx == NULL || rx->len > TASE_KLV_PACKET_MAX || rx->busy > 1u) {
         return TASE_EARG;
     }
     if (rx->busy != 0u) {

@@ -603,6 +603,36 @@ static void can_api_rejects_bad_arguments(void **state)
     assert_memory_equal(&crx, &ccopy, sizeof crx);
 }
 
+/* can.h: only TASE_EUNKNOWN and TASE_ELENGTH change the instance (a
+ * counter). A receiver whose datalink receiver is visibly corrupted (its
+ * held length beyond the window; `busy` neither 0 nor 1) is refused with
+ * TASE_EARG, as tase_rx_feed() refuses it, and nothing is counted: the
+ * frame of this role used to be counted in frames_in and
+ * frames_accepted before tase_rx_feed() refused its payload, and a busy
+ * byte of 2 read as TASE_EBUSY, which a caller retries for ever. */
+static void a_corrupted_datalink_receiver_is_refused_without_counting(void **state)
+{
+    tase_can_frame_t f = ext_frame(TASE_CAN_ID_TO_GIMBAL, angle_pkt, 8);
+    tase_can_rx_t crx;
+    tase_can_rx_t copy;
+    got_t got;
+    int k;
+    (void)state;
+    memset(&got, 0, sizeof got);
+    for (k = 0; k < 2; k++) {
+        assert_int_equal(tase_can_rx_init(&crx, TASE_CAN_ROLE_GIMBAL), TASE_OK);
+        if (k == 0) {
+            crx.rx.len = 0xFFFFu;
+        } else {
+            crx.rx.busy = 2u;
+        }
+        memcpy(&copy, &crx, sizeof crx);
+        assert_int_equal(tase_can_rx_feed(&crx, &f, on_frame, &got), TASE_EARG);
+        assert_memory_equal(&crx, &copy, sizeof crx);
+    }
+    assert_int_equal(got.n, 0);
+}
+
 /* tase_can_split() with no array: TASE_EARG for any byte count above 0
  * (a single byte too), whatever capacity is claimed. */
 static void split_into_no_array_is_an_argument_error(void **state)
@@ -622,6 +652,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(can_api_rejects_bad_arguments),
         cmocka_unit_test(split_into_no_array_is_an_argument_error),
+        cmocka_unit_test(a_corrupted_datalink_receiver_is_refused_without_counting),
         cmocka_unit_test(split_refuses_counts_an_int_result_cannot_carry),
         cmocka_unit_test(null_and_unknown_roles_are_rejected_without_counting),
         cmocka_unit_test(role_ids_follow_the_spec),

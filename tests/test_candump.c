@@ -44,6 +44,10 @@ static void standard_and_empty_frames_parse(void **state)
     assert_int_equal(r.frame.data[2], 0xBE);
     assert_int_equal(parse("(1.000000)  can1\t12020000#80F6 R\n", &r), TASE_OK);
     assert_int_equal(r.frame.id, 0x12020000u);
+    /* blanks before the timestamp too (candump.h) */
+    assert_int_equal(parse(" \t (2.000003) can1 123#01", &r), TASE_OK);
+    assert_int_equal(r.usec, 3);
+    assert_int_equal(r.frame.data[0], 1);
 }
 
 static void malformed_lines_are_rejected_and_leave_output_alone(void **state)

@@ -422,6 +422,38 @@ static void camera_pass_carries_249_bytes_and_may_be_encoded_in_place(void **sta
     assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, out, sizeof(out)), 12);
 }
 
+/* codec.h: CAMERA_PASS's camera bytes may lie anywhere in the output,
+ * also under the frame header or the 4 fixed bytes the encoders write:
+ * at every offset, tase_packet_encode() and tase_packet_encode_data()
+ * give what they give from a separate copy. */
+static void camera_bytes_anywhere_in_the_output_encode_the_same(void **state)
+{
+    static const uint8_t cam[10] = {0x81, 1, 6, 1, 0x30, 0x30, 3, 3, 0xFF, 0x5A};
+    tase_camera_pass_t cp = {2, 8, sizeof cam, cam};
+    uint8_t want[sizeof cam + 4u + TASE_FRAME_OVERHEAD];
+    uint8_t want_data[sizeof cam + 4u];
+    uint8_t buf[48];
+    size_t at;
+    (void)state;
+    assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, want, sizeof want),
+                     (int)sizeof want);
+    assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, want_data, sizeof want_data),
+                     (int)sizeof want_data);
+    for (at = 0; at + sizeof cam <= sizeof buf; at++) {
+        memset(buf, 0xEE, sizeof buf);
+        memcpy(&buf[at], cam, sizeof cam);
+        cp.data = &buf[at];
+        assert_int_equal(tase_packet_encode(TASE_ID_CAMERA_PASS, &cp, buf, sizeof buf),
+                         (int)sizeof want);
+        assert_memory_equal(buf, want, sizeof want);
+        memset(buf, 0xEE, sizeof buf);
+        memcpy(&buf[at], cam, sizeof cam);
+        assert_int_equal(tase_packet_encode_data(TASE_ID_CAMERA_PASS, &cp, buf, sizeof buf),
+                         (int)sizeof want_data);
+        assert_memory_equal(buf, want_data, sizeof want_data);
+    }
+}
+
 static void unknown_ids_and_missing_structs_are_told_apart_from_missing_buffers(void **state)
 {
     uint8_t out[TASE_FRAME_MAX];
@@ -864,6 +896,37 @@ static void decode_iter_restarts_the_walk_and_checks_its_arguments(void **state)
     assert_int_equal(tase_packet_decode_iter(&it, NULL, &cam), TASE_EARG);
 }
 
+/* codec.h: a length the packet does not accept is TASE_ELENGTH for every
+ * decoder whatever msg is: msg NULL is allowed only for a zero-length
+ * frame of a packet that has one (a query, GYRO_ZERO_CMD), so a
+ * zero-length GIMBAL_CMD (no query form) is not decoded as one, and a
+ * 7-byte one is not an argument error. tase_packet_decode_iter() gives
+ * TASE_ELENGTH for a walk begun at such a length, msg unchanged. */
+static void a_wrong_length_is_elength_with_or_without_a_struct(void **state)
+{
+    const tase_packet_desc_t *p = tase_schema_find(0x00, 0x80); /* GIMBAL_CMD */
+    tase_field_iter_t it;
+    tase_gimbal_cmd_t cmd;
+    tase_gimbal_cmd_t before;
+    uint8_t data[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    tase_frame_t f = {0, 0x00, 0x80, 0, data};
+    (void)state;
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GIMBAL_CMD, NULL, 0, NULL), TASE_ELENGTH);
+    assert_int_equal(tase_packet_decode_data(TASE_ID_GIMBAL_CMD, data, 7, NULL), TASE_ELENGTH);
+    assert_int_equal(tase_packet_decode_desc(p, NULL, 0, NULL), TASE_ELENGTH);
+    assert_int_equal(tase_packet_decode(&f, NULL), TASE_ELENGTH);
+    f.len = 7;
+    assert_int_equal(tase_packet_decode(&f, NULL), TASE_ELENGTH);
+
+    memset(&cmd, 0x5A, sizeof cmd);
+    before = cmd;
+    assert_non_null(tase_field_iter_find(&it, 0x00, 0x80, 7));
+    assert_false(it.accepted);
+    assert_int_equal(tase_packet_decode_iter(&it, data, &cmd), TASE_ELENGTH);
+    assert_int_equal(tase_packet_decode_iter(&it, data, NULL), TASE_ELENGTH);
+    assert_memory_equal(&cmd, &before, sizeof cmd);
+}
+
 /* SPOI_CMD's limits are inclusive (90 and 180 degrees either way), and
  * each of the four bounds is checked on its own; tase_command_check_data()
  * refuses a 1-byte GIMBAL_CMD or SPOI_CMD as a wrong length. */
@@ -908,12 +971,14 @@ int main(void)
         cmocka_unit_test(every_wrong_length_is_rejected_on_decode_and_encode),
         cmocka_unit_test(argument_errors_are_reported_and_write_nothing),
         cmocka_unit_test(camera_pass_carries_249_bytes_and_may_be_encoded_in_place),
+        cmocka_unit_test(camera_bytes_anywhere_in_the_output_encode_the_same),
         cmocka_unit_test(data_only_codec_matches_the_frame_codec_for_every_packet),
         cmocka_unit_test(data_only_codec_rejects_bad_arguments),
         cmocka_unit_test(command_check_takes_what_the_spec_defines_and_nothing_else),
         cmocka_unit_test(init_keep_fills_a_packet_that_changes_nothing),
         cmocka_unit_test(queries_null_data_and_lengths_past_the_maximum),
         cmocka_unit_test(decode_iter_restarts_the_walk_and_checks_its_arguments),
+        cmocka_unit_test(a_wrong_length_is_elength_with_or_without_a_struct),
         cmocka_unit_test(spoi_limits_are_inclusive_and_checked_one_by_one),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

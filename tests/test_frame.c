@@ -388,6 +388,31 @@ static void encode_in_place_payload_needs_no_copy(void **state)
     assert_memory_equal(a, b, 13);
 }
 
+/* frame.h: besides out + TASE_FRAME_HEADER, "any other overlap is
+ * allowed too": a payload that lies anywhere in out, from its first byte
+ * (under the header the build writes) to past the payload's place, gives
+ * the frame built from a separate copy. */
+static void a_payload_anywhere_in_out_gives_the_same_frame(void **state)
+{
+    uint8_t data[20];
+    uint8_t want[20 + TASE_FRAME_OVERHEAD];
+    uint8_t buf[64];
+    size_t at;
+    (void)state;
+    for (at = 0; at < sizeof data; at++) {
+        data[at] = (uint8_t)(0xC0u + at);
+    }
+    assert_int_equal(tase_frame_build(0x08, 0x40, data, sizeof data, want, sizeof want),
+                     (int)sizeof want);
+    for (at = 0; at + sizeof data <= sizeof buf; at++) {
+        memset(buf, 0xEE, sizeof buf);
+        memcpy(&buf[at], data, sizeof data);
+        assert_int_equal(tase_frame_build(0x08, 0x40, &buf[at], sizeof data, buf, sizeof buf),
+                         (int)sizeof want);
+        assert_memory_equal(buf, want, sizeof want);
+    }
+}
+
 /* Every payload length 0..TASE_DATA_MAX is copied into the frame (a
  * 1-byte payload too), and the frame carries the checksum of its bytes. */
 static void encode_copies_every_payload_length(void **state)
@@ -2392,6 +2417,8 @@ static void frame_api_rejects_bad_arguments(void **state)
         assert_int_equal(tase_rx_feed(&bad, bytes, sizeof bytes, NULL, NULL), TASE_EARG);
         assert_int_equal(tase_rx_push(&bad, 0x5A, NULL, NULL), TASE_EARG);
         assert_int_equal(tase_rx_flush(&bad, NULL, NULL), TASE_EARG);
+        assert_int_equal(tase_rx_tick(&bad, 999999u, NULL, NULL), TASE_EARG);
+        assert_int_equal(tase_rx_set_timing(&bad, 1u, 1u), TASE_EARG);
         assert_memory_equal(&bad, &copy, sizeof bad);
     }
 }
@@ -2416,7 +2443,8 @@ static void make_lagging(tase_rx_t *rx)
  * an `end` that does not say it lags; a stop flag or a busy flag left
  * set outside a call; a caught-up receiver whose `end` disagrees with
  * the candidate it holds or lies outside the window. Every entry point
- * refuses them with TASE_EARG (busy 1 reads as a call in progress:
+ * (tick and set_timing too) refuses them with TASE_EARG (busy 1 reads as
+ * a call in progress:
  * TASE_EBUSY) and changes nothing. */
 static void a_corrupted_receiver_in_any_state_is_refused(void **state)
 {
@@ -2477,6 +2505,8 @@ static void a_corrupted_receiver_in_any_state_is_refused(void **state)
             assert_int_equal(tase_rx_push(&bad, 0x5A, NULL, NULL), busy_code);
         }
         assert_int_equal(tase_rx_flush(&bad, NULL, NULL), busy_code);
+        assert_int_equal(tase_rx_tick(&bad, 999999u, NULL, NULL), busy_code);
+        assert_int_equal(tase_rx_set_timing(&bad, 1u, 1u), busy_code);
         assert_memory_equal(&bad, &copy, sizeof bad);
     }
 }
@@ -2530,6 +2560,7 @@ int main(void)
         cmocka_unit_test(encode_checksum_wraps_modulo_65536),
         cmocka_unit_test(encode_rejects_bad_arguments_without_writing),
         cmocka_unit_test(encode_in_place_payload_needs_no_copy),
+        cmocka_unit_test(a_payload_anywhere_in_out_gives_the_same_frame),
         cmocka_unit_test(encode_copies_every_payload_length),
         cmocka_unit_test(checksum_helper_matches_definition),
         cmocka_unit_test(checksum_of_long_buffers_is_the_byte_sum),

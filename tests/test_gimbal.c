@@ -980,6 +980,38 @@ static void gimbal_api_rejects_bad_arguments(void **state)
     assert_int_equal(rx[0].stats.bytes_in, 0);
 }
 
+/* A receiver that is visibly corrupted (held length beyond its window):
+ * tase_gimbal_feed() gives TASE_EARG, as tase_rx_feed() does, and
+ * changes neither the gimbal (it noted the port it was feeding before the
+ * receiver refused) nor any receiver; nothing is answered. */
+static void a_feed_into_a_corrupted_receiver_changes_nothing(void **state)
+{
+    static fake_port_t fp;
+    static tase_gimbal_t g;
+    static tase_gimbal_t copy;
+    static tase_rx_t rx[2];
+    static tase_rx_t rx_copy[2];
+    tase_port_t ports[2];
+    const uint8_t query[8] = {0x00, 0xFF, 0x5A, 0x02, 0x48, 0x00, 0x01, 0xA3};
+    (void)state;
+    memset(&fp, 0, sizeof fp);
+    memset(ports, 0, sizeof ports);
+    ports[0].ops = &fake_ops;
+    ports[0].ctx = &fp;
+    ports[1] = ports[0];
+    assert_int_equal(tase_gimbal_init(&g, ports, rx, 2, NULL, 0), TASE_OK);
+    assert_int_equal(tase_gimbal_feed(&g, 1, query, sizeof query, 0), 1); /* answered */
+    rx[0].len = 0xFFFFu;
+    memcpy(&copy, &g, sizeof g);
+    memcpy(rx_copy, rx, sizeof rx);
+    fp.nout = 0;
+    assert_int_equal(tase_gimbal_feed(&g, 0, query, sizeof query, 1), TASE_EARG);
+    assert_int_equal(tase_gimbal_feed(&g, 0, NULL, 0, 1), TASE_EARG);
+    assert_memory_equal(&g, &copy, sizeof g);
+    assert_memory_equal(rx, rx_copy, sizeof rx);
+    assert_int_equal(fp.nout, 0);
+}
+
 /* ---- typed API ------------------------------------------------------- */
 
 typedef struct {
@@ -1175,23 +1207,40 @@ static int bytes_fill(void *user, unsigned port, uint16_t id, uint8_t *data, siz
     return 0;
 }
 
+/* Init refuses an app with both forms of a callback (or both on_frame
+ * and a dispatcher) with TASE_EARG, and then writes neither the instance
+ * nor the receivers it was given (common.h). */
 static void init_refuses_both_forms_of_a_callback(void **state)
 {
     static tase_gimbal_t g;
+    static tase_gimbal_t g_before;
+    static tase_rx_t rx;
+    static tase_rx_t rx_before;
+    tase_dispatch_t d;
     fake_port_t *fp = calloc(1, sizeof *fp);
     tase_port_t port = {&fake_ops, fp, 0};
     tase_gimbal_app_t app;
     (void)state;
+    memset(&g, 0xC3, sizeof g);
+    memcpy(&g_before, &g, sizeof g);
+    memset(&rx, 0x3C, sizeof rx);
+    memcpy(&rx_before, &rx, sizeof rx);
     memset(&app, 0, sizeof app);
     app.fill_telemetry = bytes_fill;
     app.fill_telemetry_msg = typed_fill;
-    assert_int_equal(tase_gimbal_init(&g, &port, NULL, 1, &app, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(&g, &port, &rx, 1, &app, 0), TASE_EARG);
     app.fill_telemetry = NULL;
     app.apply_setup = app_apply;
     app.apply_setup_msg = typed_apply;
-    assert_int_equal(tase_gimbal_init(&g, &port, NULL, 1, &app, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_init(&g, &port, &rx, 1, &app, 0), TASE_EARG);
     app.apply_setup_msg = NULL;
-    assert_int_equal(tase_gimbal_init(&g, &port, NULL, 1, &app, 0), TASE_OK);
+    app.on_frame = app_other;
+    app.dispatch = &d;
+    assert_int_equal(tase_gimbal_init(&g, &port, &rx, 1, &app, 0), TASE_EARG);
+    assert_memory_equal(&g, &g_before, sizeof g);
+    assert_memory_equal(&rx, &rx_before, sizeof rx);
+    app.dispatch = NULL;
+    assert_int_equal(tase_gimbal_init(&g, &port, &rx, 1, &app, 0), TASE_OK);
     free(fp);
 }
 
@@ -2186,6 +2235,7 @@ int main(void)
         cmocka_unit_test(port_write_errors_are_counted_argument_errors_are_not),
         cmocka_unit_test(every_function_rejects_null_and_out_of_range_arguments),
         cmocka_unit_test(frames_from_absent_ports_and_without_callbacks_are_only_counted),
+        cmocka_unit_test(a_feed_into_a_corrupted_receiver_changes_nothing),
         cmocka_unit_test(service_reads_every_port_feeds_it_and_polls),
         cmocka_unit_test(noise_before_a_command_delays_it_only_up_to_the_quiet_limit),
         cmocka_unit_test(typed_telemetry_is_encoded_from_the_filled_structs),

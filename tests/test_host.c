@@ -1396,6 +1396,8 @@ static void typed_request_errors_send_nothing_and_leave_the_host_idle(void **sta
                      TASE_ELENGTH); /* no query form */
     assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID(0x28, 0), &cmd, &m, 10, 0, 0),
                      TASE_EUNKNOWN);
+    assert_int_equal(tase_host_request_msg_start(&x->host, TASE_ID(0x28, 0), &cmd, &m, 10, 2, 0),
+                     TASE_EARG); /* retries for a packet nothing says a repeat of is safe */
     assert_int_equal(tase_host_transact_msg(NULL, TASE_ID_PACKET_RATE, NULL, &m, 10, 0), TASE_EARG);
     assert_int_equal(x->port.nout, 0);
     assert_false(tase_host_busy(&x->host));
@@ -1551,6 +1553,8 @@ static void motion_commands_the_spec_does_not_define_are_not_sent(void **state)
     assert_int_equal(tase_host_send(&x->host, 0x00, 0x80, NULL, 0), TASE_ELENGTH);
     assert_int_equal(tase_host_send(&x->host, 0x00, 0x43, NULL, 0), TASE_ELENGTH);
     assert_int_equal(tase_host_send(&x->host, 0x00, 0x43, data, 3), TASE_ELENGTH);
+    assert_int_equal(tase_host_request_start(&x->host, 0x00, 0x43, data, 3, reply, 8, 10, 0, 0),
+                     TASE_ELENGTH);
     memset(&spoi, 0, sizeof spoi);
     spoi.flags = TASE_SPOI_ECHO;
     spoi.lat = 324000001;
@@ -1909,6 +1913,99 @@ static void a_feed_refused_inside_on_frame_leaves_the_feed_in_progress_as_it_was
     assert_int_equal(m.fed, TASE_EBUSY);
 }
 
+/* on_frame that feeds the host it is called from (refused: TASE_EBUSY)
+ * at a time far from the outer feed's, and notes whether the host
+ * changed. */
+typedef struct {
+    tase_host_t *h;
+    int fed;
+    int same;
+} refeed_t;
+
+static void refeed(void *user, const tase_frame_t *f)
+{
+    refeed_t *r = user;
+    tase_host_t before;
+    (void)f;
+    memcpy(&before, r->h, sizeof before);
+    r->fed = tase_host_feed(r->h, rates, sizeof rates, 99999u);
+    r->same = memcmp(&before, r->h, sizeof before) == 0;
+}
+
+/* common.h: a failing call leaves its instance unchanged. A refused
+ * tase_host_feed() (bytes NULL; called from on_frame) used to keep its
+ * now_ms all the same: the time the feed in progress judges owed answers
+ * by (MATCHING), and the next owe() starts from. */
+static void a_refused_feed_leaves_the_host_as_it_was(void **state)
+{
+    fix_t *x = *state;
+    tase_port_t p = {&fake_ops, &x->port, 0};
+    const uint8_t angle[6] = {0, 1, 0, 2, 0, 3};
+    tase_host_t copy;
+    refeed_t r = {NULL, 0, 0};
+
+    memcpy(&copy, &x->host, sizeof copy);
+    assert_int_equal(tase_host_feed(&x->host, NULL, 5, 7777u), TASE_EARG);
+    assert_memory_equal(&x->host, &copy, sizeof copy);
+
+    r.h = &x->host;
+    assert_int_equal(tase_host_init(&x->host, &p, refeed, &r), TASE_OK);
+    feed_frame(x, 0x08, 0x10, angle, sizeof angle, 10u);
+    assert_int_equal(r.fed, TASE_EBUSY);
+    assert_true(r.same);
+}
+
+/* host.h, tase_host_poll(): now_ms is noted even when no request is
+ * pending (TASE_ESTATE), so that an answer owed by a request that timed
+ * out stops being owed once its window has passed, also for a frame
+ * handed over by tase_host_handle_frame(), which takes no time. */
+static void a_poll_with_no_request_still_ends_the_owed_window(void **state)
+{
+    fix_t *x = *state;
+    uint8_t reply[64];
+    tase_frame_t f = {0, 0x48, 0x00, sizeof rates, rates};
+
+    query_rates(x, reply, 100, 0, 0);
+    assert_int_equal(tase_host_poll(&x->host, 100), TASE_ETIMEOUT); /* owed until 200 */
+    assert_int_equal(tase_host_poll(&x->host, 500), TASE_ESTATE);
+    assert_int_equal(tase_host_handle_frame(&x->host, &f), 0);
+    assert_int_equal(x->host.stats.late, 0); /* no longer owed at 500 */
+    assert_int_equal(x->others, 1);
+}
+
+/* The calls that read the port (service, drain, transact) refuse a host
+ * whose receiver is visibly corrupted before they read: TASE_EARG, as
+ * tase_host_feed() gives, nothing read from the port (the bytes would be
+ * lost: read, then refused by the receiver), the host unchanged. A busy
+ * byte other than 0 and 1 is such corruption, not a call from on_frame
+ * (TASE_EBUSY, which a caller retries for ever). */
+static void a_corrupted_receiver_is_refused_before_the_port_is_read(void **state)
+{
+    fix_t *x = *state;
+    tase_host_t copy;
+    uint8_t reply[64];
+    int k;
+
+    fake_push_frame(&x->port, 0x48, 0x00, rates, sizeof rates);
+    for (k = 0; k < 2; k++) {
+        if (k == 0) {
+            x->host.rx.len = 0xFFFFu;
+        } else {
+            x->host.rx.len = 0u;
+            x->host.rx.busy = 2u;
+        }
+        memcpy(&copy, &x->host, sizeof copy);
+        assert_int_equal(tase_host_service(&x->host, 0), TASE_EARG);
+        assert_int_equal(tase_host_drain(&x->host), TASE_EARG);
+        assert_int_equal(
+            tase_host_transact(&x->host, 0x48, 0x00, NULL, 0, reply, sizeof reply, 10, 0),
+            TASE_EARG);
+        assert_memory_equal(&x->host, &copy, sizeof copy);
+        assert_int_equal(x->port.rin, 0); /* nothing read */
+        assert_int_equal(x->port.nout, 0);
+    }
+}
+
 /* host.h: a port whose clock stands still ends a transact "after
  * TASE_PORT_WRITE_SPINS such reads in a row" (after the two empty reads
  * of the drain before the send). */
@@ -2126,6 +2223,11 @@ int main(void)
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(
             a_feed_refused_inside_on_frame_leaves_the_feed_in_progress_as_it_was, setup, teardown),
+        cmocka_unit_test_setup_teardown(a_refused_feed_leaves_the_host_as_it_was, setup, teardown),
+        cmocka_unit_test_setup_teardown(a_corrupted_receiver_is_refused_before_the_port_is_read,
+                                        setup, teardown),
+        cmocka_unit_test_setup_teardown(a_poll_with_no_request_still_ends_the_owed_window, setup,
+                                        teardown),
         cmocka_unit_test_setup_teardown(
             a_frozen_clock_ends_a_transact_after_exactly_the_spin_limit_of_reads, setup, teardown),
         cmocka_unit_test_setup_teardown(

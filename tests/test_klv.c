@@ -1018,6 +1018,14 @@ static void klv_api_rejects_bad_arguments(void **state)
     assert_int_equal(tase_klv_rx_feed(&rx, out, sizeof out, NULL, NULL, NULL), TASE_EARG);
     assert_int_equal(tase_klv_rx_flush(&rx, NULL, NULL, NULL), TASE_EARG);
     assert_memory_equal(&rx, &copy, sizeof rx);
+    /* a busy byte other than 0 and 1 is no call in progress but a
+     * corrupted scanner: TASE_EARG (TASE_EBUSY is retried for ever) */
+    rx.len = 5u;
+    rx.busy = 2u;
+    memcpy(&copy, &rx, sizeof rx);
+    assert_int_equal(tase_klv_rx_feed(&rx, out, sizeof out, NULL, NULL, NULL), TASE_EARG);
+    assert_int_equal(tase_klv_rx_flush(&rx, NULL, NULL, NULL), TASE_EARG);
+    assert_memory_equal(&rx, &copy, sizeof rx);
 
     assert_int_equal(tase_klv_lat_raw(NAN), 0);
     assert_int_equal(tase_klv_lon_raw(INFINITY), 0);

@@ -118,6 +118,65 @@ static void checked_to_wire_refuses_what_the_field_cannot_carry(void **state)
     }
 }
 
+/* Checked rounding of v into wire type k (0 int16, 1 uint16, 2 int32,
+ * 3 uint8), the result widened into *value; the typed output starts as 7,
+ * so a refusal that leaves it untouched reads 7. */
+static int checked_into(unsigned k, double v, int64_t *value)
+{
+    int16_t i16 = 7;
+    uint16_t u16 = 7;
+    int32_t i32 = 7;
+    uint8_t u8 = 7;
+    int r;
+    switch (k) {
+    case 0:
+        r = tase_units_checked_i16(v, &i16);
+        *value = i16;
+        break;
+    case 1:
+        r = tase_units_checked_u16(v, &u16);
+        *value = u16;
+        break;
+    case 2:
+        r = tase_units_checked_i32(v, &i32);
+        *value = i32;
+        break;
+    default:
+        r = tase_units_checked_u8(v, &u8);
+        *value = u8;
+        break;
+    }
+    return r;
+}
+
+/* The checked forms end exactly half a unit past each wire type's range
+ * (a half rounds away from zero, beyond the type): a quarter past an end
+ * gives the end, the half past it TASE_ERANGE with *out untouched, at
+ * both ends of each of the four types (every value here is exact in
+ * double arithmetic). A range typed wrong in one of the four
+ * (2147483648.0 for INT32_MAX, 65536.0 for UINT16_MAX) went unnoticed by
+ * the scaled conversions' tests, and such a cast is undefined. */
+static void each_checked_type_ends_half_a_unit_past_its_range(void **state)
+{
+    static const double ends[4][2] = {
+        {-32768.0, 32767.0}, {0.0, 65535.0}, {-2147483648.0, 2147483647.0}, {0.0, 255.0}};
+    unsigned k;
+    int64_t v;
+    (void)state;
+    for (k = 0; k < 4u; k++) {
+        double lo = ends[k][0];
+        double hi = ends[k][1];
+        assert_int_equal(checked_into(k, hi + 0.5, &v), TASE_ERANGE);
+        assert_true(v == 7);
+        assert_int_equal(checked_into(k, lo - 0.5, &v), TASE_ERANGE);
+        assert_true(v == 7);
+        assert_int_equal(checked_into(k, hi + 0.25, &v), TASE_OK);
+        assert_true(v == (int64_t)hi);
+        assert_int_equal(checked_into(k, lo - 0.25, &v), TASE_OK);
+        assert_true(v == (int64_t)lo);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -125,6 +184,7 @@ int main(void)
         cmocka_unit_test(to_wire_saturates_at_field_limits_and_maps_nan_to_zero),
         cmocka_unit_test(from_wire_applies_the_spec_scales),
         cmocka_unit_test(checked_to_wire_refuses_what_the_field_cannot_carry),
+        cmocka_unit_test(each_checked_type_ends_half_a_unit_past_its_range),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -181,8 +181,9 @@ int tase_can_rx_init(tase_can_rx_t *crx, tase_can_role_t role);
  * counted and dropped, and the return code says why: TASE_EUNKNOWN (not
  * ours: normal on a shared bus) or TASE_ELENGTH (our ID, bad dlc). These
  * two are the only "errors" that still change the instance (a counter).
- * TASE_EARG: crx or f NULL, or crx->role not a role (corrupted instance;
- * nothing counted). TASE_EBUSY: called from inside on_frame of this
+ * TASE_EARG: crx or f NULL, crx->role not a role, or crx->rx visibly
+ * corrupted, as tase_rx_feed() says (a corrupted instance; nothing
+ * counted). TASE_EBUSY: called from inside on_frame of this
  * instance (nothing counted, nothing changed). From inside on_frame,
  * tase_can_rx_init() is allowed: it resets the instance and the call that
  * made the callback returns as soon as it does (see frame.h, RE-ENTRANCY);

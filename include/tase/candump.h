@@ -18,7 +18,8 @@
  *     bytes for any DLC above 8: read as those 8 bytes, as the SocketCAN
  *     port receives such a frame).
  *
- * The reader accepts fields separated by runs of spaces/tabs, a trailing
+ * The reader accepts fields separated by runs of spaces/tabs, spaces and
+ * tabs before the timestamp, a trailing
  * "\n" or "\r\n", and an optional trailing direction flag "T" or "R"
  * (later can-utils with -x). Valid can-utils lines this library cannot
  * represent (remote frames `123#R` or `123#r`, CAN FD `123##1...`, error

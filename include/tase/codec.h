@@ -317,8 +317,10 @@ typedef union {
  *   TASE_ETOOLONG CAMERA_PASS len > TASE_CAMERA_PASS_MAX;
  *   TASE_ENOSPC   cap is too small (0 included).
  * Checked in this order, except that out NULL gives TASE_EARG first.
- * The payload is built in place at out + TASE_FRAME_HEADER (no copy; msg
- * data may even lie in out). O(length). */
+ * The payload is built in place at out + TASE_FRAME_HEADER (no copy;
+ * CAMERA_PASS's camera bytes may even lie in out, at the payload's place
+ * or anywhere else). The struct msg itself must not overlap out: the
+ * payload's bytes are zeroed before its fields are read. O(length). */
 int tase_packet_encode(uint16_t id, const void *msg, uint8_t *out, size_t cap);
 
 /* Like tase_packet_encode() but with an explicit data length `len`, which
@@ -366,7 +368,8 @@ int tase_packet_decode(const tase_frame_t *f, void *msg);
  *   TASE_ETOOLONG CAMERA_PASS len > TASE_CAMERA_PASS_MAX;
  *   TASE_ENOSPC   cap is smaller than the data length.
  * Checked in this order. CAMERA_PASS's camera bytes may lie anywhere,
- * even in data. Nothing is written on error. O(length). */
+ * even in data; the struct msg itself must not overlap data (as
+ * tase_packet_encode()). Nothing is written on error. O(length). */
 int tase_packet_encode_data(uint16_t id, const void *msg, uint8_t *data, size_t cap);
 
 /* Like tase_packet_encode_data() with an explicit data length `len`, as

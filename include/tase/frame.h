@@ -385,8 +385,9 @@ int tase_rx_flush(tase_rx_t *rx, tase_rx_handler_t on_frame, void *user);
 /* Set the byte rate of the receiver's link (bytes per second, e.g.
  * TASE_UART_BYTES_PER_S(57600); 0: unknown, taken as
  * TASE_RX_SLOWEST_RATE) and the margin of its time bound in ms (0: the
- * default TASE_RX_QUIET_MS). Returns TASE_OK, TASE_EARG (rx NULL) or
- * TASE_EBUSY (inside a callback of this receiver; nothing changed). Kept
+ * default TASE_RX_QUIET_MS). Returns TASE_OK, TASE_EARG (rx NULL or
+ * visibly corrupted, as tase_rx_feed()) or TASE_EBUSY (inside a callback
+ * of this receiver); nothing changed on error. Kept
  * by tase_rx_flush() and tase_rx_stats_reset(), reset by tase_rx_init().
  * O(1). */
 int tase_rx_set_timing(tase_rx_t *rx, uint32_t bytes_per_s, uint16_t margin_ms);

@@ -319,7 +319,9 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
  * settings in force after it), anything else goes to the dispatcher or
  * on_frame.
  * Returns frames received (>= 0), TASE_EARG (g NULL, port >= nports,
- * bytes NULL with n > 0) or TASE_ESTATE (initialised without receivers).
+ * bytes NULL with n > 0, or that port's receiver visibly corrupted, as
+ * tase_rx_feed() says; g and the receivers unchanged) or TASE_ESTATE
+ * (initialised without receivers).
  * Worst case O(n * TASE_FRAME_MAX). */
 int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
                      uint32_t now_ms);

@@ -205,7 +205,9 @@ int tase_host_init(tase_host_t *h, const tase_port_t *port, tase_rx_handler_t on
  * degrees, the packet's length): nothing moves on a value the spec gives
  * no meaning. Returns the frame length, or TASE_EARG (h NULL, data NULL
  * with len > 0), TASE_ETOOLONG (len > 253), TASE_ERANGE / TASE_ELENGTH
- * (such a GIMBAL_CMD or SPOI_CMD), all checked before anything is sent,
+ * (such a GIMBAL_CMD or SPOI_CMD; TASE_ELENGTH also for a
+ * RETRACT_DEPLOY_CMD of a length it does not accept, 0 included), all
+ * checked before anything is sent,
  * or a port error from tase_port_write_all() (port_io.h). O(len). */
 int tase_host_send(tase_host_t *h, uint8_t group, uint8_t type, const uint8_t *data, size_t len);
 
@@ -254,7 +256,10 @@ int tase_host_send_msg(tase_host_t *h, uint16_t id, const void *msg);
  *   TASE_ERANGE   a SPOI_CMD tase_command_check_data() refuses;
  *   TASE_ELENGTH  len 0 for a known packet without a query form
  *                 (GYRO_ZERO_CMD: a command, never sent as a request), a
- *                 SPOI_CMD of a length it does not accept;
+ *                 SPOI_CMD or RETRACT_DEPLOY_CMD of a length it does not
+ *                 accept (other packets' lengths are not checked: a
+ *                 setup packet of a wrong length goes out, and the
+ *                 gimbal does not answer it);
  *   TASE_ETOOLONG len > 253;
  *   TASE_EBUSY    a request is pending (it is left untouched; checked
  *                 before what the request is);
@@ -280,7 +285,9 @@ int tase_host_request_start(tase_host_t *h, uint8_t group, uint8_t type, const u
  *                 the codec: a CAMERA_PASS tail NULL with len > 0;
  *   TASE_EBUSY    a request is pending (checked before the packet is
  *                 encoded; the pending one is left untouched);
- *   TASE_EUNKNOWN id is not in the schema;
+ *   TASE_EUNKNOWN id is not in the schema (with retries 0: with
+ *                 retries > 0 it is TASE_EARG, as an unknown packet is
+ *                 for tase_host_request_start());
  *   TASE_ELENGTH  msg NULL for a packet without a query form (and
  *                 GYRO_ZERO_CMD, which has no data: a command);
  *   TASE_ETOOLONG CAMERA_PASS tail over 249 bytes;
@@ -297,7 +304,9 @@ int tase_host_query_start(tase_host_t *h, uint8_t group, uint8_t type, uint8_t *
  * complete the pending request or go to on_frame. now_ms is not used for
  * matching (a reply fed before the deadline poll always wins). Returns the
  * number of
- * frames received (>= 0) or TASE_EARG (h NULL, bytes NULL with n > 0).
+ * frames received (>= 0), TASE_EARG (h NULL, bytes NULL with n > 0) or
+ * TASE_EBUSY (called from on_frame: the feed in progress goes on); on
+ * either error nothing is fed and h is unchanged.
  * now_ms is when the bytes arrived: it drives the receiver's time bound
  * (tase/frame.h, TIME BOUND), so call it with n == 0 too whenever a look
  * at your receive buffer found it empty; frames held behind noise are then
@@ -308,7 +317,10 @@ int tase_host_feed(tase_host_t *h, const uint8_t *bytes, size_t n, uint32_t now_
 
 /* Hand over one frame received some other way (e.g. reassembled from
  * CAN). Returns 1 if it completed the pending request, 0 if it went to
- * on_frame, TASE_EARG if h or frame (or frame->data) is NULL. O(len). */
+ * on_frame, TASE_EARG if h or frame (or frame->data) is NULL. Whether it
+ * is an owed answer (MATCHING) is judged by the latest now_ms the host
+ * was given (tase_host_feed(), tase_host_poll(), a request's start), so
+ * call tase_host_poll() as time passes. O(len). */
 int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame);
 
 /* Drive the pending request. Re-sends it when its attempt timed out and
@@ -322,6 +334,9 @@ int tase_host_handle_frame(tase_host_t *h, const tase_frame_t *frame);
  *                 host idle again);
  *   TASE_ESTATE   no request was started (or its outcome was reported);
  *   TASE_EARG     h NULL.
+ * now_ms is noted whatever the result (TASE_ESTATE too): it is the time
+ * by which answers owed by ended requests expire (MATCHING), also for
+ * frames given to tase_host_handle_frame(), which takes no time.
  * A re-send the port refuses still uses up the attempt (counted in
  * stats.tx_errors). O(request length). */
 int tase_host_poll(tase_host_t *h, uint32_t now_ms);
@@ -342,8 +357,9 @@ bool tase_host_busy(const tase_host_t *h);
  * never late. Returns bytes read (>= 0), a
  * port error, TASE_EIO (the port's read() claimed more bytes than asked;
  * nothing fed), TASE_EUNSUPPORTED (port has no read or now_ms), TASE_EBUSY
- * (called from on_frame: nothing read) or TASE_EARG (h NULL, or never
- * initialised: no port ops). Stack: a 64-byte read buffer and the receive
+ * (called from on_frame: nothing read) or TASE_EARG (h NULL, never
+ * initialised: no port ops, or its receiver h->rx visibly corrupted, as
+ * tase_rx_feed() says: nothing read). Stack: a 64-byte read buffer and the receive
  * path, 436 B on Cortex-M4 and 504 B on M0+ with the host's own frame
  * handling, plus on_frame's and the port's own (docs/FOOTPRINT.md, "Role
  * entry points"). */
@@ -373,8 +389,8 @@ int tase_host_drain(tase_host_t *h);
  * tase_host_request_start() + tase_host_poll(): returns the reply length
  * or a negative code (TASE_ETIMEOUT after 1 + retries attempts). Waits at
  * most about (1 + retries) * timeout_ms. Frames that arrive meanwhile go
- * to on_frame. TASE_EARG also for h without port ops (never initialised),
- * TASE_EUNSUPPORTED for a port without read or now_ms, TASE_EBUSY called
+ * to on_frame. TASE_EARG also for h without port ops (never initialised)
+ * or with a corrupted receiver (as tase_host_service()), TASE_EUNSUPPORTED for a port without read or now_ms, TASE_EBUSY called
  * from on_frame (nothing sent).
  * Before sending it reads and feeds what the port has ready (reads of 64
  * bytes that do not wait, until two in a row bring nothing, at most 256:

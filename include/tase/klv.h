@@ -208,7 +208,8 @@ int tase_klv_rx_init(tase_klv_rx_t *rx);
  * either handler may be NULL. Returns the number of packets delivered by
  * this call (>= 0; INT_MAX if more), or TASE_EARG if rx is NULL, data is
  * NULL with n > 0 (any n up to SIZE_MAX), or rx's held length exceeds its
- * window (corrupted or never initialised), or TASE_EBUSY if called from
+ * window or its busy byte is neither 0 nor 1 (corrupted or never
+ * initialised), or TASE_EBUSY if called from
  * inside a handler of this scanner; then nothing is consumed.
  * Any split of the stream into calls gives the same packets, offsets and
  * counters. Scanners are independent; one scanner must not be used from
