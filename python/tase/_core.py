@@ -7,6 +7,7 @@ scanned by the greedy receiver (tase/frame.h) and JSON is formatted by the
 bench tools' own formatter, so it is exactly what `tase --json` prints.
 """
 
+import collections.abc
 import decimal
 import gc
 import itertools
@@ -423,7 +424,7 @@ class Packet(tuple):
 
     def __new__(cls, name, *, raw=None, length=None, data=b"", **fields):
         t = packet_type(name)
-        raw = dict(raw or {})
+        raw = _raw_arg(t.name, raw)
         for k, v in fields.items():
             f = t.by_name.get(k)
             if f is None:
@@ -590,7 +591,7 @@ class Packet(tuple):
         if t is None:
             raise UnknownPacketError("an unknown packet has no fields", lib.TASE_EUNKNOWN)
         raw = self.raw
-        extra = fields.pop("raw", None) or {}
+        extra = _raw_arg(t.name, fields.pop("raw", None))
         data = fields.pop("data", self.data)
         twice = sorted(set(fields) & set(extra))
         if twice:
@@ -670,6 +671,20 @@ def _from_data(pid, data, offset=0, time_us=None, dir=None):
 def _with_meta(p, time_us, dir):
     """p with a time and direction."""
     return _new_tuple(Packet, (p[_KEY], p[_OFF], p[_BUF], time_us, dir))
+
+
+def _raw_arg(name, raw):
+    """raw= as a dict of wire integers by field name: None or a mapping
+    ("ab" was a ValueError about a "dictionary update sequence", 5 a
+    TypeError that named neither the packet nor raw=)."""
+    if raw is None:
+        return {}
+    if not isinstance(raw, collections.abc.Mapping):
+        raise FieldError(
+            "%s: raw= takes a dict of wire integers by field name, not %s"
+            % (name, type(raw).__name__)
+        )
+    return dict(raw)
 
 
 def _bytes(what, data):

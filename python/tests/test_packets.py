@@ -343,3 +343,14 @@ def test_raw_takes_a_do_not_change_code_as_the_spec_writes_it():
         tase.Packet("CAMERA_CMD", camera=1, raw={"hfov": 0xFFFE})
     with pytest.raises(tase.FieldError, match="32768 out of range"):
         tase.Packet("GIMBAL_CMD", raw=dict(flags=0x90, pan=0x8000, tilt=0, roll=0, impulse_time=0))
+
+
+@pytest.mark.parametrize("raw", ["ab", 5, [("pan", 1)], b"pan"])
+def test_raw_must_be_a_dict(raw):
+    # a review: raw="ab" was a ValueError about a "dictionary update
+    # sequence", raw=5 a bare TypeError; neither named raw= or the packet
+    with pytest.raises(tase.FieldError, match="GIMBAL_ANGLE: raw= takes a dict"):
+        tase.Packet("GIMBAL_ANGLE", raw=raw)
+    p = tase.Packet("GIMBAL_ANGLE", pan=1, tilt=2, roll=3)
+    with pytest.raises(tase.FieldError, match="GIMBAL_ANGLE: raw= takes a dict"):
+        p.replace(raw=raw)
