@@ -357,10 +357,15 @@ def packet_type(name):
     if isinstance(name, PacketType):
         return name
     if isinstance(name, int) and not isinstance(name, bool):
+        if not 0 <= name <= 0xFFFF:
+            # 0x10810 was "no packet 0x08/0x10", GIMBAL_ANGLE's id, which is
+            raise UnknownPacketError(
+                "%r is not a packet id (group << 8 | type, 0..0xFFFF)" % name, lib.TASE_EUNKNOWN
+            )
         t = _BY_ID.get(name)
         if t is None:
             raise UnknownPacketError(
-                "no packet 0x%02X/0x%02X in the schema" % (name >> 8 & 0xFF, name & 0xFF),
+                "no packet 0x%02X/0x%02X in the schema" % (name >> 8, name & 0xFF),
                 lib.TASE_EUNKNOWN,
             )
         return t

@@ -354,3 +354,14 @@ def test_raw_must_be_a_dict(raw):
     p = tase.Packet("GIMBAL_ANGLE", pan=1, tilt=2, roll=3)
     with pytest.raises(tase.FieldError, match="GIMBAL_ANGLE: raw= takes a dict"):
         p.replace(raw=raw)
+
+
+@pytest.mark.parametrize("pid", [0x10810, -1, 2**70, 0x10000])
+def test_an_id_beyond_16_bits_is_no_packet_id(pid):
+    # a review: 0x10810 said "no packet 0x08/0x10 in the schema", which is
+    # GIMBAL_ANGLE's id; -1 said 0xFF/0xFF, 2**70 0x00/0x00
+    with pytest.raises(tase.UnknownPacketError, match="%r is not a packet id" % pid):
+        tase.packet_type(pid)
+    with pytest.raises(tase.UnknownPacketError, match="%r is not a packet id" % pid):
+        tase.Packet(pid)
+    assert tase.packet_type(0x0810).name == "GIMBAL_ANGLE"
