@@ -951,6 +951,14 @@ def decode(data):
     return DecodeResult(sink.take(), _rx_stats(rx.stats, n))
 
 
+def _time_us_arg(what, time_us):
+    """time_us= of the packets a Decoder gives: None or an int of Unix
+    microseconds (1.5 or "x" was taken, and failed later in .json() or
+    .time, far from the call that gave it)."""
+    if time_us is not None and (isinstance(time_us, bool) or not isinstance(time_us, int)):
+        raise FieldError("%s: time_us %r is not an int of Unix microseconds (or None)" % (what, time_us))
+
+
 class Decoder:
     """A stream decoder: feed() bytes as they come, get the packets they
     complete (a frame held behind a longer candidate comes later, as the
@@ -983,6 +991,7 @@ class Decoder:
 
     def feed(self, data, time_us=None):
         data = _bytes("feed", data)
+        _time_us_arg("feed", time_us)
         sink = self._sink_for(len(data))
         sink.s.base64 = self.bytes
         _check(lib.py_rx_feed(self.rx, data, len(data), sink.s), "feed")
@@ -990,12 +999,17 @@ class Decoder:
         return sink.take(time_us, self.dir)
 
     def tick(self, now_ms, time_us=None):
+        if isinstance(now_ms, bool) or not isinstance(now_ms, int):
+            # 1.5 or None was a TypeError about "&"
+            raise FieldError("tick: now_ms %r is not an int (the receiver's clock in ms)" % (now_ms,))
+        _time_us_arg("tick", time_us)
         sink = self._sink_for(0)
         sink.s.base64 = self.bytes
         _check(lib.py_rx_tick(self.rx, now_ms & 0xFFFFFFFF, sink.s), "tick")
         return sink.take(time_us, self.dir)
 
     def flush(self, time_us=None):
+        _time_us_arg("flush", time_us)
         sink = self._sink_for(0)
         sink.s.base64 = self.bytes
         _check(lib.py_rx_flush(self.rx, sink.s), "flush")

@@ -365,3 +365,26 @@ def test_an_id_beyond_16_bits_is_no_packet_id(pid):
     with pytest.raises(tase.UnknownPacketError, match="%r is not a packet id" % pid):
         tase.Packet(pid)
     assert tase.packet_type(0x0810).name == "GIMBAL_ANGLE"
+
+
+@pytest.mark.parametrize(
+    "call, text",
+    [
+        # a review: each was taken, then failed far from the call (in
+        # .json() or .time), or was a TypeError about "&"
+        (lambda d, f: d.feed(f, time_us=1.5), "feed: time_us 1.5"),
+        (lambda d, f: d.feed(f, time_us="x"), "feed: time_us 'x'"),
+        (lambda d, f: d.feed(f[:-1]) + d.flush(time_us=True), "flush: time_us True"),
+        (lambda d, f: d.tick(1.5), "tick: now_ms 1.5"),
+        (lambda d, f: d.tick(None), "tick: now_ms None"),
+        (lambda d, f: d.tick(0, time_us=2.0), "tick: time_us 2.0"),
+    ],
+)
+def test_decoder_times_are_ints_or_a_field_error_at_once(call, text):
+    frame = tase.encode(tase.Packet("GIMBAL_ANGLE", pan=1, tilt=2, roll=3))
+    with pytest.raises(tase.FieldError, match=text):
+        for p in call(tase.Decoder(), frame):
+            p.json(), p.time
+    d = tase.Decoder(dir="in")
+    got = d.feed(frame, time_us=1500000) + d.tick(10) + d.flush()
+    assert [p.time for p in got] == [1.5]
