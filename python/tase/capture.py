@@ -16,6 +16,7 @@ import struct
 import time
 
 from ._core import Decoder, Error, FieldError, LinkError, TimeoutError_, _with_meta, ffi, lib
+from .link import _packets_limits
 
 __all__ = ["read_capture", "records", "CaptureLink", "CaptureWriter"]
 
@@ -755,8 +756,10 @@ class CaptureLink:
     def packets(self, timeout=None, count=None):
         """Iterate over the packets not given yet, until the end of the
         capture or `count` packets were given (`timeout` is not waited
-        for: a capture holds what it holds)."""
+        for: a capture holds what it holds; both are checked as a serial
+        link checks them, so that a script does the same on either)."""
         self._live()
+        _packets_limits(timeout, count)
         given = 0
         while count is None or given < count:
             self._live()  # closed meanwhile
@@ -769,6 +772,7 @@ class CaptureLink:
     def recv(self, timeout=None):
         """The next packet, or TimeoutError at the end of the capture."""
         self._live()
+        _packets_limits(timeout, None)
         p = self._next()
         if p is None:
             raise TimeoutError_(

@@ -557,6 +557,15 @@ def _seconds(what, v):
     return v
 
 
+def _packets_limits(timeout, count):
+    """packets()'s timeout (None or seconds, _seconds()) and count (None or
+    an int >= 0), else FieldError; of every kind of link."""
+    if timeout is not None:
+        _seconds("packets: timeout", timeout)
+    if count is not None and (isinstance(count, bool) or not isinstance(count, int) or count < 0):
+        raise FieldError("packets: count %r is not a number of packets (an int >= 0)" % (count,))
+
+
 def _setting_differs(t, sent, echo):
     """Whether a setup packet's echo shows a setting other than the one
     sent: fields sent as "do not change" and `temporary` (what to do with
@@ -819,10 +828,7 @@ class Link:
         seconds have passed in all (None: no limit) or `count` packets
         were given."""
         self._live()
-        if timeout is not None:
-            _seconds("packets: timeout", timeout)
-        if count is not None and (isinstance(count, bool) or not isinstance(count, int) or count < 0):
-            raise FieldError("packets: count %r is not a number of packets (an int >= 0)" % (count,))
+        _packets_limits(timeout, count)
         deadline = None if timeout is None else time.monotonic() + timeout
         given = 0
         looked = False

@@ -524,6 +524,27 @@ def test_capture_link_recv_and_stats(recorded):
         next(gen)
 
 
+@pytest.mark.parametrize(
+    "call, text",
+    [
+        # a review: count=-1 gave nothing and timeout=-1 was taken where a
+        # serial link refuses both; count="3" was a TypeError about "<"
+        (lambda link: list(link.packets(count=-1)), "count -1"),
+        (lambda link: list(link.packets(count="3")), "count '3'"),
+        (lambda link: list(link.packets(timeout=-1)), "timeout: -1"),
+        (lambda link: list(link.packets(timeout=float("nan"))), "timeout: nan"),
+        (lambda link: link.recv(-1), "timeout: -1"),
+    ],
+)
+def test_capture_link_checks_packets_arguments_as_a_serial_link(recorded, call, text):
+    cap, lines = recorded
+    with tase.connect("capture:" + cap) as link:
+        with pytest.raises(tase.FieldError, match=text):
+            call(link)
+        # nothing was taken by the refused call
+        assert [p.json() for p in link.packets(timeout=0)] == lines
+
+
 def test_capture_link_to_a_missing_file(tmp_path):
     # connect() said nothing; the first packets() raised a bare FileNotFoundError
     with pytest.raises(tase.LinkError, match="nonexistent"):
