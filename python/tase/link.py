@@ -511,12 +511,13 @@ def _request_opts(timeout, retries):
     if (
         isinstance(timeout, bool)
         or not isinstance(timeout, (int, float))
-        or isinstance(retries, bool)
-        or not isinstance(retries, int)
         or not 0 < timeout < 2**31 / 1000
-        or not 0 <= retries <= 255
     ):
-        raise FieldError("timeout must be > 0 s and under 2^31 ms, retries 0..255")
+        # the value given is said: "timeout must be ..." alone did not
+        # tell which call's value, or whether timeout or retries, was wrong
+        raise FieldError("timeout must be > 0 s and under 2^31 ms, not %r" % (timeout,))
+    if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= 255:
+        raise FieldError("retries must be an int 0..255, not %r" % (retries,))
     return timeout, retries
 
 
