@@ -695,9 +695,14 @@ def _raw_arg(name, raw):
 def _bytes(what, data):
     """data as bytes: a bytes-like object (bytes(5) would be five zero
     bytes, and a str has no one encoding: both a TypeError)."""
-    if isinstance(data, (int, str)):
+    if data is None or isinstance(data, (int, str)):
         raise TypeError("%s takes bytes, not %s" % (what, type(data).__name__))
-    return bytes(data)
+    try:
+        return bytes(data)
+    except (TypeError, ValueError) as e:
+        # [300] or an object: "bytes must be in range(0, 256)" alone, or
+        # "cannot convert 'X' object to bytes", did not say whose bytes
+        raise type(e)("%s takes bytes: %s" % (what, e)) from None
 
 
 def _make(t, raw, length, data):
@@ -935,7 +940,13 @@ def decode(data):
     C receiver: the greedy scan of tase/frame.h, what is pending at the end
     settled (tase_rx_flush), exactly the frames and offsets `tase decode`
     prints. Returns a list of Packet (a DecodeResult, with .stats)."""
-    data = memoryview(data).cast("B") if not isinstance(data, bytes) else data
+    if not isinstance(data, bytes):
+        try:
+            data = memoryview(data).cast("B")
+        except TypeError:
+            # "memoryview: a bytes-like object is required" named neither
+            # decode() nor what it was given
+            raise TypeError("decode() takes bytes, not %s" % type(data).__name__) from None
     n = len(data)
     rx = ffi.new("tase_rx_t *")
     _check(lib.tase_rx_init(rx), "decode")

@@ -255,11 +255,26 @@ def test_a_short_form_never_drops_a_given_field():
         lambda: tase.Decoder().feed(5),
         lambda: tase.Packet("CAMERA_PASS", camera=1, baud=0, data=3),
         lambda: tase.Packet.from_data(1, 0, "abc"),
+        # a review: bare "cannot convert 'NoneType' object to bytes" and
+        # "memoryview: a bytes-like object is required, not 'str'"
+        lambda: tase.Packet("CAMERA_PASS", camera=1, baud=0, data=None),
+        lambda: tase.Decoder().feed(None),
+        lambda: tase.Packet.from_data(1, 0, object()),
+        lambda: tase.decode("abc"),
+        lambda: tase.decode(None),
+        lambda: tase.decode(5),
     ],
 )
 def test_an_integer_or_str_is_not_bytes(call):
     with pytest.raises(TypeError, match="takes bytes"):
         call()
+
+
+def test_a_value_that_is_no_byte_names_the_call():
+    # a review: "bytes must be in range(0, 256)", whose bytes not said
+    with pytest.raises(ValueError, match="CAMERA_PASS data takes bytes: bytes must be in range"):
+        tase.Packet("CAMERA_PASS", camera=1, baud=0, data=[1, 300])
+    assert tase.Packet("CAMERA_PASS", camera=1, baud=0, data=[1, 2]).data == b"\x01\x02"
 
 
 def test_a_bool_is_not_a_length():
