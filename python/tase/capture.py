@@ -16,7 +16,7 @@ import struct
 import time
 
 from ._core import Decoder, Error, FieldError, LinkError, TimeoutError_, _with_meta, ffi, lib
-from .link import _packets_limits
+from .link import _close_dropped, _packets_limits
 
 __all__ = ["read_capture", "records", "CaptureLink", "CaptureWriter"]
 
@@ -730,6 +730,11 @@ class CaptureLink:
             self._closed = True
             self._it.close()
             self._f.close()
+
+    def __del__(self):
+        # as a serial link (its file was left to the collector, with a
+        # ResourceWarning "unclosed file")
+        _close_dropped(self)
 
     def _live(self):
         if self._closed:

@@ -567,6 +567,16 @@ def _packets_limits(timeout, count):
         raise FieldError("packets: count %r is not a number of packets (an int >= 0)" % (count,))
 
 
+def _close_dropped(link):
+    """__del__ of a link (serial, CAN, capture): one dropped without
+    close() is closed when its last reference goes."""
+    if not getattr(link, "_closed", True):
+        try:
+            link.close()
+        except Exception:  # noqa: BLE001 - nothing to report to at collection
+            pass
+
+
 def _setting_differs(t, sent, echo):
     """Whether a setup packet's echo shows a setting other than the one
     sent: fields sent as "do not change" and `temporary` (what to do with
@@ -645,11 +655,7 @@ class Link:
         return shut
 
     def __del__(self):
-        if not getattr(self, "_closed", True):
-            try:
-                self.close()
-            except Exception:  # noqa: BLE001 - nothing to report to at collection
-                pass
+        _close_dropped(self)
 
     def _live(self):
         if self._closed:

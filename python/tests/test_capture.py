@@ -545,6 +545,22 @@ def test_capture_link_checks_packets_arguments_as_a_serial_link(recorded, call, 
         assert [p.json() for p in link.packets(timeout=0)] == lines
 
 
+def test_a_capture_link_dropped_unclosed_is_closed_without_a_warning(recorded):
+    # a review: its file was left to the collector ("ResourceWarning:
+    # unclosed file"), where a serial link dropped unclosed closes itself
+    import gc
+    import warnings
+
+    cap, lines = recorded
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        link = tase.connect("capture:" + cap)
+        assert next(link.packets()).json() == lines[0]
+        del link
+        gc.collect()
+    assert [str(w.message) for w in caught if issubclass(w.category, ResourceWarning)] == []
+
+
 def test_capture_link_to_a_missing_file(tmp_path):
     # connect() said nothing; the first packets() raised a bare FileNotFoundError
     with pytest.raises(tase.LinkError, match="nonexistent"):
