@@ -616,7 +616,10 @@ class Packet(tuple):
 
     def json(self, units=False):
         """The JSON object `tase --json` prints for this packet (one line,
-        no newline): same keys, order and numbers."""
+        no newline): same keys, order and numbers. `units` is True or
+        False ("no" or "false" is true in Python: they printed units)."""
+        if not isinstance(units, bool):
+            raise FieldError("json: units must be True or False, not %r" % (units,))
         return _json(self, units)
 
     def __eq__(self, other):

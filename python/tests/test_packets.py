@@ -403,3 +403,12 @@ def test_decoder_times_are_ints_or_a_field_error_at_once(call, text):
     d = tase.Decoder(dir="in")
     got = d.feed(frame, time_us=1500000) + d.tick(10) + d.flush()
     assert [p.time for p in got] == [1.5]
+
+
+@pytest.mark.parametrize("units", ["no", "false", 0, 1, None])
+def test_json_units_is_true_or_false(units):
+    # a review: units="no" is true in Python and printed the units
+    p = tase.Packet("GIMBAL_ANGLE", pan=1.5, tilt=0, roll=0)
+    with pytest.raises(tase.FieldError, match="units must be True or False, not %r" % (units,)):
+        p.json(units=units)
+    assert "units" in json.loads(p.json(units=True)) and "units" not in json.loads(p.json())
