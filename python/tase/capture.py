@@ -65,7 +65,7 @@ def _pcap(f, head):
     if len(rest) < 20:
         raise CaptureError("pcap header cut short")
     snaplen, linktype = struct.unpack(e + "HHiIII", rest)[4:6]
-    linktype &= 0x0FFFFFFF
+    linktype &= 0x03FFFFFF  # as libpcap (LT_LINKTYPE): the low 26 bits name it
     if snaplen == 0 or snaplen > _MAX_SNAPLEN:
         snaplen = _MAX_SNAPLEN  # libpcap's adjustment
     index = 0
