@@ -329,13 +329,16 @@ class CaptureWriter:
     """Write a serial capture as `tase record` does: nanosecond pcap, link
     type 147, one record per read or write (a direction byte, 0 from the
     gimbal, 1 to it, then the bytes). An existing file is appended to when
-    it is such a capture (as `--record`), else refused; a record a full
+    it is a classic pcap of link type 147 (as `--record`: either byte
+    order, microseconds or nanoseconds, its records in its format), else
+    refused; a record a full
     disk cut short at its end is cut off first (as `--record` does: the
     next session would be unreadable behind it); a new one is created.
     Every record is flushed. A write that fails (a full disk) is a
     CaptureError, the file left ending with its last whole record."""
 
     _HEADER = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, LINKTYPE_SERIAL)
+    _CHUNK = 4096  # bytes of a read or write per record, after the direction byte
 
     # the signals that end a Python program, or interrupt it, by default
     _ENDING = tuple(
@@ -363,6 +366,7 @@ class CaptureWriter:
         self.path = path
         self.records = 0
         self.f = None
+        self._new_format()
         fd = None
         try:
             # appended to (O_APPEND), each record in one write: another
@@ -397,6 +401,7 @@ class CaptureWriter:
                 size = os.fstat(fd_).st_size
                 if size == 0:
                     self.good = 0
+                    self._new_format()
                     self._append(self._HEADER)
                 else:
                     if (pos, index) == (24, 0):
@@ -419,12 +424,39 @@ class CaptureWriter:
                 raise
             raise _write_error(path, e) from e
 
+    def _new_format(self):
+        """The records of a file this writer gives its header: _HEADER's."""
+        self._e, self._nano, self._limit = "<", True, 65535
+
     def _check_header(self):
+        """Take the format of the existing file's header, as tase --record
+        does (tools/tk_capture.c): a classic pcap of either byte order, in
+        microseconds or nanoseconds, link type 147, a snapshot length that
+        holds our largest record; else a CaptureError, nothing appended.
+        (Only _HEADER's own bytes were taken: a capture --record appends to,
+        a microsecond or big-endian one, was refused.)"""
         head = os.pread(self.f.fileno(), 24, 0)
-        if head != self._HEADER:
+        magic = head[:4]
+        if len(head) < 24 or magic not in MAGICS[:4]:
             raise CaptureError(
-                "%s: not a nanosecond serial capture of tase record: not appending" % self.path
+                "%s: not a classic pcap file (a recording appends only to one; give a new "
+                "file name): not appending" % self.path
             )
+        e = "<" if magic in MAGICS[:2] else ">"
+        snaplen, linktype = struct.unpack(e + "II", head[16:24])
+        linktype &= 0x03FFFFFF
+        if linktype != LINKTYPE_SERIAL:
+            raise CaptureError(
+                "%s: its link type is %d, not TASE serial (%d): not appending"
+                % (self.path, linktype, LINKTYPE_SERIAL)
+            )
+        limit = _MAX_SNAPLEN if snaplen == 0 or snaplen > _MAX_SNAPLEN else snaplen
+        if limit < 1 + self._CHUNK:
+            raise CaptureError(
+                "%s: its snapshot length (%d bytes) is below the %d bytes a record of ours "
+                "may take: not appending" % (self.path, snaplen, 1 + self._CHUNK)
+            )
+        self._e, self._nano, self._limit = e, magic in (MAGICS[1], MAGICS[3]), limit
 
     def _scan(self, pos, index, size, under_lock):
         """(end, count) of the whole records from `pos` (a record boundary,
@@ -435,8 +467,8 @@ class CaptureWriter:
         from the start, a write of another program may be under way)."""
         fd = self.f.fileno()
         while pos + 16 <= size:
-            _, _, n, length = struct.unpack("<IIII", os.pread(fd, 16, pos))
-            if n > 65535 or n > length:
+            _, _, n, length = struct.unpack(self._e + "IIII", os.pread(fd, 16, pos))
+            if n > self._limit or n > length:
                 if not under_lock:
                     return 24, 0
                 raise CaptureError(
@@ -476,10 +508,11 @@ class CaptureWriter:
     def put(self, dir, data, t_ns=None):
         """One record: dir 0 (bytes from the gimbal) or 1 (to it)."""
         t = time.time_ns() if t_ns is None else t_ns
-        for i in range(0, len(data), 4096):
-            chunk = bytes((dir,)) + bytes(data[i : i + 4096])
+        frac = t % 1000000000 if self._nano else t % 1000000000 // 1000
+        for i in range(0, len(data), self._CHUNK):
+            chunk = bytes((dir,)) + bytes(data[i : i + self._CHUNK])
             self._write(
-                struct.pack("<IIII", t // 1000000000, t % 1000000000, len(chunk), len(chunk))
+                struct.pack(self._e + "IIII", t // 1000000000, frac, len(chunk), len(chunk))
                 + chunk
             )
             self.records += 1

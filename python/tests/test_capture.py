@@ -314,6 +314,51 @@ def test_bench_script_interrupted_while_turning_stops_the_gimbal(sim, tmp_path):
     assert (last["pan"], last["tilt"], last["flags"]) == (0, 0, 0x90)
 
 
+@pytest.mark.parametrize(
+    "endian, magic, snaplen",
+    [("<", 0xA1B2C3D4, 65535), (">", 0xA1B23C4D, 65535), ("<", 0xA1B23C4D, 0),
+     (">", 0xA1B2C3D4, 262144)],
+    ids=["usec", "big-endian", "snaplen-0", "big-endian-usec"],
+)
+def test_a_recording_appends_to_what_tase_record_appends_to(sim, tase_cli, tmp_path, endian,
+                                                            magic, snaplen):
+    # a review: record= took only a nanosecond little-endian file with
+    # snapshot length 65535 (_HEADER's bytes); tase --record appends to any
+    # classic pcap of link type 147, in its own byte order and resolution
+    frame = tase.encode(tase.Packet("GIMBAL_ANGLE", pan=1, tilt=2, roll=3))
+    rec = b"\x00" + frame
+    frac = 500000 if magic == 0xA1B2C3D4 else 500000000
+    head = struct.pack(endian + "IHHiIII", magic, 2, 4, 0, 0, snaplen, 147)
+    cap = tmp_path / "other.pcap"
+    cap.write_bytes(head + struct.pack(endian + "IIII", 1700000000, frac, len(rec), len(rec)) + rec)
+    t0 = time.time()
+    with tase.connect(sim.url, record=str(cap)) as link:
+        link.query("SYSTEM_VERSION")
+    assert cap.read_bytes()[:24] == head
+    r = subprocess.run([tase_cli, "decode", str(cap)], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 0, r.stderr
+    got = list(tase.read_capture(str(cap)))
+    assert [p.json() for _, p in got] == r.stdout.splitlines()
+    assert [p.name for _, p in got] == ["GIMBAL_ANGLE", "SYSTEM_VERSION", "SYSTEM_VERSION"]
+    assert got[0][0] == 1700000000.5 and all(t0 - 1 < t < time.time() + 1 for t, _ in got[1:])
+
+
+@pytest.mark.parametrize(
+    "head, text",
+    [(struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 1), "its link type is 1, not"),
+     (struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 4000, 147), r"snapshot length \(4000"),
+     (b"\x0a\x0d\x0d\x0a" + bytes(20), "not a classic pcap file")],
+    ids=["linktype-1", "snaplen-4000", "pcapng"],
+)
+def test_a_recording_refuses_what_tase_record_refuses(tmp_path, head, text):
+    # and says why, in tase --record's words
+    cap = tmp_path / "x.pcap"
+    cap.write_bytes(head)
+    with pytest.raises(tase.CaptureError, match=text):
+        tase.capture.CaptureWriter(str(cap))
+    assert cap.read_bytes() == head
+
+
 def test_two_writers_appending_to_one_capture_keep_every_record(tmp_path):
     # a review: the second writer seeked to the end it found and wrote over
     # the first one's later records (24 of 48 packets lost)
