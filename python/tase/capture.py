@@ -64,7 +64,13 @@ def _pcap(f, head):
     rest = f.read(20)
     if len(rest) < 20:
         raise CaptureError("pcap header cut short")
-    snaplen, linktype = struct.unpack(e + "HHiIII", rest)[4:6]
+    major, minor, _, _, snaplen, linktype = struct.unpack(e + "HHiIII", rest)
+    # the versions libpcap (tase decode) opens: 2.0 to 2.4, and 543.0
+    # (these were read whatever their version)
+    if major < 2:
+        raise CaptureError("archaic pcap savefile format")
+    if not ((major == 2 and minor <= 4) or (major, minor) == (543, 0)):
+        raise CaptureError("unsupported pcap savefile version %d.%d" % (major, minor))
     linktype &= 0x03FFFFFF  # as libpcap (LT_LINKTYPE): the low 26 bits name it
     if snaplen == 0 or snaplen > _MAX_SNAPLEN:
         snaplen = _MAX_SNAPLEN  # libpcap's adjustment
@@ -193,6 +199,11 @@ def _pcapng(f, head):
         if len(h) < 8:
             raise CaptureError("%struncated pcapng dump file: a block header cut short" % where)
         if h[:4] == _SHB:
+            # libpcap takes the file's first section header apart from the
+            # other blocks: version 1.0 or 1.2 only, its trailer not looked
+            # at (it refused one with a bad trailer that tase decode reads,
+            # and read 1.1 or 1.3 that it refuses); a later one like the rest
+            first = e is None
             bom = f.read(4)
             if len(bom) < 4:
                 raise CaptureError("%struncated pcapng dump file: section header cut short" % where)
@@ -243,7 +254,7 @@ def _pcapng(f, head):
                 % (where, btype, 8 + len(bom) + len(rest), blen)
             )
         trailer = struct.unpack(e + "I", rest[-4:])[0]
-        if trailer != blen:
+        if trailer != blen and not (btype == 0x0A0D0D0A and first):
             raise CaptureError(
                 "%sblock total length in header %d and trailer %d don't match"
                 % (where, blen, trailer)
@@ -252,7 +263,7 @@ def _pcapng(f, head):
         if btype == 0x0A0D0D0A:  # section header: its own interfaces
             blk.take(4)
             major, minor = blk.unpack("HH")
-            if major != 1:
+            if major != 1 or (first and minor not in (0, 2)):
                 raise CaptureError(
                     "%sunsupported pcapng savefile version %d.%d" % (where, major, minor)
                 )

@@ -714,6 +714,41 @@ def _epb_at(data, usec):
     return _block(6, body + b"\0" * (-len(body) % 4))
 
 
+def _versioned(data, at, major, minor):
+    return data[:at] + struct.pack("<HH", major, minor) + data[at + 4:]
+
+
+def test_file_versions_and_the_first_section_trailer_as_tase_decode(tmp_path, tase_cli):
+    """A differential review: python -m tase decode read a classic pcap of
+    any version (libpcap: 2.0..2.4 and 543.0), pcapng of version 1.x
+    (libpcap: 1.0 and 1.2 in the first section header, any 1.x after),
+    and refused a file whose first section header's trailer was wrong
+    (libpcap does not look at it; a later one's it does)."""
+    pcap = _pcap_ns(147, [(1700000000 * 10**9, _FRAME, None)])
+    ng = _shb() + _idb() + _epb(_FRAME)
+    bad_trailer = ng[:24] + struct.pack("<I", 99) + ng[28:]
+    cases = {
+        # name: (file bytes, exit status, lines of JSON)
+        "pcap2.3": (_versioned(pcap, 4, 2, 3), 0, 1),
+        "pcap543.0": (_versioned(pcap, 4, 543, 0), 0, 1),
+        "pcap2.5": (_versioned(pcap, 4, 2, 5), 1, 0),
+        "pcap1.0": (_versioned(pcap, 4, 1, 0), 1, 0),
+        "pcap3.0": (_versioned(pcap, 4, 3, 0), 1, 0),
+        "ng1.2": (_versioned(ng, 12, 1, 2), 0, 1),
+        "ng1.1": (_versioned(ng, 12, 1, 1), 1, 0),
+        "ng1.3": (_versioned(ng, 12, 1, 3), 1, 0),
+        "ng-second-1.3": (ng + _versioned(ng, 12, 1, 3), 0, 2),
+        "ng-first-trailer": (bad_trailer, 0, 1),
+        "ng-second-trailer": (ng + bad_trailer, 1, 1),
+    }
+    for name, (data, status, lines) in cases.items():
+        path = tmp_path / name
+        path.write_bytes(data)
+        c, p = _decode_both(tase_cli, path)
+        assert (c.returncode, len(c.stdout.splitlines())) == (status, lines), (name, c.stderr)
+        assert (p.returncode, p.stdout) == (c.returncode, c.stdout), (name, p.stderr, c.stderr)
+
+
 def test_edge_records_decode_as_tase_decode(tmp_path, tase_cli):
     """A differential review of the decoders: read_capture and `python -m
     tase decode` differed from `tase decode` on a Simple Packet Block (time
