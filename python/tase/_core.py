@@ -608,7 +608,11 @@ class Packet(tuple):
                 raise FieldError("%s has no field %r" % (t.name, k))
             raw[k] = f.to_raw(v, t.name)
         raw.update(extra)
-        return _make(t, raw, self.size if self.size != t.len and not t.tail else None, data)
+        return _make(t, raw, self._form(t), data)
+
+    def _form(self, t):
+        """The length= that builds this packet's form again (None: the full one)."""
+        return self.size if self.size != t.len and not t.tail else None
 
     def encode(self):
         """The complete frame (sync, size, group, type, data, checksum)."""
@@ -661,8 +665,13 @@ class Packet(tuple):
             args.append("raw=%r" % codes)
         if t.tail:
             args.append("data=%r" % self.data)
-        if self.size != t.len and not t.tail:
+        if self._form(t) is not None:
             args.append("length=%d" % self.size)
+        if _make(t, raw, self._form(t), self.data).payload != self.payload:
+            # bytes no field holds (reserved, not zero, as received): the
+            # fields alone made another packet (RETRACT_DEPLOY_CMD b7 66
+            # came back as b7 00), so the data bytes themselves
+            return "Packet.from_data(0x%02X, 0x%02X, %r)" % (self.group, self.type, self.payload)
         return "Packet(%s)" % ", ".join(args)
 
     def __reduce__(self):
