@@ -7,6 +7,7 @@ scanned by the greedy receiver (tase/frame.h) and JSON is formatted by the
 bench tools' own formatter, so it is exactly what `tase --json` prints.
 """
 
+import collections.abc
 import decimal
 import gc
 import itertools
@@ -356,10 +357,15 @@ def packet_type(name):
     if isinstance(name, PacketType):
         return name
     if isinstance(name, int) and not isinstance(name, bool):
+        if not 0 <= name <= 0xFFFF:
+            # 0x10810 was "no packet 0x08/0x10", GIMBAL_ANGLE's id, which is
+            raise UnknownPacketError(
+                "%r is not a packet id (group << 8 | type, 0..0xFFFF)" % name, lib.TASE_EUNKNOWN
+            )
         t = _BY_ID.get(name)
         if t is None:
             raise UnknownPacketError(
-                "no packet 0x%02X/0x%02X in the schema" % (name >> 8 & 0xFF, name & 0xFF),
+                "no packet 0x%02X/0x%02X in the schema" % (name >> 8, name & 0xFF),
                 lib.TASE_EUNKNOWN,
             )
         return t
@@ -423,7 +429,7 @@ class Packet(tuple):
 
     def __new__(cls, name, *, raw=None, length=None, data=b"", **fields):
         t = packet_type(name)
-        raw = dict(raw or {})
+        raw = _raw_arg(t.name, raw)
         for k, v in fields.items():
             f = t.by_name.get(k)
             if f is None:
@@ -590,7 +596,7 @@ class Packet(tuple):
         if t is None:
             raise UnknownPacketError("an unknown packet has no fields", lib.TASE_EUNKNOWN)
         raw = self.raw
-        extra = fields.pop("raw", None) or {}
+        extra = _raw_arg(t.name, fields.pop("raw", None))
         data = fields.pop("data", self.data)
         twice = sorted(set(fields) & set(extra))
         if twice:
@@ -602,7 +608,11 @@ class Packet(tuple):
                 raise FieldError("%s has no field %r" % (t.name, k))
             raw[k] = f.to_raw(v, t.name)
         raw.update(extra)
-        return _make(t, raw, self.size if self.size != t.len and not t.tail else None, data)
+        return _make(t, raw, self._form(t), data)
+
+    def _form(self, t):
+        """The length= that builds this packet's form again (None: the full one)."""
+        return self.size if self.size != t.len and not t.tail else None
 
     def encode(self):
         """The complete frame (sync, size, group, type, data, checksum)."""
@@ -610,7 +620,10 @@ class Packet(tuple):
 
     def json(self, units=False):
         """The JSON object `tase --json` prints for this packet (one line,
-        no newline): same keys, order and numbers."""
+        no newline): same keys, order and numbers. `units` is True or
+        False ("no" or "false" is true in Python: they printed units)."""
+        if not isinstance(units, bool):
+            raise FieldError("json: units must be True or False, not %r" % (units,))
         return _json(self, units)
 
     def __eq__(self, other):
@@ -652,8 +665,13 @@ class Packet(tuple):
             args.append("raw=%r" % codes)
         if t.tail:
             args.append("data=%r" % self.data)
-        if self.size != t.len and not t.tail:
+        if self._form(t) is not None:
             args.append("length=%d" % self.size)
+        if _make(t, raw, self._form(t), self.data).payload != self.payload:
+            # bytes no field holds (reserved, not zero, as received): the
+            # fields alone made another packet (RETRACT_DEPLOY_CMD b7 66
+            # came back as b7 00), so the data bytes themselves
+            return "Packet.from_data(0x%02X, 0x%02X, %r)" % (self.group, self.type, self.payload)
         return "Packet(%s)" % ", ".join(args)
 
     def __reduce__(self):
@@ -672,12 +690,31 @@ def _with_meta(p, time_us, dir):
     return _new_tuple(Packet, (p[_KEY], p[_OFF], p[_BUF], time_us, dir))
 
 
+def _raw_arg(name, raw):
+    """raw= as a dict of wire integers by field name: None or a mapping
+    ("ab" was a ValueError about a "dictionary update sequence", 5 a
+    TypeError that named neither the packet nor raw=)."""
+    if raw is None:
+        return {}
+    if not isinstance(raw, collections.abc.Mapping):
+        raise FieldError(
+            "%s: raw= takes a dict of wire integers by field name, not %s"
+            % (name, type(raw).__name__)
+        )
+    return dict(raw)
+
+
 def _bytes(what, data):
     """data as bytes: a bytes-like object (bytes(5) would be five zero
     bytes, and a str has no one encoding: both a TypeError)."""
-    if isinstance(data, (int, str)):
+    if data is None or isinstance(data, (int, str)):
         raise TypeError("%s takes bytes, not %s" % (what, type(data).__name__))
-    return bytes(data)
+    try:
+        return bytes(data)
+    except (TypeError, ValueError) as e:
+        # [300] or an object: "bytes must be in range(0, 256)" alone, or
+        # "cannot convert 'X' object to bytes", did not say whose bytes
+        raise type(e)("%s takes bytes: %s" % (what, e)) from None
 
 
 def _make(t, raw, length, data):
@@ -915,7 +952,13 @@ def decode(data):
     C receiver: the greedy scan of tase/frame.h, what is pending at the end
     settled (tase_rx_flush), exactly the frames and offsets `tase decode`
     prints. Returns a list of Packet (a DecodeResult, with .stats)."""
-    data = memoryview(data).cast("B") if not isinstance(data, bytes) else data
+    if not isinstance(data, bytes):
+        try:
+            data = memoryview(data).cast("B")
+        except TypeError:
+            # "memoryview: a bytes-like object is required" named neither
+            # decode() nor what it was given
+            raise TypeError("decode() takes bytes, not %s" % type(data).__name__) from None
     n = len(data)
     rx = ffi.new("tase_rx_t *")
     _check(lib.tase_rx_init(rx), "decode")
@@ -929,6 +972,14 @@ def decode(data):
     if sink.s.dropped:
         raise Error("decode: %d frames lost (internal capacity)" % sink.s.dropped)
     return DecodeResult(sink.take(), _rx_stats(rx.stats, n))
+
+
+def _time_us_arg(what, time_us):
+    """time_us= of the packets a Decoder gives: None or an int of Unix
+    microseconds (1.5 or "x" was taken, and failed later in .json() or
+    .time, far from the call that gave it)."""
+    if time_us is not None and (isinstance(time_us, bool) or not isinstance(time_us, int)):
+        raise FieldError("%s: time_us %r is not an int of Unix microseconds (or None)" % (what, time_us))
 
 
 class Decoder:
@@ -963,6 +1014,7 @@ class Decoder:
 
     def feed(self, data, time_us=None):
         data = _bytes("feed", data)
+        _time_us_arg("feed", time_us)
         sink = self._sink_for(len(data))
         sink.s.base64 = self.bytes
         _check(lib.py_rx_feed(self.rx, data, len(data), sink.s), "feed")
@@ -970,12 +1022,17 @@ class Decoder:
         return sink.take(time_us, self.dir)
 
     def tick(self, now_ms, time_us=None):
+        if isinstance(now_ms, bool) or not isinstance(now_ms, int):
+            # 1.5 or None was a TypeError about "&"
+            raise FieldError("tick: now_ms %r is not an int (the receiver's clock in ms)" % (now_ms,))
+        _time_us_arg("tick", time_us)
         sink = self._sink_for(0)
         sink.s.base64 = self.bytes
         _check(lib.py_rx_tick(self.rx, now_ms & 0xFFFFFFFF, sink.s), "tick")
         return sink.take(time_us, self.dir)
 
     def flush(self, time_us=None):
+        _time_us_arg("flush", time_us)
         sink = self._sink_for(0)
         sink.s.base64 = self.bytes
         _check(lib.py_rx_flush(self.rx, sink.s), "flush")

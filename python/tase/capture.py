@@ -16,6 +16,7 @@ import struct
 import time
 
 from ._core import Decoder, Error, FieldError, LinkError, TimeoutError_, _with_meta, ffi, lib
+from .link import _close_dropped, _packets_limits
 
 __all__ = ["read_capture", "records", "CaptureLink", "CaptureWriter"]
 
@@ -63,8 +64,14 @@ def _pcap(f, head):
     rest = f.read(20)
     if len(rest) < 20:
         raise CaptureError("pcap header cut short")
-    snaplen, linktype = struct.unpack(e + "HHiIII", rest)[4:6]
-    linktype &= 0x0FFFFFFF
+    major, minor, _, _, snaplen, linktype = struct.unpack(e + "HHiIII", rest)
+    # the versions libpcap (tase decode) opens: 2.0 to 2.4, and 543.0
+    # (these were read whatever their version)
+    if major < 2:
+        raise CaptureError("archaic pcap savefile format")
+    if not ((major == 2 and minor <= 4) or (major, minor) == (543, 0)):
+        raise CaptureError("unsupported pcap savefile version %d.%d" % (major, minor))
+    linktype &= 0x03FFFFFF  # as libpcap (LT_LINKTYPE): the low 26 bits name it
     if snaplen == 0 or snaplen > _MAX_SNAPLEN:
         snaplen = _MAX_SNAPLEN  # libpcap's adjustment
     index = 0
@@ -192,6 +199,11 @@ def _pcapng(f, head):
         if len(h) < 8:
             raise CaptureError("%struncated pcapng dump file: a block header cut short" % where)
         if h[:4] == _SHB:
+            # libpcap takes the file's first section header apart from the
+            # other blocks: version 1.0 or 1.2 only, its trailer not looked
+            # at (it refused one with a bad trailer that tase decode reads,
+            # and read 1.1 or 1.3 that it refuses); a later one like the rest
+            first = e is None
             bom = f.read(4)
             if len(bom) < 4:
                 raise CaptureError("%struncated pcapng dump file: section header cut short" % where)
@@ -242,7 +254,7 @@ def _pcapng(f, head):
                 % (where, btype, 8 + len(bom) + len(rest), blen)
             )
         trailer = struct.unpack(e + "I", rest[-4:])[0]
-        if trailer != blen:
+        if trailer != blen and not (btype == 0x0A0D0D0A and first):
             raise CaptureError(
                 "%sblock total length in header %d and trailer %d don't match"
                 % (where, blen, trailer)
@@ -251,7 +263,7 @@ def _pcapng(f, head):
         if btype == 0x0A0D0D0A:  # section header: its own interfaces
             blk.take(4)
             major, minor = blk.unpack("HH")
-            if major != 1:
+            if major != 1 or (first and minor not in (0, 2)):
                 raise CaptureError(
                     "%sunsupported pcapng savefile version %d.%d" % (where, major, minor)
                 )
@@ -328,13 +340,16 @@ class CaptureWriter:
     """Write a serial capture as `tase record` does: nanosecond pcap, link
     type 147, one record per read or write (a direction byte, 0 from the
     gimbal, 1 to it, then the bytes). An existing file is appended to when
-    it is such a capture (as `--record`), else refused; a record a full
+    it is a classic pcap of link type 147 (as `--record`: either byte
+    order, microseconds or nanoseconds, its records in its format), else
+    refused; a record a full
     disk cut short at its end is cut off first (as `--record` does: the
     next session would be unreadable behind it); a new one is created.
     Every record is flushed. A write that fails (a full disk) is a
     CaptureError, the file left ending with its last whole record."""
 
     _HEADER = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, LINKTYPE_SERIAL)
+    _CHUNK = 4096  # bytes of a read or write per record, after the direction byte
 
     # the signals that end a Python program, or interrupt it, by default
     _ENDING = tuple(
@@ -362,6 +377,7 @@ class CaptureWriter:
         self.path = path
         self.records = 0
         self.f = None
+        self._new_format()
         fd = None
         try:
             # appended to (O_APPEND), each record in one write: another
@@ -396,6 +412,7 @@ class CaptureWriter:
                 size = os.fstat(fd_).st_size
                 if size == 0:
                     self.good = 0
+                    self._new_format()
                     self._append(self._HEADER)
                 else:
                     if (pos, index) == (24, 0):
@@ -418,12 +435,39 @@ class CaptureWriter:
                 raise
             raise _write_error(path, e) from e
 
+    def _new_format(self):
+        """The records of a file this writer gives its header: _HEADER's."""
+        self._e, self._nano, self._limit = "<", True, 65535
+
     def _check_header(self):
+        """Take the format of the existing file's header, as tase --record
+        does (tools/tk_capture.c): a classic pcap of either byte order, in
+        microseconds or nanoseconds, link type 147, a snapshot length that
+        holds our largest record; else a CaptureError, nothing appended.
+        (Only _HEADER's own bytes were taken: a capture --record appends to,
+        a microsecond or big-endian one, was refused.)"""
         head = os.pread(self.f.fileno(), 24, 0)
-        if head != self._HEADER:
+        magic = head[:4]
+        if len(head) < 24 or magic not in MAGICS[:4]:
             raise CaptureError(
-                "%s: not a nanosecond serial capture of tase record: not appending" % self.path
+                "%s: not a classic pcap file (a recording appends only to one; give a new "
+                "file name): not appending" % self.path
             )
+        e = "<" if magic in MAGICS[:2] else ">"
+        snaplen, linktype = struct.unpack(e + "II", head[16:24])
+        linktype &= 0x03FFFFFF
+        if linktype != LINKTYPE_SERIAL:
+            raise CaptureError(
+                "%s: its link type is %d, not TASE serial (%d): not appending"
+                % (self.path, linktype, LINKTYPE_SERIAL)
+            )
+        limit = _MAX_SNAPLEN if snaplen == 0 or snaplen > _MAX_SNAPLEN else snaplen
+        if limit < 1 + self._CHUNK:
+            raise CaptureError(
+                "%s: its snapshot length (%d bytes) is below the %d bytes a record of ours "
+                "may take: not appending" % (self.path, snaplen, 1 + self._CHUNK)
+            )
+        self._e, self._nano, self._limit = e, magic in (MAGICS[1], MAGICS[3]), limit
 
     def _scan(self, pos, index, size, under_lock):
         """(end, count) of the whole records from `pos` (a record boundary,
@@ -434,8 +478,8 @@ class CaptureWriter:
         from the start, a write of another program may be under way)."""
         fd = self.f.fileno()
         while pos + 16 <= size:
-            _, _, n, length = struct.unpack("<IIII", os.pread(fd, 16, pos))
-            if n > 65535 or n > length:
+            _, _, n, length = struct.unpack(self._e + "IIII", os.pread(fd, 16, pos))
+            if n > self._limit or n > length:
                 if not under_lock:
                     return 24, 0
                 raise CaptureError(
@@ -475,10 +519,11 @@ class CaptureWriter:
     def put(self, dir, data, t_ns=None):
         """One record: dir 0 (bytes from the gimbal) or 1 (to it)."""
         t = time.time_ns() if t_ns is None else t_ns
-        for i in range(0, len(data), 4096):
-            chunk = bytes((dir,)) + bytes(data[i : i + 4096])
+        frac = t % 1000000000 if self._nano else t % 1000000000 // 1000
+        for i in range(0, len(data), self._CHUNK):
+            chunk = bytes((dir,)) + bytes(data[i : i + self._CHUNK])
             self._write(
-                struct.pack("<IIII", t // 1000000000, t % 1000000000, len(chunk), len(chunk))
+                struct.pack(self._e + "IIII", t // 1000000000, frac, len(chunk), len(chunk))
                 + chunk
             )
             self.records += 1
@@ -730,6 +775,11 @@ class CaptureLink:
             self._it.close()
             self._f.close()
 
+    def __del__(self):
+        # as a serial link (its file was left to the collector, with a
+        # ResourceWarning "unclosed file")
+        _close_dropped(self)
+
     def _live(self):
         if self._closed:
             raise Error("%s: the link is closed" % self.url)
@@ -755,8 +805,10 @@ class CaptureLink:
     def packets(self, timeout=None, count=None):
         """Iterate over the packets not given yet, until the end of the
         capture or `count` packets were given (`timeout` is not waited
-        for: a capture holds what it holds)."""
+        for: a capture holds what it holds; both are checked as a serial
+        link checks them, so that a script does the same on either)."""
         self._live()
+        _packets_limits(timeout, count)
         given = 0
         while count is None or given < count:
             self._live()  # closed meanwhile
@@ -769,6 +821,7 @@ class CaptureLink:
     def recv(self, timeout=None):
         """The next packet, or TimeoutError at the end of the capture."""
         self._live()
+        _packets_limits(timeout, None)
         p = self._next()
         if p is None:
             raise TimeoutError_(

@@ -511,12 +511,13 @@ def _request_opts(timeout, retries):
     if (
         isinstance(timeout, bool)
         or not isinstance(timeout, (int, float))
-        or isinstance(retries, bool)
-        or not isinstance(retries, int)
         or not 0 < timeout < 2**31 / 1000
-        or not 0 <= retries <= 255
     ):
-        raise FieldError("timeout must be > 0 s and under 2^31 ms, retries 0..255")
+        # the value given is said: "timeout must be ..." alone did not
+        # tell which call's value, or whether timeout or retries, was wrong
+        raise FieldError("timeout must be > 0 s and under 2^31 ms, not %r" % (timeout,))
+    if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= 255:
+        raise FieldError("retries must be an int 0..255, not %r" % (retries,))
     return timeout, retries
 
 
@@ -555,6 +556,25 @@ def _seconds(what, v):
     ):
         raise FieldError("%s: %r is not a number of seconds >= 0 (and under 2^31 ms)" % (what, v))
     return v
+
+
+def _packets_limits(timeout, count):
+    """packets()'s timeout (None or seconds, _seconds()) and count (None or
+    an int >= 0), else FieldError; of every kind of link."""
+    if timeout is not None:
+        _seconds("packets: timeout", timeout)
+    if count is not None and (isinstance(count, bool) or not isinstance(count, int) or count < 0):
+        raise FieldError("packets: count %r is not a number of packets (an int >= 0)" % (count,))
+
+
+def _close_dropped(link):
+    """__del__ of a link (serial, CAN, capture): one dropped without
+    close() is closed when its last reference goes."""
+    if not getattr(link, "_closed", True):
+        try:
+            link.close()
+        except Exception:  # noqa: BLE001 - nothing to report to at collection
+            pass
 
 
 def _setting_differs(t, sent, echo):
@@ -635,11 +655,7 @@ class Link:
         return shut
 
     def __del__(self):
-        if not getattr(self, "_closed", True):
-            try:
-                self.close()
-            except Exception:  # noqa: BLE001 - nothing to report to at collection
-                pass
+        _close_dropped(self)
 
     def _live(self):
         if self._closed:
@@ -819,10 +835,7 @@ class Link:
         seconds have passed in all (None: no limit) or `count` packets
         were given."""
         self._live()
-        if timeout is not None:
-            _seconds("packets: timeout", timeout)
-        if count is not None and (isinstance(count, bool) or not isinstance(count, int) or count < 0):
-            raise FieldError("packets: count %r is not a number of packets (an int >= 0)" % (count,))
+        _packets_limits(timeout, count)
         deadline = None if timeout is None else time.monotonic() + timeout
         given = 0
         looked = False

@@ -82,8 +82,9 @@ def series(path, baud=57600):
 
 
 def plot_capture(path, out, baud=57600, title=None):
-    """Draw the capture's curves into image file `out` (PNG, SVG, PDF by
-    its extension; PNG for another or none, under the name given: the file
+    """Draw the capture's curves into image file `out` (in the format of
+    its extension, PNG, SVG, PDF or another matplotlib writes such as
+    JPEG; PNG for one it does not know or none, under the name given: the file
     written is `out`, never `out` + ".png"). A directory is a ValueError.
     Returns the series drawn."""
     import matplotlib

@@ -25,7 +25,8 @@ import threading
 import time
 import weakref
 
-from ._core import Error, error, ffi, lib
+from ._core import Error, FieldError, error, ffi, lib
+from .link import _BAUDS
 
 __all__ = ["start", "Sim", "find_program"]
 
@@ -75,6 +76,21 @@ class _Running:
             shutil.rmtree(self.dir, ignore_errors=True)
 
 
+def _check_args(baud, can, virtual):
+    """FieldError, nothing started, for a sim whose url tase.connect()
+    would refuse: a baud it does not take (1200 started tase-sim, then
+    connect(sim.url) refused the url), an empty or non-str interface or
+    bus name (virtual="" gave the url "virtual:")."""
+    if isinstance(baud, bool) or not isinstance(baud, int) or baud not in _BAUDS:
+        raise FieldError(
+            "tase.sim.start(): baud %r is not one of %s (what tase.connect() takes)"
+            % (baud, ", ".join(map(str, _BAUDS)))
+        )
+    for what, v in (("can", can), ("virtual", virtual)):
+        if v is not None and (not isinstance(v, str) or not v):
+            raise FieldError("tase.sim.start(): %s %r is not an interface or bus name" % (what, v))
+
+
 class Sim:
     """A running tase-sim. url: what tase.connect() takes; log(): what it
     printed so far; pid; stop(). One never stopped is stopped when it is
@@ -87,6 +103,7 @@ class Sim:
     ):
         if can is not None and virtual is not None:
             raise Error("tase.sim.start(): can or virtual, not both")
+        _check_args(baud, can, virtual)
         self._log_text = None
         self.program = program or find_program()
         self.dir = tempfile.mkdtemp(prefix="tase-sim-")

@@ -151,7 +151,7 @@ def test_timeout_is_timeouterror_after_retries(silent_pty):
         # wait=0 sent the retract, then timed out at once (`tase retract --wait 0` is refused)
         (lambda l: l.retract(wait=0), tase.FieldError, "0 is no time to wait"),
         # retries=True was taken for 1, and checked only when a query was made
-        (lambda l: l.camera(hfov=10, retries=True), tase.FieldError, "retries 0..255"),
+        (lambda l: l.camera(hfov=10, retries=True), tase.FieldError, "retries must be an int 0..255, not True"),
         (lambda l: l.query("PACKET_RATE", timeout=True), tase.FieldError, "timeout must be"),
         # the general send path takes the verbs' ranges too (the C host role
         # refuses them): a SPOI beyond the pole and a position beyond the axes went out
@@ -574,9 +574,16 @@ def test_recv_0_does_not_wait_for_another_threads_call(silent_pty):
 
 def test_connect_checks_its_timeout_and_retries(silent_pty):
     url, master = silent_pty
-    for kw in ({"timeout": "x"}, {"timeout": 0}, {"retries": -1}, {"retries": True}):
-        with pytest.raises(tase.FieldError, match="timeout must be"):
+    # the message names the argument and its value (a review: "timeout
+    # must be > 0 s and under 2^31 ms, retries 0..255" for any of them)
+    for kw, text in (({"timeout": "x"}, "timeout must be .*, not 'x'"),
+                     ({"timeout": 0}, "timeout must be .*, not 0"),
+                     ({"retries": -1}, "retries must be .*, not -1"),
+                     ({"retries": True}, "retries must be .*, not True")):
+        with pytest.raises(tase.FieldError, match=text):
             tase.connect(url, **kw)
+        with tase.connect(url) as link, pytest.raises(tase.FieldError, match=text):
+            link.query("PACKET_RATE", **kw)
 
 
 def test_a_serial_device_path_may_hold_colons():

@@ -116,3 +116,23 @@ def test_the_stale_link_of_a_killed_sim_is_refused(tase_sim):
         with tase.sim.start() as live:  # a live simulator's link still opens
             with tase.connect(live.url) as link:
                 assert link.query("SYSTEM_VERSION").name == "SYSTEM_VERSION"
+
+
+@pytest.mark.parametrize(
+    "kw, text",
+    [
+        # a review: baud=1200 started tase-sim, whose url connect() then
+        # refused; virtual="" gave the url "virtual:"; "x" and can=5 were
+        # TypeErrors from deep inside
+        (dict(baud=1200), "baud 1200 is not one of 9600"),
+        (dict(baud="x"), "baud 'x'"),
+        (dict(virtual=""), "virtual ''"),
+        (dict(can=5), "can 5"),
+    ],
+)
+def test_start_refuses_what_connect_would_refuse(tase_sim, kw, text):
+    with pytest.raises(tase.FieldError, match=text):
+        tase.sim.start(**kw)
+    with tase.sim.start(baud=9600) as sim, tase.connect(sim.url) as link:
+        assert sim.url.endswith(":9600")
+        assert link.query("SYSTEM_VERSION").name == "SYSTEM_VERSION"
