@@ -59,6 +59,39 @@ static bool port_present(const tase_gimbal_t *g, unsigned port)
 }
 
 /* Anchor a stream at `now`: its first packet one period later. */
+/* TASE_OK when g may start a call that changes its state: not from inside
+ * one of its callbacks (busy 1: TASE_EBUSY; gimbal.h REENTRANCY), and a
+ * busy byte other than 0 and 1 is a corrupted instance (TASE_EARG). */
+static int idle(const tase_gimbal_t *g)
+{
+    if (g->busy == 0u) {
+        return TASE_OK;
+    }
+    return g->busy == 1u ? TASE_EBUSY : TASE_EARG;
+}
+
+/* Start a call that runs the application's callbacks (feed, handle_frame,
+ * poll, service): g marked busy and TASE_OK, or the call refused with
+ * TASE_EARG (g NULL) or idle()'s error. leave() ends it with result r. */
+static int enter(tase_gimbal_t *g)
+{
+    int r;
+    if (g == NULL) {
+        return TASE_EARG;
+    }
+    r = idle(g);
+    if (r == TASE_OK) {
+        g->busy = 1u;
+    }
+    return r;
+}
+
+static int leave(tase_gimbal_t *g, int r)
+{
+    g->busy = 0u;
+    return r;
+}
+
 static void sched_start(tase_gimbal_sched_t *s, uint8_t rate, uint32_t now_ms)
 {
     s->rate = rate;
@@ -154,6 +187,9 @@ int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per
 {
     if (g == NULL || port >= TASE_GIMBAL_PORTS) {
         return TASE_EARG;
+    }
+    if (idle(g) != TASE_OK) {
+        return idle(g);
     }
     g->capacity[port] = bytes_per_s != 0u ? bytes_per_s : port_capacity(&g->port[port]);
     pace_port(g, port, false);
@@ -322,6 +358,9 @@ int tase_gimbal_setup_set(tase_gimbal_t *g, uint8_t type, const uint8_t *data, s
     if (g == NULL || data == NULL) {
         return TASE_EARG;
     }
+    if (idle(g) != TASE_OK) {
+        return idle(g);
+    }
     if (type >= TASE_GIMBAL_SETUP_TYPES) {
         return TASE_EUNKNOWN;
     }
@@ -348,6 +387,9 @@ int tase_gimbal_setup_set_msg(tase_gimbal_t *g, uint16_t id, const void *msg, ui
     int n;
     if (g == NULL || msg == NULL) {
         return TASE_EARG;
+    }
+    if (idle(g) != TASE_OK) {
+        return idle(g);
     }
     if (type < 0) {
         return type;
@@ -479,11 +521,16 @@ static void handle_and_echo(tase_gimbal_t *g, unsigned port, const tase_frame_t 
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
                              uint32_t now_ms)
 {
+    int r;
     if (g == NULL || frame == NULL || frame->data == NULL || port >= TASE_GIMBAL_PORTS) {
         return TASE_EARG;
     }
+    r = enter(g);
+    if (r != TASE_OK) {
+        return r;
+    }
     handle_and_echo(g, port, frame, now_ms);
-    return TASE_OK;
+    return leave(g, TASE_OK);
 }
 
 int tase_gimbal_frame_port(const tase_gimbal_t *g)
@@ -504,17 +551,14 @@ static void gimbal_rx(void *user, const tase_frame_t *frame)
     (void)tase_rx_stop(&g->rx[g->feed_port]);
 }
 
-int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
-                     uint32_t now_ms)
+/* tase_gimbal_feed() once g is known and marked busy. */
+static int feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n, uint32_t now_ms)
 {
     tase_rx_t *rx;
     size_t done = 0;
     int frames = 0;
     bool tick = false;
     bool stopped = false;
-    if (g == NULL) {
-        return TASE_EARG;
-    }
     if (g->rx == NULL) {
         return TASE_ESTATE;
     }
@@ -561,6 +605,13 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
             /* more bytes to feed */
         }
     }
+}
+
+int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
+                     uint32_t now_ms)
+{
+    int r = enter(g);
+    return r != TASE_OK ? r : leave(g, feed(g, port, bytes, n, now_ms));
 }
 
 /* Move a stream to the first slot strictly after now_ms (a late poll
@@ -661,15 +712,13 @@ static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_
     return sent;
 }
 
-int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
+/* tase_gimbal_poll() once g is known and marked busy. */
+static int poll_due(tase_gimbal_t *g, uint32_t now_ms)
 {
     unsigned p;
     unsigned s;
     int sent = 0;
 
-    if (g == NULL) {
-        return TASE_EARG;
-    }
     if (g->app.fill_telemetry == NULL && g->app.fill_telemetry_msg == NULL) {
         return 0;
     }
@@ -685,15 +734,19 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
     return sent;
 }
 
-int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
+int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
+{
+    int r = enter(g);
+    return r != TASE_OK ? r : leave(g, poll_due(g, now_ms));
+}
+
+/* tase_gimbal_service() once g is known and marked busy. */
+static int service(tase_gimbal_t *g, uint32_t now_ms)
 {
     uint8_t buf[SERVICE_CHUNK];
     unsigned p;
     unsigned i;
 
-    if (g == NULL) {
-        return TASE_EARG;
-    }
     for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
         if (!port_present(g, p) || g->port[p].ops->read == NULL) {
             continue;
@@ -708,11 +761,17 @@ int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
                 break;
             }
             /* n == 0: nothing waiting, the receiver's time bound hears it */
-            (void)tase_gimbal_feed(g, p, buf, (size_t)n, now_ms);
+            (void)feed(g, p, buf, (size_t)n, now_ms);
             if (n == 0) {
                 break;
             }
         }
     }
-    return tase_gimbal_poll(g, now_ms);
+    return poll_due(g, now_ms);
+}
+
+int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
+{
+    int r = enter(g);
+    return r != TASE_OK ? r : leave(g, service(g, now_ms));
 }

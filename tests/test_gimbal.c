@@ -1244,6 +1244,194 @@ static void init_refuses_both_forms_of_a_callback(void **state)
     free(fp);
 }
 
+/* ---- calls from inside the role's callbacks (REENTRANCY) ------------ */
+
+/* A gimbal whose every callback tries what gimbal.h says a callback must
+ * not call (STYLE 13: refused, nothing changed or written) and what it may. */
+typedef struct {
+    tase_gimbal_t g;
+    tase_rx_t rx[1];
+    fake_port_t port;
+    unsigned tries;   /* callbacks that tried */
+    unsigned refused; /* forbidden calls that were TASE_EBUSY with nothing changed */
+    int rc[7];        /* the last try's return of each forbidden call */
+    int port_rc;      /* tase_gimbal_frame_port() */
+    int get_rc;       /* tase_gimbal_setup_get() of PACKET_RATE */
+    int send_rc;      /* tase_gimbal_send() of an empty frame */
+} reenter_t;
+
+static tase_gimbal_t reenter_g_before;
+static tase_rx_t reenter_rx_before;
+
+static void reenter_try(reenter_t *r, uint32_t now)
+{
+    static const uint8_t rates[16] = {1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    uint8_t fr[TASE_FRAME_MAX];
+    uint8_t got[16];
+    tase_packet_msg_t msg;
+    tase_frame_t f;
+    size_t nout = r->port.nout;
+    size_t rin = r->port.rin;
+    int n = tase_frame_build(TASE_GROUP_SETUP, 0x00, rates, sizeof rates, fr, sizeof fr);
+    unsigned i;
+    assert_true(n > 0);
+    memset(&msg, 0, sizeof msg);
+    f.offset = 0;
+    f.group = TASE_GROUP_SETUP;
+    f.type = 0x00;
+    f.len = (uint8_t)sizeof rates;
+    f.data = rates;
+    r->tries++;
+    memcpy(&reenter_g_before, &r->g, sizeof r->g);
+    memcpy(&reenter_rx_before, &r->rx[0], sizeof r->rx[0]);
+    fake_push(&r->port, fr, (size_t)n); /* what a service() would read */
+    r->rc[0] = tase_gimbal_feed(&r->g, 0, fr, (size_t)n, now);
+    r->rc[1] = tase_gimbal_handle_frame(&r->g, 0, &f, now);
+    r->rc[2] = tase_gimbal_poll(&r->g, now + 60000u);
+    r->rc[3] = tase_gimbal_service(&r->g, now + 60000u);
+    r->rc[4] = tase_gimbal_setup_set(&r->g, 0x00, rates, sizeof rates, now);
+    r->rc[5] = tase_gimbal_setup_set_msg(&r->g, TASE_ID_PACKET_RATE, &msg, now);
+    r->rc[6] = tase_gimbal_set_capacity(&r->g, 0, 1u);
+    r->port.nin -= (size_t)n; /* unread: take it back */
+    for (i = 0; i < 7; i++) {
+        r->refused += r->rc[i] == TASE_EBUSY;
+    }
+    /* nothing changed, read or written by the refused calls */
+    if (memcmp(&reenter_g_before, &r->g, sizeof r->g) != 0 ||
+        memcmp(&reenter_rx_before, &r->rx[0], sizeof r->rx[0]) != 0 || r->port.nout != nout ||
+        r->port.rin != rin) {
+        r->refused = 0;
+    }
+    /* what a callback may call */
+    r->port_rc = tase_gimbal_frame_port(&r->g);
+    r->get_rc = tase_gimbal_setup_get(&r->g, 0x00, got, sizeof got);
+    r->send_rc = tase_gimbal_send(&r->g, 0, 0x7E, 0x01, NULL, 0);
+}
+
+static int reenter_apply(void *user, unsigned port, uint8_t type, uint8_t *data, size_t len)
+{
+    (void)port;
+    (void)type;
+    (void)data;
+    (void)len;
+    reenter_try(user, 1000u);
+    return 0;
+}
+
+static int reenter_fill(void *user, unsigned port, uint16_t id, uint8_t *data, size_t cap,
+                        uint32_t now)
+{
+    (void)port;
+    (void)data;
+    (void)cap;
+    reenter_try(user, now);
+    return (int)tase_schema_find(TASE_ID_GROUP(id), TASE_ID_TYPE(id))->len;
+}
+
+static void reenter_other(void *user, unsigned port, const tase_frame_t *f)
+{
+    (void)port;
+    (void)f;
+    reenter_try(user, 1000u);
+}
+
+/* One callback's tries: every forbidden call refused, nothing changed; the
+ * allowed ones worked (a frame port only while a frame is handled). */
+static void assert_reentry_refused(reenter_t *r, unsigned tries, int port_rc)
+{
+    unsigned i;
+    assert_int_equal(r->tries, tries);
+    for (i = 0; i < 7; i++) {
+        assert_int_equal(r->rc[i], TASE_EBUSY);
+    }
+    assert_int_equal(r->refused, 7u * tries);
+    assert_int_equal(r->port_rc, port_rc);
+    assert_int_equal(r->get_rc, 16);
+    assert_int_equal(r->send_rc, (int)TASE_FRAME_OVERHEAD); /* an empty frame */
+}
+
+static void callbacks_cannot_feed_poll_or_change_settings_of_their_gimbal(void **state)
+{
+    reenter_t *r = calloc(1, sizeof *r);
+    tase_port_t port;
+    tase_gimbal_app_t app;
+    static const uint8_t rates[16] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    uint8_t fr[TASE_FRAME_MAX];
+    tase_frame_t f;
+    int n;
+    (void)state;
+    assert_non_null(r);
+    memset(&port, 0, sizeof port);
+    port.ops = &fake_ops;
+    port.ctx = &r->port;
+    port.bytes_per_s = 100000u;
+    memset(&app, 0, sizeof app);
+    app.apply_setup = reenter_apply;
+    app.fill_telemetry = reenter_fill;
+    app.on_frame = reenter_other;
+    app.user = r;
+    assert_int_equal(tase_gimbal_init(&r->g, &port, r->rx, 1, &app, 0), TASE_OK);
+
+    /* apply_setup() inside tase_gimbal_feed(): the setting is applied and
+     * echoed after the callback, as if it had tried nothing */
+    n = tase_frame_build(TASE_GROUP_SETUP, 0x00, rates, sizeof rates, fr, sizeof fr);
+    assert_int_equal(tase_gimbal_feed(&r->g, 0, fr, (size_t)n, 1000u), 1);
+    assert_reentry_refused(r, 1, 0);
+    assert_int_equal(r->g.stats.setup_applied, 1);
+    assert_int_equal(r->g.capacity[0], 100000u);
+
+    /* on_frame() inside tase_gimbal_handle_frame() */
+    f.offset = 0;
+    f.group = 0x7E;
+    f.type = 0x02;
+    f.len = 0;
+    f.data = rates;
+    assert_int_equal(tase_gimbal_handle_frame(&r->g, 0, &f, 1000u), TASE_OK);
+    assert_reentry_refused(r, 2, 0);
+
+    /* apply_setup() inside tase_gimbal_service() (a read of the setup) */
+    fake_push(&r->port, fr, (size_t)n);
+    assert_true(tase_gimbal_service(&r->g, 1000u) >= 0);
+    assert_reentry_refused(r, 3, 0);
+    assert_int_equal(r->g.stats.setup_applied, 2);
+
+    /* fill_telemetry() inside tase_gimbal_poll(): no frame is being handled */
+    assert_int_equal(tase_gimbal_poll(&r->g, 2000u), 1);
+    assert_reentry_refused(r, 4, TASE_ESTATE);
+
+    /* outside the callbacks every call works again */
+    assert_int_equal(tase_gimbal_set_capacity(&r->g, 0, 5000u), TASE_OK);
+    assert_int_equal(tase_gimbal_setup_set(&r->g, 0x00, rates, sizeof rates, 2000u), TASE_OK);
+    assert_int_equal(tase_gimbal_poll(&r->g, 2500u), 0);
+    free(r);
+}
+
+/* A busy byte other than 0 or 1 is no callback in progress but a
+ * corrupted instance: TASE_EARG, nothing changed (not TASE_EBUSY, which a
+ * caller would retry for ever). */
+static void a_corrupted_busy_byte_is_earg_not_ebusy(void **state)
+{
+    fix_t *x = make(0, 1, true);
+    static tase_gimbal_t before;
+    static const uint8_t rates[16] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    tase_packet_msg_t msg;
+    tase_frame_t f = {0, 0x7E, 0x02, 0, rates};
+    (void)state;
+    memset(&msg, 0, sizeof msg);
+    x->g.busy = 2u;
+    memcpy(&before, &x->g, sizeof before);
+    assert_int_equal(tase_gimbal_feed(&x->g, 0, rates, 0, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_handle_frame(&x->g, 0, &f, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_poll(&x->g, 5000u), TASE_EARG);
+    assert_int_equal(tase_gimbal_service(&x->g, 5000u), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_set(&x->g, 0x00, rates, sizeof rates, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_setup_set_msg(&x->g, TASE_ID_PACKET_RATE, &msg, 0), TASE_EARG);
+    assert_int_equal(tase_gimbal_set_capacity(&x->g, 0, 1u), TASE_EARG);
+    assert_memory_equal(&x->g, &before, sizeof before);
+    assert_int_equal(x->port[0].nout, 0);
+    free(x);
+}
+
 /* ---- priority, capacity and blocking ----------------------------------- */
 
 /* A serial line on a fake microsecond clock: `bps` bytes per second leave
@@ -2236,6 +2424,8 @@ int main(void)
         cmocka_unit_test(every_function_rejects_null_and_out_of_range_arguments),
         cmocka_unit_test(frames_from_absent_ports_and_without_callbacks_are_only_counted),
         cmocka_unit_test(a_feed_into_a_corrupted_receiver_changes_nothing),
+        cmocka_unit_test(callbacks_cannot_feed_poll_or_change_settings_of_their_gimbal),
+        cmocka_unit_test(a_corrupted_busy_byte_is_earg_not_ebusy),
         cmocka_unit_test(service_reads_every_port_feeds_it_and_polls),
         cmocka_unit_test(noise_before_a_command_delays_it_only_up_to_the_quiet_limit),
         cmocka_unit_test(typed_telemetry_is_encoded_from_the_filled_structs),

@@ -164,9 +164,16 @@
  *
  * REENTRANCY. Not reentrant per instance, not ISR-safe: call everything
  * from one context (the main loop draining the UART rings). Callbacks run
- * inside tase_gimbal_feed()/_handle_frame()/_poll(); they may call
- * tase_gimbal_send(), tase_gimbal_send_msg(), tase_gimbal_setup_get() and
- * tase_gimbal_frame_port(), nothing else of the same instance.
+ * inside tase_gimbal_feed()/_handle_frame()/_poll()/_service(); they may
+ * call tase_gimbal_send(), _send_msg(), _setup_get(), _setup_get_msg(),
+ * _setup_len() and _frame_port(), nothing else of the same instance. The
+ * calls that change its state are refused there with TASE_EBUSY, nothing
+ * changed or written: _feed(), _handle_frame(), _poll(), _service(),
+ * _setup_set(), _setup_set_msg() and _set_capacity() (a feed from a
+ * callback moved the outer feed's place in its bytes, a setup_set() from
+ * fill_telemetry() rewrote the frame being built). tase_gimbal_init() is
+ * not refused (it cannot tell an instance from uninitialised memory): do
+ * not call it from a callback.
  */
 #ifndef TASE_GIMBAL_H
 #define TASE_GIMBAL_H
@@ -272,6 +279,9 @@ typedef struct {
     tase_port_t port[TASE_GIMBAL_PORTS]; /* ops NULL: port absent */
     tase_rx_t *rx;                       /* caller's receivers, or NULL */
     uint8_t nrx;                         /* how many */
+    /* 1 while tase_gimbal_feed(), _handle_frame(), _poll() or _service()
+     * runs (and so its callbacks): see REENTRANCY */
+    uint8_t busy;
     tase_gimbal_sched_t sched[TASE_GIMBAL_PORTS][TASE_GIMBAL_STREAMS];
     uint32_t capacity[TASE_GIMBAL_PORTS]; /* bytes/s */
     uint32_t demand[TASE_GIMBAL_PORTS];   /* telemetry bytes/s the rates ask */
@@ -320,15 +330,17 @@ int tase_gimbal_init(tase_gimbal_t *g, const tase_port_t *ports, tase_rx_t *rx, 
  * on_frame.
  * Returns frames received (>= 0), TASE_EARG (g NULL, port >= nports,
  * bytes NULL with n > 0, or that port's receiver visibly corrupted, as
- * tase_rx_feed() says; g and the receivers unchanged) or TASE_ESTATE
+ * tase_rx_feed() says; g and the receivers unchanged), TASE_EBUSY (from a
+ * callback of this instance: REENTRANCY; nothing changed) or TASE_ESTATE
  * (initialised without receivers).
  * Worst case O(n * TASE_FRAME_MAX). */
 int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
                      uint32_t now_ms);
 
 /* Hand over one frame received on `port` some other way (e.g. CAN
- * reassembly). Returns TASE_OK or TASE_EARG (g, frame or frame->data
- * NULL, port >= 3; nothing counted). A setup frame for an absent port (no
+ * reassembly). Returns TASE_OK, TASE_EARG (g, frame or frame->data
+ * NULL, port >= 3; nothing counted) or TASE_EBUSY (from a callback of this
+ * instance; nothing counted or written). A setup frame for an absent port (no
  * ops: nothing could answer it) is counted in stats.frames_rx only:
  * neither applied nor answered, whatever its length (no bad_length). O(len). */
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
@@ -343,14 +355,15 @@ int tase_gimbal_frame_port(const tase_gimbal_t *g);
  * TASE_UART_BYTES_PER_S(9600) for a 9600-baud line; 0 goes back to the
  * default (the port's bytes_per_s, or 960 when it states none); UINT32_MAX
  * is no limit in practice. See PRIORITY AND CAPACITY. Takes effect at the
- * next due slot. Returns TASE_OK or TASE_EARG (g NULL, port >= 3).
- * O(1). */
+ * next due slot. Returns TASE_OK, TASE_EARG (g NULL, port >= 3) or
+ * TASE_EBUSY (from a callback of this instance; nothing changed). O(1). */
 int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per_s);
 
 /* Send every telemetry packet that is due at now_ms (at most one per
  * stream, see SCHEDULE; within the port's capacity, see PRIORITY AND
- * CAPACITY). Returns the number of frames written (>= 0) or TASE_EARG (g
- * NULL). Blocks at most one frame bound per frame written plus one per
+ * CAPACITY). Returns the number of frames written (>= 0), TASE_EARG (g
+ * NULL) or TASE_EBUSY (from a callback of this instance; nothing sent).
+ * Blocks at most one frame bound per frame written plus one per
  * present port (LONGEST BLOCK).
  * O(ports * streams) plus the callbacks and writes. */
 int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
@@ -358,7 +371,8 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
 /* Read whatever each present port has ready (timeout 0, ports with a
  * read function), feed it (a read that finds nothing ticks the port's
  * receiver: NOISE above), then tase_gimbal_poll(). Returns the poll
- * result, TASE_EARG (g NULL), or TASE_ESTATE when a port has a read function but
+ * result, TASE_EARG (g NULL), TASE_EBUSY (from a callback of this
+ * instance; nothing read), or TASE_ESTATE when a port has a read function but
  * the gimbal was initialised without receivers. A port read error is
  * skipped (the port may
  * recover), counted nowhere else: check the port; so is a read() that
@@ -402,15 +416,16 @@ int tase_gimbal_setup_get(const tase_gimbal_t *g, uint8_t type, uint8_t *out, si
  * not change" value keeps the stored setting. A PACKET_RATE change
  * reschedules as described above, anchored at now_ms. Returns TASE_OK,
  * TASE_EARG (g NULL, data NULL), TASE_EUNKNOWN (type > 7), TASE_ELENGTH
- * (len is not the type's length, 0 and SIZE_MAX included); g unchanged on
- * error. O(len). */
+ * (len is not the type's length, 0 and SIZE_MAX included), TASE_EBUSY
+ * (from a callback of this instance); g unchanged on error. O(len). */
 int tase_gimbal_setup_set(tase_gimbal_t *g, uint8_t type, const uint8_t *data, size_t len,
                           uint32_t now_ms);
 
 /* tase_gimbal_setup_set() from the typed struct of setup packet `id`
  * (TASE_ID_PACKET_RATE .. TASE_ID_CAMERA_ALIGN; reserved bytes stored as
  * zero). Returns TASE_OK, TASE_EARG (g or msg NULL), TASE_EUNKNOWN (id
- * is not a setup packet); g unchanged on error. O(length). */
+ * is not a setup packet), TASE_EBUSY (from a callback of this instance);
+ * g unchanged on error. O(length). */
 int tase_gimbal_setup_set_msg(tase_gimbal_t *g, uint16_t id, const void *msg, uint32_t now_ms);
 
 /* The stored setting of setup packet `id` decoded into its struct msg.
