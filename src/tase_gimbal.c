@@ -747,12 +747,20 @@ static int service(tase_gimbal_t *g, uint32_t now_ms)
     unsigned p;
     unsigned i;
 
+    /* Nothing is read before every port it would read has a receiver that
+     * takes the bytes: none at all (TASE_ESTATE), or one its feed would
+     * refuse, visibly corrupted (TASE_EARG): the bytes read were lost. */
+    for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
+        if (port_present(g, p) && g->port[p].ops->read != NULL) {
+            int r = g->rx == NULL ? TASE_ESTATE : tase_rx_state_check(&g->rx[p]);
+            if (r != TASE_OK) {
+                return r;
+            }
+        }
+    }
     for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
         if (!port_present(g, p) || g->port[p].ops->read == NULL) {
             continue;
-        }
-        if (g->rx == NULL) {
-            return TASE_ESTATE; /* nowhere to feed what it would read */
         }
         for (i = 0; i < TASE_GIMBAL_SERVICE_READS; i++) {
             int n = g->port[p].ops->read(g->port[p].ctx, buf, sizeof buf, 0);

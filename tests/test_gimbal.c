@@ -1012,6 +1012,30 @@ static void a_feed_into_a_corrupted_receiver_changes_nothing(void **state)
     assert_int_equal(fp.nout, 0);
 }
 
+/* tase_gimbal_service() reads a port only to feed its receiver: with one
+ * receiver visibly corrupted it reads nothing on any port (the bytes
+ * would be lost: the feed refuses them) and says so. */
+static void service_with_a_corrupted_receiver_reads_nothing(void **state)
+{
+    fix_t *x = make(0, 2, true);
+    static tase_gimbal_t copy;
+    const uint8_t query[8] = {0x00, 0xFF, 0x5A, 0x02, 0x48, 0x00, 0x01, 0xA3};
+    (void)state;
+    fake_push(&x->port[0], query, sizeof query);
+    fake_push(&x->port[1], query, sizeof query);
+    x->rx[1].len = 0xFFFFu;
+    memcpy(&copy, &x->g, sizeof copy);
+    assert_int_equal(tase_gimbal_service(&x->g, 5000u), TASE_EARG);
+    assert_memory_equal(&x->g, &copy, sizeof copy);
+    assert_int_equal(x->port[0].rin, 0);
+    assert_int_equal(x->port[1].rin, 0);
+    assert_int_equal(x->port[0].nout + x->port[1].nout, 0); /* no telemetry either */
+    x->rx[1].len = 0u; /* repaired (an empty window): both queries answered */
+    assert_true(tase_gimbal_service(&x->g, 5000u) >= 0);
+    assert_int_equal(x->g.stats.setup_queries, 2);
+    free(x);
+}
+
 /* ---- typed API ------------------------------------------------------- */
 
 typedef struct {
@@ -2424,6 +2448,7 @@ int main(void)
         cmocka_unit_test(every_function_rejects_null_and_out_of_range_arguments),
         cmocka_unit_test(frames_from_absent_ports_and_without_callbacks_are_only_counted),
         cmocka_unit_test(a_feed_into_a_corrupted_receiver_changes_nothing),
+        cmocka_unit_test(service_with_a_corrupted_receiver_reads_nothing),
         cmocka_unit_test(callbacks_cannot_feed_poll_or_change_settings_of_their_gimbal),
         cmocka_unit_test(a_corrupted_busy_byte_is_earg_not_ebusy),
         cmocka_unit_test(service_reads_every_port_feeds_it_and_polls),

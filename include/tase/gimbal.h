@@ -371,9 +371,11 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms);
 /* Read whatever each present port has ready (timeout 0, ports with a
  * read function), feed it (a read that finds nothing ticks the port's
  * receiver: NOISE above), then tase_gimbal_poll(). Returns the poll
- * result, TASE_EARG (g NULL), TASE_EBUSY (from a callback of this
- * instance; nothing read), or TASE_ESTATE when a port has a read function but
- * the gimbal was initialised without receivers. A port read error is
+ * result, TASE_EARG (g NULL, or the receiver of a port it would read
+ * visibly corrupted, as tase_rx_feed() says), TASE_EBUSY (from a callback
+ * of this instance), or TASE_ESTATE when a port has a read function but
+ * the gimbal was initialised without receivers; on an error nothing is
+ * read on any port and nothing sent. A port read error is
  * skipped (the port may
  * recover), counted nowhere else: check the port; so is a read() that
  * claims more bytes than asked (none of them is fed). Stack: a 64-byte
