@@ -42,6 +42,21 @@ typedef struct {
     unsigned rx_busy; /* callbacks that ran inside a receiver call */
 } fix_t;
 
+/* Whether two gimbals hold the same state, byte for byte, except the
+ * padding of `pending`: the role copies the receiver's frame struct there
+ * (tase_frame_t on the receiver's stack), whose padding nobody writes, so
+ * memcheck calls comparing it a use of uninitialised memory. */
+static int gimbal_same(const tase_gimbal_t *a, const tase_gimbal_t *b)
+{
+    size_t at = offsetof(tase_gimbal_t, pending);
+    size_t after = at + sizeof a->pending;
+    return memcmp(a, b, at) == 0 &&
+           memcmp((const uint8_t *)a + after, (const uint8_t *)b + after, sizeof *a - after) == 0 &&
+           a->pending.offset == b->pending.offset && a->pending.group == b->pending.group &&
+           a->pending.type == b->pending.type && a->pending.len == b->pending.len &&
+           a->pending.data == b->pending.data;
+}
+
 static unsigned stream_of(uint16_t id)
 {
     if (id == TASE_ID_GIMBAL_ANGLE) {
@@ -1007,7 +1022,7 @@ static void a_feed_into_a_corrupted_receiver_changes_nothing(void **state)
     fp.nout = 0;
     assert_int_equal(tase_gimbal_feed(&g, 0, query, sizeof query, 1), TASE_EARG);
     assert_int_equal(tase_gimbal_feed(&g, 0, NULL, 0, 1), TASE_EARG);
-    assert_memory_equal(&g, &copy, sizeof g);
+    assert_true(gimbal_same(&g, &copy));
     assert_memory_equal(rx, rx_copy, sizeof rx);
     assert_int_equal(fp.nout, 0);
 }
@@ -1026,7 +1041,7 @@ static void service_with_a_corrupted_receiver_reads_nothing(void **state)
     x->rx[1].len = 0xFFFFu;
     memcpy(&copy, &x->g, sizeof copy);
     assert_int_equal(tase_gimbal_service(&x->g, 5000u), TASE_EARG);
-    assert_memory_equal(&x->g, &copy, sizeof copy);
+    assert_true(gimbal_same(&x->g, &copy));
     assert_int_equal(x->port[0].rin, 0);
     assert_int_equal(x->port[1].rin, 0);
     assert_int_equal(x->port[0].nout + x->port[1].nout, 0); /* no telemetry either */
@@ -1321,7 +1336,7 @@ static void reenter_try(reenter_t *r, uint32_t now)
         r->refused += r->rc[i] == TASE_EBUSY;
     }
     /* nothing changed, read or written by the refused calls */
-    if (memcmp(&reenter_g_before, &r->g, sizeof r->g) != 0 ||
+    if (!gimbal_same(&reenter_g_before, &r->g) ||
         memcmp(&reenter_rx_before, &r->rx[0], sizeof r->rx[0]) != 0 || r->port.nout != nout ||
         r->port.rin != rin) {
         r->refused = 0;

@@ -38,6 +38,7 @@ static int setup(void **state)
     fix_t *x = calloc(1, sizeof *x);
     tase_port_t p;
     assert_non_null(x);
+    memset(&p, 0, sizeof p); /* its padding too: tests compare the host's bytes */
     p.ops = &fake_ops;
     p.ctx = &x->port;
     p.bytes_per_s = TASE_UART_BYTES_PER_S(57600);
@@ -1939,10 +1940,14 @@ static void refeed(void *user, const tase_frame_t *f)
 static void a_refused_feed_leaves_the_host_as_it_was(void **state)
 {
     fix_t *x = *state;
-    tase_port_t p = {&fake_ops, &x->port, 0};
+    tase_port_t p;
     const uint8_t angle[6] = {0, 1, 0, 2, 0, 3};
     tase_host_t copy;
     refeed_t r = {NULL, 0, 0};
+
+    memset(&p, 0, sizeof p); /* its padding too: the host's bytes are compared */
+    p.ops = &fake_ops;
+    p.ctx = &x->port;
 
     memcpy(&copy, &x->host, sizeof copy);
     assert_int_equal(tase_host_feed(&x->host, NULL, 5, 7777u), TASE_EARG);
