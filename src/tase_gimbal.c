@@ -58,7 +58,6 @@ static bool port_present(const tase_gimbal_t *g, unsigned port)
     return port < TASE_GIMBAL_PORTS && g->port[port].ops != NULL;
 }
 
-/* Anchor a stream at `now`: its first packet one period later. */
 /* TASE_OK when g may start a call that changes its state: not from inside
  * one of its callbacks (busy 1: TASE_EBUSY; gimbal.h REENTRANCY), and a
  * busy byte other than 0 and 1 is a corrupted instance (TASE_EARG). */
@@ -70,28 +69,7 @@ static int idle(const tase_gimbal_t *g)
     return g->busy == 1u ? TASE_EBUSY : TASE_EARG;
 }
 
-/* Start a call that runs the application's callbacks (feed, handle_frame,
- * poll, service): g marked busy and TASE_OK, or the call refused with
- * TASE_EARG (g NULL) or idle()'s error. leave() ends it with result r. */
-static int enter(tase_gimbal_t *g)
-{
-    int r;
-    if (g == NULL) {
-        return TASE_EARG;
-    }
-    r = idle(g);
-    if (r == TASE_OK) {
-        g->busy = 1u;
-    }
-    return r;
-}
-
-static int leave(tase_gimbal_t *g, int r)
-{
-    g->busy = 0u;
-    return r;
-}
-
+/* Anchor a stream at `now`: its first packet one period later. */
 static void sched_start(tase_gimbal_sched_t *s, uint8_t rate, uint32_t now_ms)
 {
     s->rate = rate;
@@ -525,12 +503,14 @@ int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t
     if (g == NULL || frame == NULL || frame->data == NULL || port >= TASE_GIMBAL_PORTS) {
         return TASE_EARG;
     }
-    r = enter(g);
+    r = idle(g);
     if (r != TASE_OK) {
         return r;
     }
+    g->busy = 1u; /* until its callbacks have returned */
     handle_and_echo(g, port, frame, now_ms);
-    return leave(g, TASE_OK);
+    g->busy = 0u;
+    return TASE_OK;
 }
 
 int tase_gimbal_frame_port(const tase_gimbal_t *g)
@@ -551,14 +531,20 @@ static void gimbal_rx(void *user, const tase_frame_t *frame)
     (void)tase_rx_stop(&g->rx[g->feed_port]);
 }
 
-/* tase_gimbal_feed() once g is known and marked busy. */
-static int feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n, uint32_t now_ms)
+int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
+                     uint32_t now_ms)
 {
     tase_rx_t *rx;
     size_t done = 0;
     int frames = 0;
     bool tick = false;
     bool stopped = false;
+    if (g == NULL) {
+        return TASE_EARG;
+    }
+    if (idle(g) != TASE_OK) {
+        return idle(g);
+    }
     if (g->rx == NULL) {
         return TASE_ESTATE;
     }
@@ -574,6 +560,7 @@ static int feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
         }
     }
     g->feed_port = (uint8_t)port;
+    g->busy = 1u; /* until the last frame's callbacks have returned */
     /* Each frame ends the receiver's call (gimbal_rx()) and is handled
      * here, between calls; after it a 0-byte call goes on with the scan
      * (frame.h, tase_rx_stop()). The first call takes no byte when n is
@@ -590,7 +577,8 @@ static int feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
             r = tase_rx_feed(rx, k > 0u ? &bytes[done] : NULL, k, gimbal_rx, g);
         }
         if (r < 0) {
-            return r;
+            frames = r; /* only after a callback damaged the receiver */
+            break;
         }
         frames += r;
         done += (size_t)(rx->stats.bytes_in - in);
@@ -598,20 +586,15 @@ static int feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
         if (stopped) {
             handle_and_echo(g, port, &g->pending, now_ms);
         } else if (tick) {
-            return frames;
+            break;
         } else if (done == n) {
             tick = true;
         } else {
             /* more bytes to feed */
         }
     }
-}
-
-int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size_t n,
-                     uint32_t now_ms)
-{
-    int r = enter(g);
-    return r != TASE_OK ? r : leave(g, feed(g, port, bytes, n, now_ms));
+    g->busy = 0u;
+    return frames;
 }
 
 /* Move a stream to the first slot strictly after now_ms (a late poll
@@ -712,16 +695,22 @@ static int stream_poll(tase_gimbal_t *g, unsigned port, unsigned stream, uint32_
     return sent;
 }
 
-/* tase_gimbal_poll() once g is known and marked busy. */
-static int poll_due(tase_gimbal_t *g, uint32_t now_ms)
+int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
 {
     unsigned p;
     unsigned s;
     int sent = 0;
 
+    if (g == NULL) {
+        return TASE_EARG;
+    }
+    if (idle(g) != TASE_OK) {
+        return idle(g);
+    }
     if (g->app.fill_telemetry == NULL && g->app.fill_telemetry_msg == NULL) {
         return 0;
     }
+    g->busy = 1u; /* until the last callback has returned */
     for (p = 0; p < TASE_GIMBAL_PORTS; p++) {
         bool failed = false;
         if (!port_present(g, p)) {
@@ -731,22 +720,24 @@ static int poll_due(tase_gimbal_t *g, uint32_t now_ms)
             sent += stream_poll(g, p, s, now_ms, &failed);
         }
     }
+    g->busy = 0u;
     return sent;
 }
 
-int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
-{
-    int r = enter(g);
-    return r != TASE_OK ? r : leave(g, poll_due(g, now_ms));
-}
-
-/* tase_gimbal_service() once g is known and marked busy. */
-static int service(tase_gimbal_t *g, uint32_t now_ms)
+int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
 {
     uint8_t buf[SERVICE_CHUNK];
     unsigned p;
     unsigned i;
 
+    if (g == NULL) {
+        return TASE_EARG;
+    }
+    /* From a callback (busy): refused here, not only by the feeds below,
+     * which would have read the bytes first */
+    if (idle(g) != TASE_OK) {
+        return idle(g);
+    }
     /* Nothing is read before every port it would read has a receiver that
      * takes the bytes: none at all (TASE_ESTATE), or one its feed would
      * refuse, visibly corrupted (TASE_EARG): the bytes read were lost. */
@@ -769,17 +760,11 @@ static int service(tase_gimbal_t *g, uint32_t now_ms)
                 break;
             }
             /* n == 0: nothing waiting, the receiver's time bound hears it */
-            (void)feed(g, p, buf, (size_t)n, now_ms);
+            (void)tase_gimbal_feed(g, p, buf, (size_t)n, now_ms);
             if (n == 0) {
                 break;
             }
         }
     }
-    return poll_due(g, now_ms);
-}
-
-int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
-{
-    int r = enter(g);
-    return r != TASE_OK ? r : leave(g, service(g, now_ms));
+    return tase_gimbal_poll(g, now_ms);
 }
