@@ -731,7 +731,7 @@ static ssize_t head_read(void *cookie, char *buf, size_t size)
     }
     for (;;) {
         ssize_t got = read(h->fd, buf, size);
-        if (got >= 0 || errno == EIO) { /* EIO: a pty whose writer went away */
+        if (got >= 0 || (errno == EIO && tk_read_eio_is_end(h->fd))) {
             return got < 0 ? 0 : got;
         }
         if (errno != EINTR || tk_signal != 0) {

@@ -262,6 +262,15 @@ void tk_stdout_flush(void)
     }
 }
 
+bool tk_read_eio_is_end(int fd)
+{
+    struct stat st;
+    int e = errno;
+    bool end = fstat(fd, &st) == 0 && S_ISCHR(st.st_mode);
+    errno = e; /* the caller reports the read's error */
+    return end;
+}
+
 void tk_exit_broken_pipe(void)
 {
     /* quietly, as SIGPIPE would, but through the path that closes the

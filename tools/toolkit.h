@@ -139,6 +139,10 @@ void tk_release_fatal_signals(const sigset_t *old);
  * its log into the first file it opened (tase-sim: the lock file of its
  * link, which then named no simulator). */
 void tk_std_fds_open(void);
+/* Whether a read() of fd that failed with EIO is the end of the input:
+ * for a terminal (a pty whose other side went away), and for nothing
+ * else (a disk's read error would pass a file cut short for complete). */
+bool tk_read_eio_is_end(int fd);
 /* If a signal was caught: run the cleanup the caller did (nothing here)
  * and exit 128 + signal with "interrupted by SIGxxx". */
 void tk_exit_if_signalled(void);

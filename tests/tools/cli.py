@@ -417,6 +417,49 @@ for args in (["decode", noisy], ["list"], ["--help"], ["klv", os.path.join(os.pa
     ok("tase %s > /dev/full fails with a message" % args[0],
        rc == 1 and "cannot write to standard output" in err, "exit %d %s" % (rc, err))
 
+# an environment review: a read error of the input (EIO of a failing disk,
+# here /proc/self/mem, whose first page is not mapped) was taken for the end
+# of the input, so decode printed what it had and exited 0; EIO is the end
+# only for a terminal (a pty whose other side went away)
+if os.path.exists("/proc/self/mem"):
+    for args in (["decode", "/proc/self/mem"], ["klv", "/proc/self/mem"],
+                 ["replay", "/proc/self/mem", "--serial", "/dev/null", "--dir", "in"]):
+        expect("tase %s of a file that fails with EIO: exit 1, the error said" % args[0], args, 1,
+               r"^tase: cannot read /proc/self/mem: Input/output error$")
+    with open("/proc/self/mem", "rb") as mem:
+        p = subprocess.run(VG + [TASE, "decode"], stdin=mem, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, timeout=30)
+    ok("tase decode of a standard input that fails with EIO: exit 1, the error said",
+       p.returncode == 1 and p.stderr == b"tase: cannot read standard input: Input/output error\n",
+       "exit %d %r" % (p.returncode, p.stderr))
+
+    # and a capture whose read fails after its third record (the bytes at
+    # the end of a page of ours, the next page unmapped, read through
+    # /proc/self/mem): decoded up to there, then the error, exit 1 (it was
+    # a complete capture, exit 0)
+    import ctypes
+    import mmap
+    import struct
+    cap = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 147)
+    for i in range(3):
+        d = b"\x00" + angle(i, -i)
+        cap += struct.pack("<IIII", 1700000000 + i, 0, len(d), len(d)) + d
+    page = mmap.PAGESIZE
+    area = mmap.mmap(-1, 2 * page)
+    addr = ctypes.addressof(ctypes.c_char.from_buffer(area))
+    area[page - len(cap):page] = cap
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.munmap.argtypes = [ctypes.c_void_p, ctypes.c_size_t]
+    if libc.munmap(addr + page, page) == 0:
+        with open("/proc/self/mem", "rb", buffering=0) as mem:
+            mem.seek(addr + page - len(cap))
+            p = subprocess.run(VG + [TASE, "decode"], stdin=mem, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, timeout=30)
+        ok("tase decode of a capture whose read fails after record 3: the 3, then exit 1",
+           p.returncode == 1 and p.stdout.decode().count("GIMBAL_ANGLE") == 3 and
+           p.stderr == b"tase: standard input: after record 3: error reading dump file: "
+           b"Input/output error\n", "exit %d %r %r" % (p.returncode, p.stdout, p.stderr))
+
 # a review: tase-sim's log into /dev/full was lost without a word (exit 0).
 # It says so at once on stderr and exits 1 at the end (that it goes on
 # serving its link meanwhile: e2e.sh).
