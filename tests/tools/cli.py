@@ -249,6 +249,13 @@ expect("--timeout given twice (as --timeout=N) is refused",
 expect("record -o and --output together are refused",
        ["record", "--serial", "/a", "-o", "x.pcap", "--output", "y.pcap"], 2,
        "option -o/--output given twice")
+# an environment review: an empty -o was taken, the whole session recorded
+# into ".partial-PID" in the current directory, then "cannot write capture :
+# No such file or directory" (exit 1) at the end; --record "" was refused
+for o in (["-o", ""], ["--output="]):
+    expect("record %s: the value is missing (as --record '')" % " ".join(repr(x) for x in o),
+           ["record", "--serial", "/dev/null"] + o + ["--seconds", "1"], 2,
+           r"^tase: option -o/--output needs a value$")
 expect("camera --hfov followed by an option: the value is missing",
        ["camera", "--hfov", "--serial", "/dev/ttyUSB9"], 2, "option --hfov needs a value")
 expect("a negative number is still a value", ["camera", "--hfov", "-5"] + L, 2,

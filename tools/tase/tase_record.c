@@ -22,6 +22,9 @@ int cli_cmd_record(cli_args_t *a)
             if (out != NULL) {
                 tk_usage_error("option -o/--output given twice");
             }
+            if (v[0] == '\0') { /* was recorded into ".partial-PID", then refused */
+                tk_usage_error("option -o/--output needs a value");
+            }
             out = v;
             continue;
         }
