@@ -398,8 +398,11 @@ void tk_std_fds_open(void)
     int fd;
     for (fd = 0; fd <= 2; fd++) {
         if (fcntl(fd, F_GETFD) == -1 && errno == EBADF) {
-            /* the lowest free descriptor: this one */
-            if (open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY) != fd) {
+            /* the lowest free descriptor: this one, opened the other way,
+             * so that a read of standard input, a write to standard output
+             * or error fails (EBADF) as on the closed descriptor and never
+             * passes for success (output lost with exit 0) */
+            if (open("/dev/null", fd == 0 ? O_WRONLY : O_RDONLY) != fd) {
                 _exit(TK_EXIT_FAIL); /* nothing to say it on */
             }
         }

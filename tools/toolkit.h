@@ -137,7 +137,9 @@ void tk_release_fatal_signals(const sigset_t *old);
 /* Open /dev/null on whichever of descriptors 0, 1 and 2 is closed (first
  * thing in main): a program started with its standard output closed wrote
  * its log into the first file it opened (tase-sim: the lock file of its
- * link, which then named no simulator). */
+ * link, which then named no simulator). It is opened the other way (0 for
+ * writing, 1 and 2 for reading), so that using the descriptor fails with
+ * EBADF as on the closed one: output is never lost with success. */
 void tk_std_fds_open(void);
 /* Whether a read() of fd that failed with EIO is the end of the input:
  * for a terminal (a pty whose other side went away), and for nothing

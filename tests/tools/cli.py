@@ -467,6 +467,33 @@ if os.path.exists("/proc/self/mem"):
            p.stderr == b"tase: standard input: after record 3: error reading dump file: "
            b"Input/output error\n", "exit %d %r %r" % (p.returncode, p.stdout, p.stderr))
 
+# an environment review: a closed standard output was opened on /dev/null
+# (so that no device or file took descriptor 1), which made every write
+# succeed: `tase decode FILE >&-` exited 0 with its output lost, and a closed
+# standard input read as empty. The descriptor is still held, but opened
+# the other way, so a write (a read of stdin) fails as on the closed one.
+def closed(args, fd, stdin=b""):
+    p = subprocess.run(VG + ([TASE] + args if args[0] != SIM else args), input=stdin,
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=30,
+                       preexec_fn=lambda: os.close(fd))
+    return p.returncode, p.stderr.decode(errors="replace")
+
+
+for args in (["decode", noisy], ["list"]):
+    rc, err = closed(args, 1)
+    ok("tase %s >&-: exit 1, cannot write to standard output" % args[0],
+       rc == 1 and err == "tase: cannot write to standard output: Bad file descriptor\n",
+       "exit %d %r" % (rc, err))
+rc, err = closed(["decode"], 0)
+ok("tase decode <&-: exit 1, cannot read standard input", rc == 1 and
+   err == "tase: cannot read standard input: Bad file descriptor\n", "exit %d %r" % (rc, err))
+rc, err = closed([SIM, "--seconds", "0.3", "--quiet"], 1)
+ok("tase-sim --quiet >&-: exit 1, the startup line said lost", rc == 1 and
+   "tase-sim: cannot write the log to standard output: Bad file descriptor" in err,
+   "exit %d %r" % (rc, err))
+rc, err = closed(["decode", "/nonexistent/x"], 2)
+ok("tase 2>&-: the status still says it", rc == 1, "exit %d %r" % (rc, err))
+
 # a review: tase-sim's log into /dev/full was lost without a word (exit 0).
 # It says so at once on stderr and exits 1 at the end (that it goes on
 # serving its link meanwhile: e2e.sh).
