@@ -573,6 +573,36 @@ if not VALGRIND:
     os.close(sm)
     os.close(ss)
 
+# an environment review: `record --serial DEV -o DEV` (or `-o -` with the
+# output on DEV) wrote the capture into the line it recorded, so the
+# gimbal got its own packets back, echoes of RETRACT_DEPLOY_CMD, SPOI_CMD
+# and setup packets included, which it takes as commands: refused, nothing
+# written
+# (`-o -` on a terminal was refused already: a capture is binary)
+ptys_ = [os.openpty() for _ in range(2)]
+for pm_, ps_ in ptys_:
+    tty.setraw(pm_)
+    tty.setraw(ps_)
+    os.set_blocking(pm_, False)
+name_, tap_ = (os.ttyname(ps_) for _, ps_ in ptys_)
+for o_ in (["-o", name_], ["-o", "/dev/./" + name_[5:]], ["--tap-in", tap_, "-o", tap_]):
+    p = subprocess.run(VG + [TASE, "record", "--serial", name_, "--seconds", "0.3"] + o_,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, timeout=30)
+    wrote = b""
+    for pm_, _ in ptys_:
+        try:
+            wrote += os.read(pm_, 4096)
+        except BlockingIOError:
+            pass
+    ok("record %s onto a recorded line: refused (exit 2), nothing written to it" % " ".join(o_),
+       p.returncode == 2 and wrote == b"" and
+       re.match(r"tase: -o .* is a serial device being recorded \(.*\): the capture would "
+                r"go to the gimbal's line; write it to a file\n$", p.stderr.decode()) is not None,
+       "exit %d, %d bytes written, %r" % (p.returncode, len(wrote), p.stderr))
+for pm_, ps_ in ptys_:
+    os.close(pm_)
+    os.close(ps_)
+
 # ---- live input is read as it arrives ----
 def live(args, data, what):
     fifo = os.path.join(TMP, "fifo-" + what)
