@@ -603,6 +603,38 @@ for pm_, ps_ in ptys_:
     os.close(pm_)
     os.close(ps_)
 
+# an environment review: the stale link of a killed tase-sim (here made by
+# hand: a symlink to a pty, and a lock file naming that pty that nobody
+# holds) was refused by its path, but not by a path near PATH_MAX to it
+# ("/./././...": LINK.lock was too long to form, and the check was
+# skipped), nor through a user's relative symlink whose joined path was too
+# long: the other program's pty got the GIMBAL_CMD
+sd_ = os.path.join(TMP, "stale-dir")
+os.mkdir(sd_)
+pm_, ps_ = os.openpty()
+tty.setraw(pm_)
+os.set_blocking(pm_, False)
+os.symlink(os.ttyname(ps_), os.path.join(sd_, "stale"))
+with open(os.path.join(sd_, "stale.lock"), "w") as f:
+    f.write("tase-sim 999999 %s\n" % os.ttyname(ps_))
+os.symlink("./" * 40 + "stale", os.path.join(sd_, "user"))
+for what_, n_ in (("stale", 4090), ("stale", 4091), ("stale", 4095), ("user", 4080)):
+    k_ = n_ - len(sd_) - len(what_) - 1
+    path_ = sd_ + "/." * (k_ // 2) + ("/" if k_ % 2 else "") + "/" + what_
+    p = subprocess.run(VG + [TASE, "point", "1", "1", "--serial", path_], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, timeout=30)
+    try:
+        wrote = os.read(pm_, 4096)
+    except BlockingIOError:
+        wrote = b""
+    ok("a stale tase-sim link by a %d-character path%s: refused, nothing written" %
+       (len(path_), " through a user's relative symlink" if what_ == "user" else ""),
+       p.returncode == 1 and wrote == b"" and b"is the link of a tase-sim that is no longer running"
+       in p.stderr and b"not opened, nothing sent" in p.stderr,
+       "exit %d, %d bytes written, %r" % (p.returncode, len(wrote), p.stderr[-200:]))
+os.close(pm_)
+os.close(ps_)
+
 # ---- live input is read as it arrives ----
 def live(args, data, what):
     fifo = os.path.join(TMP, "fifo-" + what)
