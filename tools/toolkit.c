@@ -412,6 +412,10 @@ void tk_std_fds_open(void)
 void tk_catch_signals(void)
 {
     struct sigaction sa;
+    sigset_t caught;
+    sigemptyset(&caught);
+    (void)sigaddset(&caught, SIGINT);
+    (void)sigaddset(&caught, SIGTERM);
     memset(&sa, 0, sizeof(sa));
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
@@ -423,6 +427,7 @@ void tk_catch_signals(void)
         struct sigaction hup;
         if (sigaction(SIGHUP, NULL, &hup) != 0 || hup.sa_handler != SIG_IGN) {
             (void)sigaction(SIGHUP, &sa, NULL);
+            (void)sigaddset(&caught, SIGHUP);
         }
     }
     (void)signal(SIGPIPE, SIG_IGN);
@@ -442,9 +447,14 @@ void tk_catch_signals(void)
             if (sigaction(sig, NULL, &old) == 0 && old.sa_handler != SIG_IGN) {
                 (void)sigaction(sig, &sa, NULL);
                 (void)sigaddset(&fatal_set, sig);
+                (void)sigaddset(&caught, sig);
             }
         }
     }
+    /* A signal mask is inherited: a launcher that blocks these in its
+     * threads left them blocked here, so SIGTERM did not end the run and
+     * the SIGKILL after it left the line raw (and tase-sim's link). */
+    (void)sigprocmask(SIG_UNBLOCK, &caught, NULL);
 }
 
 void tk_exit_if_signalled(void)

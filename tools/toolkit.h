@@ -127,7 +127,8 @@ extern volatile sig_atomic_t tk_signal;
  * SIGHUP the process was started with ignored stays ignored) and ignore
  * SIGPIPE (a closed reader is then a write error). The signals that end a
  * process (SIGQUIT, SIGUSR1, ...) give the open serial lines their settings
- * back and remove tase-sim's links first, and say what was sent. */
+ * back and remove tase-sim's links first, and say what was sent. Every
+ * signal caught is unblocked (a blocked one may be inherited). */
 void tk_catch_signals(void);
 /* Hold those fatal signals (*old: the mask before) until
  * tk_release_fatal_signals(old), for a step that must not be cut in two

@@ -537,20 +537,27 @@ ok("a reader that goes away ends decode quietly with 141 (SIGPIPE's status)",
 # ---- a signal ends decode/klv of an input that never blocks ----
 # (a file or /dev/zero never gives EINTR: decode of /dev/zero spun at 100%
 # CPU through SIGINT, SIGTERM and SIGHUP until SIGKILL)
+def signal_after(p, sig, delay, timeout):
+    """Send sig to p after delay s: its exit status, None if it still ran
+    after timeout s (then killed)."""
+    time.sleep(delay * SLOW)
+    p.send_signal(sig)
+    try:
+        return p.wait(timeout=timeout * SLOW)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        p.wait()
+        return None
+
+
 for cmd, sig, want in (("decode", signal.SIGINT, 130), ("klv", signal.SIGTERM, 143),
                        ("decode", signal.SIGHUP, 129)):
     p = subprocess.Popen(VG + [TASE, cmd, "/dev/zero"], stdout=subprocess.DEVNULL,
                          stderr=subprocess.PIPE)
-    time.sleep(0.3 * SLOW)
-    p.send_signal(sig)
-    try:
-        rc = p.wait(timeout=5 * SLOW)
-    except subprocess.TimeoutExpired:
-        p.kill()
-        rc = p.wait()
+    rc = signal_after(p, sig, 0.3, 5)
     err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
     ok("%s /dev/zero ends on %s with %d" % (cmd, sig.name, want),
-       rc == want and "interrupted by %s" % sig.name in err, "exit %d %r" % (rc, err))
+       rc == want and "interrupted by %s" % sig.name in err, "exit %s %r" % (rc, err))
 
 # ---- Ctrl-C while the device takes no bytes ----
 # (it ended with exit 1 "try again" after the write gave up, not 130)
@@ -634,6 +641,39 @@ for what_, n_ in (("stale", 4090), ("stale", 4091), ("stale", 4095), ("user", 40
        "exit %d, %d bytes written, %r" % (p.returncode, len(wrote), p.stderr[-200:]))
 os.close(pm_)
 os.close(ps_)
+
+# an environment review: a signal mask inherited blocking SIGINT, SIGTERM
+# and SIGHUP (a launcher that blocks them in its threads) left them
+# blocked: SIGTERM did not stop `monitor` or `tase-sim`, and the SIGKILL
+# that followed left the line raw (VMIN 0) and the simulator's link and
+# lock file behind. The tools unblock the signals they catch.
+def blocked_mask():
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM, signal.SIGHUP,
+                                              signal.SIGUSR1})
+
+
+bm_, bs_ = os.openpty()
+tty.setraw(bm_)
+before_ = termios.tcgetattr(bs_)
+blink_ = os.path.join(TMP, "blocked-link")
+for args_, sig_, want_ in (([TASE, "monitor", "--serial", os.ttyname(bs_)], signal.SIGTERM, 0),
+                           ([SIM, "--link", blink_, "--quiet"], signal.SIGTERM, 0),
+                           ([SIM, "--link", blink_, "--quiet"], signal.SIGUSR1, -signal.SIGUSR1)):
+    p = subprocess.Popen(VG + args_, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                         preexec_fn=blocked_mask)
+    rc = signal_after(p, sig_, 0.5, 3)
+    rc = "still running (killed)" if rc is None else rc
+    left_ = [f for f in os.listdir(TMP) if f.startswith("blocked-link")]
+    ok("%s started with the signals blocked: %s ends it (%s)" %
+       (os.path.basename(args_[0]), signal.Signals(sig_).name, rc),
+       rc == want_ and left_ == [] and termios.tcgetattr(bs_) == before_,
+       "exit %s, left %r, termios %s" % (rc, left_, "kept" if termios.tcgetattr(bs_) == before_
+                                         else "changed"))
+    for f in left_:
+        os.unlink(os.path.join(TMP, f))
+    p.stderr.close()
+os.close(bm_)
+os.close(bs_)
 
 # ---- live input is read as it arrives ----
 def live(args, data, what):
