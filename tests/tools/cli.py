@@ -13,6 +13,7 @@ import json
 import os
 import re
 import select
+import shutil
 import signal
 import subprocess
 import sys
@@ -674,6 +675,43 @@ for args_, sig_, want_ in (([TASE, "monitor", "--serial", os.ttyname(bs_)], sign
     p.stderr.close()
 os.close(bm_)
 os.close(bs_)
+
+# an environment review: `record -o FILE` writes FILE.partial-PID and
+# renames it onto FILE, which replaced a FILE its user had made read-only
+# (chmod 444: any write to it is refused): such a FILE is now refused, as an
+# open for writing would refuse it, and left as it was. As nobody (root may
+# write any file), where the tools run as root and nobody can run them.
+def as_nobody_ok():
+    if os.getuid() != 0 or VALGRIND or not shutil.which("setpriv"):
+        return False
+    return subprocess.run(["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", TASE,
+                           "--version"], stdout=subprocess.DEVNULL,
+                          stderr=subprocess.DEVNULL).returncode == 0
+
+
+if as_nobody_ok():
+    pub_ = tempfile.mkdtemp(prefix="tase-cli-pub-")
+    os.chmod(pub_, 0o777)
+    nm_, ns_ = os.openpty()
+    os.chmod(os.ttyname(ns_), 0o666)
+    keep_ = os.path.join(pub_, "keep.pcap")
+    with open(keep_, "w") as f:
+        f.write("precious\n")
+    os.chown(keep_, 65534, 65534)
+    os.chmod(keep_, 0o444)
+    p = subprocess.run(["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", TASE,
+                        "record", "--serial", os.ttyname(ns_), "-o", keep_, "--seconds", "0.3"],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, timeout=30)
+    with open(keep_, "rb") as f:
+        kept_ = f.read()
+    ok("record -o a read-only FILE (as its owner): refused, FILE kept, nothing left beside it",
+       p.returncode == 1 and kept_ == b"precious\n" and os.listdir(pub_) == ["keep.pcap"] and
+       p.stderr.decode() == "tase: cannot write capture %s: Permission denied (it is not writable; "
+       "record replaces it)\n" % keep_,
+       "exit %d, %r, %r, %r" % (p.returncode, kept_, os.listdir(pub_), p.stderr))
+    os.close(nm_)
+    os.close(ns_)
+    shutil.rmtree(pub_)
 
 # ---- live input is read as it arrives ----
 def live(args, data, what):
