@@ -485,6 +485,16 @@ for args in (["decode", noisy], ["list"]):
     ok("tase %s >&-: exit 1, cannot write to standard output" % args[0],
        rc == 1 and err == "tase: cannot write to standard output: Bad file descriptor\n",
        "exit %d %r" % (rc, err))
+# record -o - (written through /dev/stdout, which reopens descriptor 1 by
+# its path: the placeholder /dev/null, for writing) recorded into it, exit 0
+cm, cs = os.openpty()
+for o in ("-", "/dev/stdout"):
+    rc, err = closed(["record", "--serial", os.ttyname(cs), "-o", o, "--seconds", "0.3"], 1)
+    ok("tase record -o %s >&-: exit 1, standard output is closed" % o, rc == 1 and
+       err == "tase: cannot write capture to standard output: Bad file descriptor (it is "
+       "closed)\n", "exit %d %r" % (rc, err))
+os.close(cm)
+os.close(cs)
 rc, err = closed(["decode"], 0)
 ok("tase decode <&-: exit 1, cannot read standard input", rc == 1 and
    err == "tase: cannot read standard input: Bad file descriptor\n", "exit %d %r" % (rc, err))

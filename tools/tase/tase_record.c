@@ -1,6 +1,7 @@
 /* tase: `record` and `replay`, the command lines of the capture loops of
  * tk_capture.h. */
 #include <errno.h>
+#include <fcntl.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -63,6 +64,13 @@ int cli_cmd_record(cli_args_t *a)
     }
     if (strcmp(out, "-") == 0) {
         out = "/dev/stdout"; /* as `-` is standard input to decode and replay */
+    }
+    /* /dev/stdout reopens descriptor 1 by its path: a closed one is held
+     * by /dev/null for reading (tk_std_fds_open()), which that open
+     * would write to, the capture lost with success */
+    if (strcmp(out, "/dev/stdout") == 0 &&
+        (fcntl(STDOUT_FILENO, F_GETFL) & O_ACCMODE) == O_RDONLY) {
+        tk_die("cannot write capture to standard output: %s (it is closed)", strerror(EBADF));
     }
     if (strcmp(out, "/dev/stdout") == 0 && isatty(STDOUT_FILENO)) {
         tk_usage_error("-o %s is a terminal: a capture is binary (redirect it, or pipe it to "
