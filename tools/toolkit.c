@@ -393,6 +393,33 @@ void tk_release_fatal_signals(const sigset_t *old)
     (void)sigprocmask(SIG_SETMASK, old, NULL);
 }
 
+/* A standard output or error inherited non-blocking (a program sharing the
+ * pipe or terminal set O_NONBLOCK on it) fails a write that would wait
+ * with EAGAIN, and stdio drops what it could not write. Opened again
+ * through /proc (a description of our own: theirs keeps its flags) and
+ * made blocking; a socket, which cannot be opened so, stays as it is. */
+static void std_fd_blocking(int fd)
+{
+    char path[32];
+    struct stat st;
+    int fl = fcntl(fd, F_GETFL), nfd;
+    if (fl < 0 || (fl & O_NONBLOCK) == 0 || (fl & O_ACCMODE) == O_RDONLY || fstat(fd, &st) != 0 ||
+        !(S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode))) {
+        return;
+    }
+    (void)snprintf(path, sizeof(path), "/proc/self/fd/%d", fd);
+    /* non-blocking for the open: a pipe whose reader is gone fails (ENXIO)
+     * rather than waits */
+    nfd = open(path, O_WRONLY | O_NONBLOCK | O_NOCTTY | (fl & O_APPEND));
+    if (nfd < 0) {
+        return;
+    }
+    if (fcntl(nfd, F_SETFL, fl & ~O_NONBLOCK) == 0) {
+        (void)dup2(nfd, fd);
+    }
+    (void)close(nfd);
+}
+
 void tk_std_fds_open(void)
 {
     int fd;
@@ -407,6 +434,8 @@ void tk_std_fds_open(void)
             }
         }
     }
+    std_fd_blocking(STDOUT_FILENO);
+    std_fd_blocking(STDERR_FILENO);
 }
 
 void tk_catch_signals(void)

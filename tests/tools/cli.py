@@ -546,6 +546,31 @@ err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.mat
 ok("a reader that goes away ends decode quietly with 141 (SIGPIPE's status)",
    rc == 141 and err == "", "exit %d %r" % (rc, err))
 
+# an environment review: standard output inherited in non-blocking mode (a
+# program sharing the pipe or terminal set O_NONBLOCK on it) made a write
+# that would wait fail with EAGAIN: decode stopped after 64 KB with
+# "cannot write to standard output: Resource temporarily unavailable" (exit
+# 1). The tools write through a blocking description of their own.
+nr, nw = os.pipe()
+os.set_blocking(nw, False)
+p = subprocess.Popen(VG + [TASE, "decode", big], stdout=nw, stderr=subprocess.PIPE)
+os.close(nw)
+time.sleep(0.3 * SLOW)  # the pipe fills meanwhile
+got = 0
+while True:
+    chunk = os.read(nr, 4096)
+    if not chunk:
+        break
+    got += len(chunk)
+    time.sleep(0.0002)
+os.close(nr)
+rc = p.wait(timeout=60 * SLOW)
+err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
+p.stderr.close()
+want = len(run(["decode", big])[1].encode())
+ok("decode into a non-blocking pipe whose reader is slow: all %d bytes, exit 0" % want,
+   rc == 0 and got == want and err == "", "exit %d, %d bytes, %r" % (rc, got, err))
+
 # ---- a signal ends decode/klv of an input that never blocks ----
 # (a file or /dev/zero never gives EINTR: decode of /dev/zero spun at 100%
 # CPU through SIGINT, SIGTERM and SIGHUP until SIGKILL)
