@@ -1270,4 +1270,6 @@ if not VALGRIND:
        p.stdout.decode().startswith('{"offset":4294967300,'), repr(p.stdout[:200]))
 
 print("%d failure(s)" % fails)
+if not fails:
+    shutil.rmtree(TMP, ignore_errors=True)  # kept after a failure, to look at
 sys.exit(1 if fails else 0)
