@@ -378,7 +378,14 @@ void tk_cap_create(tk_cap_writer_t *w, const char *path, int linktype, bool appe
      * one): a device, a FIFO, a symlink (/dev/stdout) is written in place
      * (through the link), never replaced by a rename */
     if (existed ? S_ISREG(st.st_mode) : errno == ENOENT) {
-        int k = snprintf(w->tmp, sizeof(w->tmp), "%s.partial-%ld", path, (long)getpid());
+        int k;
+        /* the rename would replace a FILE that an open for writing is
+         * refused (made read-only by its user): refused as that open */
+        if (existed && faccessat(AT_FDCWD, path, W_OK, AT_EACCESS) != 0) {
+            tk_die("cannot write capture %s: %s (it is not writable; record replaces it)", path,
+                   strerror(errno));
+        }
+        k = snprintf(w->tmp, sizeof(w->tmp), "%s.partial-%ld", path, (long)getpid());
         if (k < 0 || (size_t)k >= sizeof(w->tmp)) {
             tk_die("cannot write capture %s: the path is too long", path);
         }
@@ -731,7 +738,7 @@ static ssize_t head_read(void *cookie, char *buf, size_t size)
     }
     for (;;) {
         ssize_t got = read(h->fd, buf, size);
-        if (got >= 0 || errno == EIO) { /* EIO: a pty whose writer went away */
+        if (got >= 0 || (errno == EIO && tk_read_eio_is_end(h->fd))) {
             return got < 0 ? 0 : got;
         }
         if (errno != EINTR || tk_signal != 0) {

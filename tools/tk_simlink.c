@@ -215,20 +215,29 @@ void tk_simlink_release(const char *link, int fd)
  * to the dead one's pty). Whether the simulator lives is whether anyone
  * holds the lock: no pid is compared (a simulator in another pid
  * namespace records a pid the tool's namespace does not know). */
-static int check_one(const char *given, const char *link, const char *target, char *why, size_t cap)
+static int check_one(const char *given, const char *link, int dir, const char *name,
+                     const char *target, char *why, size_t cap)
 {
-    char lock[PATH_MAX], slave[PATH_MAX], through[PATH_MAX + 16];
+    char lock[PATH_MAX], slave[PATH_MAX], through[PATH_MAX + 16], lockname[NAME_MAX + 8];
     struct stat st;
     long pid = 0, holder;
     int fd, rec;
-    if (tk_simlink_lock_path(link, lock, sizeof(lock)) != 0) {
-        return 0;
+    /* opened beside the link through its directory: LINK.lock as one path
+     * may be too long where LINK is not (a path near PATH_MAX, "/./././"),
+     * which passed a stale link unchecked */
+    if ((size_t)snprintf(lockname, sizeof(lockname), "%s%s", name, TK_SIMLINK_LOCK_SUFFIX) >=
+        sizeof(lockname)) {
+        return 0; /* a name no lock file can have: not tase-sim's link */
+    }
+    /* for messages (shortened if need be) */
+    if (snprintf(lock, sizeof(lock), "%s%s", link, TK_SIMLINK_LOCK_SUFFIX) < 0) {
+        strcpy(lock, lockname);
     }
     through[0] = '\0';
     if (strcmp(given, link) != 0) {
         snprintf(through, sizeof(through), " (through %s)", link);
     }
-    fd = open(lock, O_RDONLY | O_NOFOLLOW | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    fd = openat(dir, lockname, O_RDONLY | O_NOFOLLOW | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) {
         if (errno == EACCES) {
             /* a simulator's lock file we may not read: whether its
@@ -274,42 +283,75 @@ static int check_one(const char *given, const char *link, const char *target, ch
     return 0;
 }
 
+/* The directory of path (relative to at) opened for the *at() calls, and
+ * its last name in name; -1 if there is none to check. */
+static int open_parent(int at, const char *path, char *name, size_t cap)
+{
+    const char *slash = strrchr(path, '/');
+    const char *base = slash == NULL ? path : slash + 1;
+    char dir[PATH_MAX];
+    if (*base == '\0' || strlen(base) >= cap || strlen(path) >= sizeof(dir)) {
+        return -1;
+    }
+    strcpy(name, base);
+    if (slash == NULL) {
+        strcpy(dir, ".");
+    } else if (slash == path) {
+        strcpy(dir, "/");
+    } else {
+        memcpy(dir, path, (size_t)(slash - path));
+        dir[slash - path] = '\0';
+    }
+    return openat(at, dir, O_PATH | O_DIRECTORY | O_CLOEXEC);
+}
+
 int tk_simlink_check(const char *path, char *why, size_t cap)
 {
-    char cur[PATH_MAX], target[PATH_MAX], next[PATH_MAX];
+    char cur[PATH_MAX], target[PATH_MAX], name[NAME_MAX + 1];
     unsigned hops;
+    int rc = 0, dir;
     if (strlen(path) >= sizeof(cur)) {
         return 0; /* the open will say what is wrong with it */
     }
     strcpy(cur, path);
-    /* every symlink on the way: a user's link to a tase-sim link counts */
-    for (hops = 0; hops < 40u; hops++) {
+    /* every symlink on the way: a user's link to a tase-sim link counts.
+     * Followed as the kernel follows them, each from the directory of the
+     * link before (no path joined: one too long for a string is not too
+     * long for the open); cur is the link as shown in messages. */
+    dir = open_parent(AT_FDCWD, path, name, sizeof(name));
+    for (hops = 0; dir >= 0 && hops < 40u; hops++) {
         struct stat st;
         ssize_t n;
-        if (lstat(cur, &st) != 0 || !S_ISLNK(st.st_mode)) {
-            return 0;
+        int next;
+        if (fstatat(dir, name, &st, AT_SYMLINK_NOFOLLOW) != 0 || !S_ISLNK(st.st_mode)) {
+            break;
         }
-        n = readlink(cur, target, sizeof(target) - 1u);
+        n = readlinkat(dir, name, target, sizeof(target) - 1u);
         if (n <= 0 || (size_t)n >= sizeof(target) - 1u) {
-            return 0;
+            break;
         }
         target[n] = '\0';
-        if (check_one(path, cur, target, why, cap) != 0) {
-            return -1;
+        if (check_one(path, cur, dir, name, target, why, cap) != 0) {
+            rc = -1;
+            break;
         }
+        next = open_parent(target[0] == '/' ? AT_FDCWD : dir, target, name, sizeof(name));
+        (void)close(dir);
+        dir = next;
         if (target[0] == '/') {
-            strcpy(next, target);
+            strcpy(cur, target);
         } else {
-            /* relative to the directory of the link */
+            /* relative to the directory of the link (shortened if need be) */
+            char shown[PATH_MAX];
             const char *slash = strrchr(cur, '/');
-            int w = slash == NULL
-                        ? snprintf(next, sizeof(next), "%s", target)
-                        : snprintf(next, sizeof(next), "%.*s/%s", (int)(slash - cur), cur, target);
-            if (w < 0 || (size_t)w >= sizeof(next)) {
-                return 0;
-            }
+            int w = slash == NULL ? snprintf(shown, sizeof(shown), "%s", target)
+                                  : snprintf(shown, sizeof(shown), "%.*s/%s", (int)(slash - cur),
+                                             cur, target);
+            strcpy(cur, w < 0 ? target : shown);
         }
-        strcpy(cur, next);
     }
-    return 0;
+    if (dir >= 0) {
+        (void)close(dir);
+    }
+    return rc;
 }

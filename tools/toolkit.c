@@ -262,6 +262,15 @@ void tk_stdout_flush(void)
     }
 }
 
+bool tk_read_eio_is_end(int fd)
+{
+    struct stat st;
+    int e = errno;
+    bool end = fstat(fd, &st) == 0 && S_ISCHR(st.st_mode);
+    errno = e; /* the caller reports the read's error */
+    return end;
+}
+
 void tk_exit_broken_pipe(void)
 {
     /* quietly, as SIGPIPE would, but through the path that closes the
@@ -384,22 +393,58 @@ void tk_release_fatal_signals(const sigset_t *old)
     (void)sigprocmask(SIG_SETMASK, old, NULL);
 }
 
+/* A standard output or error inherited non-blocking (a program sharing the
+ * pipe or terminal set O_NONBLOCK on it) fails a write that would wait
+ * with EAGAIN, and stdio drops what it could not write. Opened again
+ * through /proc (a description of our own: theirs keeps its flags) and
+ * made blocking; a socket, which cannot be opened so, stays as it is. */
+static void std_fd_blocking(int fd)
+{
+    char path[32];
+    struct stat st;
+    int fl = fcntl(fd, F_GETFL), nfd;
+    if (fl < 0 || (fl & O_NONBLOCK) == 0 || (fl & O_ACCMODE) == O_RDONLY || fstat(fd, &st) != 0 ||
+        !(S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode))) {
+        return;
+    }
+    (void)snprintf(path, sizeof(path), "/proc/self/fd/%d", fd);
+    /* non-blocking for the open: a pipe whose reader is gone fails (ENXIO)
+     * rather than waits */
+    nfd = open(path, O_WRONLY | O_NONBLOCK | O_NOCTTY | (fl & O_APPEND));
+    if (nfd < 0) {
+        return;
+    }
+    if (fcntl(nfd, F_SETFL, fl & ~O_NONBLOCK) == 0) {
+        (void)dup2(nfd, fd);
+    }
+    (void)close(nfd);
+}
+
 void tk_std_fds_open(void)
 {
     int fd;
     for (fd = 0; fd <= 2; fd++) {
         if (fcntl(fd, F_GETFD) == -1 && errno == EBADF) {
-            /* the lowest free descriptor: this one */
-            if (open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY) != fd) {
+            /* the lowest free descriptor: this one, opened the other way,
+             * so that a read of standard input, a write to standard output
+             * or error fails (EBADF) as on the closed descriptor and never
+             * passes for success (output lost with exit 0) */
+            if (open("/dev/null", fd == 0 ? O_WRONLY : O_RDONLY) != fd) {
                 _exit(TK_EXIT_FAIL); /* nothing to say it on */
             }
         }
     }
+    std_fd_blocking(STDOUT_FILENO);
+    std_fd_blocking(STDERR_FILENO);
 }
 
 void tk_catch_signals(void)
 {
     struct sigaction sa;
+    sigset_t caught;
+    sigemptyset(&caught);
+    (void)sigaddset(&caught, SIGINT);
+    (void)sigaddset(&caught, SIGTERM);
     memset(&sa, 0, sizeof(sa));
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
@@ -411,6 +456,7 @@ void tk_catch_signals(void)
         struct sigaction hup;
         if (sigaction(SIGHUP, NULL, &hup) != 0 || hup.sa_handler != SIG_IGN) {
             (void)sigaction(SIGHUP, &sa, NULL);
+            (void)sigaddset(&caught, SIGHUP);
         }
     }
     (void)signal(SIGPIPE, SIG_IGN);
@@ -430,9 +476,14 @@ void tk_catch_signals(void)
             if (sigaction(sig, NULL, &old) == 0 && old.sa_handler != SIG_IGN) {
                 (void)sigaction(sig, &sa, NULL);
                 (void)sigaddset(&fatal_set, sig);
+                (void)sigaddset(&caught, sig);
             }
         }
     }
+    /* A signal mask is inherited: a launcher that blocks these in its
+     * threads left them blocked here, so SIGTERM did not end the run and
+     * the SIGKILL after it left the line raw (and tase-sim's link). */
+    (void)sigprocmask(SIG_UNBLOCK, &caught, NULL);
 }
 
 void tk_exit_if_signalled(void)

@@ -127,7 +127,8 @@ extern volatile sig_atomic_t tk_signal;
  * SIGHUP the process was started with ignored stays ignored) and ignore
  * SIGPIPE (a closed reader is then a write error). The signals that end a
  * process (SIGQUIT, SIGUSR1, ...) give the open serial lines their settings
- * back and remove tase-sim's links first, and say what was sent. */
+ * back and remove tase-sim's links first, and say what was sent. Every
+ * signal caught is unblocked (a blocked one may be inherited). */
 void tk_catch_signals(void);
 /* Hold those fatal signals (*old: the mask before) until
  * tk_release_fatal_signals(old), for a step that must not be cut in two
@@ -137,8 +138,16 @@ void tk_release_fatal_signals(const sigset_t *old);
 /* Open /dev/null on whichever of descriptors 0, 1 and 2 is closed (first
  * thing in main): a program started with its standard output closed wrote
  * its log into the first file it opened (tase-sim: the lock file of its
- * link, which then named no simulator). */
+ * link, which then named no simulator). It is opened the other way (0 for
+ * writing, 1 and 2 for reading), so that using the descriptor fails with
+ * EBADF as on the closed one: output is never lost with success. A
+ * standard output or error inherited non-blocking (pipe, FIFO, terminal)
+ * is replaced by a blocking description of the same file. */
 void tk_std_fds_open(void);
+/* Whether a read() of fd that failed with EIO is the end of the input:
+ * for a terminal (a pty whose other side went away), and for nothing
+ * else (a disk's read error would pass a file cut short for complete). */
+bool tk_read_eio_is_end(int fd);
 /* If a signal was caught: run the cleanup the caller did (nothing here)
  * and exit 128 + signal with "interrupted by SIGxxx". */
 void tk_exit_if_signalled(void);

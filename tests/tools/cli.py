@@ -13,6 +13,7 @@ import json
 import os
 import re
 import select
+import shutil
 import signal
 import subprocess
 import sys
@@ -249,6 +250,13 @@ expect("--timeout given twice (as --timeout=N) is refused",
 expect("record -o and --output together are refused",
        ["record", "--serial", "/a", "-o", "x.pcap", "--output", "y.pcap"], 2,
        "option -o/--output given twice")
+# an environment review: an empty -o was taken, the whole session recorded
+# into ".partial-PID" in the current directory, then "cannot write capture :
+# No such file or directory" (exit 1) at the end; --record "" was refused
+for o in (["-o", ""], ["--output="]):
+    expect("record %s: the value is missing (as --record '')" % " ".join(repr(x) for x in o),
+           ["record", "--serial", "/dev/null"] + o + ["--seconds", "1"], 2,
+           r"^tase: option -o/--output needs a value$")
 expect("camera --hfov followed by an option: the value is missing",
        ["camera", "--hfov", "--serial", "/dev/ttyUSB9"], 2, "option --hfov needs a value")
 expect("a negative number is still a value", ["camera", "--hfov", "-5"] + L, 2,
@@ -417,6 +425,87 @@ for args in (["decode", noisy], ["list"], ["--help"], ["klv", os.path.join(os.pa
     ok("tase %s > /dev/full fails with a message" % args[0],
        rc == 1 and "cannot write to standard output" in err, "exit %d %s" % (rc, err))
 
+# an environment review: a read error of the input (EIO of a failing disk,
+# here /proc/self/mem, whose first page is not mapped) was taken for the end
+# of the input, so decode printed what it had and exited 0; EIO is the end
+# only for a terminal (a pty whose other side went away)
+if os.path.exists("/proc/self/mem"):
+    for args in (["decode", "/proc/self/mem"], ["klv", "/proc/self/mem"],
+                 ["replay", "/proc/self/mem", "--serial", "/dev/null", "--dir", "in"]):
+        expect("tase %s of a file that fails with EIO: exit 1, the error said" % args[0], args, 1,
+               r"^tase: cannot read /proc/self/mem: Input/output error$")
+    with open("/proc/self/mem", "rb") as mem:
+        p = subprocess.run(VG + [TASE, "decode"], stdin=mem, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, timeout=30)
+    ok("tase decode of a standard input that fails with EIO: exit 1, the error said",
+       p.returncode == 1 and p.stderr == b"tase: cannot read standard input: Input/output error\n",
+       "exit %d %r" % (p.returncode, p.stderr))
+
+    # and a capture whose read fails after its third record (the bytes at
+    # the end of a page of ours, the next page unmapped, read through
+    # /proc/self/mem): decoded up to there, then the error, exit 1 (it was
+    # a complete capture, exit 0)
+    import ctypes
+    import mmap
+    import struct
+    cap = struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 147)
+    for i in range(3):
+        d = b"\x00" + angle(i, -i)
+        cap += struct.pack("<IIII", 1700000000 + i, 0, len(d), len(d)) + d
+    page = mmap.PAGESIZE
+    area = mmap.mmap(-1, 2 * page)
+    addr = ctypes.addressof(ctypes.c_char.from_buffer(area))
+    area[page - len(cap):page] = cap
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.munmap.argtypes = [ctypes.c_void_p, ctypes.c_size_t]
+    if libc.munmap(addr + page, page) == 0:
+        with open("/proc/self/mem", "rb", buffering=0) as mem:
+            mem.seek(addr + page - len(cap))
+            p = subprocess.run(VG + [TASE, "decode"], stdin=mem, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, timeout=30)
+        ok("tase decode of a capture whose read fails after record 3: the 3, then exit 1",
+           p.returncode == 1 and p.stdout.decode().count("GIMBAL_ANGLE") == 3 and
+           p.stderr == b"tase: standard input: after record 3: error reading dump file: "
+           b"Input/output error\n", "exit %d %r %r" % (p.returncode, p.stdout, p.stderr))
+
+# an environment review: a closed standard output was opened on /dev/null
+# (so that no device or file took descriptor 1), which made every write
+# succeed: `tase decode FILE >&-` exited 0 with its output lost, and a closed
+# standard input read as empty. The descriptor is still held, but opened
+# the other way, so a write (a read of stdin) fails as on the closed one.
+def closed(args, fd, stdin=b""):
+    p = subprocess.run(VG + ([TASE] + args if args[0] != SIM else args), input=stdin,
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=30,
+                       preexec_fn=lambda: os.close(fd))
+    return p.returncode, p.stderr.decode(errors="replace")
+
+
+for args in (["decode", noisy], ["list"]):
+    rc, err = closed(args, 1)
+    ok("tase %s >&-: exit 1, cannot write to standard output" % args[0],
+       rc == 1 and err == "tase: cannot write to standard output: Bad file descriptor\n",
+       "exit %d %r" % (rc, err))
+# record -o - (written through /dev/stdout, which reopens descriptor 1 by
+# its path: the placeholder /dev/null, for writing) recorded into it, exit 0
+cm, cs = os.openpty()
+for o in ("-", "/dev/stdout"):
+    rc, err = closed(["record", "--serial", os.ttyname(cs), "-o", o, "--seconds", "0.3"], 1)
+    ok("tase record -o %s >&-: exit 1, standard output is closed" % o, rc == 1 and
+       err == "tase: cannot write capture to standard output: Bad file descriptor (it is "
+       "closed)\n", "exit %d %r" % (rc, err))
+os.close(cm)
+os.close(cs)
+rc, err = closed(["decode"], 0)
+ok("tase decode <&-: exit 1, cannot read standard input", rc == 1 and
+   err == "tase: cannot read standard input: Bad file descriptor\n", "exit %d %r" % (rc, err))
+rc, err = closed([SIM, "--seconds", "0.3", "--quiet"], 1)
+ok("tase-sim --quiet >&-: exit 1, the startup line said lost", rc == 1 and
+   "tase-sim: cannot write the log to standard output: Bad file descriptor" in err,
+   "exit %d %r" % (rc, err))
+if not VALGRIND:  # memcheck needs its standard error (exit 127 without it)
+    rc, err = closed(["decode", "/nonexistent/x"], 2)
+    ok("tase 2>&-: the status still says it", rc == 1, "exit %d %r" % (rc, err))
+
 # a review: tase-sim's log into /dev/full was lost without a word (exit 0).
 # It says so at once on stderr and exits 1 at the end (that it goes on
 # serving its link meanwhile: e2e.sh).
@@ -457,23 +546,55 @@ err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.mat
 ok("a reader that goes away ends decode quietly with 141 (SIGPIPE's status)",
    rc == 141 and err == "", "exit %d %r" % (rc, err))
 
+# an environment review: standard output inherited in non-blocking mode (a
+# program sharing the pipe or terminal set O_NONBLOCK on it) made a write
+# that would wait fail with EAGAIN: decode stopped after 64 KB with
+# "cannot write to standard output: Resource temporarily unavailable" (exit
+# 1). The tools write through a blocking description of their own.
+nr, nw = os.pipe()
+os.set_blocking(nw, False)
+p = subprocess.Popen(VG + [TASE, "decode", big], stdout=nw, stderr=subprocess.PIPE)
+os.close(nw)
+time.sleep(0.3 * SLOW)  # the pipe fills meanwhile
+got = 0
+while True:
+    chunk = os.read(nr, 4096)
+    if not chunk:
+        break
+    got += len(chunk)
+    time.sleep(0.0002)
+os.close(nr)
+rc = p.wait(timeout=60 * SLOW)
+err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
+p.stderr.close()
+want = len(run(["decode", big])[1].encode())
+ok("decode into a non-blocking pipe whose reader is slow: all %d bytes, exit 0" % want,
+   rc == 0 and got == want and err == "", "exit %d, %d bytes, %r" % (rc, got, err))
+
 # ---- a signal ends decode/klv of an input that never blocks ----
 # (a file or /dev/zero never gives EINTR: decode of /dev/zero spun at 100%
 # CPU through SIGINT, SIGTERM and SIGHUP until SIGKILL)
+def signal_after(p, sig, delay, timeout):
+    """Send sig to p after delay s: its exit status, None if it still ran
+    after timeout s (then killed)."""
+    time.sleep(delay * SLOW)
+    p.send_signal(sig)
+    try:
+        return p.wait(timeout=timeout * SLOW)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        p.wait()
+        return None
+
+
 for cmd, sig, want in (("decode", signal.SIGINT, 130), ("klv", signal.SIGTERM, 143),
                        ("decode", signal.SIGHUP, 129)):
     p = subprocess.Popen(VG + [TASE, cmd, "/dev/zero"], stdout=subprocess.DEVNULL,
                          stderr=subprocess.PIPE)
-    time.sleep(0.3 * SLOW)
-    p.send_signal(sig)
-    try:
-        rc = p.wait(timeout=5 * SLOW)
-    except subprocess.TimeoutExpired:
-        p.kill()
-        rc = p.wait()
+    rc = signal_after(p, sig, 0.3, 5)
     err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
     ok("%s /dev/zero ends on %s with %d" % (cmd, sig.name, want),
-       rc == want and "interrupted by %s" % sig.name in err, "exit %d %r" % (rc, err))
+       rc == want and "interrupted by %s" % sig.name in err, "exit %s %r" % (rc, err))
 
 # ---- Ctrl-C while the device takes no bytes ----
 # (it ended with exit 1 "try again" after the write gave up, not 130)
@@ -495,6 +616,138 @@ if not VALGRIND:
        rc == 130 and err == "tase: interrupted by SIGINT\n", "exit %d %r" % (rc, err))
     os.close(sm)
     os.close(ss)
+
+# an environment review: `record --serial DEV -o DEV` (or `-o -` with the
+# output on DEV) wrote the capture into the line it recorded, so the
+# gimbal got its own packets back, echoes of RETRACT_DEPLOY_CMD, SPOI_CMD
+# and setup packets included, which it takes as commands: refused, nothing
+# written
+# (`-o -` on a terminal was refused already: a capture is binary)
+ptys_ = [os.openpty() for _ in range(2)]
+for pm_, ps_ in ptys_:
+    tty.setraw(pm_)
+    tty.setraw(ps_)
+    os.set_blocking(pm_, False)
+name_, tap_ = (os.ttyname(ps_) for _, ps_ in ptys_)
+for o_ in (["-o", name_], ["-o", "/dev/./" + name_[5:]], ["--tap-in", tap_, "-o", tap_]):
+    p = subprocess.run(VG + [TASE, "record", "--serial", name_, "--seconds", "0.3"] + o_,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, timeout=30)
+    wrote = b""
+    for pm_, _ in ptys_:
+        try:
+            wrote += os.read(pm_, 4096)
+        except BlockingIOError:
+            pass
+    ok("record %s onto a recorded line: refused (exit 2), nothing written to it" % " ".join(o_),
+       p.returncode == 2 and wrote == b"" and
+       re.match(r"tase: -o .* is a serial device being recorded \(.*\): the capture would "
+                r"go to the gimbal's line; write it to a file\n$", p.stderr.decode()) is not None,
+       "exit %d, %d bytes written, %r" % (p.returncode, len(wrote), p.stderr))
+for pm_, ps_ in ptys_:
+    os.close(pm_)
+    os.close(ps_)
+
+# an environment review: the stale link of a killed tase-sim (here made by
+# hand: a symlink to a pty, and a lock file naming that pty that nobody
+# holds) was refused by its path, but not by a path near PATH_MAX to it
+# ("/./././...": LINK.lock was too long to form, and the check was
+# skipped), nor through a user's relative symlink whose joined path was too
+# long: the other program's pty got the GIMBAL_CMD
+sd_ = os.path.join(TMP, "stale-dir")
+os.mkdir(sd_)
+pm_, ps_ = os.openpty()
+tty.setraw(pm_)
+os.set_blocking(pm_, False)
+os.symlink(os.ttyname(ps_), os.path.join(sd_, "stale"))
+with open(os.path.join(sd_, "stale.lock"), "w") as f:
+    f.write("tase-sim 999999 %s\n" % os.ttyname(ps_))
+os.symlink("./" * 40 + "stale", os.path.join(sd_, "user"))
+for what_, n_ in (("stale", 4090), ("stale", 4091), ("stale", 4095), ("user", 4080)):
+    k_ = n_ - len(sd_) - len(what_) - 1
+    path_ = sd_ + "/." * (k_ // 2) + ("/" if k_ % 2 else "") + "/" + what_
+    p = subprocess.run(VG + [TASE, "point", "1", "1", "--serial", path_], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, timeout=30)
+    try:
+        wrote = os.read(pm_, 4096)
+    except BlockingIOError:
+        wrote = b""
+    ok("a stale tase-sim link by a %d-character path%s: refused, nothing written" %
+       (len(path_), " through a user's relative symlink" if what_ == "user" else ""),
+       p.returncode == 1 and wrote == b"" and b"is the link of a tase-sim that is no longer running"
+       in p.stderr and b"not opened, nothing sent" in p.stderr,
+       "exit %d, %d bytes written, %r" % (p.returncode, len(wrote), p.stderr[-200:]))
+os.close(pm_)
+os.close(ps_)
+
+# an environment review: a signal mask inherited blocking SIGINT, SIGTERM
+# and SIGHUP (a launcher that blocks them in its threads) left them
+# blocked: SIGTERM did not stop `monitor` or `tase-sim`, and the SIGKILL
+# that followed left the line raw (VMIN 0) and the simulator's link and
+# lock file behind. The tools unblock the signals they catch.
+def blocked_mask():
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM, signal.SIGHUP,
+                                              signal.SIGUSR1})
+
+
+bm_, bs_ = os.openpty()
+tty.setraw(bm_)
+before_ = termios.tcgetattr(bs_)
+blink_ = os.path.join(TMP, "blocked-link")
+for args_, sig_, want_ in (([TASE, "monitor", "--serial", os.ttyname(bs_)], signal.SIGTERM, 0),
+                           ([SIM, "--link", blink_, "--quiet"], signal.SIGTERM, 0),
+                           ([SIM, "--link", blink_, "--quiet"], signal.SIGUSR1, -signal.SIGUSR1)):
+    p = subprocess.Popen(VG + args_, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                         preexec_fn=blocked_mask)
+    rc = signal_after(p, sig_, 0.5, 3)
+    rc = "still running (killed)" if rc is None else rc
+    left_ = [f for f in os.listdir(TMP) if f.startswith("blocked-link")]
+    ok("%s started with the signals blocked: %s ends it (%s)" %
+       (os.path.basename(args_[0]), signal.Signals(sig_).name, rc),
+       rc == want_ and left_ == [] and termios.tcgetattr(bs_) == before_,
+       "exit %s, left %r, termios %s" % (rc, left_, "kept" if termios.tcgetattr(bs_) == before_
+                                         else "changed"))
+    for f in left_:
+        os.unlink(os.path.join(TMP, f))
+    p.stderr.close()
+os.close(bm_)
+os.close(bs_)
+
+# an environment review: `record -o FILE` writes FILE.partial-PID and
+# renames it onto FILE, which replaced a FILE its user had made read-only
+# (chmod 444: any write to it is refused): such a FILE is now refused, as an
+# open for writing would refuse it, and left as it was. As nobody (root may
+# write any file), where the tools run as root and nobody can run them.
+def as_nobody_ok():
+    if os.getuid() != 0 or VALGRIND or not shutil.which("setpriv"):
+        return False
+    return subprocess.run(["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", TASE,
+                           "--version"], stdout=subprocess.DEVNULL,
+                          stderr=subprocess.DEVNULL).returncode == 0
+
+
+if as_nobody_ok():
+    pub_ = tempfile.mkdtemp(prefix="tase-cli-pub-")
+    os.chmod(pub_, 0o777)
+    nm_, ns_ = os.openpty()
+    os.chmod(os.ttyname(ns_), 0o666)
+    keep_ = os.path.join(pub_, "keep.pcap")
+    with open(keep_, "w") as f:
+        f.write("precious\n")
+    os.chown(keep_, 65534, 65534)
+    os.chmod(keep_, 0o444)
+    p = subprocess.run(["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", TASE,
+                        "record", "--serial", os.ttyname(ns_), "-o", keep_, "--seconds", "0.3"],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, timeout=30)
+    with open(keep_, "rb") as f:
+        kept_ = f.read()
+    ok("record -o a read-only FILE (as its owner): refused, FILE kept, nothing left beside it",
+       p.returncode == 1 and kept_ == b"precious\n" and os.listdir(pub_) == ["keep.pcap"] and
+       p.stderr.decode() == "tase: cannot write capture %s: Permission denied (it is not writable; "
+       "record replaces it)\n" % keep_,
+       "exit %d, %r, %r, %r" % (p.returncode, kept_, os.listdir(pub_), p.stderr))
+    os.close(nm_)
+    os.close(ns_)
+    shutil.rmtree(pub_)
 
 # ---- live input is read as it arrives ----
 def live(args, data, what):
@@ -1017,4 +1270,6 @@ if not VALGRIND:
        p.stdout.decode().startswith('{"offset":4294967300,'), repr(p.stdout[:200]))
 
 print("%d failure(s)" % fails)
+if not fails:
+    shutil.rmtree(TMP, ignore_errors=True)  # kept after a failure, to look at
 sys.exit(1 if fails else 0)

@@ -115,7 +115,7 @@ size_t cli_input_read(cli_input_t *in, uint8_t *buf, size_t cap)
         if (n > 0) {
             return input_keep_head(in, buf, (size_t)n);
         }
-        if (n == 0 || errno == EIO) { /* EIO: a pty whose writer went away */
+        if (n == 0 || (errno == EIO && tk_read_eio_is_end(in->fd))) {
             return 0;
         }
         if (errno == EINTR && tk_signal == 0) {

@@ -1,12 +1,28 @@
 /* tase: `record` and `replay`, the command lines of the capture loops of
  * tk_capture.h. */
 #include <errno.h>
+#include <fcntl.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "tase_cli.h"
 #include "tk_capture.h"
+
+/* Whether paths a and b name the same file (symlinks followed), or the
+ * same character device through two nodes. */
+static bool same_file(const char *a, const char *b)
+{
+    struct stat s1, s2;
+    if (strcmp(a, b) == 0) {
+        return true;
+    }
+    if (stat(a, &s1) != 0 || stat(b, &s2) != 0) {
+        return false;
+    }
+    return (s1.st_dev == s2.st_dev && s1.st_ino == s2.st_ino) ||
+           (S_ISCHR(s1.st_mode) && S_ISCHR(s2.st_mode) && s1.st_rdev == s2.st_rdev);
+}
 
 int cli_cmd_record(cli_args_t *a)
 {
@@ -21,6 +37,9 @@ int cli_cmd_record(cli_args_t *a)
         if (cli_opt(a, "-o", true, &v) || cli_opt(a, "--output", true, &v)) {
             if (out != NULL) {
                 tk_usage_error("option -o/--output given twice");
+            }
+            if (v[0] == '\0') { /* was recorded into ".partial-PID", then refused */
+                tk_usage_error("option -o/--output needs a value");
             }
             out = v;
             continue;
@@ -46,6 +65,13 @@ int cli_cmd_record(cli_args_t *a)
     if (strcmp(out, "-") == 0) {
         out = "/dev/stdout"; /* as `-` is standard input to decode and replay */
     }
+    /* /dev/stdout reopens descriptor 1 by its path: a closed one is held
+     * by /dev/null for reading (tk_std_fds_open()), which that open
+     * would write to, the capture lost with success */
+    if (strcmp(out, "/dev/stdout") == 0 &&
+        (fcntl(STDOUT_FILENO, F_GETFL) & O_ACCMODE) == O_RDONLY) {
+        tk_die("cannot write capture to standard output: %s (it is closed)", strerror(EBADF));
+    }
     if (strcmp(out, "/dev/stdout") == 0 && isatty(STDOUT_FILENO)) {
         tk_usage_error("-o %s is a terminal: a capture is binary (redirect it, or pipe it to "
                        "'tase decode -')",
@@ -58,17 +84,19 @@ int cli_cmd_record(cli_args_t *a)
     if (tap_in != NULL && lo.serial == NULL) {
         tk_usage_error("--tap-in is the second line of a serial tap: it needs --serial");
     }
-    if (tap_in != NULL) {
-        struct stat s1, s2;
-        /* the same line twice (by any path: symlinks followed) would be
-         * "busy: in use by another program", the other program being this
-         * one */
-        if (strcmp(tap_in, lo.serial) == 0 ||
-            (stat(tap_in, &s1) == 0 && stat(lo.serial, &s2) == 0 && s1.st_dev == s2.st_dev &&
-             s1.st_ino == s2.st_ino)) {
-            tk_usage_error("--tap-in must be the other line of the tap, not --serial's %s",
-                           lo.serial);
-        }
+    /* the same line twice (by any path: symlinks followed) would be
+     * "busy: in use by another program", the other program being this one */
+    if (tap_in != NULL && same_file(tap_in, lo.serial)) {
+        tk_usage_error("--tap-in must be the other line of the tap, not --serial's %s", lo.serial);
+    }
+    /* a capture written into a line it records (a device is written in
+     * place) would hand the gimbal its own packets, echoes of commands
+     * included, which it takes as commands */
+    if (lo.serial != NULL &&
+        (same_file(out, lo.serial) || (tap_in != NULL && same_file(out, tap_in)))) {
+        tk_usage_error("-o %s is a serial device being recorded (%s): the capture would go to "
+                       "the gimbal's line; write it to a file",
+                       out, same_file(out, lo.serial) ? lo.serial : tap_in);
     }
     /* a signal is the normal end of a recording: the loops stop on it and
      * close the capture, and the command succeeds */
