@@ -58,14 +58,11 @@ static bool port_present(const tase_gimbal_t *g, unsigned port)
     return port < TASE_GIMBAL_PORTS && g->port[port].ops != NULL;
 }
 
-/* TASE_OK when g may start a call that changes its state: not from inside
- * one of its callbacks (busy 1: TASE_EBUSY; gimbal.h REENTRANCY), and a
- * busy byte other than 0 and 1 is a corrupted instance (TASE_EARG). */
-static int idle(const tase_gimbal_t *g)
+/* The error of a call g refuses while its busy byte is set (gimbal.h
+ * REENTRANCY): TASE_EBUSY from inside one of its callbacks (1), TASE_EARG
+ * for any other value (a corrupted instance). */
+static int busy_error(const tase_gimbal_t *g)
 {
-    if (g->busy == 0u) {
-        return TASE_OK;
-    }
     return g->busy == 1u ? TASE_EBUSY : TASE_EARG;
 }
 
@@ -166,8 +163,8 @@ int tase_gimbal_set_capacity(tase_gimbal_t *g, unsigned port, uint32_t bytes_per
     if (g == NULL || port >= TASE_GIMBAL_PORTS) {
         return TASE_EARG;
     }
-    if (idle(g) != TASE_OK) {
-        return idle(g);
+    if (g->busy != 0u) {
+        return busy_error(g);
     }
     g->capacity[port] = bytes_per_s != 0u ? bytes_per_s : port_capacity(&g->port[port]);
     pace_port(g, port, false);
@@ -336,8 +333,8 @@ int tase_gimbal_setup_set(tase_gimbal_t *g, uint8_t type, const uint8_t *data, s
     if (g == NULL || data == NULL) {
         return TASE_EARG;
     }
-    if (idle(g) != TASE_OK) {
-        return idle(g);
+    if (g->busy != 0u) {
+        return busy_error(g);
     }
     if (type >= TASE_GIMBAL_SETUP_TYPES) {
         return TASE_EUNKNOWN;
@@ -366,8 +363,8 @@ int tase_gimbal_setup_set_msg(tase_gimbal_t *g, uint16_t id, const void *msg, ui
     if (g == NULL || msg == NULL) {
         return TASE_EARG;
     }
-    if (idle(g) != TASE_OK) {
-        return idle(g);
+    if (g->busy != 0u) {
+        return busy_error(g);
     }
     if (type < 0) {
         return type;
@@ -499,13 +496,11 @@ static void handle_and_echo(tase_gimbal_t *g, unsigned port, const tase_frame_t 
 int tase_gimbal_handle_frame(tase_gimbal_t *g, unsigned port, const tase_frame_t *frame,
                              uint32_t now_ms)
 {
-    int r;
     if (g == NULL || frame == NULL || frame->data == NULL || port >= TASE_GIMBAL_PORTS) {
         return TASE_EARG;
     }
-    r = idle(g);
-    if (r != TASE_OK) {
-        return r;
+    if (g->busy != 0u) {
+        return busy_error(g);
     }
     g->busy = 1u; /* until its callbacks have returned */
     handle_and_echo(g, port, frame, now_ms);
@@ -542,8 +537,8 @@ int tase_gimbal_feed(tase_gimbal_t *g, unsigned port, const uint8_t *bytes, size
     if (g == NULL) {
         return TASE_EARG;
     }
-    if (idle(g) != TASE_OK) {
-        return idle(g);
+    if (g->busy != 0u) {
+        return busy_error(g);
     }
     if (g->rx == NULL) {
         return TASE_ESTATE;
@@ -704,8 +699,8 @@ int tase_gimbal_poll(tase_gimbal_t *g, uint32_t now_ms)
     if (g == NULL) {
         return TASE_EARG;
     }
-    if (idle(g) != TASE_OK) {
-        return idle(g);
+    if (g->busy != 0u) {
+        return busy_error(g);
     }
     if (g->app.fill_telemetry == NULL && g->app.fill_telemetry_msg == NULL) {
         return 0;
@@ -735,8 +730,8 @@ int tase_gimbal_service(tase_gimbal_t *g, uint32_t now_ms)
     }
     /* From a callback (busy): refused here, not only by the feeds below,
      * which would have read the bytes first */
-    if (idle(g) != TASE_OK) {
-        return idle(g);
+    if (g->busy != 0u) {
+        return busy_error(g);
     }
     /* Nothing is read before every port it would read has a receiver that
      * takes the bytes: none at all (TASE_ESTATE), or one its feed would
