@@ -814,6 +814,10 @@ void tk_cap_reader_open(tk_cap_reader_t *r, int fd, const uint8_t *head, size_t 
     r->pcap = p;
     r->linktype = lt;
     r->pcapng = pcap_major_version(p) == 1; /* a pcapng section's version 1.0 */
+    /* the microsecond magic in either byte order (pcapng's is neither) */
+    r->usec = nhead >= 4u &&
+              ((head[0] == 0xA1u && head[1] == 0xB2u && head[2] == 0xC3u && head[3] == 0xD4u) ||
+               (head[0] == 0xD4u && head[1] == 0xC3u && head[2] == 0xB2u && head[3] == 0xA1u));
     open_reader = r;
 }
 
@@ -911,13 +915,25 @@ int tk_cap_next(tk_cap_reader_t *r, tk_cap_rec_t *rec, char *why, size_t cap)
      * field. (A pcapng time is 64-bit: one before 1970, from its
      * if_tsoffset, stays negative.) A fraction of a second beyond 10^9 ns
      * (a writer that did not normalise; libpcap scales a microsecond
-     * file's to nanoseconds in a 64-bit field) carries into the seconds. */
+     * file's to nanoseconds in a 64-bit field) carries into the seconds.
+     * That fraction is an unsigned 32-bit field too, which libpcap also
+     * hands over signed: one of 2^31 or more came out negative (as 0, the
+     * Python reader carrying it: a review), and a microsecond file's is
+     * that negative number times 1000. */
     {
         int64_t sec = (int64_t)h->ts.tv_sec;
-        uint64_t ns = h->ts.tv_usec > 0 ? (uint64_t)h->ts.tv_usec : 0u; /* opened in ns */
+        int64_t frac = (int64_t)h->ts.tv_usec; /* opened in ns */
+        uint64_t ns;
         if (!r->pcapng && sec < 0 && sec >= -(int64_t)0x80000000) {
             sec += (int64_t)0x100000000;
         }
+        if (!r->pcapng && frac < 0) {
+            int64_t unit = r->usec ? 1000 : 1;
+            if (frac >= -(int64_t)0x80000000 * unit && frac % unit == 0) {
+                frac += (int64_t)0x100000000 * unit;
+            }
+        }
+        ns = frac > 0 ? (uint64_t)frac : 0u;
         sec += (int64_t)(ns / 1000000000u);
         rec->t.sec = sec;
         rec->t.usec = (uint32_t)(ns % 1000000000u / 1000u);

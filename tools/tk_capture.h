@@ -152,6 +152,7 @@ typedef struct {
     void *pcap;
     int linktype;   /* TK_CAP_LINKTYPE_SERIAL or TK_CAP_LINKTYPE_CAN */
     bool pcapng;    /* else classic pcap */
+    bool usec;      /* a classic pcap whose fractions are microseconds */
     tk_time_t last; /* the time of the record read last */
     const char *path;
     unsigned long index; /* records read so far */

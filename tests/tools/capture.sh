@@ -69,7 +69,7 @@ check "decode of a serial pcap (both directions, 1..64-byte records): every pack
 $U times "$dir/times.pcap"
 t=$("$TASE" decode "$dir/times.pcap" | sed -n 's/.*"time":\([0-9.-]*\),.*/\1/p' | tr '\n' ' ')
 check "decode: times past 2038 and unnormalised fractions ($t)" \
-    test "$t" = "2147483647.750000 2147483648.250000 1700000001.500000 "
+    test "$t" = "2147483647.750000 2147483648.250000 1700000001.500000 1700000002.147483 1700000004.294967 "
 # A fuzzing review's findings on reading captures (each failed before):
 # a microsecond fraction of 4,294,968 us or more came out wrong (a 32-bit
 # cut of libpcap's nanoseconds); a record with more bytes captured than
@@ -79,8 +79,9 @@ check "decode: times past 2038 and unnormalised fractions ($t)" \
 # split across it; a CAN capture of only remote frames exited 0 silently,
 # one of only 3AX frames was "not a capture of a TASE serial line?".
 $U reader-edges "$dir"
-t=$("$TASE" decode "$dir/usfrac.pcap" 2>&1 | sed -n 's/.*"time":\([0-9.-]*\),.*/\1/p')
-check "decode: a microsecond fraction of 5,000,000 carries 5 s ($t)" test "$t" = "1700000005.000000"
+t=$("$TASE" decode "$dir/usfrac.pcap" 2>&1 | sed -n 's/.*"time":\([0-9.-]*\),.*/\1/p' | tr '\n' ' ')
+check "decode: microsecond fractions of 5,000,000, 2^31 and 2^32 - 1 carry into the seconds ($t)" \
+    test "$t" = "1700000005.000000 1700002147.483648 1700004294.967295 "
 "$TASE" decode "$dir/capbig.pcap" >"$dir/capbig.out" 2>"$dir/capbig.err"
 rc=$?
 check "decode: a record of more bytes than its packet had: a bad record, exit $rc (4), '$(head -1 "$dir/capbig.err")'" \

@@ -481,11 +481,14 @@ def times(out):
     """Issue 25 item 6: a serial capture of three GIMBAL_ANGLEs stamped
     2147483647.75 (the last second a signed 32-bit field holds), 2147483648.25
     (past 2038-01-19 03:14:07: the unsigned field) and 1700000000 s plus
-    1,500,000,000 ns (a fraction not normalised: 1700000001.5)."""
+    1,500,000,000 ns (a fraction not normalised: 1700000001.5), 2^31 ns and
+    2^32 - 1 ns (an unsigned fraction libpcap hands over negative:
+    1700000002.147483, 1700000004.294967)."""
     with open(out, "wb") as f:
         f.write(pcap_header(LINKTYPE_SERIAL))
         for i, (sec, ns) in enumerate([(2147483647, 750000000), (2147483648, 250000000),
-                                       (1700000000, 1500000000)]):
+                                       (1700000000, 1500000000), (1700000000, 0x80000000),
+                                       (1700000000, 0xFFFFFFFF)]):
             f.write(pcap_record(sec, ns, bytes([DIRS["out"]]) + gimbal_angle(i, 0)[1]))
 
 
@@ -574,8 +577,9 @@ def spb(out, other="no"):
 
 def reader_edges(d):
     """A fuzzing review's captures of the readers' edges, each a
-    GIMBAL_ANGLE from the gimbal: a microsecond pcap whose fraction is
-    5,000,000 us (usfrac); a record claiming more bytes captured than its
+    GIMBAL_ANGLE from the gimbal: a microsecond pcap whose fractions are
+    5,000,000 us, 2^31 us and 2^32 - 1 us (usfrac; libpcap hands the last two
+    over negative, times 1000); a record claiming more bytes captured than its
     packet had (capbig); a pcapng whose if_tsoffset puts it before 1970
     (negtime); a frame split over an Enhanced and a Simple Packet Block
     (spb); CAN captures of only a remote frame (rtr) and of only a 3AX
@@ -583,7 +587,8 @@ def reader_edges(d):
     f = bytes.fromhex("00FF5A08081004D2EE6C000003A9")
     usec = struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, LINKTYPE_SERIAL)
     with open(d + "/usfrac.pcap", "wb") as fh:
-        fh.write(usec + pcap_record(T0, 5000000, b"\0" + f))
+        fh.write(usec + b"".join(pcap_record(T0, frac, b"\0" + f)
+                                 for frac in (5000000, 0x80000000, 0xFFFFFFFF)))
     with open(d + "/capbig.pcap", "wb") as fh:
         fh.write(pcap_header(LINKTYPE_SERIAL) + struct.pack("<IIII", T0, 0, 15, 3) + b"\0" + f)
     shb = pcapng_block(0x0A0D0D0A, struct.pack("<IHHq", 0x1A2B3C4D, 1, 0, -1))
