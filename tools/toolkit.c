@@ -393,18 +393,34 @@ void tk_release_fatal_signals(const sigset_t *old)
     (void)sigprocmask(SIG_SETMASK, old, NULL);
 }
 
+/* Whether fd is the master side of a pty: its path (/proc/self/fd/N is
+ * /dev/ptmx) opens a new pty, not this one. */
+static bool pty_master(int fd)
+{
+#ifdef TIOCGPTN
+    unsigned int n;
+    return ioctl(fd, TIOCGPTN, &n) == 0;
+#else
+    (void)fd;
+    return false;
+#endif
+}
+
 /* A standard output or error inherited non-blocking (a program sharing the
  * pipe or terminal set O_NONBLOCK on it) fails a write that would wait
  * with EAGAIN, and stdio drops what it could not write. Opened again
  * through /proc (a description of our own: theirs keeps its flags) and
- * made blocking; a socket, which cannot be opened so, stays as it is. */
+ * made blocking; a socket, which cannot be opened so, stays as it is, and
+ * so does a pty's master side (opened again it was a new pty that nobody
+ * reads: the output lost with success) and any character device but a
+ * terminal (/dev/null never waits; another's open may do anything). */
 static void std_fd_blocking(int fd)
 {
     char path[32];
     struct stat st;
     int fl = fcntl(fd, F_GETFL), nfd;
     if (fl < 0 || (fl & O_NONBLOCK) == 0 || (fl & O_ACCMODE) == O_RDONLY || fstat(fd, &st) != 0 ||
-        !(S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode))) {
+        !(S_ISFIFO(st.st_mode) || (S_ISCHR(st.st_mode) && isatty(fd) && !pty_master(fd)))) {
         return;
     }
     (void)snprintf(path, sizeof(path), "/proc/self/fd/%d", fd);

@@ -141,8 +141,9 @@ void tk_release_fatal_signals(const sigset_t *old);
  * link, which then named no simulator). It is opened the other way (0 for
  * writing, 1 and 2 for reading), so that using the descriptor fails with
  * EBADF as on the closed one: output is never lost with success. A
- * standard output or error inherited non-blocking (pipe, FIFO, terminal)
- * is replaced by a blocking description of the same file. */
+ * standard output or error inherited non-blocking (pipe, FIFO, terminal;
+ * not a pty's master side) is replaced by a blocking description of the
+ * same file. */
 void tk_std_fds_open(void);
 /* Whether a read() of fd that failed with EIO is the end of the input:
  * for a terminal (a pty whose other side went away), and for nothing

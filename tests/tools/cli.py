@@ -571,6 +571,33 @@ want = len(run(["decode", big])[1].encode())
 ok("decode into a non-blocking pipe whose reader is slow: all %d bytes, exit 0" % want,
    rc == 0 and got == want and err == "", "exit %d, %d bytes, %r" % (rc, got, err))
 
+# a diff review: a standard output that is a pty's master side, non-blocking
+# (a program driving a line through a pty pair hands the tool its master),
+# was opened again through /proc/self/fd: its path is /dev/ptmx, which made a
+# new pty that nobody reads, so the output was lost with exit 0
+pm_, ps_ = os.openpty()
+tty.setraw(ps_)
+os.set_blocking(pm_, False)
+os.set_blocking(ps_, False)
+p = subprocess.Popen(VG + [TASE, "list"], stdout=pm_, stderr=subprocess.PIPE)
+got_ = b""
+t0_ = time.monotonic()
+while time.monotonic() - t0_ < 10 * SLOW:
+    try:
+        got_ += os.read(ps_, 65536)
+    except BlockingIOError:
+        if p.poll() is not None:
+            break
+        time.sleep(0.01)
+rc = p.wait(timeout=30 * SLOW)
+err = "".join(l for l in p.stderr.read().decode().splitlines(True) if not re.match(r"==\d+== ", l))
+p.stderr.close()
+want_ = run(["list"])[1].encode()
+ok("tase list into a non-blocking pty master: its output on the pty, exit 0",
+   rc == 0 and got_ == want_ and err == "", "exit %d, %d of %d bytes, %r" % (rc, len(got_), len(want_), err))
+os.close(pm_)
+os.close(ps_)
+
 # ---- a signal ends decode/klv of an input that never blocks ----
 # (a file or /dev/zero never gives EINTR: decode of /dev/zero spun at 100%
 # CPU through SIGINT, SIGTERM and SIGHUP until SIGKILL)
