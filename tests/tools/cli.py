@@ -211,6 +211,14 @@ expect("--no-wait setup packet needs every field",
 expect("point: out-of-range angle states the range", ["point", "200", "0"] + L, 2,
        r"out of range -180\.\.180 deg")
 expect("point: not a number", ["point", "ten", "0"] + L, 2, "not a number")
+# a review: a bad number with a minus sign was "unknown option '-inf'"
+for bad in ("-inf", "-nan", "-1x", "-1e999"):
+    expect("point: %s is a bad pan, not an unknown option" % bad, ["point", bad, "0"] + L, 2,
+           r"bad pan '%s': not a number" % re.escape(bad))
+expect("point: a bad tilt with a minus sign is named as one", ["point", "0", "-inf"] + L, 2,
+       r"bad tilt '-inf': not a number")
+expect("point: an unknown --option is still one", ["point", "0", "0", "--inf"] + L, 2,
+       r"unknown option '--inf'")
 # issue 23 item 3: tilt is -270..90 (spec 4.3.3), pan -180..180
 expect("point: tilt 150 is outside the spec's -270..90", ["point", "0", "150"] + L, 2,
        r"bad tilt '150': out of range -270\.\.90 deg")

@@ -74,13 +74,15 @@ bool cli_common_opt(cli_args_t *a)
 
 /* Whether argv[i] is an argument rather than an option: after "--", "-"
  * (standard input), anything not starting with '-', and, where numbers are
- * expected, a negative number. */
+ * expected, anything starting with a single '-' (no such option is left
+ * there: -h is taken first): a negative number, or a bad one its parser
+ * names ("bad pan '-inf': not a number", not "unknown option"). */
 bool cli_is_arg(const cli_args_t *a, bool numbers)
 {
     const char *s = a->argv[a->i];
     double x;
     return a->dashdash || s[0] != '-' || s[1] == '\0' ||
-           (numbers && tk_parse_real(s, &x) == TK_NUM_OK);
+           (numbers && (s[1] != '-' || tk_parse_real(s, &x) == TK_NUM_OK));
 }
 
 /* --baud N */

@@ -71,8 +71,8 @@ void cli_print_usage(const cli_args_t *a);
 bool cli_opt(cli_args_t *a, const char *name, bool has_arg, const char **val);
 /* --help, -h (print the usage, exit 0) and "--". */
 bool cli_common_opt(cli_args_t *a);
-/* Whether argv[i] is an argument rather than an option (with `numbers`, a
- * negative number is an argument). */
+/* Whether argv[i] is an argument rather than an option (with `numbers`,
+ * anything starting with a single '-': a negative number, or a bad one). */
 bool cli_is_arg(const cli_args_t *a, bool numbers);
 bool cli_baud_opt(cli_args_t *a, long *baud);
 /* --serial, --can, --record, --baud */
