@@ -696,22 +696,29 @@ bool tk_cap_session_last_read(uint32_t *ms, struct timespec *t)
 
 /* ---- reading ---- */
 
+/* The magic numbers of the captures libpcap reads here, big-endian. */
+static const uint8_t cap_magics[][4] = {
+    {0xA1, 0xB2, 0xC3, 0xD4}, /* pcap, microseconds */
+    {0xA1, 0xB2, 0x3C, 0x4D}, /* pcap, nanoseconds */
+    {0x0A, 0x0D, 0x0D, 0x0A}, /* pcapng section header block */
+};
+#define CAP_MAGIC_PCAP_US 0u
+
+/* Whether head[0..4) is magic m in either byte order. */
+static bool cap_magic_is(const uint8_t *head, const uint8_t *m)
+{
+    return memcmp(head, m, 4) == 0 ||
+           (head[0] == m[3] && head[1] == m[2] && head[2] == m[1] && head[3] == m[0]);
+}
+
 bool tk_cap_is_capture(const uint8_t *head, size_t n)
 {
-    static const uint8_t magics[][4] = {
-        {0xA1, 0xB2, 0xC3, 0xD4}, /* pcap, microseconds */
-        {0xA1, 0xB2, 0x3C, 0x4D}, /* pcap, nanoseconds */
-        {0x0A, 0x0D, 0x0D, 0x0A}, /* pcapng section header block */
-    };
     size_t i;
     if (n < 4) {
         return false;
     }
-    for (i = 0; i < sizeof(magics) / sizeof(magics[0]); i++) {
-        const uint8_t *m = magics[i];
-        bool be = memcmp(head, m, 4) == 0;
-        bool le = head[0] == m[3] && head[1] == m[2] && head[2] == m[1] && head[3] == m[0];
-        if (be || le) {
+    for (i = 0; i < sizeof(cap_magics) / sizeof(cap_magics[0]); i++) {
+        if (cap_magic_is(head, cap_magics[i])) {
             return true;
         }
     }
@@ -814,10 +821,7 @@ void tk_cap_reader_open(tk_cap_reader_t *r, int fd, const uint8_t *head, size_t 
     r->pcap = p;
     r->linktype = lt;
     r->pcapng = pcap_major_version(p) == 1; /* a pcapng section's version 1.0 */
-    /* the microsecond magic in either byte order (pcapng's is neither) */
-    r->usec = nhead >= 4u &&
-              ((head[0] == 0xA1u && head[1] == 0xB2u && head[2] == 0xC3u && head[3] == 0xD4u) ||
-               (head[0] == 0xD4u && head[1] == 0xC3u && head[2] == 0xB2u && head[3] == 0xA1u));
+    r->usec = nhead >= 4u && cap_magic_is(head, cap_magics[CAP_MAGIC_PCAP_US]);
     open_reader = r;
 }
 
