@@ -132,16 +132,15 @@ static void app_other(void *user, unsigned port, const tase_frame_t *f)
     x->other_type = f->type;
 }
 
-/* A port on fake port f that carries any rate the tests ask, its padding
- * zeroed too (tests compare the role's copy byte for byte). */
-static tase_port_t fake_gimbal_port(fake_port_t *f)
+/* *p: a port on fake port f that carries any rate the tests ask, its
+ * padding zeroed too (tests compare the role's copy byte for byte; a
+ * struct returned by value need not carry its padding). */
+static void fake_gimbal_port(tase_port_t *p, fake_port_t *f)
 {
-    tase_port_t p;
-    memset(&p, 0, sizeof p);
-    p.ops = &fake_ops;
-    p.ctx = f;
-    p.bytes_per_s = 100000u;
-    return p;
+    memset(p, 0, sizeof *p);
+    p->ops = &fake_ops;
+    p->ctx = f;
+    p->bytes_per_s = 100000u;
 }
 
 static fix_t *make(uint32_t now, unsigned nports, bool with_fill)
@@ -157,7 +156,7 @@ static fix_t *make(uint32_t now, unsigned nports, bool with_fill)
         app.fill_telemetry = NULL;
     }
     for (i = 0; i < 3; i++) {
-        ports[i] = fake_gimbal_port(&x->port[i]);
+        fake_gimbal_port(&ports[i], &x->port[i]);
     }
     assert_int_equal(tase_gimbal_init(&x->g, ports, x->rx, nports, &app, now), TASE_OK);
     return x;
@@ -1124,7 +1123,7 @@ static typed_fix_t *make_typed(void)
     tase_port_t port;
     tase_gimbal_app_t app;
     assert_non_null(x);
-    port = fake_gimbal_port(&x->fp);
+    fake_gimbal_port(&port, &x->fp);
     memset(&app, 0, sizeof app);
     app.fill_telemetry_msg = typed_fill;
     app.apply_setup_msg = typed_apply;
@@ -1408,7 +1407,7 @@ static void callbacks_cannot_feed_poll_or_change_settings_of_their_gimbal(void *
     int n;
     (void)state;
     assert_non_null(r);
-    port = fake_gimbal_port(&r->port);
+    fake_gimbal_port(&port, &r->port);
     memset(&app, 0, sizeof app);
     app.apply_setup = reenter_apply;
     app.fill_telemetry = reenter_fill;
@@ -1902,7 +1901,7 @@ static void commands_reach_the_dispatcher_typed_with_their_port(void **state)
     a.g = &x->g;
     a.port = -100;
     for (i = 0; i < 3; i++) {
-        ports[i] = fake_gimbal_port(&x->port[i]);
+        fake_gimbal_port(&ports[i], &x->port[i]);
     }
     assert_int_equal(tase_dispatch_init(&d, handlers, on_cmd_default, on_cmd_error, &a, NULL),
                      TASE_OK);
